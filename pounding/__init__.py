@@ -1,0 +1,34 @@
+"""pounding — structural pounding of adjacent shear buildings under earthquake records.
+
+Public API
+----------
+``load_model(path)``
+    Read and validate a YAML building model (:mod:`pounding.model`).
+``simulate(model, record=None, xi=None, ...)``
+    Integrate it under a ground-acceleration record; returns an
+    ``xarray.Dataset`` (:mod:`pounding.simulation`, :mod:`pounding.results`).
+``open_run(path)``
+    Reopen a NetCDF results archive (:mod:`pounding.archive`).
+"""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+from .errors import PoundingError  # noqa: E402
+
+__all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun"]
+
+
+def __getattr__(name: str):
+    # Lazy imports keep `import pounding` (and the CLI's start-up) light.
+    if name == "load_model":
+        from .model import load_model
+        return load_model
+    if name == "simulate":
+        from .simulation import simulate
+        return simulate
+    if name in ("open_run", "save_run", "rerun"):
+        from . import archive
+        return getattr(archive, name)
+    raise AttributeError(f"module 'pounding' has no attribute {name!r}")

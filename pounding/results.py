@@ -1,0 +1,232 @@
+"""Label the integrator's arrays as one self-describing ``xarray.Dataset``.
+
+Dimensions
+----------
+``time``
+    Output samples every ``solver.output_dt`` seconds.
+``floor``
+    Every floor of every building, left to right (coords ``building``,
+    ``level`` 1…n from the ground up, ``elevation`` m).
+``storey``
+    Every storey (coords ``storey_building``, ``storey_level`` — storey i
+    lies between floors i−1 and i — and ``height`` m).  xarray coordinate
+    names are unique within a dataset, hence the ``storey_`` prefix; storey i
+    of a building lies directly under floor i of that building.
+``contact``
+    Every gap element (coords ``building_left``, ``building_right``,
+    ``level_left``, ``level_right``, ``gap`` m, ``law``, ``xi``).
+``impact``
+    One row per impact (gap closure), in time order.
+
+Every variable carries ``units`` and ``long_name``.  Peaks and impact data
+are tracked by the solver at full resolution, not read off the decimated
+histories.
+"""
+
+from __future__ import annotations
+
+import json
+from datetime import datetime, timezone
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from . import contact as contact_laws
+from .ground_motion import Record
+from .model import Model
+from .solver import RawSolution, System
+
+__all__ = ["to_dataset", "energy_closure", "REFERENCES"]
+
+REFERENCES = (
+    "Muthukumar, S. & DesRoches, R. (2006) EESD 35, 811-828; "
+    "Ye, K., Li, L. & Zhu, H. (2009) EESD 38, 1135-1142; "
+    "Dormand, J.R. & Prince, P.J. (1980) J. Comput. Appl. Math. 6, 19-26; "
+    "FEMA P695 (2009) Quantification of Building Seismic Performance Factors."
+)
+
+
+def _var(dims, data, units: str, long_name: str, **extra) -> tuple:
+    attrs = {"units": units, "long_name": long_name}
+    attrs.update(extra)
+    return (dims, data, attrs)
+
+
+def _labels(model: Model) -> dict[str, np.ndarray]:
+    building, level, elevation, height = [], [], [], []
+    for b in model.buildings:
+        n = b.n_floors
+        building += [b.name] * n
+        level += list(range(1, n + 1))
+        elevation += list(b.elevation)
+        height += list(b.height)
+    return {"building": np.array(building, dtype=object), "level": np.array(level, dtype=np.int32),
+            "elevation": np.array(elevation, dtype=float), "height": np.array(height, dtype=float)}
+
+
+def _contact_potential(system: System, penetration: np.ndarray) -> np.ndarray:
+    """Elastic energy stored in the contacts at each output time, J."""
+    total = np.zeros(penetration.shape[0])
+    for c in range(system.n_contacts):
+        law = int(system.contact_law[c])
+        prm = system.contact_parameters[c]
+        total += np.array([contact_laws.potential(law, prm, d) for d in penetration[:, c]])
+    return total
+
+
+def energy_closure(ds: xr.Dataset) -> float:
+    """``max |E_in − Σ parts| / max |E_in|`` of a results dataset (dimensionless)."""
+    parts = (ds.energy_kinetic + ds.energy_strain + ds.energy_damping
+             + ds.energy_contact_dissipated + ds.energy_contact_strain)
+    scale = float(np.abs(ds.energy_input).max())
+    if scale == 0.0:
+        return 0.0
+    return float(np.abs(ds.energy_input - parts).max()) / scale
+
+
+def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *,
+               end_time: float, wall_time: float) -> xr.Dataset:
+    """Build the results dataset of one simulation."""
+    n = system.n_floors
+    nc = system.n_contacts
+    labels = _labels(model)
+    u = raw.state[:, :n]
+    v = raw.state[:, n:2 * n]
+    work = raw.state[:, 2 * n + nc:2 * n + 2 * nc]
+    e_input = raw.state[:, 2 * n + 2 * nc]
+    e_damping = raw.state[:, 2 * n + 2 * nc + 1]
+
+    below = system.below
+    u_below = np.where(below >= 0, u[:, np.maximum(below, 0)], 0.0)
+    drift = u - u_below
+    heights = labels["height"]
+    penetration = (u[:, system.contact_left] - u[:, system.contact_right] - system.contact_gap)
+
+    kinetic = 0.5 * (v * v) @ system.mass
+    strain = 0.5 * (drift * drift) @ system.storey_stiffness
+    contact_strain = _contact_potential(system, penetration)
+    contact_work = work.sum(axis=1)
+
+    floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
+    building_names = [b.name for b in model.buildings]
+    gaps = model.gaps
+    contact_names = [f"{building_names[g.left]}:{g.level_left}-{building_names[g.right]}:{g.level_right}"
+                     for g in gaps]
+
+    impact_count = np.bincount(raw.impact_contact, minlength=nc).astype(np.int32) if nc else np.zeros(0, np.int32)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        restitution = raw.impact_separation_velocity / raw.impact_velocity
+    is_hertz_damp = np.array([g.law.law_id == contact_laws.LAW_HERTZ_DAMP for g in gaps], dtype=bool)
+    impact_xi = np.where(is_hertz_damp[raw.impact_contact] if nc else np.zeros(0, bool),
+                         raw.impact_constant, np.nan)
+
+    coords = {
+        "time": ("time", raw.time, {"units": "s", "long_name": "time", "standard_name": "time"}),
+        "floor": ("floor", np.array(floor_names, dtype=object), {"long_name": "floor label building:level"}),
+        "building": ("floor", labels["building"], {"long_name": "building of the floor"}),
+        "level": ("floor", labels["level"], {"units": "1", "long_name": "floor number above ground"}),
+        "elevation": ("floor", labels["elevation"], {"units": "m", "long_name": "floor elevation above ground"}),
+        "storey": ("storey", np.array(floor_names, dtype=object),
+                   {"long_name": "storey label building:level (storey i between floors i-1 and i)"}),
+        "storey_building": ("storey", labels["building"], {"long_name": "building of the storey"}),
+        "storey_level": ("storey", labels["level"], {"units": "1", "long_name": "storey number above ground"}),
+        "height": ("storey", heights, {"units": "m", "long_name": "storey height"}),
+        "contact": ("contact", np.array(contact_names, dtype=object), {"long_name": "gap element label"}),
+        "building_left": ("contact", np.array([building_names[g.left] for g in gaps], dtype=object),
+                          {"long_name": "left building of the gap element"}),
+        "building_right": ("contact", np.array([building_names[g.right] for g in gaps], dtype=object),
+                           {"long_name": "right building of the gap element"}),
+        "level_left": ("contact", np.array([g.level_left for g in gaps], dtype=np.int32),
+                       {"units": "1", "long_name": "floor number in the left building"}),
+        "level_right": ("contact", np.array([g.level_right for g in gaps], dtype=np.int32),
+                        {"units": "1", "long_name": "floor number in the right building"}),
+        "gap": ("contact", np.array([g.gap for g in gaps], dtype=float),
+                {"units": "m", "long_name": "gap at rest"}),
+        "law": ("contact", np.array([g.law.name for g in gaps], dtype=object), {"long_name": "contact law"}),
+        "xi_formula": ("contact", np.array([getattr(g.law, "xi", "") for g in gaps], dtype=object),
+                       {"long_name": "formula for the Hertz-damp damping constant"}),
+        "law_parameters": ("contact", np.array([g.law.describe() for g in gaps], dtype=object),
+                           {"long_name": "contact law and its parameters"}),
+    }
+    variables = {
+        "displacement": _var(("time", "floor"), u, "m", "floor displacement relative to the ground"),
+        "velocity": _var(("time", "floor"), v, "m s-1", "floor velocity relative to the ground"),
+        "absolute_acceleration": _var(("time", "floor"), raw.acceleration + raw.ground_acceleration[:, None],
+                                      "m s-2", "absolute floor acceleration"),
+        "storey_drift": _var(("time", "storey"), drift, "m", "storey drift u_i - u_(i-1)"),
+        "drift_ratio": _var(("time", "storey"), drift / heights, "1", "storey drift ratio (drift / height)"),
+        "contact_force": _var(("time", "contact"), raw.contact_force, "N", "contact force (>= 0 pushes apart)"),
+        "penetration": _var(("time", "contact"), penetration, "m",
+                            "penetration u_left - u_right - gap (positive = overlap, negative = open gap)"),
+        "ground_acceleration": _var(("time",), raw.ground_acceleration, "m s-2", "ground acceleration"),
+        "peak_displacement": _var(("floor",), raw.peak_displacement, "m",
+                                  "peak absolute floor displacement relative to the ground"),
+        "peak_storey_drift": _var(("storey",), raw.peak_drift, "m", "peak absolute storey drift"),
+        "peak_drift_ratio": _var(("storey",), raw.peak_drift / heights, "1", "peak absolute storey drift ratio"),
+        "peak_contact_force": _var(("contact",), raw.peak_contact_force, "N", "peak contact force"),
+        "impact_count": _var(("contact",), impact_count, "1", "number of impacts (gap closures)"),
+        "impact_time": _var(("impact",), raw.impact_time, "s", "time of gap closure (located event)"),
+        "impact_contact": _var(("impact",), raw.impact_contact.astype(np.int32), "1",
+                               "index of the gap element along the contact dimension"),
+        "impact_velocity": _var(("impact",), raw.impact_velocity, "m s-1", "approach velocity at gap closure"),
+        "impact_xi": _var(("impact",), impact_xi, "N s m-2.5",
+                          "Hertz-damp damping constant fixed at gap closure (nan for other laws)"),
+        "impact_peak_force": _var(("impact",), raw.impact_peak_force, "N", "peak contact force of the impact"),
+        "impact_duration": _var(("impact",), raw.impact_end_time - raw.impact_time, "s",
+                                "contact duration (nan if still in contact at the end)"),
+        "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the contact force"),
+        "impact_restitution": _var(("impact",), restitution, "1",
+                                   "separation velocity / approach velocity"),
+        "energy_input": _var(("time",), e_input, "J", "input energy -integral a_g 1'M du/dt dt"),
+        "energy_kinetic": _var(("time",), kinetic, "J", "kinetic energy (relative motion)"),
+        "energy_strain": _var(("time",), strain, "J", "elastic strain energy of the storeys"),
+        "energy_damping": _var(("time",), e_damping, "J", "energy dissipated by structural damping"),
+        "energy_contact_dissipated": _var(("time",), contact_work - contact_strain, "J",
+                                          "energy dissipated by the contacts"),
+        "energy_contact_strain": _var(("time",), contact_strain, "J", "elastic energy stored in the contacts"),
+    }
+    ds = xr.Dataset(variables, coords=coords)
+    closure = energy_closure(ds)
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    ds.attrs = {
+        "Conventions": "CF-1.10",
+        "title": f"pounding simulation of model '{model.name}' under {record.name}",
+        "source": f"pounding {__version__}",
+        "history": f"{now} simulated with pounding {__version__}",
+        "references": REFERENCES,
+        "model_name": model.name,
+        "model_path": str(model.path or ""),
+        "model_yaml": model.source,
+        "run_spec": json.dumps(run_spec(model, record, end_time)),
+        "record_name": record.name,
+        "record_source": record.source,
+        "record_scale": float(record.scale),
+        "record_time_step": float(record.time_step),
+        "record_metadata": json.dumps(record.metadata, default=str),
+        "duration": float(end_time),
+        "solver": "Dormand-Prince 5(4), event-located contacts (pounding.solver)",
+        "solver_rtol": float(model.solver.rtol),
+        "solver_atol": float(model.solver.atol),
+        "solver_atol_velocity": float(model.solver.atol_velocity),
+        "solver_output_dt": float(model.solver.output_dt),
+        "solver_steps": int(raw.n_steps),
+        "solver_rejected_steps": int(raw.n_rejected),
+        "wall_time": float(wall_time),
+        "energy_closure_error": closure,
+        "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
+        "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
+    }
+    return ds
+
+
+def run_spec(model: Model, record: Record, end_time: float) -> dict:
+    """Everything :func:`pounding.archive.rerun` needs besides the model YAML."""
+    return {
+        "model": model.to_document(),
+        "base_dir": model.ground_motion.base_dir,
+        "record": record.source,
+        "scale": float(record.scale),
+        "duration": float(end_time),
+        "record_sha256": record.metadata.get("sha256", ""),
+    }
