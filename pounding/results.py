@@ -17,6 +17,9 @@ Dimensions
     ``level_left``, ``level_right``, ``gap`` m, ``law``, ``xi``).
 ``impact``
     One row per impact (gap closure), in time order.
+``trace``
+    Full-resolution samples (every solver step, on its interpolant) of every
+    closed contact: what force–penetration loops are drawn from.
 
 Every variable carries ``units`` and ``long_name``.  Peaks and impact data
 are tracked by the solver at full resolution, not read off the decimated
@@ -178,6 +181,13 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the contact force"),
         "impact_restitution": _var(("impact",), restitution, "1",
                                    "separation velocity / approach velocity"),
+        "trace_time": _var(("trace",), raw.trace_time, "s",
+                           "time of a full-resolution sample of a closed contact"),
+        "trace_contact": _var(("trace",), raw.trace_contact.astype(np.int32), "1",
+                              "index of the gap element along the contact dimension"),
+        "trace_penetration": _var(("trace",), raw.trace_penetration, "m",
+                                  "penetration at the full-resolution sample"),
+        "trace_force": _var(("trace",), raw.trace_force, "N", "contact force at the full-resolution sample"),
         "energy_input": _var(("time",), e_input, "J", "input energy -integral a_g 1'M du/dt dt"),
         "energy_kinetic": _var(("time",), kinetic, "J", "kinetic energy (relative motion)"),
         "energy_strain": _var(("time",), strain, "J", "elastic strain energy of the storeys"),

@@ -138,6 +138,10 @@ class RawSolution:
     impact_end_time: np.ndarray      # (ni,) s (nan if still closed at the end)
     impact_impulse: np.ndarray       # (ni,) N·s
     impact_separation_velocity: np.ndarray  # (ni,) m/s, −δ̇ at separation (nan if open)
+    trace_time: np.ndarray           # (nr,) s, full-resolution samples of closed contacts
+    trace_contact: np.ndarray        # (nr,) int
+    trace_penetration: np.ndarray    # (nr,) m
+    trace_force: np.ndarray          # (nr,) N
     n_steps: int
     n_rejected: int
     status: int
@@ -315,17 +319,23 @@ def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward
 
 
 @njit(cache=True)
-def _closed_peak_force(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
-                       yr0, vr0, yr1, vr1, ar0, ar1, h) -> float:
-    """Peak contact force over a step during which the contact stays closed."""
+def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
+                            yr0, vr0, yr1, vr1, ar0, ar1, h, fractions, deltas, values) -> float:
+    """Sample a closed contact over a step on the interpolant; return its peak force.
+
+    Fills *fractions*, *deltas* (penetration, m) and *values* (force, N) at
+    ``s = i/FORCE_SAMPLES``; the peak is refined by a parabola through the
+    largest sample and its neighbours.
+    """
     best = 0.0
     best_i = 0
-    values = np.empty(FORCE_SAMPLES + 1)
     for i in range(FORCE_SAMPLES + 1):
         s = i / FORCE_SAMPLES
         delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
         rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
         f = contact_laws.force(claw, prm, const, delta, rate)
+        fractions[i] = s
+        deltas[i] = delta
         values[i] = f
         if f > best:
             best = f
@@ -393,13 +403,14 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                cl, cr, cgap, claw, cprm, ag, dt_rec, t_end, rtol, atol_u, atol_v,
-               output_dt, first_step):
+               output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
     S = 2 * n + 2 * nc + 2
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
 
     y = np.zeros(S)
+    y[: 2 * n] = y_initial
     ynew = np.zeros(S)
     ystage = np.zeros(S)
     k1 = np.zeros(S)
@@ -426,6 +437,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 
     impacts = np.full((64, 8), np.nan)
     n_imp = 0
+    # Full-resolution trace of closed contacts: time, contact, penetration, force.
+    trace = np.empty((1024, 4))
+    n_trace = 0
+    fractions = np.empty(FORCE_SAMPLES + 1)
+    deltas = np.empty(FORCE_SAMPLES + 1)
+    values = np.empty(FORCE_SAMPLES + 1)
     open_imp = np.full(nc, -1, dtype=np.int64)
 
     t = 0.0
@@ -573,10 +590,22 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if closed[c]:
                 lf = cl[c]
                 rf = cr[c]
-                fpk = _closed_peak_force(claw[c], cprm[c], cconst[c], cgap[c],
-                                         y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
-                                         y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
-                                         h_used)
+                fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cgap[c],
+                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf],
+                                              k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
+                                              k1[n + rf], k7[n + rf], h_used, fractions, deltas, values)
+                if n_trace + FORCE_SAMPLES + 1 > trace.shape[0]:
+                    bigger = np.empty((2 * trace.shape[0], 4))
+                    bigger[:n_trace] = trace[:n_trace]
+                    trace = bigger
+                for i in range(FORCE_SAMPLES + 1):
+                    if i == 0 and n_trace > 0 and trace[n_trace - 1, 1] == c and trace[n_trace - 1, 0] == t:
+                        continue  # the previous step already recorded its end point
+                    trace[n_trace, 0] = t + fractions[i] * h_used
+                    trace[n_trace, 1] = c
+                    trace[n_trace, 2] = deltas[i]
+                    trace[n_trace, 3] = values[i]
+                    n_trace += 1
                 if fpk > peak_force[c]:
                     peak_force[c] = fpk
                 row = open_imp[c]
@@ -636,11 +665,13 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         i_out = n_out
     return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out],
             peak_u, peak_drift, peak_force,
-            impacts[:n_imp], n_steps, n_rej, status, t)
+            impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,
-              *, rtol: float, atol: float, atol_velocity: float, output_dt: float) -> RawSolution:
+              *, rtol: float, atol: float, atol_velocity: float, output_dt: float,
+              initial_displacement: np.ndarray | None = None,
+              initial_velocity: np.ndarray | None = None) -> RawSolution:
     """Integrate the row of buildings under a piecewise-linear ground motion.
 
     Parameters
@@ -659,19 +690,29 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     output_dt : float
         Sampling interval of the stored histories, s (peaks and impacts are
         tracked at full solver resolution regardless).
+    initial_displacement, initial_velocity : (N,) ndarray, optional
+        Initial state relative to the ground (m, m/s); default at rest.  All
+        contacts start open.
     """
     ag = np.ascontiguousarray(ground_acceleration, dtype=np.float64)
     first_step = min(time_step, output_dt) * 0.1
+    y_initial = np.zeros(2 * system.n_floors)
+    if initial_displacement is not None:
+        y_initial[: system.n_floors] = initial_displacement
+    if initial_velocity is not None:
+        y_initial[system.n_floors:] = initial_velocity
     raw = _integrate(system.mass, system.storey_stiffness, system.below, system.rayleigh_mass,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
                      system.dense_offset, system.dense_values, system.contact_left,
                      system.contact_right, system.contact_gap, system.contact_law,
                      system.contact_parameters, ag, float(time_step), float(duration), float(rtol),
-                     float(atol), float(atol_velocity), float(output_dt), float(first_step))
-    (time, state, acc, force, ag_out, peak_u, peak_drift, peak_force, impacts, n_steps, n_rej,
+                     float(atol), float(atol_velocity), float(output_dt), float(first_step),
+                     y_initial)
+    (time, state, acc, force, ag_out, peak_u, peak_drift, peak_force, impacts, trace, n_steps, n_rej,
      status, t_final) = raw
     return RawSolution(time, state, acc, force, ag_out, peak_u, peak_drift, peak_force,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
                        impacts[:, IMP_VELOCITY], impacts[:, IMP_CONSTANT], impacts[:, IMP_PEAK_FORCE],
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],
+                       trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
                        int(n_steps), int(n_rej), int(status), float(t_final))

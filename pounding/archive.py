@@ -1,0 +1,142 @@
+"""NetCDF archives of runs: atomic writing, reopening, and rerunning.
+
+An archive is the results dataset written with the netCDF4 engine, numeric
+variables zlib-compressed.  It carries, as global attributes, the model YAML
+as written, the effective model actually run (``run_spec``), the record's
+source, scale and SHA-256 of its samples: enough for :func:`rerun` to
+reproduce every variable.
+
+Writing is atomic: the dataset goes to a temporary file in the target
+directory, is flushed to disk and then renamed over the target, so a crash
+never leaves a truncated archive; an existing file is never replaced unless
+``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .errors import ArchiveError, PoundingError
+
+__all__ = ["save_run", "open_run", "rerun", "check_writable"]
+
+_COMPRESSION = {"zlib": True, "complevel": 4}
+
+
+def check_writable(path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+    """Fail early (before any computation) if *path* cannot be written.
+
+    Raises
+    ------
+    ArchiveError
+        If the file exists and *overwrite* is false, or its directory is missing.
+    """
+    target = Path(path)
+    if target.exists() and not overwrite:
+        raise ArchiveError(f"{target} already exists; pass --overwrite (overwrite=True) or choose another "
+                           "output file")
+    if target.is_dir():
+        raise ArchiveError(f"{target} is a directory; give a file name such as {target / 'run.nc'}")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.exists():
+        raise ArchiveError(f"{target}: directory {parent} does not exist; create it first")
+    return target
+
+
+def _encoding(ds: xr.Dataset) -> dict:
+    encoding = {}
+    for name, var in ds.variables.items():
+        if np.issubdtype(var.dtype, np.number) and var.ndim > 0:
+            encoding[name] = dict(_COMPRESSION)
+    return encoding
+
+
+def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+    """Write a results dataset to NetCDF atomically.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From :func:`pounding.simulate`.
+    path : path-like
+        Target ``.nc`` file.
+    overwrite : bool
+        Replace an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+    """
+    target = check_writable(path, overwrite=overwrite)
+    descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
+                                             dir=target.parent if str(target.parent) else ".")
+    os.close(descriptor)
+    try:
+        ds.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
+        with open(temporary, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.replace(temporary, target)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
+    return target
+
+
+def open_run(path: str | os.PathLike) -> xr.Dataset:
+    """Open a results archive written by :func:`save_run` (loaded into memory).
+
+    Raises
+    ------
+    ArchiveError
+        If the file is missing, not NetCDF, or not a pounding archive.
+    """
+    source = Path(path)
+    if not source.exists():
+        raise ArchiveError(f"{source}: no such file")
+    try:
+        with xr.open_dataset(source, engine="netcdf4") as handle:
+            ds = handle.load()
+    except (OSError, ValueError) as exc:
+        raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]})") from None
+    if not str(ds.attrs.get("source", "")).startswith("pounding") or "run_spec" not in ds.attrs:
+        raise ArchiveError(f"{source}: not a pounding run archive (no 'run_spec' attribute)")
+    return ds
+
+
+def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
+    """Simulate again what an archive recorded; returns a new results dataset.
+
+    The model is rebuilt from the effective model stored in ``run_spec`` and
+    the record is reloaded from its source; if the record's samples no longer
+    hash to the archived SHA-256, the rerun is refused rather than silently
+    different.
+    """
+    from .model import model_from_text
+    from .simulation import record_for, simulate
+
+    ds = open_run(run) if not isinstance(run, xr.Dataset) else run
+    name = str(run) if not isinstance(run, xr.Dataset) else "archive"
+    spec = json.loads(ds.attrs["run_spec"])
+    model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
+                            path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
+    model = model.with_ground_motion(record=spec["record"], scale=spec["scale"], duration=spec["duration"])
+    record = record_for(model)
+    expected = spec.get("record_sha256", "")
+    actual = record.metadata.get("sha256", "")
+    if expected and actual != expected:
+        raise PoundingError(f"{name}: record {spec['record']} has changed since the run was archived "
+                            f"(sha256 {actual[:12]}… ≠ {expected[:12]}…); restore the original file")
+    again = simulate(model, record)
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
+    return again
