@@ -58,8 +58,10 @@ class XiFormula:
         ``confirmed`` (checked against the paper), ``secondary`` (taken from a
         review that cites it) or ``unconfirmed`` (forms differ between sources).
     bounded : bool
-        True if ``p(e)`` stays finite as e → 0; such a formula cannot produce
-        low restitution in a free impact.
+        True if ``p(e)`` stays of order one as e → 0 (at most 3·exp(2)/4 ≈
+        5.5, zhiying-qishao's limit); such a formula cannot produce low restitution
+        in a free impact.  ``carvalho-martins`` tends to 16.5 and ``exact``
+        and the 1/e-type formulas diverge: they are not bounded in this sense.
     """
 
     key: str
@@ -201,9 +203,11 @@ def _relation_over_p2(p_value: float, e: float) -> float:
     cancellation.
     """
     if p_value < 0.05 and e * p_value < 0.05:
+        log_e = math.log1p(-(1.0 - e))  # 1 − e is exact for e ≥ 0.5: no cancellation in e^k − 1
         total, term_p, k = 0.0, 1.0, 2
         while True:
-            term = term_p * (e**k - (-1.0) ** k) / k
+            coefficient = math.expm1(k * log_e) if k % 2 == 0 else e**k + 1.0
+            term = term_p * coefficient / k
             total += term
             if abs(term) <= 1e-18 * abs(total) or k > 60:
                 return total
