@@ -13,14 +13,19 @@ Contract of a law
     Integer that selects the branch of the compiled kernels below.
 ``kernel_parameters(mass_left, mass_right)``
     A float64 vector of length :data:`N_PARAMETERS` handed to the kernels.
-``force(law_id, prm, impact_constant, δ, δ̇)``
+``force(law_id, prm, impact_constant, δ, δ̇, q)``
     Contact force (N, ≥ 0 unless the law allows tension) while the contact is
     closed.  ``impact_constant`` is fixed once per impact by
-    ``onset_constant`` at the located instant of gap closure.
+    ``onset_constant`` at the located instant of gap closure; ``q`` is the
+    law's internal state (the hysteretic force of the bilinear law), reset to
+    0 at every gap closure and advanced by ``internal_rate``.
+``instantaneous``
+    True for laws that act as a velocity jump at the located closure instead
+    of a force (stereo-mechanical); the solver applies ``jump_impulse``.
 ``onset_constant(law_id, prm, v0)``
     The per-impact constant from the approach velocity ``v0`` (m/s); for
     Hertz-damp this is ξ.
-``potential(law_id, prm, δ)``
+``potential(law_id, prm, δ, q)``
     Elastic energy stored in the contact (J), for the energy audit.
 
 Adding a law is one subclass with its citation, one ``register`` line and one
@@ -44,6 +49,10 @@ __all__ = [
     "HertzDamp",
     "Hertz",
     "Linear",
+    "Kelvin",
+    "Jankowski",
+    "Bilinear",
+    "StereoMechanical",
     "LAWS",
     "register",
     "law_from_mapping",
@@ -66,6 +75,10 @@ MIN_IMPACT_VELOCITY = 1.0e-3
 LAW_LINEAR = 0
 LAW_HERTZ = 1
 LAW_HERTZ_DAMP = 2
+LAW_KELVIN = 3
+LAW_JANKOWSKI = 4
+LAW_BILINEAR = 5
+LAW_STEREO = 6
 
 Restitution = Annotated[float, Field(gt=0.0, le=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
@@ -84,6 +97,7 @@ class ContactLaw(BaseModel):
     law_id: ClassVar[int]
     reference: ClassVar[str]
     dissipative: ClassVar[bool] = False
+    instantaneous: ClassVar[bool] = False
 
     law: str
 
@@ -211,6 +225,155 @@ class HertzDamp(ContactLaw):
         return self.p * self.kh / max(v0, self.min_impact_velocity)
 
 
+def _effective_mass(mass_left: float, mass_right: float) -> float:
+    """m1·m2/(m1+m2), kg: the two floor masses stand for the colliding bodies."""
+    return mass_left * mass_right / (mass_left + mass_right)
+
+
+@register
+class Kelvin(ContactLaw):
+    """Kelvin–Voigt spring-dashpot, ``F = k·δ + c·δ̇`` (Anagnostopoulos 1988).
+
+    ``c = 2ζ·sqrt(k·m_eff)`` with ``ζ = −ln e / sqrt(π² + ln² e)`` (exact for
+    a free linear impact), ``m_eff`` from the two floor masses.  The force
+    jumps to ``c·v0`` at the touch and turns negative (pulls) before
+    separation: ``tension: clamp`` (default) sets it to ``max(F, 0)``,
+    ``tension: allow`` keeps the pull, as the original model does.
+
+    Reference: Anagnostopoulos, S.A. (1988). Pounding of buildings in series
+    during earthquakes. Earthquake Eng. Struct. Dyn. 16, 443-456.
+    """
+
+    name: ClassVar[str] = "kelvin"
+    law_id: ClassVar[int] = LAW_KELVIN
+    reference: ClassVar[str] = "Anagnostopoulos (1988), EESD 16, 443-456"
+    dissipative: ClassVar[bool] = True
+
+    law: Literal["kelvin"] = "kelvin"
+    k: Positive = Field(description="contact stiffness, N/m")
+    restitution: Restitution = Field(description="coefficient of restitution e, 0 < e <= 1")
+    tension: Literal["clamp", "allow"] = "clamp"
+
+    @property
+    def damping_ratio(self) -> float:
+        """ζ = −ln e / sqrt(π² + ln² e)."""
+        log_e = math.log(self.restitution)
+        return -log_e / math.sqrt(math.pi**2 + log_e**2)
+
+    def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
+        c = 2.0 * self.damping_ratio * math.sqrt(self.k * _effective_mass(mass_left, mass_right))
+        return _pack(self.k, c, 1.0 if self.tension == "allow" else 0.0)
+
+
+@register
+class Jankowski(ContactLaw):
+    """Nonlinear viscoelastic contact (Jankowski 2005).
+
+    ``F = β·δ^1.5 + c·δ̇`` while approaching (δ̇ > 0), ``F = β·δ^1.5`` while
+    separating, with ``c = 2ζ·sqrt(β·sqrt(δ)·m_eff)`` and
+    ``ζ = (9√5/2)·(1 − e²)/(e·(e·(9π − 16) + 16))`` (Jankowski 2006);
+    ``m_eff`` from the two floor masses.
+
+    References
+    ----------
+    Jankowski, R. (2005). Non-linear viscoelastic modelling of earthquake-
+    induced structural pounding. Earthquake Eng. Struct. Dyn. 34, 595-611.
+    Jankowski, R. (2006). Analytical expression between the impact damping
+    ratio and the coefficient of restitution in the non-linear viscoelastic
+    model of structural pounding. EESD 35, 517-524.
+    """
+
+    name: ClassVar[str] = "jankowski"
+    law_id: ClassVar[int] = LAW_JANKOWSKI
+    reference: ClassVar[str] = "Jankowski (2005), EESD 34, 595-611; Jankowski (2006), EESD 35, 517-524"
+    dissipative: ClassVar[bool] = True
+
+    law: Literal["jankowski"] = "jankowski"
+    beta: Positive = Field(description="impact stiffness β, N/m^1.5")
+    restitution: Restitution = Field(description="coefficient of restitution e, 0 < e <= 1")
+
+    @property
+    def damping_ratio(self) -> float:
+        """ζ of Jankowski (2006)."""
+        e = self.restitution
+        return 9.0 * math.sqrt(5.0) / 2.0 * (1.0 - e * e) / (e * (e * (9.0 * math.pi - 16.0) + 16.0))
+
+    def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
+        return _pack(self.beta, self.damping_ratio, _effective_mass(mass_left, mass_right))
+
+
+@register
+class Bilinear(ContactLaw):
+    """Muthukumar's bilinear impact element (OpenSees ``ImpactMaterial``).
+
+    Loading follows ``K1`` up to the yield penetration ``δy = a·δm`` and
+    ``K2`` beyond; unloading follows ``K1`` down to the line ``F = K2·δ`` and
+    then that line back to zero, a parallelogram loop (the rules of
+    ``ImpactMaterial::setTrialStrain``).  Stiffnesses follow from the
+    Hertz-damp parameters: ``Keff = kh·sqrt(δm)``,
+    ``ΔE = kh·δm^2.5·(1 − e²)/2.5``, ``K1 = Keff + ΔE/(a·δm²)``,
+    ``K2 = Keff − ΔE/((1 − a)·δm²)``.  ``δm`` is an assumed maximum
+    penetration.  The hysteretic force is the law's internal state.
+
+    Reference: Muthukumar, S. (2003). A contact element approach with
+    hysteresis damping for the analysis and design of pounding in bridges.
+    PhD thesis, Georgia Institute of Technology; Muthukumar & DesRoches (2006).
+    """
+
+    name: ClassVar[str] = "bilinear"
+    law_id: ClassVar[int] = LAW_BILINEAR
+    reference: ClassVar[str] = "Muthukumar (2003), PhD thesis, Georgia Tech; OpenSees ImpactMaterial"
+    dissipative: ClassVar[bool] = True
+
+    law: Literal["bilinear"] = "bilinear"
+    kh: Positive = Field(description="Hertz stiffness the element approximates, N/m^1.5")
+    restitution: Restitution = Field(description="coefficient of restitution e, 0 < e <= 1")
+    max_penetration: Positive = Field(description="assumed maximum penetration δm, m")
+    yield_ratio: Annotated[float, Field(gt=0.0, lt=1.0)] = Field(0.1, description="a = δy/δm")
+
+    @property
+    def stiffnesses(self) -> tuple[float, float, float]:
+        """(K1 N/m, K2 N/m, δy m)."""
+        dm, a = self.max_penetration, self.yield_ratio
+        k_eff = self.kh * math.sqrt(dm)
+        energy = self.kh * dm**2.5 * (1.0 - self.restitution**2) / 2.5
+        return k_eff + energy / (a * dm * dm), k_eff - energy / ((1.0 - a) * dm * dm), a * dm
+
+    def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
+        k1, k2, dy = self.stiffnesses
+        if k2 <= 0.0:
+            raise PoundingError(f"bilinear law: K2 = {k2:.3g} N/m <= 0 for restitution {self.restitution}; "
+                                "raise restitution or yield_ratio")
+        return _pack(k1, k2, dy)
+
+
+@register
+class StereoMechanical(ContactLaw):
+    """Stereo-mechanical impact: an instantaneous velocity jump (Goldsmith 1960).
+
+    At the located gap closure the floor velocities jump to
+    ``v1' = v1 − (1+e)·m2·(v1−v2)/(m1+m2)`` and
+    ``v2' = v2 + (1+e)·m1·(v1−v2)/(m1+m2)``, with the two floor masses;
+    there is no force history, the impulse ``(1+e)·m_eff·(v1 − v2)`` is
+    recorded instead.
+
+    Reference: Goldsmith, W. (1960). Impact: the theory and physical behaviour
+    of colliding solids. Edward Arnold, London.
+    """
+
+    name: ClassVar[str] = "stereo-mechanical"
+    law_id: ClassVar[int] = LAW_STEREO
+    reference: ClassVar[str] = "Goldsmith (1960), Impact, Edward Arnold"
+    dissipative: ClassVar[bool] = True
+    instantaneous: ClassVar[bool] = True
+
+    law: Literal["stereo-mechanical"] = "stereo-mechanical"
+    restitution: Restitution = Field(description="coefficient of restitution e, 0 < e <= 1")
+
+    def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
+        return _pack(self.restitution, _effective_mass(mass_left, mass_right))
+
+
 def law_from_mapping(fields: dict) -> ContactLaw:
     """Build a law from a mapping with a ``law`` key (used outside the YAML loader).
 
@@ -247,9 +410,31 @@ def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
 
 
 @njit(cache=True)
+def is_instantaneous(law_id: int) -> bool:
+    """True for laws applied as a velocity jump at closure (stereo-mechanical)."""
+    return law_id == LAW_STEREO
+
+
+@njit(cache=True)
+def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
+    """Impulse (N·s) of an instantaneous law for approach velocity *v0*: (1+e)·m_eff·v0."""
+    if law_id == LAW_STEREO:
+        return (1.0 + prm[0]) * prm[1] * v0
+    return 0.0
+
+
+@njit(cache=True)
+def _bilinear_bounds(prm: np.ndarray, delta: float) -> tuple:
+    """Lower (K2·δ) and upper (K1·δy + K2·(δ − δy)) envelopes of the bilinear loop, N."""
+    k1, k2, dy = prm[0], prm[1], prm[2]
+    upper = k1 * delta if delta <= dy else k1 * dy + k2 * (delta - dy)
+    return k2 * delta, upper
+
+
+@njit(cache=True)
 def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
-          delta_rate: float) -> float:
-    """Contact force (N) for penetration *delta* (m) and its rate (m/s)."""
+          delta_rate: float, q: float) -> float:
+    """Contact force (N) for penetration *delta* (m), its rate (m/s) and internal state *q*."""
     if delta <= 0.0:
         return 0.0
     if law_id == LAW_HERTZ_DAMP:
@@ -262,16 +447,51 @@ def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
         return prm[0] * delta * math.sqrt(delta)
     if law_id == LAW_LINEAR:
         return prm[0] * delta
+    if law_id == LAW_KELVIN:
+        f = prm[0] * delta + prm[1] * delta_rate
+        if prm[2] == 0.0 and f < 0.0:
+            return 0.0
+        return f
+    if law_id == LAW_JANKOWSKI:
+        f = prm[0] * delta * math.sqrt(delta)
+        if delta_rate > 0.0:
+            f += 2.0 * prm[1] * math.sqrt(prm[0] * math.sqrt(delta) * prm[2]) * delta_rate
+        return f
+    if law_id == LAW_BILINEAR:
+        lower, upper = _bilinear_bounds(prm, delta)
+        return min(max(q, lower), upper)
     return 0.0
 
 
 @njit(cache=True)
-def potential(law_id: int, prm: np.ndarray, delta: float) -> float:
-    """Elastic energy stored in the contact at penetration *delta* (J)."""
+def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
+    """Rate of the internal state (N/s): the bilinear force follows K1, or K2 on an envelope."""
+    if law_id == LAW_BILINEAR:
+        if delta <= 0.0:
+            return 0.0
+        lower, upper = _bilinear_bounds(prm, delta)
+        if delta_rate > 0.0 and q >= upper:
+            return prm[1] * delta_rate if delta > prm[2] else prm[0] * delta_rate
+        if delta_rate < 0.0 and q <= lower:
+            return prm[1] * delta_rate
+        return prm[0] * delta_rate
+    return 0.0
+
+
+@njit(cache=True)
+def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
+    """Elastic energy stored in the contact (J): what unloading would give back."""
     if delta <= 0.0:
         return 0.0
-    if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ:
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI:
         return prm[0] * delta * delta * math.sqrt(delta) / 2.5
-    if law_id == LAW_LINEAR:
+    if law_id == LAW_LINEAR or law_id == LAW_KELVIN:
         return 0.5 * prm[0] * delta * delta
+    if law_id == LAW_BILINEAR:
+        k1, k2 = prm[0], prm[1]
+        f = force(law_id, prm, 0.0, delta, 0.0, q)
+        # Unloading: slope K1 from (δ, f) down to the line K2·δ at δ*, then that line to 0.
+        d_star = (k1 * delta - f) / (k1 - k2)
+        d_star = min(max(d_star, 0.0), delta)
+        return 0.5 * (f + k2 * d_star) * (delta - d_star) + 0.5 * k2 * d_star * d_star
     return 0.0

@@ -68,13 +68,14 @@ def _labels(model: Model) -> dict[str, np.ndarray]:
             "elevation": np.array(elevation, dtype=float), "height": np.array(height, dtype=float)}
 
 
-def _contact_potential(system: System, penetration: np.ndarray) -> np.ndarray:
+def _contact_potential(system: System, penetration: np.ndarray, internal: np.ndarray) -> np.ndarray:
     """Elastic energy stored in the contacts at each output time, J."""
     total = np.zeros(penetration.shape[0])
     for c in range(system.n_contacts):
         law = int(system.contact_law[c])
         prm = system.contact_parameters[c]
-        total += np.array([contact_laws.potential(law, prm, d) for d in penetration[:, c]])
+        total += np.array([contact_laws.potential(law, prm, d, q)
+                           for d, q in zip(penetration[:, c], internal[:, c])])
     return total
 
 
@@ -97,8 +98,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     u = raw.state[:, :n]
     v = raw.state[:, n:2 * n]
     work = raw.state[:, 2 * n + nc:2 * n + 2 * nc]
-    e_input = raw.state[:, 2 * n + 2 * nc]
-    e_damping = raw.state[:, 2 * n + 2 * nc + 1]
+    internal = raw.state[:, 2 * n + 2 * nc:2 * n + 3 * nc]
+    e_input = raw.state[:, 2 * n + 3 * nc]
+    e_damping = raw.state[:, 2 * n + 3 * nc + 1]
 
     below = system.below
     u_below = np.where(below >= 0, u[:, np.maximum(below, 0)], 0.0)
@@ -108,7 +110,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
 
     kinetic = 0.5 * (v * v) @ system.mass
     strain = 0.5 * (drift * drift) @ system.storey_stiffness
-    contact_strain = _contact_potential(system, penetration)
+    contact_strain = _contact_potential(system, penetration, internal)
     contact_work = work.sum(axis=1)
 
     floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]

@@ -31,7 +31,8 @@ Design
   impulse ``∫F dt`` and the work ``∫F δ̇ dt`` are integrated as extra states
   (excluded from the error norm: they are quadratures of a controlled solution).
 
-State vector layout: ``[u (N), v (N), impulse (nc), work (nc), E_input, E_damping]``.
+State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping]``
+(``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force).
 
 References
 ----------
@@ -199,10 +200,13 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         if closed[c]:
             delta = y[cl[c]] - y[cr[c]] - cgap[c]
             rate = y[n + cl[c]] - y[n + cr[c]]
-            f = contact_laws.force(claw[c], cprm[c], cconst[c], delta, rate)
+            q = y[2 * n + 2 * nc + c]
+            f = contact_laws.force(claw[c], cprm[c], cconst[c], delta, rate, q)
             out[2 * n + nc + c] = f * rate
+            out[2 * n + 2 * nc + c] = contact_laws.internal_rate(claw[c], cprm[c], delta, rate, q)
         else:
             out[2 * n + nc + c] = 0.0
+            out[2 * n + 2 * nc + c] = 0.0
         forces[c] = f
         out[2 * n + c] = f
         fbuf[cl[c]] += f
@@ -212,8 +216,8 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         out[j] = y[n + j]
         out[n + j] = -fbuf[j] / mass[j] - ag_t
         e_in_rate -= ag_t * mass[j] * y[n + j]
-    out[2 * n + 2 * nc] = e_in_rate
-    out[2 * n + 2 * nc + 1] = _damping_power(y, mass, kst, below, a0, a1, dstart, dsize, doff, dvals)
+    out[2 * n + 3 * nc] = e_in_rate
+    out[2 * n + 3 * nc + 1] = _damping_power(y, mass, kst, below, a0, a1, dstart, dsize, doff, dvals)
 
 
 @njit(cache=True)
@@ -320,7 +324,8 @@ def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward
 
 @njit(cache=True)
 def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
-                            yr0, vr0, yr1, vr1, ar0, ar1, h, fractions, deltas, values) -> float:
+                            yr0, vr0, yr1, vr1, ar0, ar1, q0, qr0, q1, qr1, h, fractions, deltas,
+                            values) -> float:
     """Sample a closed contact over a step on the interpolant; return its peak force.
 
     Fills *fractions*, *deltas* (penetration, m) and *values* (force, N) at
@@ -333,7 +338,7 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
         s = i / FORCE_SAMPLES
         delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
         rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-        f = contact_laws.force(claw, prm, const, delta, rate)
+        f = contact_laws.force(claw, prm, const, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
         fractions[i] = s
         deltas[i] = delta
         values[i] = f
@@ -348,7 +353,7 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
             s = (best_i + offset) / FORCE_SAMPLES
             delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
             rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-            f = contact_laws.force(claw, prm, const, delta, rate)
+            f = contact_laws.force(claw, prm, const, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
             if f > best:
                 best = f
     return best
@@ -359,7 +364,48 @@ IMP_CONTACT, IMP_TIME, IMP_VELOCITY, IMP_CONSTANT, IMP_PEAK_FORCE, IMP_END, IMP_
 
 
 @njit(cache=True)
-def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp):
+def _new_impact_row(impacts, n_imp):
+    """Make room for one more row of the impact table (doubling it when full)."""
+    if n_imp == impacts.shape[0]:
+        bigger = np.full((2 * impacts.shape[0], impacts.shape[1]), np.nan)
+        bigger[:n_imp] = impacts
+        return bigger
+    return impacts
+
+
+@njit(cache=True)
+def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
+    """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
+
+    The impulse ``J = (1+e)·m_eff·v0`` acts on the two floors (−J on the
+    left, +J on the right); the work ``J·(v0 + v0')/2`` it does (the energy
+    lost, ½·m_eff·(1−e²)·v0²) and the impulse are added to the contact's
+    energy-audit states.  The impact row opens and closes at once.
+    """
+    nc = (y.size - 2 * n - 2) // 3
+    lf = cl[c]
+    rf = cr[c]
+    v0 = y[n + lf] - y[n + rf]
+    impulse = contact_laws.jump_impulse(claw[c], cprm[c], v0)
+    y[n + lf] -= impulse / mass[lf]
+    y[n + rf] += impulse / mass[rf]
+    v_after = y[n + lf] - y[n + rf]
+    y[2 * n + c] += impulse
+    y[2 * n + nc + c] += impulse * 0.5 * (v0 + v_after)
+    impacts = _new_impact_row(impacts, n_imp)
+    impacts[n_imp, IMP_CONTACT] = c
+    impacts[n_imp, IMP_TIME] = t
+    impacts[n_imp, IMP_VELOCITY] = v0
+    impacts[n_imp, IMP_CONSTANT] = np.nan
+    impacts[n_imp, IMP_PEAK_FORCE] = np.nan
+    impacts[n_imp, IMP_END] = t
+    impacts[n_imp, IMP_IMPULSE] = impulse
+    impacts[n_imp, IMP_SEPARATION] = -v_after
+    return impacts, n_imp + 1
+
+
+@njit(cache=True)
+def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
     Closure fixes the per-impact constant from the approach velocity
@@ -370,12 +416,12 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     rate = y[n + cl[c]] - y[n + cr[c]]
     nc = closed.size
     if upward:
+        if contact_laws.is_instantaneous(claw[c]):
+            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
         closed[c] = True
+        y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = contact_laws.onset_constant(claw[c], cprm[c], rate)
-        if n_imp == impacts.shape[0]:
-            bigger = np.full((2 * impacts.shape[0], impacts.shape[1]), np.nan)
-            bigger[:n_imp] = impacts
-            impacts = bigger
+        impacts = _new_impact_row(impacts, n_imp)
         impacts[n_imp, IMP_CONTACT] = c
         impacts[n_imp, IMP_TIME] = t
         impacts[n_imp, IMP_VELOCITY] = rate
@@ -406,8 +452,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
-    S = 2 * n + 2 * nc + 2
+    S = 2 * n + 3 * nc + 2
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
+    iq = 2 * n + 2 * nc  # first internal-state component
 
     y = np.zeros(S)
     y[: 2 * n] = y_initial
@@ -547,7 +594,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     if h_event <= tiny:
                         # The event is at the start of the step: switch now, redo the step.
                         impacts, n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
-                                                         closed, cconst, impacts, n_imp, open_imp)
+                                                         closed, cconst, impacts, n_imp, open_imp, mass)
                         _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
                              dvals, cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
                         event_c = -1
@@ -593,7 +640,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cgap[c],
                                               y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf],
                                               k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
-                                              k1[n + rf], k7[n + rf], h_used, fractions, deltas, values)
+                                              k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
+                                              k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > trace.shape[0]:
                     bigger = np.empty((2 * trace.shape[0], 4))
                     bigger[:n_trace] = trace[:n_trace]
@@ -638,7 +686,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         n_steps += 1
         if event_c >= 0:
             impacts, n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
-                                             closed, cconst, impacts, n_imp, open_imp)
+                                             closed, cconst, impacts, n_imp, open_imp, mass)
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
             # Keep the step size the controller had before the event cut it short.
