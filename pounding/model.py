@@ -33,7 +33,7 @@ import yaml
 
 from . import schema
 from . import xi as xi_formulas
-from .contact import LAWS, ContactLaw, HertzDamp
+from .contact import ContactLaw, HertzDamp
 from .errors import ModelError, PoundingError, did_you_mean
 
 __all__ = [
@@ -80,7 +80,7 @@ class Damping:
     ratio : float, optional
         Rayleigh damping ratio ζ, 0 ≤ ζ < 1.
     modes : (int, int), optional
-        Rayleigh modes i ≠ j, 1-based.
+        Rayleigh modes i ≠ j, 1-based; default (1, 2).
     modal_ratios : tuple of float, optional
         Per-mode ratios, each in [0, 1).
     """
@@ -133,7 +133,7 @@ def _floor_array(name: str, what: str, values: Any) -> np.ndarray:
         raise ModelError(f"building {name}: {what} must list at least one storey")
     if not np.all(np.isfinite(array)) or np.any(array <= 0):
         bad = int(np.flatnonzero(~(np.isfinite(array) & (array > 0)))[0])
-        raise ModelError(f"building {name}: {what} of storey {bad + 1} must be > 0 (got {array[bad]!r})")
+        raise ModelError(f"building {name}: {what} of storey {bad + 1} must be > 0 (got {float(array[bad])!r})")
     array.setflags(write=False)
     return array
 
@@ -535,6 +535,14 @@ class Model:
                      + (f", first {gm.duration:g} s" if gm.duration is not None else ""))
         return lines
 
+    def to_document(self) -> str:
+        """YAML text of the effective model, for archives (same as :meth:`to_yaml`).
+
+        Always regenerated from the objects, so it rebuilds this exact model
+        with :func:`model_from_text` even if ``source`` was set by hand.
+        """
+        return self.to_yaml()
+
     def to_yaml(self) -> str:
         """A YAML document that :func:`model_from_text` turns back into this model.
 
@@ -550,7 +558,7 @@ class Model:
                 "levels": [[g.level_left, g.level_right] for g in gaps],
                 "gap": float(first.gap),
             }
-            entry.update(first.law.model_dump())
+            entry.update(first.law.model_dump(mode="json"))
             contacts.append(entry)
         document = {
             "name": self.name,
