@@ -187,6 +187,10 @@ def build_parser() -> argparse.ArgumentParser:
     xi_sub = xi.add_subparsers(dest="xi_command", required=True)
     xi_list = xi_sub.add_parser("list", help="print the catalogue")
     xi_list.set_defaults(func=_cmd_xi_list)
+
+    from .verify import register_cli
+
+    register_cli(sub)
     return parser
 
 

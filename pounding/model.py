@@ -415,10 +415,11 @@ class Model:
     ground_motion : GroundMotionSpec
     solver : SolverSettings
     source : str
-        The YAML text this model was loaded from.  For a model derived with
-        ``with_xi`` / ``with_ground_motion`` / ``with_solver`` it is a
-        regenerated YAML document (comments lost) that rebuilds the derived
-        model exactly with :func:`model_from_text`.
+        The YAML text this model was loaded from, as the user wrote it; a
+        model derived with ``with_xi`` / ``with_ground_motion`` /
+        ``with_solver`` keeps it.  :meth:`to_document` gives the YAML of the
+        model as it actually is (derived changes included), which rebuilds it
+        exactly with :func:`model_from_text`.
     path : str or None
         The model file as given by the user.
     """
@@ -477,8 +478,7 @@ class Model:
 
     # ----------------------------------------------------------- derived models
     def _derived(self, **changes: Any) -> Model:
-        draft = dataclasses.replace(self, **changes)
-        return dataclasses.replace(draft, source=draft.to_yaml())
+        return dataclasses.replace(self, **changes)
 
     def with_xi(self, name: str) -> Model:
         """The same model with every hertz-damp gap using xi formula *name*.

@@ -182,7 +182,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                                 "contact duration (nan if still in contact at the end)"),
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the contact force"),
         "impact_restitution": _var(("impact",), restitution, "1",
-                                   "separation velocity / approach velocity"),
+                                   "separation velocity / approach velocity (can exceed 1 between floors of buildings)"),
         "trace_time": _var(("trace",), raw.trace_time, "s",
                            "time of a full-resolution sample of a closed contact"),
         "trace_contact": _var(("trace",), raw.trace_contact.astype(np.int32), "1",

@@ -108,19 +108,35 @@ def hunt_crossley(e: float) -> float:
 
 @register("herbert-mcwhannell", "6(1-e)/((2e-1)^2+3)",
           "Herbert, R.G. & McWhannell, D.C. (1977). Shape and frequency composition of pulses "
-          "from an impact pair. J. Eng. Ind. 99(3), 513-518.",
+          "from an impact pair. J. Eng. Ind. 99(3), 513-518. Form as in ladisk/DyS (Skrinjar, after "
+          "Machado et al. 2012).",
           "secondary", bounded=True)
 def herbert_mcwhannell(e: float) -> float:
-    """Herbert & McWhannell (1977), as quoted in later reviews."""
+    """Herbert & McWhannell (1977), as quoted in later reviews.
+
+    Catalogue check: the original paper was not reachable.  The same form,
+    ``6(1−e)/((2e−1)²+3)``, is what L. Skrinjar (Ladisk, Ljubljana, the group
+    of the review Skrinjar, Slavič & Boltežar 2018, Int. J. Mech. Sci. 145,
+    171-187) implements in GitHub ladisk/DyS,
+    ``MBD_system/contact_model/contact_model.py``, which states it follows
+    Machado et al. (2012), Mech. Mach. Theory 53, 99-121.  Secondary.
+    """
     return 6.0 * (1.0 - e) / ((2.0 * e - 1.0) ** 2 + 3.0)
 
 
 @register("lee-wang", "3(1-e)/4",
           "Lee, T.W. & Wang, A.C. (1983). On the dynamics of intermittent-motion mechanisms. "
-          "Part 1. J. Mech. Transm. Autom. Des. 105(3), 534-540.",
+          "Part 1. J. Mech. Transm. Autom. Des. 105(3), 534-540. Form as in ladisk/DyS (Skrinjar, after "
+          "Machado et al. 2012).",
           "secondary", bounded=True)
 def lee_wang(e: float) -> float:
-    """Lee & Wang (1983)."""
+    """Lee & Wang (1983).
+
+    Catalogue check: the original paper was not reachable.  ``3(1−e)/4``
+    matches ladisk/DyS ``MBD_system/contact_model/contact_model.py`` (Skrinjar,
+    after Machado et al. 2012); one stored version of that file multiplies by
+    ``K/v0`` twice, an evident slip, the other has the plain form.  Secondary.
+    """
     return 0.75 * (1.0 - e)
 
 
@@ -150,10 +166,17 @@ def gonthier(e: float) -> float:
 
 @register("zhiying-qishao", "3(1-e^2)exp(2(1-e))/4",
           "Zhiying, Q. & Qishao, L. (2006). Analysis of impact process based on restitution "
-          "coefficient. J. Dyn. Control 4, 294-298.",
+          "coefficient. J. Dyn. Control 4, 294-298. Form as in ladisk/DyS (Skrinjar, after Machado et "
+          "al. 2012).",
           "secondary", bounded=True)
 def zhiying_qishao(e: float) -> float:
-    """Zhiying & Qishao (2006)."""
+    """Zhiying & Qishao (2006).
+
+    Catalogue check: the original (in Chinese) was not reachable.
+    ``3(1−e²)·exp(2(1−e))/4`` matches ladisk/DyS
+    ``MBD_system/contact_model/contact_model.py`` (Skrinjar, after Machado et
+    al. 2012).  Secondary.
+    """
     return 0.75 * (1.0 - e * e) * math.exp(2.0 * (1.0 - e))
 
 
@@ -169,19 +192,34 @@ def ye(e: float) -> float:
 
 @register("gharib-hurmuzlu", "(1-e)/e",
           "Gharib, M. & Hurmuzlu, Y. (2012). A new contact force model for low coefficient of "
-          "restitution impact. J. Appl. Mech. 79(6), 064506.",
+          "restitution impact. J. Appl. Mech. 79(6), 064506. Form not confirmed in any source found.",
           "unconfirmed", bounded=False)
 def gharib_hurmuzlu(e: float) -> float:
-    """Gharib & Hurmuzlu (2012)."""
+    """Gharib & Hurmuzlu (2012).
+
+    Catalogue check: not confirmable with the sources searched (the paper,
+    the reviews of Machado et al. 2012 and Skrinjar et al. 2018 were not
+    readable; no code implementing it with a formula was found, only plot
+    labels).  ``(1−e)/e`` is kept as the brief gives it; unconfirmed.
+    """
     return (1.0 - e) / e
 
 
 @register("hu-guo", "3(1-e)/(2e)",
           "Hu, S. & Guo, X. (2015). A dissipative contact force model for impact analysis in "
-          "multibody dynamics. Multibody Syst. Dyn. 35, 131-151.",
+          "multibody dynamics. Multibody Syst. Dyn. 35, 131-151. Form not confirmed: ladisk/DyS "
+          "(Skrinjar) uses 3(1-e)/(4e).",
           "unconfirmed", bounded=False)
 def hu_guo(e: float) -> float:
-    """Hu & Guo (2015); a 3(1-e)/(4e) variant also circulates."""
+    """Hu & Guo (2015); a 3(1-e)/(4e) variant also circulates.
+
+    Catalogue check: the two forms remain in conflict.  ladisk/DyS
+    ``MBD_system/contact_model/contact_model.py`` (Skrinjar, author of the
+    2018 review) implements Hu-Guo as ``(3/2)(1−e)/(2e)`` = ``3(1−e)/(4e)``,
+    the variant, not the ``3(1−e)/(2e)`` used here; no readable copy of the
+    paper or of a review quoting its formula was found.  Unconfirmed: check
+    the paper before relying on this key.
+    """
     return 1.5 * (1.0 - e) / e
 
 
@@ -190,7 +228,13 @@ def hu_guo(e: float) -> float:
           "Hunt-Crossley contact model. Mech. Mach. Theory 139, 174-194 (rational approximation).",
           "secondary", bounded=False)
 def carvalho_martins(e: float) -> float:
-    """Carvalho & Martins (2019), rational approximation of the exact relation."""
+    """Carvalho & Martins (2019), rational approximation of the exact relation.
+
+    Catalogue check: not found in the sources searched (no review or code
+    quoting it).  Numerically it is a good fit of :func:`exact` for e ≳ 0.5
+    (the ball drop of :mod:`pounding.verify` gives e_post within 2e-4 of
+    e_pre there) and drifts high below (0.303 at e = 0.3, 0.128 at 0.1).
+    """
     return 1.5 * (1.0 - e) * (11.0 - e) / (1.0 + 9.0 * e)
 
 
