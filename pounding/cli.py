@@ -7,6 +7,7 @@ with exit status 2; ``--debug`` shows the traceback instead.
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 import time
 from pathlib import Path
@@ -15,7 +16,11 @@ from typing import Callable, Sequence
 from . import __version__
 from .errors import PoundingError
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "build_parser", "SUBCOMMAND_MODULES"]
+
+#: Modules that add their own subcommands through ``register_cli(subparsers)``;
+#: their heavy imports happen inside the handlers, not at registration.
+SUBCOMMAND_MODULES = ["verify"]
 
 
 # --------------------------------------------------------------------------- #
@@ -188,9 +193,9 @@ def build_parser() -> argparse.ArgumentParser:
     xi_list = xi_sub.add_parser("list", help="print the catalogue")
     xi_list.set_defaults(func=_cmd_xi_list)
 
-    from .verify import register_cli
-
-    register_cli(sub)
+    for module_name in SUBCOMMAND_MODULES:
+        module = importlib.import_module(f"{__package__}.{module_name}")
+        module.register_cli(sub)
     return parser
 
 

@@ -104,9 +104,11 @@ def _drift_profiles(plt, ds: xr.Dataset, path: Path) -> None:
     for ax, name in zip(axes[0], names):
         sel = ds.peak_drift_ratio.where(ds.storey_building == name, drop=True)
         levels = ds.storey_level.where(ds.storey_building == name, drop=True).values
-        ax.step(np.r_[100 * sel.values, 100 * sel.values[-1]], np.r_[levels - 1, levels[-1]], where="post",
-                color="C0")
-        ax.plot(100 * sel.values, levels - 0.5, "o", color="C0", ms=4)
+        # Storey k spans heights k−1 … k on the vertical axis: a vertical
+        # segment at its drift ratio, joined to the next storey's.
+        ratio = 100 * sel.values
+        ax.plot(np.repeat(ratio, 2), np.column_stack([levels - 1, levels]).ravel(), color="C0")
+        ax.plot(ratio, levels - 0.5, "o", color="C0", ms=4)
         ax.set_title(f"building {name}", fontsize=9)
         ax.set_xlabel("peak drift ratio (%)")
         ax.set_ylim(0, levels.max())
