@@ -181,6 +181,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "impact_duration": _var(("impact",), raw.impact_end_time - raw.impact_time, "s",
                                 "contact duration (nan if still in contact at the end)"),
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the contact force"),
+        "impact_dissipated_energy": _var(("impact",), raw.impact_work, "J",
+                                         "energy dissipated by the contact during the impact "
+                                         "(work of the contact force; partial if still in contact at the end)"),
         "impact_restitution": _var(("impact",), restitution, "1",
                                    "separation velocity / approach velocity (can exceed 1 between floors of buildings)"),
         "trace_time": _var(("trace",), raw.trace_time, "s",

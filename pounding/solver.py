@@ -139,6 +139,7 @@ class RawSolution:
     impact_end_time: np.ndarray      # (ni,) s (nan if still closed at the end)
     impact_impulse: np.ndarray       # (ni,) N·s
     impact_separation_velocity: np.ndarray  # (ni,) m/s, −δ̇ at separation (nan if open)
+    impact_work: np.ndarray          # (ni,) J, ∫F·δ̇ dt over the impact (= energy dissipated once separated)
     trace_time: np.ndarray           # (nr,) s, full-resolution samples of closed contacts
     trace_contact: np.ndarray        # (nr,) int
     trace_penetration: np.ndarray    # (nr,) m
@@ -360,7 +361,8 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
 
 
 # Columns of the impact table built during integration.
-IMP_CONTACT, IMP_TIME, IMP_VELOCITY, IMP_CONSTANT, IMP_PEAK_FORCE, IMP_END, IMP_IMPULSE, IMP_SEPARATION = range(8)
+(IMP_CONTACT, IMP_TIME, IMP_VELOCITY, IMP_CONSTANT, IMP_PEAK_FORCE, IMP_END, IMP_IMPULSE, IMP_SEPARATION,
+ IMP_WORK) = range(9)
 
 
 @njit(cache=True)
@@ -401,6 +403,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     impacts[n_imp, IMP_END] = t
     impacts[n_imp, IMP_IMPULSE] = impulse
     impacts[n_imp, IMP_SEPARATION] = -v_after
+    impacts[n_imp, IMP_WORK] = impulse * 0.5 * (v0 + v_after)
     return impacts, n_imp + 1
 
 
@@ -428,6 +431,7 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
         impacts[n_imp, IMP_CONSTANT] = cconst[c]
         impacts[n_imp, IMP_PEAK_FORCE] = 0.0
         impacts[n_imp, IMP_IMPULSE] = y[2 * n + c]  # impulse state at onset; difference taken at the end
+        impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]  # contact work at onset; likewise
         open_imp[c] = n_imp
         n_imp += 1
     else:
@@ -437,6 +441,7 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
             impacts[row, IMP_END] = t
             impacts[row, IMP_SEPARATION] = -rate
             impacts[row, IMP_IMPULSE] = y[2 * n + c] - impacts[row, IMP_IMPULSE]
+            impacts[row, IMP_WORK] = y[2 * n + nc + c] - impacts[row, IMP_WORK]
             open_imp[c] = -1
     return impacts, n_imp
 
@@ -482,7 +487,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     peak_drift = np.zeros(n)
     peak_force = np.zeros(nc)
 
-    impacts = np.full((64, 8), np.nan)
+    impacts = np.full((64, 9), np.nan)
     n_imp = 0
     # Full-resolution trace of closed contacts: time, contact, penetration, force.
     trace = np.empty((1024, 4))
@@ -698,6 +703,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         row = open_imp[c]
         if row >= 0:
             impacts[row, IMP_IMPULSE] = y[2 * n + c] - impacts[row, IMP_IMPULSE]
+            impacts[row, IMP_WORK] = y[2 * n + nc + c] - impacts[row, IMP_WORK]
     if status == 0 and i_out < n_out:
         # t_end reached within round-off before the last output sample: fill it.
         for i2 in range(i_out, n_out):
@@ -762,5 +768,5 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
                        impacts[:, IMP_VELOCITY], impacts[:, IMP_CONSTANT], impacts[:, IMP_PEAK_FORCE],
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],
-                       trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
+                       impacts[:, IMP_WORK], trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
                        int(n_steps), int(n_rej), int(status), float(t_final))
