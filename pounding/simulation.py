@@ -88,11 +88,35 @@ def assemble(model: Model) -> System:
     )
 
 
-def record_for(model: Model) -> Record:
-    """Load the ground motion a model names (record, units, dt, scale, duration)."""
+def record_for(model: Model, *, factor: float | None = None) -> Record:
+    """Load the ground motion a model names: read, process, scale.
+
+    The record (file, catalogue name or reference, with its units and dt) is
+    processed as ``ground_motion.processing`` asks (trim, then baseline
+    correction) and then scaled by ``ground_motion.scale``: a factor, or a
+    target PGA / Sa(T) / the FEMA P695 normalisation, resolved here — a
+    ``period: building X`` is building X's first period.  The resolved factor
+    and the method are in ``metadata['scale_factor']`` / ``['scale_method']``
+    / ``['scale_description']``, the processing steps in
+    ``metadata['processing']``.
+
+    Parameters
+    ----------
+    model : Model
+    factor : float, optional
+        Use this factor instead of resolving the scaling method (a rerun uses
+        the archived factor, so the samples are bit-identical).
+    """
+    from .processing import process, scale_record
+
     spec = model.ground_motion
-    return load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units,
-                       scale=spec.scale)
+    record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units)
+    record = process(record, spec.processing)
+    period = None
+    building = getattr(spec.scale, "building", None)
+    if building is not None:
+        period = float(model.buildings[model.building_index(building)].periods[0])
+    return scale_record(record, spec.scale, period=period, factor=factor)
 
 
 def simulate(model: Model, record: Record | str | None = None, xi: str | None = None, *,

@@ -319,3 +319,16 @@ def test_gap_element_and_settings_are_frozen():
     with pytest.raises(AttributeError):
         gap.gap = 0.0
     assert SolverSettings() == SolverSettings(rtol=1e-6, atol=1e-8, atol_velocity=1e-7, output_dt=0.01)
+
+
+def test_target_scaling_round_trips_through_the_document():
+    model = load_model(MODELS / "pair.yaml")
+    for scale in ({"pga": "0.4g"}, {"sa": "0.8g", "period": "building B"}, {"sa": "300 gal", "period": 0.5},
+                  {"fema-p695": True}):
+        changed = model.with_ground_motion(scale=scale, processing={"baseline": True})
+        same_model(changed, model_from_text(changed.to_document(), base_dir=changed.ground_motion.base_dir))
+    with pytest.raises(ModelError, match=r"ground_motion.scale.period: unknown building 'C'"):
+        model.with_ground_motion(scale={"sa": "0.8g", "period": "building C"})
+    with pytest.raises(ModelError, match=r"ground_motion.processing.trim must be significant-duration"):
+        model.with_ground_motion(processing={"trim": "arias"})
+    assert model.with_ground_motion(record="synthetic-ricker-2hz").ground_motion.is_catalogue

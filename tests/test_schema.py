@@ -292,7 +292,60 @@ CASES = {
         "  rtol: 1.0e-6", "\trtol: 1.0e-6", 33,
         "invalid YAML: found character '\\t' that cannot start any token (while scanning for the next token); "
         "indent with spaces, not tabs"),
+    # ground_motion.scale as a target, ground_motion.processing (issue 4)
+    "scale pga without units": (
+        "scale: 1.0", "scale: {pga: 0.4}", 31,
+        "ground_motion.scale.pga must be an acceleration with units, e.g. 0.4g, 3.9 m/s2 or 390 gal (got 0.4); "
+        "a number alone is ambiguous (g or m/s2?)"),
+    "scale negative pga": (
+        "scale: 1.0", "scale: {pga: -0.4g}", 31,
+        "ground_motion.scale.pga must be > 0 (got '-0.4g')"),
+    "scale sa without period": (
+        "scale: 1.0", "scale: {sa: 0.8g}", 31,
+        "ground_motion.scale: sa needs a period: {sa: 0.8g, period: 1.0} (seconds) or "
+        "{sa: 0.8g, period: building A} (that building's first period)"),
+    "scale sa at an unknown building": (
+        "scale: 1.0", "scale:\n    sa: 0.8g\n    period: building Bb", 33,
+        "ground_motion.scale.period: unknown building 'Bb' (did you mean 'B'?); buildings are: A, B, C"),
+    "scale sa negative period": (
+        "scale: 1.0", "scale: {sa: 0.8g, period: -1.0}", 31,
+        "ground_motion.scale.period must be a period > 0 s or 'building <name>' (got -1.0)"),
+    "scale unknown key": (
+        "scale: 1.0", "scale:\n    pga: 0.4g\n    perod: 1.0", 33,
+        "ground_motion.scale: unknown key 'perod' (did you mean 'period'?)"),
+    "scale two targets": (
+        "scale: 1.0", "scale: {pga: 0.4g, sa: 0.8g, period: 1.0}", 31,
+        "ground_motion.scale: give one of pga, sa or fema-p695, not pga and sa"),
+    "scale fema-p695 for a file": (
+        "record: fema-p695:farfield/1a                                     # 30\n  scale: 1.0",
+        "record: RSN953.AT2\n  scale:\n    fema-p695: true", 32,
+        "ground_motion.scale.fema-p695: the FEMA P695 normalisation factor exists only for FEMA P695 records; "
+        "'RSN953.AT2' is a file: scale it with pga or sa instead"),
+    "unknown catalogue name": (
+        "record: fema-p695:farfield/1a", "record: northridge-1994-beverly-hills-mul00", 30,
+        "ground_motion.record: unknown record 'northridge-1994-beverly-hills-mul00' (did you mean "
+        "'northridge-1994-beverly-hills-mul009'?); `pounding records list` shows the catalogue keys (a file "
+        "without an extension is written ./northridge-1994-beverly-hills-mul00)"),
+    "processing unknown trim": (
+        "scale: 1.0", "scale: 1.0\n  processing: {trim: arias}", 32,
+        "ground_motion.processing.trim must be significant-duration (the 5-95% Arias-intensity window) "
+        "(got 'arias')"),
+    "processing unknown key": (
+        "scale: 1.0", "scale: 1.0\n  processing:\n    baselin: true", 33,
+        "ground_motion.processing: unknown key 'baselin' (did you mean 'baseline'?)"),
 }
+
+
+def test_catalogue_names_need_no_units_and_take_target_scaling():
+    model = model_from_text(edit("record: fema-p695:farfield/1a                                     # 30\n"
+                                 "  scale: 1.0",
+                                 "record: northridge-1994-beverly-hills-mul009\n"
+                                 "  scale: {sa: 0.8g, period: building B}\n"
+                                 "  processing: {trim: significant-duration}"))
+    gm = model.ground_motion
+    assert gm.record == "northridge-1994-beverly-hills-mul009" and gm.units is None
+    assert (gm.scale.method, gm.scale.building, gm.scale.target_text) == ("sa", "B", "0.8g")
+    assert gm.processing.trim == "significant-duration" and not gm.processing.baseline
 
 
 @pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
