@@ -128,6 +128,7 @@ class RawSolution:
     acceleration: np.ndarray         # (nt, N) relative floor acceleration, m/s²
     contact_force: np.ndarray        # (nt, nc) N
     ground_acceleration: np.ndarray  # (nt,) m/s²
+    contact_potential: np.ndarray    # (nt,) J, elastic energy stored in all contacts
     peak_displacement: np.ndarray    # (N,) m
     peak_drift: np.ndarray           # (N,) m, storey under each floor
     peak_contact_force: np.ndarray   # (nc,) N
@@ -360,17 +361,38 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
     return best
 
 
+@njit(cache=True)
+def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
+    """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
+    nc = cgap.size
+    total = 0.0
+    for c in range(nc):
+        delta = y[cl[c]] - y[cr[c]] - cgap[c]
+        total += contact_laws.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
+    return total
+
+
 # Columns of the impact table built during integration.
 (IMP_CONTACT, IMP_TIME, IMP_VELOCITY, IMP_CONSTANT, IMP_PEAK_FORCE, IMP_END, IMP_IMPULSE, IMP_SEPARATION,
  IMP_WORK) = range(9)
 
 
 @njit(cache=True)
+def _copy_rows(dst, src, rows):
+    """dst[:rows] = src[:rows] as loops: numba's array-to-slice assignment adds seconds of compilation."""
+    for i in range(rows):
+        for j in range(src.shape[1]):
+            dst[i, j] = src[i, j]
+
+
+@njit(cache=True)
 def _new_impact_row(impacts, n_imp):
     """Make room for one more row of the impact table (doubling it when full)."""
     if n_imp == impacts.shape[0]:
-        bigger = np.full((2 * impacts.shape[0], impacts.shape[1]), np.nan)
-        bigger[:n_imp] = impacts
+        # np.empty + fill, not np.full: numba's np.full pulls in seconds of string-formatting compilation.
+        bigger = np.empty((2 * impacts.shape[0], impacts.shape[1]))
+        bigger[:] = np.nan
+        _copy_rows(bigger, impacts, n_imp)
         return bigger
     return impacts
 
@@ -462,7 +484,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     iq = 2 * n + 2 * nc  # first internal-state component
 
     y = np.zeros(S)
-    y[: 2 * n] = y_initial
+    for i in range(2 * n):
+        y[i] = y_initial[i]
     ynew = np.zeros(S)
     ystage = np.zeros(S)
     k1 = np.zeros(S)
@@ -482,33 +505,41 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     out_acc = np.empty((n_out, n))
     out_force = np.empty((n_out, nc))
     out_ag = np.empty(n_out)
+    out_pot = np.empty(n_out)
 
     peak_u = np.zeros(n)
     peak_drift = np.zeros(n)
     peak_force = np.zeros(nc)
 
-    impacts = np.full((64, 9), np.nan)
-    n_imp = 0
+    impacts = np.empty((64, 9))
+    impacts[:] = np.nan
+    # Counters, indices and flags start from non-literal values: a literal (0, -1, False) reaching a
+    # call makes numba compile a throw-away literal specialisation of the callee first (seconds).
+    zero = nc - nc
+    n_imp = zero
     # Full-resolution trace of closed contacts: time, contact, penetration, force.
     trace = np.empty((1024, 4))
-    n_trace = 0
+    n_trace = zero
     fractions = np.empty(FORCE_SAMPLES + 1)
     deltas = np.empty(FORCE_SAMPLES + 1)
     values = np.empty(FORCE_SAMPLES + 1)
-    open_imp = np.full(nc, -1, dtype=np.int64)
+    open_imp = np.empty(nc, dtype=np.int64)
+    open_imp[:] = -1
 
     t = 0.0
-    seg = 0
-    _rhs(y, _ground(ag, dt_rec, 0, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+    seg = zero
+    _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
     # First output sample at t = 0.
     out_time[0] = 0.0
-    out_state[0, :] = y
+    for i in range(S):
+        out_state[0, i] = y[i]
     for j in range(n):
         out_acc[0, j] = k1[n + j]
     for c in range(nc):
         out_force[0, c] = 0.0
-    out_ag[0] = _ground(ag, dt_rec, 0, 0.0)
+    out_ag[0] = _ground(ag, dt_rec, seg, 0.0)
+    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
     i_out = 1
 
     h = first_step
@@ -525,8 +556,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         h_try = h
         if h_try >= room or t + 1.01 * h_try >= seg_end:
             h_try = room
-        event_c = -1
-        event_upward = False
+        event_c = zero - 1
+        event_upward = zero < 0
         while True:
             if h_try < 1e-14 * max(1.0, t):
                 status = 1
@@ -572,12 +603,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if not finite:
                 n_rej += 1
                 h_try *= MIN_FACTOR
-                event_c = -1
+                event_c = zero - 1
                 continue
             if err > 1.0:
                 n_rej += 1
                 h_try *= max(MIN_FACTOR, SAFETY * err ** -0.2)
-                event_c = -1
+                event_c = zero - 1
                 continue
             # ---- contact events inside the accepted step -------------------
             if event_c < 0:
@@ -602,7 +633,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                                          closed, cconst, impacts, n_imp, open_imp, mass)
                         _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
                              dvals, cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
-                        event_c = -1
+                        event_c = zero - 1
                         continue
                     h_try = h_event
                     continue  # retake the step to end at the event
@@ -649,7 +680,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                               k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > trace.shape[0]:
                     bigger = np.empty((2 * trace.shape[0], 4))
-                    bigger[:n_trace] = trace[:n_trace]
+                    _copy_rows(bigger, trace, n_trace)
                     trace = bigger
                 for i in range(FORCE_SAMPLES + 1):
                     if i == 0 and n_trace > 0 and trace[n_trace - 1, 1] == c and trace[n_trace - 1, 0] == t:
@@ -676,12 +707,14 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, k2, fbuf, forces)
             out_time[i_out] = t_o
-            out_state[i_out, :] = ystage
+            for i in range(S):
+                out_state[i_out, i] = ystage[i]
             for j in range(n):
                 out_acc[i_out, j] = k2[n + j]
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
             out_ag[i_out] = ag_o
+            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm)
             i_out += 1
         # ---- accept ---------------------------------------------------------
         t = t_new
@@ -708,7 +741,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         # t_end reached within round-off before the last output sample: fill it.
         for i2 in range(i_out, n_out):
             out_time[i2] = t
-            out_state[i2, :] = y
+            for i in range(S):
+                out_state[i2, i] = y[i]
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
@@ -716,8 +750,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
+            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
         i_out = n_out
-    return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out],
+    return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out], out_pot[:i_out],
             peak_u, peak_drift, peak_force,
             impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
 
@@ -748,8 +783,10 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         Initial state relative to the ground (m, m/s); default at rest.  All
         contacts start open.
     """
-    ag = np.ascontiguousarray(ground_acceleration, dtype=np.float64)
-    first_step = min(time_step, output_dt) * 0.1
+    # A fresh writable copy: a read-only array would compile a second specialisation.
+    ag = np.array(ground_acceleration, dtype=np.float64, copy=True)
+    # Independent of output_dt, so the step sequence (and every peak) is the same whatever the output sampling.
+    first_step = 0.1 * time_step
     y_initial = np.zeros(2 * system.n_floors)
     if initial_displacement is not None:
         y_initial[: system.n_floors] = initial_displacement
@@ -762,9 +799,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                      system.contact_parameters, ag, float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
-    (time, state, acc, force, ag_out, peak_u, peak_drift, peak_force, impacts, trace, n_steps, n_rej,
+    (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, n_steps, n_rej,
      status, t_final) = raw
-    return RawSolution(time, state, acc, force, ag_out, peak_u, peak_drift, peak_force,
+    return RawSolution(time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
                        impacts[:, IMP_VELOCITY], impacts[:, IMP_CONSTANT], impacts[:, IMP_PEAK_FORCE],
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],

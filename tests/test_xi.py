@@ -102,3 +102,9 @@ def test_unknown_formula_suggests_the_closest_name():
 def test_restitution_outside_unit_interval_is_rejected(e):
     with pytest.raises(PoundingError, match=r"restitution must be in \(0, 1\]"):
         xi.p("ye", e)
+
+
+def test_module_examples_are_right():
+    import doctest
+
+    assert doctest.testmod(xi).failed == 0

@@ -1,0 +1,519 @@
+"""Export a model to a standalone OpenSeesPy script (the peer simulator).
+
+``pounding export opensees MODEL.yaml [--record SPEC] [--dt 1e-4] [--xi NAME] -o model.py``
+writes a Python script that builds the same row of shear buildings in
+OpenSeesPy and runs it under the same record:
+
+* one node per floor (its mass) and one fixed ground node per building, all
+  on one axis (``model basic -ndm 1 -ndf 1``);
+* each storey a ``zeroLength`` element with an ``Elastic`` material
+  (``k_i``) and ``-doRayleigh 1``; each Rayleigh-damped building gets its own
+  ``a0, a1`` through a ``region`` holding its storey elements and their nodes
+  (the nodes carry ``a0·M``, the elements ``a1·K``);
+* a building with modal damping gets its dense damping matrix ``C`` as a
+  network of linear dashpots (``zeroLength`` + ``Elastic`` with ``E = 0``,
+  ``eta = c``, ``-doRayleigh 0``): ``−C_ij`` between floors i and j and the
+  row sum ``Σ_j C_ij`` from floor i to the ground, which assembles to ``C``
+  exactly;
+* each gap element a ``zeroLength`` from the left floor to the right floor
+  with ``uniaxialMaterial Hertzdamp Kh xiNorm −gap`` (``xiNorm = p(e)`` of the
+  chosen ξ formula) and ``-doRayleigh 0`` (``hertz`` exports as ``xiNorm = 0``,
+  ``linear`` as ``ElasticPPGap``);
+* the record as ``timeSeries Path`` + ``pattern UniformExcitation`` (linear
+  between samples and zero after the end, as in :func:`pounding.simulate`);
+* ``Newmark`` average acceleration (γ = 1/2, β = 1/4), ``Newton`` with an
+  unbalanced-force test at 1e-12 of the stiffest storey's force at 1 m, at a
+  fixed step ``dt`` (a failed step is retaken in ten sub-steps with line
+  search);
+* recorders for our results schema's peaks: ``peak_displacement`` (floor),
+  ``peak_drift_ratio`` (storey), ``peak_contact_force`` and ``impact_count``
+  (contact), labelled as in the results dataset (``A:3``, ``A:1-B:1``),
+  printed as JSON and optionally written to a file.
+
+Differences from our solver that remain by construction (with them the
+peer converges slowly once impacts start):
+
+* OpenSees' ``Hertzdamp`` fixes ξ from the strain rate at the end of the
+  first step inside the gap, not at the located instant of closure, so its
+  ξ is slightly too large (the floors have already slowed down);
+* it has no ``min_impact_velocity`` floor on v0;
+* it never clamps tension: a model with ``tension: clamp`` exports with a
+  warning; compare against ``tension: allow`` (:func:`allow_tension`);
+* peaks are read at the committed steps and an impact shorter than one step
+  can be missed.
+
+:func:`run_opensees` runs the generated script in-process and returns the
+peaks (the cross-check tests and the benchmarks use it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .errors import PoundingError
+
+__all__ = ["opensees_script", "run_opensees", "allow_tension", "register_cli", "DEFAULT_DT"]
+
+#: Default OpenSees time step, s.
+DEFAULT_DT = 1.0e-4
+
+
+def allow_tension(model):
+    """The same model with ``tension: allow`` on every hertz-damp (and kelvin) gap element.
+
+    OpenSees' ``Hertzdamp`` material does not clamp the pull that the damping
+    term produces just before separation; a model compared with it must not
+    either.
+    """
+    from .contact import HertzDamp, Kelvin
+
+    laws: dict[int, object] = {}
+
+    def switched(law):
+        if not isinstance(law, (HertzDamp, Kelvin)) or law.tension == "allow":
+            return law
+        if id(law) not in laws:
+            laws[id(law)] = type(law)(**{**law.model_dump(), "tension": "allow"})
+        return laws[id(law)]
+
+    gaps = tuple(dataclasses.replace(g, law=switched(g.law)) for g in model.gaps)
+    return dataclasses.replace(model, gaps=gaps)
+
+
+def _prepare(model, record=None, xi=None, duration=None):
+    """Apply the overrides as :func:`pounding.simulate` does; return (model, record, end_time).
+
+    A record given as a string replaces the model's ``ground_motion.record``
+    (processed and scaled as the model says, by :func:`pounding.simulation.record_for`);
+    a :class:`~pounding.ground_motion.Record` is used as it is.
+    """
+    from .ground_motion import Record
+    from .simulation import record_for
+
+    if xi is not None:
+        model = model.with_xi(xi)
+    changes = {}
+    if isinstance(record, str):
+        changes["record"] = record
+    if duration is not None:
+        changes["duration"] = duration
+    if changes:
+        model = model.with_ground_motion(**changes)
+    motion = record if isinstance(record, Record) else record_for(model)
+    end_time = model.ground_motion.duration or motion.duration
+    if end_time <= 0.0:
+        raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
+    return model, motion, float(end_time)
+
+
+def _contact_material(law, gap: float) -> tuple[list, list[str]]:
+    """OpenSees material arguments (after the tag) for one gap element, and warnings."""
+    from .contact import Hertz, HertzDamp, Linear
+
+    if isinstance(law, HertzDamp):
+        notes = []
+        if law.tension == "clamp":
+            notes.append("hertz-damp with tension: clamp — OpenSees' Hertzdamp does not clamp the pull "
+                         "before separation (it behaves as tension: allow)")
+        return ["Hertzdamp", float(law.kh), float(law.p), -float(gap)], notes
+    if isinstance(law, Hertz):
+        return ["Hertzdamp", float(law.kh), 0.0, -float(gap)], []
+    if isinstance(law, Linear):
+        # Compression-only elastic gap: ElasticPPGap E Fy gap with a yield force it never reaches.
+        return ["ElasticPPGap", float(law.k), -1.0e30, -float(gap)], []
+    raise PoundingError(f"contact law '{law.name}' has no OpenSees counterpart in this exporter "
+                        "(supported: hertz-damp, hertz, linear)")
+
+
+def _fmt(x: float) -> str:
+    return repr(float(x))
+
+
+def opensees_script(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None = None,
+                    duration: float | None = None) -> str:
+    """Text of a standalone OpenSeesPy script of *model* under *record*.
+
+    Parameters
+    ----------
+    model : Model
+    record : Record or str, optional
+        Default: the model's own ground motion.
+    dt : float
+        OpenSees time step, s.
+    xi : str, optional
+        ξ formula for every hertz-damp contact (overrides the model).
+    duration : float, optional
+        Simulated time, s (default: the model's, else the record's duration).
+
+    Returns
+    -------
+    str
+        Python source.  Run it (``python model.py [--dt DT] [-o peaks.json]``)
+        or import it and call ``analyse()``, which returns the peaks as a dict.
+    """
+    return _script(model, record, dt=dt, xi=xi, duration=duration)[0]
+
+
+def _script(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None = None,
+            duration: float | None = None) -> tuple[str, list[str]]:
+    """(script text, notes on what the export cannot reproduce exactly)."""
+    if not (dt > 0.0 and math.isfinite(dt)):
+        raise PoundingError(f"--dt must be > 0 (got {dt!r})")
+    model, motion, end_time = _prepare(model, record, xi, duration)
+    notes: list[str] = []
+
+    # ---- nodes and elements ---------------------------------------------------
+    node = 0
+    element = 0
+    floors = []        # (node, label, mass)
+    grounds = []       # node
+    storeys = []       # (element, node below, node, k, label, height)
+    buildings = []     # (name, a0, a1, [storey elements], [nodes]) for Rayleigh buildings
+    dashpots = []      # (element, node i, node j, c)
+    floor_node: dict[tuple[int, int], int] = {}
+    for b_index, b in enumerate(model.buildings):
+        node += 1
+        ground = node
+        grounds.append(ground)
+        nodes = [ground]
+        for level in range(1, b.n_floors + 1):
+            node += 1
+            floor_node[(b_index, level)] = node
+            floors.append((node, f"{b.name}:{level}", float(b.mass[level - 1])))
+            nodes.append(node)
+        elements = []
+        for level in range(1, b.n_floors + 1):
+            element += 1
+            below = ground if level == 1 else floor_node[(b_index, level - 1)]
+            storeys.append((element, below, floor_node[(b_index, level)], float(b.stiffness[level - 1]),
+                            f"{b.name}:{level}", float(b.height[level - 1])))
+            elements.append(element)
+        if b.damping.kind == "rayleigh":
+            a0, a1 = b.rayleigh_coefficients
+            buildings.append((b.name, float(a0), float(a1), elements, nodes))
+        else:
+            c = np.asarray(b.damping_matrix(), dtype=float)
+            n = b.n_floors
+            for i in range(n):
+                element += 1
+                dashpots.append((element, ground, floor_node[(b_index, i + 1)], float(c[i].sum())))
+                for j in range(i + 1, n):
+                    if c[i, j] != 0.0:
+                        element += 1
+                        dashpots.append((element, floor_node[(b_index, i + 1)], floor_node[(b_index, j + 1)],
+                                         float(-c[i, j])))
+    names = [b.name for b in model.buildings]
+    contacts = []      # (element, node left, node right, material args, label)
+    for g in model.gaps:
+        element += 1
+        material, warnings = _contact_material(g.law, g.gap)
+        for w in warnings:
+            if w not in notes:
+                notes.append(w)
+        contacts.append((element, floor_node[(g.left, g.level_left)], floor_node[(g.right, g.level_right)],
+                         material, f"{names[g.left]}:{g.level_left}-{names[g.right]}:{g.level_right}"))
+
+    n_samples = min(motion.acceleration.size, int(math.ceil(end_time / motion.time_step - 1e-9)) + 1)
+    samples = motion.acceleration[:n_samples]
+    lines = []
+    for start in range(0, samples.size, 6):
+        lines.append("    " + ", ".join(_fmt(a) for a in samples[start:start + 6]) + ",")
+    record_text = "\n".join(lines)
+
+    def rows(items) -> str:
+        return "\n".join(f"    {tuple(item)!r}," for item in items)
+
+    summary = "\n".join("#   " + line for line in model.summary_lines())
+    note_text = "\n".join("# NOTE: " + n for n in notes)
+    return _TEMPLATE.format(
+        version=__version__, name=model.name, summary=summary, notes=note_text,
+        record_name=motion.name, record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
+        duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
+        floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
+        dashpots=rows(dashpots), contacts=rows(contacts),
+    ), notes
+
+
+_TEMPLATE = '''#!/usr/bin/env python3
+"""OpenSeesPy model '{name}' exported by pounding {version}.
+
+Run:   python THIS.py [--dt DT] [-o peaks.json]
+Import: analyse(dt=..., duration=...) -> dict of peaks (results-schema names).
+
+Units SI (kg, N/m, m, s).  Model:
+{summary}
+Record: {record_name} x {record_scale}, {n_samples} samples at {record_dt} s (m/s^2),
+simulated for {duration} s.
+"""
+{notes}
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from array import array
+
+import openseespy.opensees as ops
+
+MODEL_NAME = {name!r}
+UNBALANCE_TOLERANCE = {unbalance}  # N
+DT = {dt}
+DURATION = {duration}
+RECORD_NAME = {record_name!r}
+RECORD_DT = {record_dt}
+RECORD = [  # ground acceleration, m/s^2, linear between samples, 0 after the last
+{record}
+]
+
+# (node, floor label, mass kg)
+FLOORS = [
+{floors}
+]
+# fixed ground node of each building
+GROUNDS = {grounds}
+# (element, node below, node, storey stiffness N/m, storey label, storey height m)
+STOREYS = [
+{storeys}
+]
+# Rayleigh-damped buildings: (name, a0 1/s, a1 s, storey elements, nodes)
+RAYLEIGH = [
+{buildings}
+]
+# dashpots carrying a modal damping matrix: (element, node i, node j, c N s/m)
+DASHPOTS = [
+{dashpots}
+]
+# gap elements: (element, left floor node, right floor node, material args, contact label)
+CONTACTS = [
+{contacts}
+]
+
+
+def build(log_file=None):
+    """Create the OpenSees domain (wipes any previous one)."""
+    ops.wipe()
+    if log_file is not None:
+        ops.logFile(log_file, "-noEcho")  # Hertzdamp prints one line per impact
+    ops.model("basic", "-ndm", 1, "-ndf", 1)
+    for tag in GROUNDS:
+        ops.node(tag, 0.0)
+        ops.fix(tag, 1)
+    for tag, _label, mass in FLOORS:
+        ops.node(tag, 0.0)
+        ops.mass(tag, mass)
+    for ele, i, j, k, _label, _h in STOREYS:
+        ops.uniaxialMaterial("Elastic", ele, k)
+        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 1)
+    for ele, i, j, c in DASHPOTS:
+        ops.uniaxialMaterial("Elastic", ele, 0.0, c)
+        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
+    for ele, i, j, material, _label in CONTACTS:
+        ops.uniaxialMaterial(material[0], ele, *material[1:])
+        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
+    for region, (_name, a0, a1, elements, nodes) in enumerate(RAYLEIGH, start=1):
+        # Each building its own a0 (on its nodes' masses) and a1 (on its storeys' stiffness).
+        ops.region(region, "-ele", *elements, "-rayleigh", a0, a1, 0.0, 0.0)
+    ops.timeSeries("Path", 1, "-dt", RECORD_DT, "-values", *RECORD, "-factor", 1.0)
+    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
+
+
+def _read_rows(path, width):
+    """Rows of an OpenSees ``-binary`` recorder: *width* native doubles, then a newline byte."""
+    with open(path, "rb") as handle:
+        raw = handle.read()
+    size = 8 * width + 1
+    for start in range(0, len(raw) - size + 1, size):
+        row = array("d")
+        row.frombytes(raw[start:start + 8 * width])
+        yield row
+
+
+def analyse(dt=DT, duration=DURATION, workdir=None):
+    """Run the analysis; return the peaks and the solver wall time.
+
+    Peaks are read at every committed step; an impact is a step on which a
+    gap element carries force after a step on which it carried none.
+    """
+    own = workdir is None
+    workdir = tempfile.mkdtemp(prefix="pounding-opensees-") if own else workdir
+    try:
+        build(os.path.join(workdir, "opensees.log"))
+        floor_nodes = [tag for tag, _l, _m in FLOORS]
+        storey_elements = [row[0] for row in STOREYS]
+        contact_elements = [row[0] for row in CONTACTS]
+        disp = os.path.join(workdir, "disp.env")
+        drift = os.path.join(workdir, "drift.env")
+        force = os.path.join(workdir, "contact_force.bin")
+        ops.recorder("EnvelopeNode", "-file", disp, "-precision", 16, "-node", *floor_nodes, "-dof", 1, "disp")
+        ops.recorder("EnvelopeElement", "-file", drift, "-precision", 16, "-ele", *storey_elements,
+                     "deformation")
+        if contact_elements:
+            ops.recorder("Element", "-binary", force, "-ele", *contact_elements, "basicForce")
+        ops.constraints("Plain")
+        ops.numberer("RCM")
+        ops.system("BandGeneral")
+        # Unbalanced force below 1e-12 of the stiffest storey's force at 1 m: round-off level,
+        # and a linear step converges in one Newton iteration.
+        ops.test("NormUnbalance", UNBALANCE_TOLERANCE, 25)
+        ops.algorithm("Newton")
+        ops.integrator("Newmark", 0.5, 0.25)
+        ops.analysis("Transient")
+
+        n_steps = int(round(duration / dt))
+        started = time.perf_counter()
+        status = ops.analyze(n_steps, dt)
+        cut_steps = 0
+        while status != 0 and ops.getTime() < n_steps * dt - 0.5 * dt:
+            # Newton failed: retake that step in 10 sub-steps with line search, then go on.
+            cut_steps += 1
+            ops.algorithm("NewtonLineSearch")
+            status = ops.analyze(10, dt / 10.0)
+            ops.algorithm("Newton")
+            if status != 0:
+                break
+            status = ops.analyze(int(round((n_steps * dt - ops.getTime()) / dt)), dt)
+        wall = time.perf_counter() - started
+        end = ops.getTime()
+        ops.wipe()  # flushes and closes the recorders
+
+        with open(disp) as handle:
+            env = [[float(x) for x in line.split()] for line in handle if line.strip()]
+        peak_u = env[2]
+        with open(drift) as handle:
+            env = [[float(x) for x in line.split()] for line in handle if line.strip()]
+        peak_drift = env[2]
+        nc = len(contact_elements)
+        peak_force = [0.0] * nc
+        impacts = [0] * nc
+        if nc:
+            closed = [False] * nc
+            for row in _read_rows(force, nc):
+                for c in range(nc):
+                    f = -row[c]  # compression is negative in OpenSees
+                    if f != 0.0 and not closed[c]:
+                        impacts[c] += 1
+                    closed[c] = f != 0.0
+                    if f > peak_force[c]:
+                        peak_force[c] = f
+        return {{
+            "model": MODEL_NAME,
+            "record": RECORD_NAME,
+            "simulator": "OpenSeesPy Newmark(1/2, 1/4) + Newton",
+            "dt": dt,
+            "duration": duration,
+            "end_time": end,
+            "converged": status == 0,
+            "cut_steps": cut_steps,
+            "wall_time": wall,
+            "floor": [row[1] for row in FLOORS],
+            "peak_displacement": peak_u,
+            "storey": [row[4] for row in STOREYS],
+            "peak_drift_ratio": [d / row[5] for d, row in zip(peak_drift, STOREYS)],
+            "contact": [row[4] for row in CONTACTS],
+            "peak_contact_force": peak_force,
+            "impact_count": impacts,
+        }}
+    finally:
+        if own:
+            shutil.rmtree(workdir, ignore_errors=True)
+
+
+def main(argv=None):
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dt", type=float, default=DT, help="time step, s (default %(default)g)")
+    parser.add_argument("--duration", type=float, default=DURATION, help="simulated time, s")
+    parser.add_argument("-o", "--output", help="also write the peaks to this JSON file")
+    args = parser.parse_args(argv)
+    peaks = analyse(args.dt, args.duration)
+    text = json.dumps(peaks, indent=1)
+    print(text)
+    if args.output:
+        with open(args.output, "w") as handle:
+            handle.write(text + "\\n")
+    return 0 if peaks["converged"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+'''
+
+
+def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None = None,
+                 duration: float | None = None) -> dict:
+    """Export *model* and run the script in this process; return its peaks.
+
+    Returns
+    -------
+    dict
+        ``floor``/``peak_displacement`` (m), ``storey``/``peak_drift_ratio``,
+        ``contact``/``peak_contact_force`` (N)/``impact_count``, labelled as
+        in the results dataset, plus ``wall_time`` (s, the ``analyze`` calls
+        only), ``converged`` and ``dt``.
+
+    Raises
+    ------
+    PoundingError
+        If OpenSeesPy is not installed or the model cannot be exported.
+    """
+    try:
+        import openseespy.opensees  # noqa: F401
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise PoundingError(f"OpenSeesPy is not available ({exc}); pip install openseespy") from None
+    source, _notes = _script(model, record, dt=dt, xi=xi, duration=duration)
+    namespace: dict = {"__name__": "pounding_opensees_export"}
+    exec(compile(source, f"<opensees export of {model.name}>", "exec"), namespace)
+    return namespace["analyse"]()
+
+
+# --------------------------------------------------------------------------- #
+# Command line
+# --------------------------------------------------------------------------- #
+
+
+def _cmd_export_opensees(args: argparse.Namespace) -> int:
+    from .model import load_model
+
+    model = load_model(args.model)
+    source, notes = _script(model, args.record, dt=args.dt, xi=args.xi, duration=args.duration)
+    output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
+    if output.exists() and not args.overwrite:
+        raise PoundingError(f"{output} exists; pass --overwrite to replace it")
+    try:
+        output.write_text(source, encoding="utf-8")
+    except OSError as exc:
+        raise PoundingError(f"cannot write {output}: {exc.strerror}") from None
+    for note in notes:
+        print(f"pounding: note: {note}", file=sys.stderr)
+    print(f"wrote {output} (run: python {output} [--dt DT] [-o peaks.json])")
+    return 0
+
+
+def register_cli(subparsers) -> argparse.ArgumentParser:
+    """Add ``export opensees`` to *subparsers* (from ``add_subparsers``)."""
+    export = subparsers.add_parser("export", help="write a model for another simulator")
+    sub = export.add_subparsers(dest="export_format", required=True)
+    parser = sub.add_parser(
+        "opensees", help="standalone OpenSeesPy script of a model (the peer for cross-checks)",
+        description="Write a standalone OpenSeesPy script of the model: floor masses, zeroLength storey "
+                    "springs with per-building Rayleigh damping, Hertzdamp gap elements (xiNorm = p(e)), "
+                    "the record as Path/UniformExcitation, Newmark average acceleration + Newton at DT. "
+                    "Running it prints the peaks of our results schema as JSON.")
+    parser.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
+    parser.add_argument("--record", help="record spec (default: the model's ground motion)")
+    parser.add_argument("--duration", type=float, help="simulated time, s")
+    parser.add_argument("--dt", type=float, default=DEFAULT_DT, help="OpenSees time step, s (default 1e-4)")
+    parser.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
+    parser.add_argument("-o", "--output", help="script to write (default: MODEL-STEM_opensees.py)")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing script")
+    parser.set_defaults(func=_cmd_export_opensees)
+    return parser

