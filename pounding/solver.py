@@ -171,9 +171,13 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     """Time derivative of the state; contact forces are written to *forces*."""
     n = mass.size
     nc = cgap.size
-    # fbuf[:n] accumulates internal + damping forces, N.
+    # fbuf[:n] accumulates internal + damping forces (N); power is the
+    # damping power v·C v (W), summed in the same loops.
+    power = 0.0
     for j in range(n):
-        fbuf[j] = a0[j] * mass[j] * y[n + j]
+        v = y[n + j]
+        fbuf[j] = a0[j] * mass[j] * v
+        power += fbuf[j] * v
     for j in range(n):
         b = below[j]
         if b >= 0:
@@ -182,7 +186,9 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         else:
             du = y[j]
             dv = y[n + j]
-        s = kst[j] * (du + a1[j] * dv)
+        damping = kst[j] * a1[j] * dv
+        s = kst[j] * du + damping
+        power += damping * dv
         fbuf[j] += s
         if b >= 0:
             fbuf[b] -= s
@@ -197,6 +203,7 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for k in range(m):
                 acc += dvals[off + i * m + k] * y[n + s0 + k]
             fbuf[s0 + i] += acc
+            power += acc * y[n + s0 + i]
     for c in range(nc):
         f = 0.0
         if closed[c]:
@@ -219,32 +226,7 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         out[n + j] = -fbuf[j] / mass[j] - ag_t
         e_in_rate -= ag_t * mass[j] * y[n + j]
     out[2 * n + 3 * nc] = e_in_rate
-    out[2 * n + 3 * nc + 1] = _damping_power(y, mass, kst, below, a0, a1, dstart, dsize, doff, dvals)
-
-
-@njit(cache=True)
-def _damping_power(y, mass, kst, below, a0, a1, dstart, dsize, doff, dvals) -> float:
-    """Power dissipated by the structural damping, v·C v (W)."""
-    n = mass.size
-    p = 0.0
-    for j in range(n):
-        v = y[n + j]
-        p += a0[j] * mass[j] * v * v
-        b = below[j]
-        dv = v - y[n + b] if b >= 0 else v
-        p += a1[j] * kst[j] * dv * dv
-    for bidx in range(dsize.size):
-        m = dsize[bidx]
-        if m == 0:
-            continue
-        s0 = dstart[bidx]
-        off = doff[bidx]
-        for i in range(m):
-            acc = 0.0
-            for k in range(m):
-                acc += dvals[off + i * m + k] * y[n + s0 + k]
-            p += y[n + s0 + i] * acc
-    return p
+    out[2 * n + 3 * nc + 1] = power
 
 
 # --------------------------------------------------------------------------- #
