@@ -1,0 +1,344 @@
+"""Compare ξ formulas on storey drifts: ``pounding compare MODEL.yaml --xi ye,lankarani-nikravesh,exact``.
+
+A sweep (:mod:`pounding.sweep`) over the ξ formula of every hertz-damp
+contact × a list of records.  For each building it prints the peak storey
+drift ratio profile of each formula (mean over the records) and its
+difference from the reference formula (``exact`` by default): for each
+record ``(d_formula − d_exact) / d_exact``, summarised by its mean and its
+largest magnitude over the records.  ``--plot DIR`` draws the profiles (one
+panel per building) and the distribution over records of each building's
+largest storey drift ratio and of its difference from the reference.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import PoundingError, did_you_mean
+
+__all__ = ["compare", "comparison_table", "differences", "plot_comparison", "register_cli"]
+
+REFERENCE = "exact"
+
+
+def _formulas(text: str | list[str], reference: str) -> list[str]:
+    from . import xi
+
+    names = [n.strip() for n in (text.split(",") if isinstance(text, str) else text) if n.strip()]
+    if not names:
+        raise PoundingError("--xi needs at least one formula, e.g. --xi ye,lankarani-nikravesh,exact")
+    keys = []
+    known = [r["key"] for r in xi.catalogue()]
+    for name in names:
+        try:
+            key = xi.get(name).key
+        except PoundingError:
+            raise PoundingError(f"--xi: unknown xi formula '{name}'{did_you_mean(name, known)}; choose from: "
+                                f"{', '.join(known)}") from None
+        if key not in keys:
+            keys.append(key)
+    reference_key = xi.get(reference).key if reference else reference
+    if reference_key not in keys:
+        keys.append(reference_key)
+    return keys
+
+
+def _records(text: str | list[str] | None) -> list[str] | None:
+    from .sweep import expand_records
+
+    if text is None:
+        return None
+    items = [r.strip() for r in (text.split(",") if isinstance(text, str) else text) if r.strip()]
+    records: list[str] = []
+    for item in items:
+        try:
+            expanded = expand_records(item)
+        except PoundingError as exc:
+            raise PoundingError(f"--records: {exc}") from None
+        records += [r for r in expanded if r not in records]
+    if not records:
+        raise PoundingError("--records needs a set (fema-p695:farfield) or a comma-separated list of records")
+    return records
+
+
+def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: str | list[str] | None = None, *,
+                duration: float | None = None, reference: str = REFERENCE):
+    """The sweep behind ``pounding compare`` (formulas × records)."""
+    import yaml
+
+    from .model import load_model
+    from .sweep import sweep_from_text
+
+    path = os.path.abspath(os.fspath(model))
+    from .contact import HertzDamp
+
+    base = load_model(model)                # the model's own errors, with its file name
+    if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
+        raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only to "
+                            "law hertz-damp")
+    keys = _formulas(formulas, reference)
+    axes: dict[str, Any] = {"xi": keys}
+    listed = _records(records)
+    if listed is not None:
+        axes["records"] = [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
+    document: dict[str, Any] = {"name": f"compare-{Path(path).stem}", "model": path, "axes": axes}
+    if duration is not None:
+        if not duration > 0:
+            raise PoundingError(f"--duration must be > 0 (got {duration:g})")
+        document["set"] = {"ground_motion.duration": float(duration)}
+    text = yaml.safe_dump(document, sort_keys=False)
+    sweep = sweep_from_text(text, label=f"<compare {os.fspath(model)}>", base_dir=os.getcwd())
+    invalid = sweep.invalid_values()
+    if invalid:
+        raise PoundingError(invalid[0].split(": ", 1)[-1])
+    return sweep
+
+
+def compare(model: str | os.PathLike, formulas: str | list[str] = ("ye", "lankarani-nikravesh", "exact"),
+            records: str | list[str] | None = None, *, output: str | os.PathLike | None = None,
+            duration: float | None = None, reference: str = REFERENCE, **run_options):
+    """Run the comparison and return the sweep results dataset (dims ``xi``, ``record``, ...).
+
+    Parameters
+    ----------
+    model : path-like
+        The YAML model (with at least one hertz-damp contact).
+    formulas : str or list of str
+        ξ formulas; the reference is added if missing.
+    records : str or list of str, optional
+        Record specs or a set (``fema-p695:farfield``); default: the model's record.
+    output : path-like, optional
+        NetCDF file for the results (resumable, like ``pounding sweep``).
+    duration : float, optional
+        Simulated time, s.
+    run_options
+        Passed to :func:`pounding.sweep.run_sweep` (workers, scheduler, client, progress, overwrite...).
+    """
+    from .sweep import run_sweep
+
+    sweep = build_sweep(model, formulas, records, duration=duration, reference=reference)
+    ds = run_sweep(sweep, output, **run_options)
+    ds.attrs["reference_xi"] = reference
+    return ds
+
+
+def differences(ds, reference: str = REFERENCE):
+    """``(d − d_ref) / d_ref`` of the peak drift ratios, per formula, record and storey."""
+    ref = ds.peak_drift_ratio.sel(xi=reference)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (ds.peak_drift_ratio - ref) / ref
+
+
+def _buildings(ds) -> list[str]:
+    return list(dict.fromkeys(str(b) for b in ds.storey_building.values))
+
+
+def comparison_table(ds, reference: str = REFERENCE) -> str:
+    """The per-building text table printed by ``pounding compare``."""
+    formulas = [str(x) for x in ds.xi.values]
+    records = [str(r) for r in ds.record.values]
+    ok = (ds.status == "ok")
+    lines = [f"xi formulas compared over {len(records)} record{'s' if len(records) != 1 else ''}: "
+             + ", ".join(records[:4]) + (f", ... ({len(records)} in all)" if len(records) > 4 else "")]
+    failed = int((~ok).sum())
+    if failed:
+        lines.append(f"{failed} scenario(s) failed and are left out (see the 'error' variable)")
+    rel = differences(ds, reference)
+    drift = ds.peak_drift_ratio
+    for building in _buildings(ds):
+        mask = (ds.storey_building == building).values
+        d = drift.isel(storey=mask)
+        r = rel.isel(storey=mask)
+        levels = ds.storey_level.values[mask]
+        lines.append("")
+        lines.append(f"building {building}: peak storey drift ratio, % (mean over records); "
+                     f"[mean, max |.|] over records of the difference from {reference}, % of {reference}; "
+                     "max = largest storey drift of the building")
+        cells = {}
+        for f in formulas:
+            mean = d.sel(xi=f).mean("record", skipna=True).values * 100
+            if f == reference:
+                cells[f] = [f"{m:.4f}" for m in mean]
+                continue
+            dm = r.sel(xi=f).mean("record", skipna=True).values * 100
+            dx = np.abs(r.sel(xi=f)).max("record", skipna=True).values * 100
+            cells[f] = [f"{m:.4f} [{a:+.1f}, {b:.1f}]" for m, a, b in zip(mean, dm, dx)]
+        # the building's largest storey drift, per record, then averaged
+        peak = d.max("storey", skipna=True)
+        peak_ref = peak.sel(xi=reference)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            peak_rel = (peak - peak_ref) / peak_ref
+        for f in formulas:
+            m = float(peak.sel(xi=f).mean("record", skipna=True)) * 100
+            if f == reference:
+                cells[f].append(f"{m:.4f}")
+            else:
+                a = float(peak_rel.sel(xi=f).mean("record", skipna=True)) * 100
+                b = float(np.abs(peak_rel.sel(xi=f)).max("record", skipna=True)) * 100
+                cells[f].append(f"{m:.4f} [{a:+.1f}, {b:.1f}]")
+        rows = [f"{int(lv)}" for lv in levels] + ["max"]   # max: the building's largest storey drift
+        widths = [max(len(f), *(len(c) for c in cells[f])) for f in formulas]
+        lines.append("  storey  " + "  ".join(f"{f:>{w}}" for f, w in zip(formulas, widths)))
+        for i, row in enumerate(rows):
+            lines.append(f"  {row:>6}  " + "  ".join(f"{cells[f][i]:>{w}}" for f, w in zip(formulas, widths)))
+    return "\n".join(lines)
+
+
+def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE) -> list[Path]:
+    """Write ``xi_drift_profiles.png`` and ``xi_drift_distribution.png`` to *directory*."""
+    from .plots import _pyplot
+
+    out = Path(directory)
+    if out.exists() and not out.is_dir():
+        raise PoundingError(f"{out} is a file; --plot needs a directory")
+    out.mkdir(parents=True, exist_ok=True)
+    plt = _pyplot()
+    formulas = [str(x) for x in ds.xi.values]
+    buildings = _buildings(ds)
+    n_records = ds.sizes["record"]
+    colours = {f: ("k" if f == reference else f"C{i}") for i, f in enumerate(formulas)}
+
+    # ---- profiles: one panel per building; below, the difference from the reference
+    rel = differences(ds, reference) * 100
+    fig, axes = plt.subplots(2, len(buildings), figsize=(3.4 * len(buildings) + 0.6, 8.0), squeeze=False,
+                             gridspec_kw={"height_ratios": [3, 2]})
+    for col, building in enumerate(buildings):
+        mask = (ds.storey_building == building).values
+        levels = ds.storey_level.values[mask].astype(float)
+        d = ds.peak_drift_ratio.isel(storey=mask) * 100
+        r = rel.isel(storey=mask)
+        ax, low_ax = axes[0][col], axes[1][col]
+        others = [f for f in formulas if f != reference]
+        for k, f in enumerate(formulas):
+            mean = d.sel(xi=f).mean("record", skipna=True).values
+            style = dict(color=colours[f], lw=1.6 if f == reference else 1.2, ls="--" if f == reference else "-")
+            ax.plot(np.repeat(mean, 2), np.column_stack([levels - 1, levels]).ravel(), label=f, **style)
+            ax.plot(mean, levels - 0.5, "o", color=colours[f], ms=3.5)
+            if f == reference:
+                continue
+            # mean difference per storey, bar from min to max over the records
+            shift = (others.index(f) - (len(others) - 1) / 2) * 0.12
+            per = r.sel(xi=f)
+            mean_r = per.mean("record", skipna=True).values
+            low_ax.plot(np.repeat(mean_r, 2), np.column_stack([levels - 1, levels]).ravel(), color=colours[f],
+                        lw=1.2, label=f)
+            if n_records > 1:
+                low_ax.hlines(levels - 0.5 + shift, per.min("record", skipna=True).values,
+                              per.max("record", skipna=True).values, color=colours[f], lw=0.8, alpha=0.7)
+            low_ax.plot(mean_r, levels - 0.5 + shift, "o", color=colours[f], ms=3)
+        ax.set_title(f"building {building}", fontsize=9)
+        ax.set_xlabel("peak storey drift ratio (%)")
+        ax.set_xlim(left=0)
+        low_ax.axvline(0.0, color="k", lw=0.8, ls="--")
+        low_ax.set_xlabel(f"difference from {reference} (% of {reference})")
+        for a in (ax, low_ax):
+            a.set_ylim(0, levels.max())
+            a.grid(alpha=0.3)
+        ax.set_ylabel("storey")
+        low_ax.set_ylabel("storey")
+    axes[0][-1].legend(fontsize=7, loc="best", title="xi formula", title_fontsize=7)
+    what = (f"mean over {n_records} records; lower panels: bars span the records" if n_records > 1
+            else str(ds.record.values[0]))
+    fig.suptitle(f"peak storey drift ratio per xi formula ({what})", fontsize=9)
+    fig.tight_layout()
+    profiles = out / "xi_drift_profiles.png"
+    fig.savefig(profiles, dpi=110)
+    plt.close(fig)
+
+    # ---- distribution over records of each building's largest storey drift
+    fig, axes = plt.subplots(2, len(buildings), figsize=(3.4 * len(buildings) + 0.6, 6.4), squeeze=False)
+    rng = np.random.default_rng(0)
+    for col, building in enumerate(buildings):
+        mask = (ds.storey_building == building).values
+        peak = (ds.peak_drift_ratio.isel(storey=mask) * 100).max("storey", skipna=True)
+        ref = peak.sel(xi=reference)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = (peak - ref) / ref * 100
+        for row, (data, label) in enumerate(((peak, "largest storey drift ratio (%)"),
+                                             (rel, f"its difference from {reference} (%)"))):
+            ax = axes[row][col]
+            shown = formulas if row == 0 else [f for f in formulas if f != reference]
+            series = [data.sel(xi=f).values[np.isfinite(data.sel(xi=f).values)] for f in shown]
+            positions = np.arange(1, len(shown) + 1)
+            if n_records > 1:
+                ax.boxplot([s if s.size else [np.nan] for s in series], positions=positions, widths=0.5,
+                           showfliers=False, medianprops={"color": "0.3"})
+            for p, f, s in zip(positions, shown, series):
+                ax.plot(p + rng.uniform(-0.12, 0.12, s.size), s, "o", ms=3, alpha=0.6, color=colours[f])
+            ax.set_xticks(positions)
+            ax.set_xticklabels(shown, rotation=25, ha="right", fontsize=7)
+            ax.set_ylabel(label, fontsize=8)
+            ax.grid(alpha=0.3, axis="y")
+            if row == 1:
+                ax.axhline(0.0, color="k", lw=0.7)
+            else:
+                ax.set_title(f"building {building}", fontsize=9)
+    fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}", fontsize=9)
+    fig.tight_layout()
+    distribution = out / "xi_drift_distribution.png"
+    fig.savefig(distribution, dpi=110)
+    plt.close(fig)
+    return [profiles, distribution]
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from .archive import check_writable
+    from .sweep import parts_dir
+
+    if args.workers is not None and args.workers < 1:
+        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
+    if args.output:
+        check_writable(args.output, overwrite=args.overwrite)
+    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
+        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
+    try:
+        ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,
+                     reference=args.reference, workers=args.workers, scheduler=args.scheduler,
+                     overwrite=args.overwrite, progress=not args.no_progress)
+    except KeyboardInterrupt:
+        if args.output:
+            print(f"pounding: interrupted; finished scenarios are kept in {parts_dir(args.output)}; run the same "
+                  "command again to finish the others", file=sys.stderr)
+        else:
+            print("pounding: interrupted", file=sys.stderr)
+        return 130
+    print(comparison_table(ds, args.reference))
+    if args.output:
+        print(f"wrote {args.output}")
+    if args.plot:
+        for png in plot_comparison(ds, args.plot, args.reference):
+            print(f"wrote {png}")
+    return 0
+
+
+def register_cli(subparsers) -> argparse.ArgumentParser:
+    """Add ``pounding compare`` to *subparsers*."""
+    from .sweep import add_cluster_options
+
+    parser = subparsers.add_parser(
+        "compare", help="compare xi formulas on storey drifts over a set of records",
+        description="Run MODEL once per xi formula and record (on all cores or a Dask cluster) and print, per "
+                    "building, the peak storey drift ratio profile of each formula and its difference from "
+                    "the reference formula (mean and max over records).")
+    parser.add_argument("model", help="YAML model with hertz-damp contacts, e.g. models/pair.yaml")
+    parser.add_argument("--xi", default="ye,lankarani-nikravesh,exact", metavar="LIST",
+                        help="comma-separated xi formulas (default ye,lankarani-nikravesh,exact; "
+                             "see `pounding xi list`)")
+    parser.add_argument("--records", metavar="SET|LIST",
+                        help="a record set (fema-p695:farfield, fema-p695:nearfield) or a comma-separated list "
+                             "of records (default: the model's record)")
+    parser.add_argument("--reference", default=REFERENCE, help="formula the others are compared with "
+                        "(default exact; added if not in --xi)")
+    parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")
+    parser.add_argument("-o", "--output", metavar="CMP.nc", help="also write the results (NetCDF); resumable")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    parser.add_argument("--plot", metavar="DIR", help="write xi_drift_profiles.png and xi_drift_distribution.png")
+    add_cluster_options(parser)
+    parser.set_defaults(func=_cmd_compare)
+    return parser
