@@ -18,14 +18,16 @@ import json
 import os
 import tempfile
 from datetime import datetime, timezone
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 import xarray as xr
 
 from .errors import ArchiveError, PoundingError
 
-__all__ = ["save_run", "open_run", "rerun", "check_writable"]
+__all__ = ["save_run", "open_run", "rerun", "check_writable", "atomic_path"]
 
 _COMPRESSION = {"zlib": True, "complevel": 4}
 
@@ -48,6 +50,28 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False) -> Path:
     if not parent.exists():
         raise ArchiveError(f"{target}: directory {parent} does not exist; create it first")
     return target
+
+
+@contextmanager
+def atomic_path(target: Path) -> Iterator[str]:
+    """Yield a temporary file name beside *target* to write to.
+
+    On success the file is flushed to disk and renamed over *target* (an
+    atomic replacement on POSIX); on any failure, including KeyboardInterrupt,
+    it is removed and *target* is left as it was.
+    """
+    folder = target.parent if str(target.parent) else Path(".")
+    descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
+    os.close(descriptor)
+    try:
+        yield temporary
+        with open(temporary, "rb+") as handle:
+            os.fsync(handle.fileno())
+        os.replace(temporary, target)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
 
 
 def _encoding(ds: xr.Dataset) -> dict:
@@ -76,18 +100,8 @@ def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False
         The written file.
     """
     target = check_writable(path, overwrite=overwrite)
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
-                                             dir=target.parent if str(target.parent) else ".")
-    os.close(descriptor)
-    try:
+    with atomic_path(target) as temporary:
         ds.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
-        with open(temporary, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.replace(temporary, target)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
     return target
 
 

@@ -71,7 +71,6 @@ import math
 import os
 import re
 import sys
-import tempfile
 import time
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
@@ -1007,17 +1006,10 @@ def parts_dir(output: str | os.PathLike) -> Path:
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(descriptor, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
+    from .archive import atomic_path
+
+    with atomic_path(path) as temporary:
+        Path(temporary).write_bytes(data)
 
 
 def _fsync_dir(path: Path) -> None:
