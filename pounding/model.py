@@ -688,6 +688,29 @@ def model_from_text(text: str, *, name: str = "model", path: str | None = None,
     return _build(parsed, name=name, text=text, path=path, base_dir=base_dir)
 
 
+def read_yaml_text(path: str | os.PathLike, *, kind: str) -> str:
+    """Read a YAML file (a *kind* file: model, sweep) as UTF-8 text.
+
+    Raises
+    ------
+    ModelError
+        One line naming the file: not found (with a similar file suggested),
+        a directory, not UTF-8, or unreadable.
+    """
+    label = os.fspath(path)
+    file = Path(label)
+    try:
+        return file.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelError(f"file not found{_similar_file(file)}", file=label) from None
+    except IsADirectoryError:
+        raise ModelError(f"is a directory, not a {kind} file", file=label) from None
+    except UnicodeDecodeError as exc:
+        raise ModelError(f"is not UTF-8 text (byte {exc.start})", file=label) from None
+    except OSError as exc:
+        raise ModelError(f"cannot read the file: {exc.strerror}", file=label) from None
+
+
 def load_model(path: str | os.PathLike) -> Model:
     """Read and validate a model file.
 
@@ -702,16 +725,7 @@ def load_model(path: str | os.PathLike) -> Model:
     """
     label = os.fspath(path)
     file = Path(label)
-    try:
-        text = file.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelError(f"file not found{_similar_file(file)}", file=label) from None
-    except IsADirectoryError:
-        raise ModelError("is a directory, not a model file", file=label) from None
-    except UnicodeDecodeError as exc:
-        raise ModelError(f"is not UTF-8 text (byte {exc.start})", file=label) from None
-    except OSError as exc:
-        raise ModelError(f"cannot read the file: {exc.strerror}", file=label) from None
+    text = read_yaml_text(label, kind="model")
     return model_from_text(text, name=file.stem, path=label,
                            base_dir=os.path.dirname(os.path.abspath(label)))
 

@@ -660,17 +660,10 @@ def load_sweep(path: str | os.PathLike) -> Sweep:
     ModelError
         ``<path>:<line>: <problem>`` for a malformed sweep file or base model.
     """
+    from .model import read_yaml_text
+
     label = os.fspath(path)
-    try:
-        text = Path(label).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelError("file not found", file=label) from None
-    except IsADirectoryError:
-        raise ModelError("is a directory, not a sweep file", file=label) from None
-    except UnicodeDecodeError as exc:
-        raise ModelError(f"is not UTF-8 text (byte {exc.start})", file=label) from None
-    except OSError as exc:
-        raise ModelError(f"cannot read the file: {exc.strerror}", file=label) from None
+    text = read_yaml_text(label, kind="sweep")
     return sweep_from_text(text, label=label, base_dir=os.path.dirname(os.path.abspath(label)))
 
 
