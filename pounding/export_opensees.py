@@ -450,7 +450,10 @@ if __name__ == "__main__":
 
 def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None = None,
                  duration: float | None = None) -> dict:
-    """Export *model* and run the script in this process; return its peaks.
+    """Export *model* and run the script in a child Python process; return its peaks.
+
+    The child keeps OpenSees' global state (and the "Process 0 Terminating"
+    line OpenSees prints at interpreter exit) out of the calling process.
 
     Returns
     -------
@@ -463,16 +466,27 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
     Raises
     ------
     PoundingError
-        If OpenSeesPy is not installed or the model cannot be exported.
+        If OpenSeesPy is not installed, the model cannot be exported or the
+        script fails.
     """
-    try:
-        import openseespy.opensees  # noqa: F401
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise PoundingError(f"OpenSeesPy is not available ({exc}); pip install openseespy") from None
+    import importlib.util
+    import json
+    import subprocess
+    import tempfile
+
+    if importlib.util.find_spec("openseespy") is None:  # pragma: no cover - depends on the environment
+        raise PoundingError("OpenSeesPy is not available; pip install openseespy")
     source, _notes = _script(model, record, dt=dt, xi=xi, duration=duration)
-    namespace: dict = {"__name__": "pounding_opensees_export"}
-    exec(compile(source, f"<opensees export of {model.name}>", "exec"), namespace)
-    return namespace["analyse"]()
+    with tempfile.TemporaryDirectory(prefix="pounding-opensees-") as folder:
+        script = Path(folder) / f"{model.name}_opensees.py"
+        peaks_file = Path(folder) / "peaks.json"
+        script.write_text(source, encoding="utf-8")
+        done = subprocess.run([sys.executable, str(script), "-o", str(peaks_file)], capture_output=True,
+                              text=True, cwd=folder)
+        if not peaks_file.exists():
+            last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+            raise PoundingError(f"the OpenSees script for {model.name} failed (exit {done.returncode}): {last}")
+        return json.loads(peaks_file.read_text(encoding="utf-8"))
 
 
 # --------------------------------------------------------------------------- #

@@ -39,7 +39,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-pytest.importorskip("openseespy.opensees", reason="the OpenSees cross-check needs openseespy")
+pytest.importorskip("openseespy", reason="the OpenSees cross-check needs openseespy")
 
 import pounding  # noqa: E402
 from pounding.cli import main  # noqa: E402
