@@ -83,3 +83,18 @@ def test_xi_list_prints_every_formula(capsys):
     text = capsys.readouterr().out
     for key in xi.FORMULAS:
         assert f"\n{key} " in text
+
+
+def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
+    # xarray imports dask only to test for dask arrays; a `pounding run`
+    # process never makes any, so the console entry point marks dask absent
+    # (≈0.5 s of start-up).  The run must still write a complete archive.
+    out = tmp_path / "run.nc"
+    code = ("import sys; from pounding.cli import console_main; "
+            f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
+            "status = console_main(); "
+            "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
+            "sys.exit(status)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert open_run(out).sizes["time"] == 301
