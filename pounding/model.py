@@ -28,7 +28,6 @@ from pathlib import Path, PurePath
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 import yaml
 
 from . import schema
@@ -210,10 +209,15 @@ class Building:
 
         ``omega`` (n,) circular frequencies, rad/s, ascending; ``phi`` (n, n)
         mass-normalised mode shapes in columns (``phiᵀ M phi = I``), each
-        signed so that its roof component is positive.  From
-        ``scipy.linalg.eigh(K, M)``; computed once.
+        signed so that its roof component is positive; computed once.  M is
+        diagonal, so ``K φ = ω² M φ`` is solved as the symmetric problem
+        ``(M^-1/2 K M^-1/2) ψ = ω² ψ`` with ``φ = M^-1/2 ψ`` (numpy's
+        ``eigh``; no scipy import on the start-up path of a run).
         """
-        eigenvalues, phi = scipy.linalg.eigh(self.stiffness_matrix(), self.mass_matrix())
+        scale = 1.0 / np.sqrt(self.mass)
+        symmetric = self.stiffness_matrix() * scale[:, None] * scale[None, :]
+        eigenvalues, psi = np.linalg.eigh(symmetric)
+        phi = psi * scale[:, None]
         omega = np.sqrt(np.clip(eigenvalues, 0.0, None))
         phi = phi * np.where(phi[-1] < 0, -1.0, 1.0)
         omega.setflags(write=False)
