@@ -71,8 +71,7 @@ EVENT_SAMPLES = 8
 FORCE_SAMPLES = 6
 
 STATUS_OK = 0
-STATUS_STEP_TOO_SMALL = 1
-STATUS_NOT_FINITE = 2
+STATUS_STEP_TOO_SMALL = 1  # also the outcome of a non-finite state: such steps are rejected and shrunk
 
 
 @dataclass(frozen=True)

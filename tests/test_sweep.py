@@ -39,15 +39,6 @@ def write(tmp_path: Path, text: str, name: str = "sweep.yaml") -> Path:
     return path
 
 
-@pytest.fixture(scope="module")
-def client():
-    """One 2-worker LocalCluster (one process per worker) for the tests of this module."""
-    c, cluster = sw.start_client(workers=2)
-    yield c
-    c.close()
-    cluster.close()
-
-
 def comparable(ds: xr.Dataset) -> xr.Dataset:
     """A results dataset without what legitimately differs between runs (timings, history)."""
     out = ds.drop_vars(["wall_time", "solver_wall_time"])
