@@ -9,7 +9,6 @@ import pytest
 import xarray as xr
 
 from pounding import compare as cmp
-from pounding import sweep as sw
 from pounding.cli import main
 from pounding.errors import PoundingError
 
