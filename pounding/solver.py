@@ -45,12 +45,71 @@ Equations I, 2nd ed., §II.4 (step control) and §II.6 (dense output).
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from . import contact as contact_laws
+
+
+def _load_numba_registries_without_scipy() -> None:
+    """Load numba's implementation registries without importing ``scipy.linalg``.
+
+    numba's first compilation or cache load in a process imports
+    ``numba.np.arraymath``, which tries ``import scipy.linalg.cython_blas``
+    only to decide how *np.correlate* and *np.convolve* take inner products.
+    That import of ``scipy.linalg`` costs 0.2–0.4 s of every ``pounding run``
+    (a fifth of a warm run).  The solver uses no BLAS, so the probe is
+    answered "absent" while the registry module is imported; the marker is
+    removed at once, so ``import scipy.linalg`` works normally afterwards, and
+    numba functions that really need BLAS (``np.dot``, ``np.linalg``) still
+    import it when they are compiled.  Nothing is done if scipy.linalg or the
+    registry module is already imported.
+    """
+    blas = "scipy.linalg.cython_blas"
+    if "numba.np.arraymath" in sys.modules or blas in sys.modules:
+        return
+    sys.modules[blas] = None  # type: ignore[assignment]  # makes the import raise ImportError
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if sys.modules.get(blas, 0) is None:
+            del sys.modules[blas]
+
+
+_load_numba_registries_without_scipy()
+
+
+def _load_from_cache_without_refresh(dispatcher) -> None:
+    """Let *dispatcher* load its cached machine code without a registry refresh.
+
+    Before loading a cached overload, numba refreshes its target context:
+    it installs every typing and lowering registry (thousands of
+    implementations, ~0.2 s), which only *compiling* needs.  Running cached
+    code needs the compiled library and numba's runtime (NRT) symbols, so
+    this loader initialises the runtime and loads the library.  On a cache
+    miss nothing changes: numba's compiler refreshes the context itself
+    before it compiles (``CompilerBase.__init__``).  If numba's internals are
+    not as expected (another numba version), the dispatcher is left alone.
+    """
+    try:
+        from numba.core.runtime import rtsys
+
+        cache = dispatcher._cache
+        load = cache._load_overload
+        guard = cache._guard_against_spurious_io_errors
+    except (ImportError, AttributeError):  # pragma: no cover - other numba internals
+        return
+
+    def load_overload(signature, target_context):
+        rtsys.initialize(target_context)
+        with guard():
+            return load(signature, target_context)
+        return None  # the guard swallowed a spurious I/O error: compile instead
+
+    cache.load_overload = load_overload
 
 # Dormand–Prince 5(4) tableau.
 C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
@@ -61,6 +120,16 @@ A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
 A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
 B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+#: The tableau as arrays for the stage loop (row 6 is the 5th-order solution: first same as last).
+RK_A = np.array([[0, 0, 0, 0, 0, 0],
+                 [A21, 0, 0, 0, 0, 0],
+                 [A31, A32, 0, 0, 0, 0],
+                 [A41, A42, A43, 0, 0, 0],
+                 [A51, A52, A53, A54, 0, 0],
+                 [A61, A62, A63, A64, A65, 0],
+                 [B1, 0, B3, B4, B5, B6]], dtype=np.float64)
+RK_C = np.array([0, C2, C3, C4, C5, 1, 1], dtype=np.float64)
+RK_E = np.array([E1, 0, E3, E4, E5, E6, E7], dtype=np.float64)
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -155,7 +224,7 @@ class RawSolution:
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     """Piecewise-linear ground acceleration inside segment *seg* at time *t*."""
     t0 = seg * dt_rec
@@ -164,7 +233,7 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     return ag[seg] + (ag[seg + 1] - ag[seg]) * ((t - t0) / dt_rec)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cl, cr, cgap, claw, cprm, closed, cconst, out, fbuf, forces):
     """Time derivative of the state; contact forces are written to *forces*."""
@@ -233,7 +302,7 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> float:
     """Cubic Hermite value at fraction *s* of a step of length *h*."""
     s2 = s * s
@@ -242,7 +311,7 @@ def _hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> 
             + (-2.0 * s3 + 3.0 * s2) * y1 + (s3 - s2) * h * r1)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
     """Largest |y| of the Hermite cubic at its interior stationary points (0 if none)."""
     qa = 6.0 * y0 + 3.0 * h * r0 - 6.0 * y1 + 3.0 * h * r1
@@ -270,7 +339,7 @@ def _extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> f
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward: bool) -> float:
     """Fraction of the step where the Hermite cubic of δ first crosses zero.
 
@@ -305,7 +374,7 @@ def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward
     return -1.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
                             yr0, vr0, yr1, vr1, ar0, ar1, q0, qr0, q1, qr1, h, fractions, deltas,
                             values) -> float:
@@ -342,7 +411,7 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
@@ -358,34 +427,30 @@ def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
  IMP_WORK) = range(9)
 
 
-@njit(cache=True)
-def _copy_rows(dst, src, rows):
-    """dst[:rows] = src[:rows] as loops: numba's array-to-slice assignment adds seconds of compilation."""
-    for i in range(rows):
-        for j in range(src.shape[1]):
-            dst[i, j] = src[i, j]
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _with_room(table, rows, extra):
+    """*table* if it has room for *extra* rows after its first *rows*; else a copy twice as long (NaN-padded).
+
+    Written as loops: numba's slice assignment and np.full add seconds of compilation.
+    """
+    if rows + extra <= table.shape[0]:
+        return table
+    bigger = np.empty((2 * table.shape[0] + extra, table.shape[1]))
+    for i in range(bigger.shape[0]):
+        for j in range(table.shape[1]):
+            bigger[i, j] = table[i, j] if i < rows else np.nan
+    return bigger
 
 
-@njit(cache=True)
-def _new_impact_row(impacts, n_imp):
-    """Make room for one more row of the impact table (doubling it when full)."""
-    if n_imp == impacts.shape[0]:
-        # np.empty + fill, not np.full: numba's np.full pulls in seconds of string-formatting compilation.
-        bigger = np.empty((2 * impacts.shape[0], impacts.shape[1]))
-        bigger[:] = np.nan
-        _copy_rows(bigger, impacts, n_imp)
-        return bigger
-    return impacts
-
-
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
     The impulse ``J = (1+e)·m_eff·v0`` acts on the two floors (−J on the
     left, +J on the right); the work ``J·(v0 + v0')/2`` it does (the energy
     lost, ½·m_eff·(1−e²)·v0²) and the impulse are added to the contact's
-    energy-audit states.  The impact row opens and closes at once.
+    energy-audit states.  The impact row (room made by the caller) opens and
+    closes at once; returns the new row count.
     """
     nc = (y.size - 2 * n - 2) // 3
     lf = cl[c]
@@ -397,7 +462,6 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     v_after = y[n + lf] - y[n + rf]
     y[2 * n + c] += impulse
     y[2 * n + nc + c] += impulse * 0.5 * (v0 + v_after)
-    impacts = _new_impact_row(impacts, n_imp)
     impacts[n_imp, IMP_CONTACT] = c
     impacts[n_imp, IMP_TIME] = t
     impacts[n_imp, IMP_VELOCITY] = v0
@@ -407,17 +471,17 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     impacts[n_imp, IMP_IMPULSE] = impulse
     impacts[n_imp, IMP_SEPARATION] = -v_after
     impacts[n_imp, IMP_WORK] = impulse * 0.5 * (v0 + v_after)
-    return impacts, n_imp + 1
+    return n_imp + 1
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
     Closure fixes the per-impact constant from the approach velocity
     ``v0 = δ̇(t)`` and opens a row of the impact table; separation closes that
-    row with the separation velocity and the impulse.  Returns the (possibly
-    enlarged) impact table and its new row count.
+    row with the separation velocity and the impulse.  The caller makes room
+    for one more row first (:func:`_with_room`); returns the new row count.
     """
     rate = y[n + cl[c]] - y[n + cr[c]]
     nc = closed.size
@@ -427,7 +491,6 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
         closed[c] = True
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = contact_laws.onset_constant(claw[c], cprm[c], rate)
-        impacts = _new_impact_row(impacts, n_imp)
         impacts[n_imp, IMP_CONTACT] = c
         impacts[n_imp, IMP_TIME] = t
         impacts[n_imp, IMP_VELOCITY] = rate
@@ -446,7 +509,7 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
             impacts[row, IMP_IMPULSE] = y[2 * n + c] - impacts[row, IMP_IMPULSE]
             impacts[row, IMP_WORK] = y[2 * n + nc + c] - impacts[row, IMP_WORK]
             open_imp[c] = -1
-    return impacts, n_imp
+    return n_imp
 
 
 # --------------------------------------------------------------------------- #
@@ -469,13 +532,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         y[i] = y_initial[i]
     ynew = np.zeros(S)
     ystage = np.zeros(S)
-    k1 = np.zeros(S)
-    k2 = np.zeros(S)
-    k3 = np.zeros(S)
-    k4 = np.zeros(S)
-    k5 = np.zeros(S)
-    k6 = np.zeros(S)
-    k7 = np.zeros(S)
+    K = np.zeros((7, S))  # stage derivatives k1..k7
+    k1 = K[0]
+    k2 = K[1]
+    k7 = K[6]
     fbuf = np.zeros(n)
     forces = np.zeros(nc)
     closed = np.zeros(nc, dtype=np.bool_)
@@ -492,8 +552,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     peak_drift = np.zeros(n)
     peak_force = np.zeros(nc)
 
-    impacts = np.empty((64, 9))
-    impacts[:] = np.nan
+    impacts = _with_room(np.empty((0, 9)), 0, 64)  # NaN-filled
     # Counters, indices and flags start from non-literal values: a literal (0, -1, False) reaching a
     # call makes numba compile a throw-away literal specialisation of the callee first (seconds).
     zero = nc - nc
@@ -505,7 +564,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     deltas = np.empty(FORCE_SAMPLES + 1)
     values = np.empty(FORCE_SAMPLES + 1)
     open_imp = np.empty(nc, dtype=np.int64)
-    open_imp[:] = -1
+    for c in range(nc):
+        open_imp[c] = -1
 
     t = 0.0
     seg = zero
@@ -543,37 +603,24 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if h_try < 1e-14 * max(1.0, t):
                 status = 1
                 break
-            # ---- Dormand–Prince stages -----------------------------------
-            for i in range(S):
-                ystage[i] = y[i] + h_try * A21 * k1[i]
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k2, fbuf, forces)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k3, fbuf, forces)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k4, fbuf, forces)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k5, fbuf, forces)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
-                                            + A65 * k5[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k6, fbuf, forces)
-            for i in range(S):
-                ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-            _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k7, fbuf, forces)
+            # ---- Dormand–Prince stages 2..7 (stage 7 is evaluated at the new state)
+            for stage in range(1, 7):
+                target = ynew if stage == 6 else ystage
+                for i in range(S):
+                    acc = 0.0
+                    for j in range(stage):
+                        acc += RK_A[stage, j] * K[j, i]
+                    target[i] = y[i] + h_try * acc
+                _rhs(target, _ground(ag, dt_rec, seg, t + RK_C[stage] * h_try), mass, kst, below, a0, a1, dstart,
+                     dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, K[stage], fbuf, forces)
             # ---- error norm (max norm over displacements and velocities) --
             err = 0.0
             finite = True
             for i in range(2 * n):
-                e = h_try * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+                acc = 0.0
+                for j in range(7):
+                    acc += RK_E[j] * K[j, i]
+                e = h_try * acc
                 tol = (atol_u if i < n else atol_v) + rtol * max(abs(y[i]), abs(ynew[i]))
                 r = abs(e) / tol
                 if not (r < 1e300):
@@ -610,7 +657,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     h_event = s_first * h_try
                     if h_event <= tiny:
                         # The event is at the start of the step: switch now, redo the step.
-                        impacts, n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
+                        impacts = _with_room(impacts, n_imp, 1)
+                        n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
                                                          closed, cconst, impacts, n_imp, open_imp, mass)
                         _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
                              dvals, cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
@@ -659,10 +707,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                               k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
                                               k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
-                if n_trace + FORCE_SAMPLES + 1 > trace.shape[0]:
-                    bigger = np.empty((2 * trace.shape[0], 4))
-                    _copy_rows(bigger, trace, n_trace)
-                    trace = bigger
+                trace = _with_room(trace, n_trace, FORCE_SAMPLES + 1)
                 for i in range(FORCE_SAMPLES + 1):
                     if i == 0 and n_trace > 0 and trace[n_trace - 1, 1] == c and trace[n_trace - 1, 0] == t:
                         continue  # the previous step already recorded its end point
@@ -704,7 +749,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             k1[i] = k7[i]
         n_steps += 1
         if event_c >= 0:
-            impacts, n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
+            impacts = _with_room(impacts, n_imp, 1)
+            n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
                                              closed, cconst, impacts, n_imp, open_imp, mass)
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
@@ -736,6 +782,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out], out_pot[:i_out],
             peak_u, peak_drift, peak_force,
             impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
+
+
+_load_from_cache_without_refresh(_integrate)
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,
