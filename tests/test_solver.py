@@ -135,3 +135,61 @@ def test_bilinear_loop_dissipates_and_returns_to_zero_force():
     rebound = raw.impact_separation_velocity[0] / raw.impact_velocity[0]
     assert 0.0 < rebound < 1.0
     assert raw.contact_force[-1, 0] == 0.0
+
+
+# A fresh process running the shipped pair, as `pounding run` does, in one of two modes:
+# "fast" keeps the solver's start-up shortcuts, "numba" restores numba's own cache loader.
+STARTUP_PROBE = r"""
+import json, sys
+import numpy as np
+from pounding import load_model, simulate
+from pounding.solver import _integrate
+if sys.argv[2] == "numba":
+    del _integrate._cache.load_overload  # back to numba's loader (refreshes every registry)
+ds = simulate(load_model(sys.argv[1]))
+scipy_linalg_during_run = "scipy.linalg" in sys.modules
+from numba import njit
+@njit
+def dot(a, b):  # needs BLAS, hence scipy.linalg, compiled after the run
+    return np.dot(a, b)
+print(json.dumps({
+    "scipy_linalg_during_run": scipy_linalg_during_run,
+    "cache_hits": int(sum(_integrate.stats.cache_hits.values())),
+    "dot": float(dot(np.arange(3.0), np.arange(3.0))),
+    "peak_drift_ratio": ds.peak_drift_ratio.values.tolist(),
+    "peak_contact_force": ds.peak_contact_force.values.tolist(),
+    "impact_time": ds.impact_time.values.tolist(),
+    "impact_velocity": ds.impact_velocity.values.tolist(),
+}))
+"""
+
+
+def _probe(mode: str) -> dict:
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    model = Path(__file__).resolve().parents[1] / "models" / "pair.yaml"
+    result = subprocess.run([sys.executable, "-c", STARTUP_PROBE, str(model), mode],
+                            capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def test_start_up_shortcuts_change_nothing_but_time():
+    # numba's own path first (it compiles if the cache is cold), then the
+    # solver's loader, which must find the cached solver.
+    reference = _probe("numba")
+    fast = _probe("fast")
+    assert fast["cache_hits"] == 1
+    # The same machine code runs either way: results are bit-identical.
+    for key in ("peak_drift_ratio", "peak_contact_force", "impact_time", "impact_velocity"):
+        assert fast[key] == reference[key], key
+    # More impacts than the table's first 64 rows: every grown row is a real impact.
+    assert len(fast["impact_time"]) > 64
+    assert np.all(np.isfinite(fast["impact_time"])) and np.all(np.isfinite(fast["impact_velocity"]))
+    # The run itself never imports scipy.linalg (numba's BLAS probe is answered
+    # without it), yet numba code compiled afterwards still gets BLAS.
+    assert fast["scipy_linalg_during_run"] is False
+    assert fast["dot"] == 5.0
