@@ -428,14 +428,14 @@ def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _with_room(table, rows, extra):
-    """*table* if it has room for *extra* rows after its first *rows*; else a copy twice as long (NaN-padded).
+def _grown(table, rows, needed):
+    """*table* if it has *needed* rows; else a copy of its first *rows* rows, NaN-padded to twice that.
 
     Written as loops: numba's slice assignment and np.full add seconds of compilation.
     """
-    if rows + extra <= table.shape[0]:
+    if needed <= table.shape[0]:
         return table
-    bigger = np.empty((2 * table.shape[0] + extra, table.shape[1]))
+    bigger = np.empty((2 * needed, table.shape[1]))
     for i in range(bigger.shape[0]):
         for j in range(table.shape[1]):
             bigger[i, j] = table[i, j] if i < rows else np.nan
@@ -481,7 +481,7 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     Closure fixes the per-impact constant from the approach velocity
     ``v0 = δ̇(t)`` and opens a row of the impact table; separation closes that
     row with the separation velocity and the impulse.  The caller makes room
-    for one more row first (:func:`_with_room`); returns the new row count.
+    for one more row first (:func:`_grown`); returns the new row count.
     """
     rate = y[n + cl[c]] - y[n + cr[c]]
     nc = closed.size
@@ -527,6 +527,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
 
+    # Sizes and counters are non-literal (``zero``): a literal (0, 64, FORCE_SAMPLES + 1, False) reaching
+    # np.empty or a callee makes numba compile a throw-away literal specialisation of it (seconds in all).
+    zero = nc - nc
     y = np.zeros(S)
     for i in range(2 * n):
         y[i] = y_initial[i]
@@ -552,17 +555,14 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     peak_drift = np.zeros(n)
     peak_force = np.zeros(nc)
 
-    impacts = _with_room(np.empty((0, 9)), 0, 64)  # NaN-filled
-    # Counters, indices and flags start from non-literal values: a literal (0, -1, False) reaching a
-    # call makes numba compile a throw-away literal specialisation of the callee first (seconds).
-    zero = nc - nc
+    impacts = _grown(np.empty((zero, zero + 9)), zero, zero + 64)  # NaN-filled
     n_imp = zero
     # Full-resolution trace of closed contacts: time, contact, penetration, force.
-    trace = np.empty((1024, 4))
+    trace = np.empty((zero + 1024, zero + 4))
     n_trace = zero
-    fractions = np.empty(FORCE_SAMPLES + 1)
-    deltas = np.empty(FORCE_SAMPLES + 1)
-    values = np.empty(FORCE_SAMPLES + 1)
+    fractions = np.empty(zero + FORCE_SAMPLES + 1)
+    deltas = np.empty(zero + FORCE_SAMPLES + 1)
+    values = np.empty(zero + FORCE_SAMPLES + 1)
     open_imp = np.empty(nc, dtype=np.int64)
     for c in range(nc):
         open_imp[c] = -1
@@ -657,7 +657,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     h_event = s_first * h_try
                     if h_event <= tiny:
                         # The event is at the start of the step: switch now, redo the step.
-                        impacts = _with_room(impacts, n_imp, 1)
+                        impacts = _grown(impacts, n_imp, n_imp + 1)
                         n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
                                                          closed, cconst, impacts, n_imp, open_imp, mass)
                         _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
@@ -707,7 +707,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                               k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
                                               k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
-                trace = _with_room(trace, n_trace, FORCE_SAMPLES + 1)
+                trace = _grown(trace, n_trace, n_trace + FORCE_SAMPLES + 1)
                 for i in range(FORCE_SAMPLES + 1):
                     if i == 0 and n_trace > 0 and trace[n_trace - 1, 1] == c and trace[n_trace - 1, 0] == t:
                         continue  # the previous step already recorded its end point
@@ -749,7 +749,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             k1[i] = k7[i]
         n_steps += 1
         if event_c >= 0:
-            impacts = _with_room(impacts, n_imp, 1)
+            impacts = _grown(impacts, n_imp, n_imp + 1)
             n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
                                              closed, cconst, impacts, n_imp, open_imp, mass)
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
