@@ -45,71 +45,17 @@ Equations I, 2nd ed., §II.4 (step control) and §II.6 (dense output).
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from numba.core.dispatcher import Dispatcher
 
 from . import contact as contact_laws
+from . import jit
 
 
-def _load_numba_registries_without_scipy() -> None:
-    """Load numba's implementation registries without importing ``scipy.linalg``.
-
-    numba's first compilation or cache load in a process imports
-    ``numba.np.arraymath``, which tries ``import scipy.linalg.cython_blas``
-    only to decide how *np.correlate* and *np.convolve* take inner products.
-    That import of ``scipy.linalg`` costs 0.2–0.4 s of every ``pounding run``
-    (a fifth of a warm run).  The solver uses no BLAS, so the probe is
-    answered "absent" while the registry module is imported; the marker is
-    removed at once, so ``import scipy.linalg`` works normally afterwards, and
-    numba functions that really need BLAS (``np.dot``, ``np.linalg``) still
-    import it when they are compiled.  Nothing is done if scipy.linalg or the
-    registry module is already imported.
-    """
-    blas = "scipy.linalg.cython_blas"
-    if "numba.np.arraymath" in sys.modules or blas in sys.modules:
-        return
-    sys.modules[blas] = None  # type: ignore[assignment]  # makes the import raise ImportError
-    try:
-        import numba.np.arraymath  # noqa: F401
-    finally:
-        if sys.modules.get(blas, 0) is None:
-            del sys.modules[blas]
-
-
-_load_numba_registries_without_scipy()
-
-
-def _load_from_cache_without_refresh(dispatcher) -> None:
-    """Let *dispatcher* load its cached machine code without a registry refresh.
-
-    Before loading a cached overload, numba refreshes its target context:
-    it installs every typing and lowering registry (thousands of
-    implementations, ~0.2 s), which only *compiling* needs.  Running cached
-    code needs the compiled library and numba's runtime (NRT) symbols, so
-    this loader initialises the runtime and loads the library.  On a cache
-    miss nothing changes: numba's compiler refreshes the context itself
-    before it compiles (``CompilerBase.__init__``).  If numba's internals are
-    not as expected (another numba version), the dispatcher is left alone.
-    """
-    try:
-        from numba.core.runtime import rtsys
-
-        cache = dispatcher._cache
-        load = cache._load_overload
-        guard = cache._guard_against_spurious_io_errors
-    except (ImportError, AttributeError):  # pragma: no cover - other numba internals
-        return
-
-    def load_overload(signature, target_context):
-        rtsys.initialize(target_context)
-        with guard():
-            return load(signature, target_context)
-        return None  # the guard swallowed a spurious I/O error: compile instead
-
-    cache.load_overload = load_overload
+jit.load_registries_without_scipy()
 
 # Dormand–Prince 5(4) tableau.
 C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
@@ -784,7 +730,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
 
 
-_load_from_cache_without_refresh(_integrate)
+# The kernels inline contact.py's force laws: their cached code is stale when either file changes.
+jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
+                              [__file__, contact_laws.__file__])
+jit.load_from_cache_without_refresh(_integrate)
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,

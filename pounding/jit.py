@@ -1,0 +1,105 @@
+"""numba start-up and on-disk cache handling for the compiled solver.
+
+The solver is compiled once per machine (``cache=True``) and loaded from
+numba's cache by every later process.  Three things make that load fast and
+safe:
+
+* :func:`load_registries_without_scipy` — numba's registries are imported
+  without the ``scipy.linalg`` import numba makes only to probe for BLAS
+  (0.2–0.4 s of every process);
+* :func:`load_from_cache_without_refresh` — a cached overload is loaded
+  without first installing every typing and lowering registry (~0.2 s),
+  which only compiling needs;
+* :func:`stamp_caches_with_sources` — a cached kernel is keyed on *every*
+  source file compiled into it, not only its own: numba keys a cache entry
+  on the function's file alone, so editing ``contact.py`` (a new contact
+  law, a changed force) would otherwise leave the solver running the old
+  contact kernels it inlined.
+
+The last two use numba internals that have been stable for years; if they
+are not found (another numba version), the dispatcher is left as numba
+made it — slower to start, never wrong.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from typing import Iterable
+
+__all__ = ["load_registries_without_scipy", "load_from_cache_without_refresh", "stamp_caches_with_sources",
+           "source_stamp"]
+
+
+def load_registries_without_scipy() -> None:
+    """Import numba's implementation registries without importing ``scipy.linalg``.
+
+    numba's first compilation or cache load in a process imports
+    ``numba.np.arraymath``, which tries ``import scipy.linalg.cython_blas``
+    only to decide how *np.correlate* and *np.convolve* take inner products.
+    The solver uses no BLAS, so the probe is answered "absent" while that
+    module is imported; the marker is removed at once, so ``import
+    scipy.linalg`` works normally afterwards, and numba functions that need
+    BLAS (``np.dot``, ``np.linalg``) still import it when they are compiled.
+    Nothing is done if scipy.linalg or the registry module is already imported.
+    """
+    blas = "scipy.linalg.cython_blas"
+    if "numba.np.arraymath" in sys.modules or blas in sys.modules:
+        return
+    sys.modules[blas] = None  # type: ignore[assignment]  # makes the import raise ImportError
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if sys.modules.get(blas, 0) is None:
+            del sys.modules[blas]
+
+
+def load_from_cache_without_refresh(dispatcher) -> None:
+    """Let *dispatcher* load its cached machine code without a registry refresh.
+
+    Before loading a cached overload, numba refreshes its target context: it
+    installs every typing and lowering registry (thousands of
+    implementations), which only *compiling* needs.  Running cached code
+    needs the compiled library and numba's runtime (NRT) symbols, so this
+    loader initialises the runtime and loads the library.  On a cache miss
+    nothing changes: numba's compiler refreshes the context itself before it
+    compiles (``CompilerBase.__init__``).
+    """
+    try:
+        from numba.core.runtime import rtsys
+
+        cache = dispatcher._cache
+        load = cache._load_overload
+        guard = cache._guard_against_spurious_io_errors
+    except (ImportError, AttributeError):  # pragma: no cover - other numba internals
+        return
+
+    def load_overload(signature, target_context):
+        rtsys.initialize(target_context)
+        with guard():
+            return load(signature, target_context)
+        return None  # the guard swallowed a spurious I/O error: compile instead
+
+    cache.load_overload = load_overload
+
+
+def source_stamp(files: Iterable[str | os.PathLike]) -> tuple[float, int]:
+    """(newest modification time, total size) of *files*: numba's source stamp over several files."""
+    stats = [os.stat(f) for f in files]
+    return max(s.st_mtime for s in stats), sum(s.st_size for s in stats)
+
+
+def stamp_caches_with_sources(dispatchers: Iterable, files: Iterable[str | os.PathLike]) -> None:
+    """Key the on-disk cache of each of *dispatchers* on all of *files*.
+
+    numba stores, with each cache index, the (mtime, size) of the function's
+    own source file and discards the index when they change.  A kernel that
+    inlines functions from other files must be discarded when *those* change
+    too, so its stamp is replaced by :func:`source_stamp` over *files* (its
+    own file included).  Must be called before the dispatcher's first call.
+    """
+    stamp = source_stamp(list(files))
+    for dispatcher in dispatchers:
+        cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+        if cache_file is not None and hasattr(cache_file, "_source_stamp"):
+            cache_file._source_stamp = stamp
