@@ -66,16 +66,6 @@ A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
 A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
 B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
-#: The tableau as arrays for the stage loop (row 6 is the 5th-order solution: first same as last).
-RK_A = np.array([[0, 0, 0, 0, 0, 0],
-                 [A21, 0, 0, 0, 0, 0],
-                 [A31, A32, 0, 0, 0, 0],
-                 [A41, A42, A43, 0, 0, 0],
-                 [A51, A52, A53, A54, 0, 0],
-                 [A61, A62, A63, A64, A65, 0],
-                 [B1, 0, B3, B4, B5, B6]], dtype=np.float64)
-RK_C = np.array([0, C2, C3, C4, C5, 1, 1], dtype=np.float64)
-RK_E = np.array([E1, 0, E3, E4, E5, E6, E7], dtype=np.float64)
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -481,10 +471,13 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         y[i] = y_initial[i]
     ynew = np.zeros(S)
     ystage = np.zeros(S)
-    K = np.zeros((7, S))  # stage derivatives k1..k7
-    k1 = K[0]
-    k2 = K[1]
-    k7 = K[6]
+    k1 = np.zeros(S)
+    k2 = np.zeros(S)
+    k3 = np.zeros(S)
+    k4 = np.zeros(S)
+    k5 = np.zeros(S)
+    k6 = np.zeros(S)
+    k7 = np.zeros(S)
     fbuf = np.zeros(n)
     forces = np.zeros(nc)
     closed = np.zeros(nc, dtype=np.bool_)
@@ -549,24 +542,37 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if h_try < 1e-14 * max(1.0, t):
                 status = 1
                 break
-            # ---- Dormand–Prince stages 2..7 (stage 7 is evaluated at the new state)
-            for stage in range(1, 7):
-                target = ynew if stage == 6 else ystage
-                for i in range(S):
-                    acc = 0.0
-                    for j in range(stage):
-                        acc += RK_A[stage, j] * K[j, i]
-                    target[i] = y[i] + h_try * acc
-                _rhs(target, _ground(ag, dt_rec, seg, t + RK_C[stage] * h_try), mass, kst, below, a0, a1, dstart,
-                     dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, K[stage], fbuf, forces)
+            # ---- Dormand–Prince stages -----------------------------------
+            for i in range(S):
+                ystage[i] = y[i] + h_try * A21 * k1[i]
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k2, fbuf, forces)
+            for i in range(S):
+                ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k3, fbuf, forces)
+            for i in range(S):
+                ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k4, fbuf, forces)
+            for i in range(S):
+                ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k5, fbuf, forces)
+            for i in range(S):
+                ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
+                                            + A65 * k5[i])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k6, fbuf, forces)
+            for i in range(S):
+                ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+            _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k7, fbuf, forces)
             # ---- error norm (max norm over displacements and velocities) --
             err = 0.0
             finite = True
             for i in range(2 * n):
-                acc = 0.0
-                for j in range(7):
-                    acc += RK_E[j] * K[j, i]
-                e = h_try * acc
+                e = h_try * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
                 tol = (atol_u if i < n else atol_v) + rtol * max(abs(y[i]), abs(ynew[i]))
                 r = abs(e) / tol
                 if not (r < 1e300):
