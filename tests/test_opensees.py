@@ -39,7 +39,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-pytest.importorskip("openseespy", reason="the OpenSees cross-check needs openseespy")
+# Probed in a child process, like every OpenSees run here: importing OpenSees into pytest's own
+# process would print its "Process 0 Terminating" after pytest's closing line.
+_probe = subprocess.run([sys.executable, "-c", "import openseespy.opensees"], capture_output=True, text=True)
+if _probe.returncode != 0:  # not installed, or Debian's BLAS/LAPACK missing
+    reason = (_probe.stderr.strip().splitlines() or ["?"])[-1]
+    pytest.skip(f"the OpenSees cross-check needs openseespy (pip install -e '.[test]') and Debian's libblas3 "
+                f"and liblapack3 (apt-get install -y libblas3 liblapack3): {reason}", allow_module_level=True)
 
 import pounding  # noqa: E402
 from pounding.cli import main  # noqa: E402
