@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 import time
 from pathlib import Path
@@ -18,9 +19,10 @@ from .errors import PoundingError
 
 __all__ = ["main", "console_main", "build_parser", "SUBCOMMAND_MODULES"]
 
-#: Modules that add their own subcommands through ``register_cli(subparsers)``;
-#: their heavy imports happen inside the handlers, not at registration.
-SUBCOMMAND_MODULES = ["verify", "sweep", "compare", "catalogue", "export_opensees"]
+#: Modules that add their own subcommand through ``register_cli(subparsers)``, by
+#: subcommand name; their heavy imports happen inside the handlers, not at registration.
+SUBCOMMAND_MODULES = {"verify": "verify", "sweep": "sweep", "compare": "compare", "records": "catalogue",
+                      "export": "export_opensees"}
 
 
 # --------------------------------------------------------------------------- #
@@ -153,7 +155,18 @@ def _cmd_xi_list(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- #
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``pounding`` argument parser.
+
+    Parameters
+    ----------
+    command : str, optional
+        The subcommand about to be parsed.  A subcommand of this module
+        (``run``, ``info`` …) needs none of the modules in
+        :data:`SUBCOMMAND_MODULES`, and one of theirs needs only its own, so
+        the others are not imported (0.05 s of a run's start-up).  ``None``
+        (help, or an unknown command) registers every subcommand.
+    """
     parser = argparse.ArgumentParser(prog="pounding", description="Structural pounding of adjacent buildings.")
     parser.add_argument("--version", action="version", version=f"pounding {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
@@ -193,15 +206,22 @@ def build_parser() -> argparse.ArgumentParser:
     xi_list = xi_sub.add_parser("list", help="print the catalogue")
     xi_list.set_defaults(func=_cmd_xi_list)
 
-    for module_name in SUBCOMMAND_MODULES:
-        module = importlib.import_module(f"{__package__}.{module_name}")
-        module.register_cli(sub)
+    own = {"run", "rerun", "info", "plot", "xi"}
+    for name, module_name in SUBCOMMAND_MODULES.items():
+        if command is None or (command not in own and command not in SUBCOMMAND_MODULES) or command == name:
+            importlib.import_module(f"{__package__}.{module_name}").register_cli(sub)
     return parser
+
+
+def _subcommand(argv: Sequence[str]) -> str | None:
+    """The first word of *argv* that is not an option (the subcommand), if any."""
+    return next((a for a in argv if not a.startswith("-")), None)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pounding`` console script."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_subcommand(argv))
     args = parser.parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
     try:
@@ -214,6 +234,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("pounding: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # The reader went away (`pounding records list | head`): stop quietly, as Unix tools do.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python flushes stdout
+        return 141  # 128 + SIGPIPE
 
 
 #: Subcommands that never use dask in their own process (everything but sweep/compare).
@@ -230,8 +254,7 @@ def console_main() -> int:
     entry point does it; :func:`main` called from Python leaves imports alone.
     """
     argv = sys.argv[1:]
-    command = next((a for a in argv if not a.startswith("-")), None)
-    if command in LEAN_COMMANDS:
+    if _subcommand(argv) in LEAN_COMMANDS:
         for name in ("dask", "distributed"):
             sys.modules.setdefault(name, None)  # type: ignore[arg-type]
     return main(argv)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -88,13 +89,45 @@ def test_xi_list_prints_every_formula(capsys):
 def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
     # xarray imports dask only to test for dask arrays; a `pounding run`
     # process never makes any, so the console entry point marks dask absent
-    # (≈0.5 s of start-up).  The run must still write a complete archive.
+    # (≈0.5 s of start-up), and the other subcommands' modules are not
+    # imported (≈0.05 s).  The run must still write a complete archive.
     out = tmp_path / "run.nc"
     code = ("import sys; from pounding.cli import console_main; "
             f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
             "status = console_main(); "
             "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
+            "other = [m for m in ('sweep', 'compare', 'verify', 'export_opensees') "
+            "         if 'pounding.' + m in sys.modules]; "
+            "assert not other, f'other subcommands imported: {other}'; "
             "sys.exit(status)")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert open_run(out).sizes["time"] == 301
+
+
+def test_help_lists_every_subcommand_and_each_parses_its_own_options(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--help"])
+    assert exit_info.value.code == 0
+    listed = capsys.readouterr().out
+    for name in ("run", "rerun", "info", "plot", "xi", "verify", "sweep", "compare", "records", "export"):
+        assert f"\n    {name} " in listed, name
+    # A subcommand registered by its own module is still parsed in full when named.
+    with pytest.raises(SystemExit) as exit_info:
+        main(["export", "opensees", "--help"])
+    assert exit_info.value.code == 0
+    assert "--dt DT" in capsys.readouterr().out
+
+
+def test_output_into_a_closed_pipe_ends_quietly():
+    # `pounding records list | head -1`: the reader has gone when we write (here
+    # before the first line, so the write surely fails); no traceback, status 141.
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        writer = subprocess.run([sys.executable, "-m", "pounding", "records", "list"], stdout=write_end,
+                                stderr=subprocess.PIPE, text=True)
+    finally:
+        os.close(write_end)
+    assert writer.returncode == 141
+    assert writer.stderr == ""
