@@ -423,7 +423,7 @@ def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
 def _bilinear_bounds(prm: np.ndarray, delta: float) -> tuple:
     """Lower (K2·δ) and upper (K1·δy + K2·(δ − δy)) envelopes of the bilinear loop, N."""
     k1, k2, dy = prm[0], prm[1], prm[2]
@@ -478,7 +478,7 @@ def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float,
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
 def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
     """Elastic energy stored in the contact (J): what unloading would give back."""
     if delta <= 0.0:
