@@ -236,7 +236,8 @@ def process_times(warm_runs: int = 10, cold_runs: int = 3) -> dict:
             fresh = dict(env, NUMBA_CACHE_DIR=str(Path(tmp) / f"numba-{i}"), XDG_CACHE_HOME=str(Path(tmp) / f"xdg-{i}"))
             cold.append(_timed(command, fresh))
             cold_again.append(_timed(command, fresh))
-    return {"warm": min(warm), "warm_median": statistics.median(warm), "warm_max": max(warm),
+    return {"warm_runs": warm_runs, "cold_runs": cold_runs,
+            "warm": min(warm), "warm_median": statistics.median(warm), "warm_max": max(warm),
             "import_floor_median": statistics.median(floor),
             "warm_above_floor_median": statistics.median(w - f for w, f in zip(warm, floor)),
             "no_fema_cache": min(no_cache),
@@ -288,12 +289,12 @@ def main(argv: list[str] | None = None) -> int:
         result["process"] = times
         print("\n== whole process: `python -m pounding run models/pair.yaml` ==")
         print(f"  warm (numba + FEMA P695 caches):     median {times['warm_median']:.2f} s, best {times['warm']:.2f} s, "
-              f"worst {times['warm_max']:.2f} s of 10 (target <= 2 s)")
+              f"worst {times['warm_max']:.2f} s of {times['warm_runs']} (target <= 2 s)")
         print(f"  import floor (numpy, numba, pandas, xarray, ...): median {times['import_floor_median']:.2f} s; "
               f"a warm run adds {times['warm_above_floor_median']:.2f} s to it")
         print(f"  warm, FEMA P695 on-disk cache off:   {times['no_fema_cache']:.2f} s")
         print(f"  first run, empty numba + FEMA caches: median {times['first_with_compilation']:.2f} s, worst "
-              f"{times['first_with_compilation_max']:.2f} s of 3 (target <= 15 s)")
+              f"{times['first_with_compilation_max']:.2f} s of {times['cold_runs']} (target <= 15 s)")
         print(f"  second run with that cache:          {times['second_after_compilation']:.2f} s")
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1))

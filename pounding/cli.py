@@ -206,10 +206,14 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     xi_list = xi_sub.add_parser("list", help="print the catalogue")
     xi_list.set_defaults(func=_cmd_xi_list)
 
-    own = {"run", "rerun", "info", "plot", "xi"}
-    for name, module_name in SUBCOMMAND_MODULES.items():
-        if command is None or (command not in own and command not in SUBCOMMAND_MODULES) or command == name:
-            importlib.import_module(f"{__package__}.{module_name}").register_cli(sub)
+    if command in sub.choices:  # one of the subcommands above: no other module needed
+        needed = {}
+    elif command in SUBCOMMAND_MODULES:  # only the module that defines it
+        needed = {command: SUBCOMMAND_MODULES[command]}
+    else:  # help or an unknown word: all, so that usage lists every choice
+        needed = SUBCOMMAND_MODULES
+    for module_name in needed.values():
+        importlib.import_module(f"{__package__}.{module_name}").register_cli(sub)
     return parser
 
 

@@ -611,7 +611,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         # The event is at the start of the step: switch now, redo the step.
                         impacts = _grown(impacts, n_imp, n_imp + 1)
                         n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
-                                                         closed, cconst, impacts, n_imp, open_imp, mass)
+                                                closed, cconst, impacts, n_imp, open_imp, mass)
                         _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
                              dvals, cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
                         event_c = zero - 1
@@ -703,7 +703,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         if event_c >= 0:
             impacts = _grown(impacts, n_imp, n_imp + 1)
             n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
-                                             closed, cconst, impacts, n_imp, open_imp, mass)
+                                    closed, cconst, impacts, n_imp, open_imp, mass)
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
             # Keep the step size the controller had before the event cut it short.

@@ -25,8 +25,7 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     reporter = session.config.pluginmanager.get_plugin("terminalreporter")
     skipped = len(reporter.stats.get("skipped", [])) if reporter is not None else 0
     if skipped and exitstatus == pytest.ExitCode.OK:
-        if reporter is not None:
-            reporter.ensure_newline()
-            reporter.write_line(f"CI: {skipped} test(s) skipped; under CI a skip is a failure "
-                                "(see the skip reasons above for what to install)", red=True)
+        reporter.ensure_newline()
+        reporter.write_line(f"CI: {skipped} test(s) skipped; under CI a skip is a failure "
+                            "(see the skip reasons above for what to install)", red=True)
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
