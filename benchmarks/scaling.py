@@ -43,8 +43,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
-from pounding.ground_motion import Record, load_record  # noqa: E402
-from pounding.model import model_from_text  # noqa: E402
+from pounding.records.record import Record
+from pounding.records.load import load_record# noqa: E402
+from pounding.model.model import model_from_text# noqa: E402
 
 STOREYS = [5, 10, 20, 50, 100]
 DURATIONS = [10.0, 20.0, 30.0, 60.0, 90.0, 120.0]

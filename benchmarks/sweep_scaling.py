@@ -25,7 +25,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pounding import sweep as sw  # noqa: E402
+from pounding.studies import sweep as sw  # noqa: E402
 
 GAPS = [0.005, 0.01, 0.015, 0.02, 0.03, 0.04]
 RESTITUTIONS = [0.5, 0.65, 0.8, 0.95]

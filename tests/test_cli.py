@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from pounding.archive import open_run
+from pounding.results.archive import open_run
 from pounding.cli import main
 
 PAIR = "models/pair.yaml"
@@ -78,8 +78,7 @@ def test_info_and_rerun(tmp_path, capsys):
 
 
 def test_xi_list_prints_every_formula(capsys):
-    from pounding import xi
-
+    from pounding.contact import xi
     assert main(["xi", "list"]) == 0
     text = capsys.readouterr().out
     for key in xi.FORMULAS:
@@ -96,7 +95,8 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
             f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
             "status = console_main(); "
             "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
-            "other = [m for m in ('sweep', 'compare', 'verify', 'export_opensees') "
+            "other = [m for m in ('studies.sweep', 'studies.compare', 'studies.verify', 'export.opensees', "
+            "                    'cli.sweep', 'cli.compare', 'cli.records', 'cli.export') "
             "         if 'pounding.' + m in sys.modules]; "
             "assert not other, f'other subcommands imported: {other}'; "
             "sys.exit(status)")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pounding import compare as cmp
+from pounding.studies import compare as cmp
 from pounding.cli import main
 from pounding.errors import PoundingError
 

@@ -23,16 +23,9 @@ import numpy as np
 import pytest
 
 from pounding.errors import PoundingError, RecordError
-from pounding.ground_motion import (
-    STANDARD_GRAVITY,
-    UNITS,
-    Record,
-    load_record,
-    normalise_units,
-    read_at2,
-    read_text,
-    record_sha256,
-)
+from pounding.records.record import STANDARD_GRAVITY, UNITS, Record, normalise_units, record_sha256
+from pounding.records.load import load_record
+from pounding.records.readers import read_at2, read_text
 
 ROOT = Path(__file__).resolve().parents[1]
 PEER = ROOT / "ground_motions" / "peer"

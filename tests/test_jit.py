@@ -19,7 +19,7 @@ STARTUP_PROBE = r"""
 import json, sys
 import numpy as np
 from pounding import load_model, simulate
-from pounding.solver import _integrate
+from pounding.solver.integrator import _integrate
 if sys.argv[2] == "numba":
     del _integrate._cache.load_overload  # back to numba's loader (refreshes every registry)
 ds = simulate(load_model(sys.argv[1]))
@@ -73,7 +73,7 @@ TOY_LAW = "from numba import njit\n\n@njit(cache=True)\ndef stiffness():\n    re
 TOY_MAIN = textwrap.dedent("""
     import json
     from numba import njit
-    from pounding import jit
+    from pounding.solver import jit
     from . import law
 
     @njit(cache=True)

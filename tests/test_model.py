@@ -8,10 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pounding.contact import HertzDamp
+from pounding.contact.laws import HertzDamp
 from pounding.errors import ModelError
-from pounding.model import (Building, Damping, GapElement, GroundMotionSpec, Model, SolverSettings,
-                            load_model, model_from_text)
+from pounding.model.model import Building, Damping, GapElement, GroundMotionSpec, Model, SolverSettings, load_model, model_from_text
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 

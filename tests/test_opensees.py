@@ -9,7 +9,7 @@ What agrees, and why not exactly
 --------------------------------
 OpenSees' Hertzdamp never clamps the pull that the damping term produces
 just before separation, so the models are compared with ``tension: allow``
-(:func:`pounding.export_opensees.allow_tension`).  The remaining difference
+(:func:`pounding.export.opensees.allow_tension`).  The remaining difference
 is OpenSees' discretisation of the impact: Hertzdamp fixes ξ = xiNorm·kh/v0
 from the strain rate at the end of the first step inside the gap instead of at
 the located instant of closure (its v0 is low, its ξ high: ~2e-6 relative at
@@ -49,10 +49,10 @@ if _probe.returncode != 0:  # not installed, or Debian's BLAS/LAPACK missing
 
 import pounding  # noqa: E402
 from pounding.cli import main  # noqa: E402
-from pounding import xi  # noqa: E402
+from pounding.contact import xi  # noqa: E402
 from pounding.errors import PoundingError  # noqa: E402
-from pounding.export_opensees import allow_tension, opensees_script, run_opensees  # noqa: E402
-from pounding.model import model_from_text  # noqa: E402
+from pounding.export.opensees import allow_tension, opensees_script, run_opensees# noqa: E402
+from pounding.model.model import model_from_text# noqa: E402
 from pounding.simulation import record_for  # noqa: E402
 
 MODELS = ["models/pair.yaml", "models/row_of_three.yaml"]

@@ -12,16 +12,17 @@ import pytest
 import xarray as xr
 
 import pounding
-from pounding.archive import rerun, save_run
+from pounding.simulation import rerun
+from pounding.results.archive import save_run
 from pounding.cli import main
 from pounding.errors import ModelError, PoundingError, RecordError
-from pounding.ground_motion import STANDARD_GRAVITY, Record, fema_set, load_record
-from pounding.model import load_model, model_from_text
-from pounding.processing import (Processing, Scaling, SpecProblem, arias_intensity, baseline_correct,
-                                 fema_normalisation_factor, parse_acceleration, parse_processing, parse_scale,
-                                 process, scale_record, trim_significant_duration)
+from pounding.records.record import STANDARD_GRAVITY, Record
+from pounding.records.fema import fema_set
+from pounding.records.load import load_record
+from pounding.model.model import load_model, model_from_text
+from pounding.records.processing import Processing, Scaling, SpecProblem, arias_intensity, baseline_correct, fema_normalisation_factor, parse_acceleration, parse_processing, parse_scale, process, scale_record, trim_significant_duration
 from pounding.simulation import record_for
-from pounding.spectra import spectral_acceleration
+from pounding.records.spectra import spectral_acceleration
 
 ROOT = Path(__file__).resolve().parent.parent
 PAIR = ROOT / "models" / "pair.yaml"

@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pounding import xi as xi_formulas
-from pounding.contact import LAWS
+from pounding.contact import xi as xi_formulas
+from pounding.contact.laws import LAWS
 from pounding.errors import ModelError, PoundingError
-from pounding.model import load_model, model_from_text
+from pounding.model.model import load_model, model_from_text
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 
@@ -572,7 +572,7 @@ def test_readme_example_loads():
 
 
 def test_readme_documents_every_key():
-    from pounding import schema
+    from pounding.model import schema
 
     readme = (MODELS / "README.md").read_text()
     classes = [schema.TopLevel, schema.BuildingEntry, schema.StoreyShorthand, schema.RayleighEntry,

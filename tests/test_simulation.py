@@ -7,7 +7,7 @@ import pytest
 from scipy import signal
 
 import pounding
-from pounding.ground_motion import load_record
+from pounding.records.load import load_record
 
 PAIR = "models/pair.yaml"
 
@@ -167,7 +167,7 @@ def test_formulas_that_dissipate_more_in_the_ball_drop_dissipate_more_at_the_fir
     compared with a 1e-6 relative allowance for the integration error of the
     contact work (rtol 1e-6).
     """
-    from pounding.verify import ball_drop
+    from pounding.studies.verify import ball_drop
 
     model = pounding.load_model(PAIR)
     e = model.gaps[0].law.restitution

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pounding import contact
-from pounding.solver import System, integrate
+from pounding.contact import laws as contact
+from pounding.solver.integrator import System, integrate
 
 
 def free_pair(m1: float, m2: float, law: contact.ContactLaw, gap: float = 0.01) -> System:

@@ -10,10 +10,10 @@ import pytest
 import scipy.signal
 
 from pounding.errors import RecordError
-from pounding.ground_motion import STANDARD_GRAVITY, load_record
-from pounding.spectra import (Spectrum, default_periods, response_spectrum, sdof_response,
-                              spectral_acceleration)
-from pounding.spectra import _closed_form
+from pounding.records.record import STANDARD_GRAVITY
+from pounding.records.load import load_record
+from pounding.records.spectra import Spectrum, default_periods, response_spectrum, sdof_response, spectral_acceleration
+from pounding.records.spectra import _closed_form
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from pounding import sweep as sw
+from pounding.studies import sweep as sw
 from pounding.errors import ModelError, PoundingError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,7 +52,7 @@ def comparable(ds: xr.Dataset) -> xr.Dataset:
 
 
 def base_document() -> dict:
-    from pounding.model import load_model
+    from pounding.model.model import load_model
 
     return yaml.safe_load(load_model(PAIR).to_document())
 
@@ -83,7 +83,7 @@ def test_paths_write_into_the_model_document():
     ("solver.rtoll", "did you mean 'rtol'?"),
 ])
 def test_paths_that_lead_nowhere_are_refused(path, message):
-    with pytest.raises(sw._PathError, match=message.replace("[", r"\[").replace("]", r"\]")
+    with pytest.raises(sw.PathError, match=message.replace("[", r"\[").replace("]", r"\]")
                        .replace("(", r"\(").replace(")", r"\)").replace("?", r"\?").replace("*", r"\*")):
         sw.apply_path(base_document(), sw.parse_path(path), 1.0)
 
@@ -200,7 +200,7 @@ axes:
 
 
 def test_a_two_worker_sweep_gives_the_results_layout_and_matches_simulate(tmp_path, client):
-    from pounding.model import load_model
+    from pounding.model.model import load_model
     from pounding.simulation import simulate
 
     sweep = sw.load_sweep(write(tmp_path, BASIC))
@@ -331,7 +331,7 @@ axes:
 
 
 def test_keep_histories_saves_one_archive_per_scenario(tmp_path, client):
-    from pounding.archive import open_run
+    from pounding.results.archive import open_run
 
     sweep = sw.load_sweep(write(tmp_path, f"""\
 model: {PAIR}

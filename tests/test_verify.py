@@ -19,18 +19,9 @@ import pytest
 import xarray as xr
 from scipy.optimize import brentq
 
-from pounding import xi
+from pounding.contact import xi
 from pounding.errors import PoundingError
-from pounding.verify import (
-    OTHER_MODELS,
-    TABLE_I,
-    TABLE_I_E_PRE,
-    ball_drop,
-    hertz_max_penetration,
-    model_keys,
-    register_cli,
-    run_verification,
-)
+from pounding.studies.verify import OTHER_MODELS, TABLE_I, TABLE_I_E_PRE, ball_drop, hertz_max_penetration, model_keys, register_cli, run_verification
 
 
 @pytest.fixture(scope="module")
@@ -113,7 +104,7 @@ def test_exact_is_exact_without_gravity(grid_free):
 
 
 def test_gravity_effect_is_a_few_1e_4(grid, grid_free):
-    # physics.md §4: gravity during the contact lowers e_post by a few 1e-4.
+    # docs/physics.md §4: gravity during the contact lowers e_post by a few 1e-4.
     # Bound: 1e-3 absolute, and it lowers it (never raises) for Hertz-damp.
     for key in xi.FORMULAS:
         diff = grid_free.e_post.sel(model=key).values - grid.e_post.sel(model=key).values
@@ -201,7 +192,7 @@ def test_impact_velocity_is_located_exactly(grid):
 def test_hertz_peak_penetration_and_duration(grid_free):
     # Free elastic Hertz impact: δmax = (5 m v0²/(4 kh))^(2/5) exactly (1e-8
     # relative covers the integration error), contact duration 2.9432·δmax/v0
-    # (physics.md rounds the constant to 2.94: 0.2 % bound).
+    # (docs/physics.md §2 rounds the constant to 2.94: 0.2 % bound).
     v0 = float(grid_free.impact_velocity.values[0, 0])
     dmax = hertz_max_penetration(0.5, v0, 2.0e9)
     np.testing.assert_allclose(grid_free.max_penetration.sel(model="hertz").values, dmax, rtol=1e-8)

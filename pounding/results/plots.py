@@ -23,12 +23,13 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .errors import PoundingError
+from pounding.errors import PoundingError
 
 __all__ = ["plot_run"]
 
 
-def _pyplot():
+def pyplot():
+    """``matplotlib.pyplot`` on the non-interactive Agg backend (imported on first use: it is slow)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -161,7 +162,7 @@ def plot_run(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
     if out.exists() and not out.is_dir():
         raise PoundingError(f"{out} is a file; --plot needs a directory")
     out.mkdir(parents=True, exist_ok=True)
-    plt = _pyplot()
+    plt = pyplot()
     written = []
     for name, draw in (("contact_displacements.png", _contact_displacements),
                        ("contact_forces.png", _contact_forces),

@@ -12,7 +12,7 @@ keeps them in a registry keyed by name, in the style of
 ``scipy.integrate._ivp``: adding a formula is one function and one
 :func:`register` line with its citation.
 
->>> from pounding import xi
+>>> from pounding.contact import xi
 >>> round(xi.p("ye", 0.65), 6)
 0.861538
 >>> round(xi.damping_constant("lankarani-nikravesh", restitution=0.65, kh=1e10, v0=0.5))
@@ -25,7 +25,7 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-from .errors import PoundingError, did_you_mean
+from pounding.errors import PoundingError, did_you_mean
 
 __all__ = [
     "XiFormula",
@@ -93,7 +93,7 @@ def register(key: str, expression: str, reference: str, status: str, *, bounded:
 
 
 # --------------------------------------------------------------------------- #
-# The catalogue (physics.md §3).  Each entry: one function, one register line.
+# The catalogue (docs/physics.md §3).  Each entry: one function, one register line.
 # --------------------------------------------------------------------------- #
 
 
@@ -264,7 +264,7 @@ def _relation_over_p2(p_value: float, e: float) -> float:
 
 
 @register("exact", "root of ln((1+p)/(1-e p)) = (1+e) p",
-          "Exact restitution of the Hunt-Crossley law for two free bodies (physics.md §3); the "
+          "Exact restitution of the Hunt-Crossley law for two free bodies (docs/physics.md §3); the "
           "exact-restitution idea of Carvalho, A.S. & Martins, J.M. (2019), Mech. Mach. Theory "
           "139, 174-194.",
           "derived", bounded=False, aliases=("exact-restitution",))

@@ -14,10 +14,8 @@ never leaves a truncated archive; an existing file is never replaced unless
 
 from __future__ import annotations
 
-import json
 import os
 import tempfile
-from datetime import datetime, timezone
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
@@ -25,9 +23,9 @@ from typing import Iterator
 import numpy as np
 import xarray as xr
 
-from .errors import ArchiveError, PoundingError
+from pounding.errors import ArchiveError
 
-__all__ = ["save_run", "open_run", "rerun", "check_writable", "atomic_path"]
+__all__ = ["save_run", "open_run", "check_writable", "atomic_path"]
 
 _COMPRESSION = {"zlib": True, "complevel": 4}
 
@@ -125,36 +123,3 @@ def open_run(path: str | os.PathLike) -> xr.Dataset:
     if not str(ds.attrs.get("source", "")).startswith("pounding") or "run_spec" not in ds.attrs:
         raise ArchiveError(f"{source}: not a pounding run archive (no 'run_spec' attribute)")
     return ds
-
-
-def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
-    """Simulate again what an archive recorded; returns a new results dataset.
-
-    The model is rebuilt from the effective model stored in ``run_spec``; the
-    record is reloaded from its source, processed the same way (trim,
-    baseline correction: in the model's ``ground_motion.processing``) and
-    multiplied by the archived factor (so a target-PGA or target-Sa scaling is
-    not re-resolved).  If the samples no longer hash to the archived SHA-256,
-    the rerun is refused rather than silently different.
-    """
-    from .model import model_from_text
-    from .simulation import record_for, simulate
-
-    ds = open_run(run) if not isinstance(run, xr.Dataset) else run
-    name = str(run) if not isinstance(run, xr.Dataset) else "archive"
-    spec = json.loads(ds.attrs["run_spec"])
-    model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
-                            path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
-    model = model.with_ground_motion(record=spec["record"], duration=spec["duration"])
-    record = record_for(model, factor=spec["scale"])
-    expected = spec.get("record_sha256", "")
-    actual = record.metadata.get("sha256", "")
-    if expected and actual != expected:
-        steps = spec.get("processing") or []
-        how = f" after {len(steps)} processing step(s)" if steps else ""
-        raise PoundingError(f"{name}: record {spec['record']}{how} has changed since the run was archived "
-                            f"(sha256 {actual[:12]}… ≠ {expected[:12]}…); restore the original file")
-    again = simulate(model, record)
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-    again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
-    return again

@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import RecordError
+from pounding.errors import RecordError
 
 __all__ = ["DEFAULT_DAMPING", "Spectrum", "default_periods", "response_spectrum", "spectral_acceleration",
            "sdof_response"]

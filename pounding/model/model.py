@@ -6,7 +6,7 @@ A model file (YAML, see ``models/README.md``) is validated by
 the :class:`GapElement` objects between adjacent floors, the ground-motion
 choice and the solver settings.  SI units throughout (kg, N/m, m, s).
 
-Shear building (physics.md §1): floor i (1 = first above ground) carries mass
+Shear building (docs/physics.md §1): floor i (1 = first above ground) carries mass
 m_i; storey i, between floor i−1 and floor i (floor 0 = ground), has lateral
 stiffness k_i and height h_i.  M is diagonal, K tridiagonal::
 
@@ -30,10 +30,10 @@ from typing import Any
 import numpy as np
 import yaml
 
-from . import schema
-from . import xi as xi_formulas
-from .contact import ContactLaw, HertzDamp
-from .errors import ModelError, PoundingError, did_you_mean
+from pounding.model import schema
+from pounding.contact import xi as xi_formulas
+from pounding.contact.laws import ContactLaw, HertzDamp
+from pounding.errors import ModelError, PoundingError, did_you_mean
 
 __all__ = [
     "Damping",
@@ -234,7 +234,7 @@ class Building:
         """Rayleigh ``(a0, a1)`` (1/s, s) for ``C = a0·M + a1·K``; None for modal damping.
 
         ``a0 = 2ζ·ωi·ωj/(ωi+ωj)``, ``a1 = 2ζ/(ωi+ωj)`` give ratio ζ exactly at
-        modes i and j (physics.md §1).
+        modes i and j (docs/physics.md §1).
         """
         if self.damping.kind != "rayleigh":
             return None
@@ -308,7 +308,7 @@ def _record_needs_units(record: str) -> bool:
 
 def _scale(value: Any) -> Any:
     """``ground_motion.scale`` as a float or a :class:`pounding.processing.Scaling` (from a mapping)."""
-    from .processing import Scaling, SpecProblem, parse_scale
+    from pounding.records.processing import Scaling, SpecProblem, parse_scale
 
     if isinstance(value, Scaling):
         return value.factor if value.method == "factor" else value
@@ -322,7 +322,7 @@ def _scale(value: Any) -> Any:
 
 
 def _processing(value: Any) -> Any:
-    from .processing import SpecProblem, parse_processing
+    from pounding.records.processing import SpecProblem, parse_processing
 
     try:
         return parse_processing(value)

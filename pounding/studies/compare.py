@@ -12,23 +12,21 @@ largest storey drift ratio and of its difference from the reference.
 
 from __future__ import annotations
 
-import argparse
 import os
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .errors import PoundingError, did_you_mean
+from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "comparison_table", "differences", "plot_comparison", "register_cli"]
+__all__ = ["compare", "comparison_table", "differences", "plot_comparison"]
 
 REFERENCE = "exact"
 
 
 def _formulas(text: str | list[str], reference: str) -> list[str]:
-    from . import xi
+    from pounding.contact import xi
 
     names = [n.strip() for n in (text.split(",") if isinstance(text, str) else text) if n.strip()]
     if not names:
@@ -50,7 +48,7 @@ def _formulas(text: str | list[str], reference: str) -> list[str]:
 
 
 def _records(text: str | list[str] | None) -> list[str] | None:
-    from .sweep import expand_records
+    from pounding.studies.sweep.spec import expand_records
 
     if text is None:
         return None
@@ -72,11 +70,11 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: st
     """The sweep behind ``pounding compare`` (formulas × records)."""
     import yaml
 
-    from .model import load_model
-    from .sweep import sweep_from_text
+    from pounding.model.model import load_model
+    from pounding.studies.sweep.spec import sweep_from_text
 
     path = os.path.abspath(os.fspath(model))
-    from .contact import HertzDamp
+    from pounding.contact.laws import HertzDamp
 
     base = load_model(model)                # the model's own errors, with its file name
     if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
@@ -120,7 +118,7 @@ def compare(model: str | os.PathLike, formulas: str | list[str] = ("ye", "lankar
     run_options
         Passed to :func:`pounding.sweep.run_sweep` (workers, scheduler, client, progress, overwrite...).
     """
-    from .sweep import run_sweep
+    from pounding.studies.sweep.execution import run_sweep
 
     sweep = build_sweep(model, formulas, records, duration=duration, reference=reference)
     ds = run_sweep(sweep, output, **run_options)
@@ -192,13 +190,13 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
 
 def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE) -> list[Path]:
     """Write ``xi_drift_profiles.png`` and ``xi_drift_distribution.png`` to *directory*."""
-    from .plots import _pyplot
+    from pounding.results.plots import pyplot
 
     out = Path(directory)
     if out.exists() and not out.is_dir():
         raise PoundingError(f"{out} is a file; --plot needs a directory")
     out.mkdir(parents=True, exist_ok=True)
-    plt = _pyplot()
+    plt = pyplot()
     formulas = [str(x) for x in ds.xi.values]
     buildings = _buildings(ds)
     n_records = ds.sizes["record"]
@@ -285,60 +283,3 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     fig.savefig(distribution, dpi=110)
     plt.close(fig)
     return [profiles, distribution]
-
-
-def _cmd_compare(args: argparse.Namespace) -> int:
-    from .archive import check_writable
-    from .sweep import parts_dir
-
-    if args.workers is not None and args.workers < 1:
-        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
-    if args.output:
-        check_writable(args.output, overwrite=args.overwrite)
-    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
-        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
-    try:
-        ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,
-                     reference=args.reference, workers=args.workers, scheduler=args.scheduler,
-                     overwrite=args.overwrite, progress=not args.no_progress)
-    except KeyboardInterrupt:
-        if args.output:
-            print(f"pounding: interrupted; finished scenarios are kept in {parts_dir(args.output)}; run the same "
-                  "command again to finish the others", file=sys.stderr)
-        else:
-            print("pounding: interrupted", file=sys.stderr)
-        return 130
-    print(comparison_table(ds, args.reference))
-    if args.output:
-        print(f"wrote {args.output}")
-    if args.plot:
-        for png in plot_comparison(ds, args.plot, args.reference):
-            print(f"wrote {png}")
-    return 0
-
-
-def register_cli(subparsers) -> argparse.ArgumentParser:
-    """Add ``pounding compare`` to *subparsers*."""
-    from .sweep import add_cluster_options
-
-    parser = subparsers.add_parser(
-        "compare", help="compare xi formulas on storey drifts over a set of records",
-        description="Run MODEL once per xi formula and record (on all cores or a Dask cluster) and print, per "
-                    "building, the peak storey drift ratio profile of each formula and its difference from "
-                    "the reference formula (mean and max over records).")
-    parser.add_argument("model", help="YAML model with hertz-damp contacts, e.g. models/pair.yaml")
-    parser.add_argument("--xi", default="ye,lankarani-nikravesh,exact", metavar="LIST",
-                        help="comma-separated xi formulas (default ye,lankarani-nikravesh,exact; "
-                             "see `pounding xi list`)")
-    parser.add_argument("--records", metavar="SET|LIST",
-                        help="a record set (fema-p695:farfield, fema-p695:nearfield) or a comma-separated list "
-                             "of records (default: the model's record)")
-    parser.add_argument("--reference", default=REFERENCE, help="formula the others are compared with "
-                        "(default exact; added if not in --xi)")
-    parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")
-    parser.add_argument("-o", "--output", metavar="CMP.nc", help="also write the results (NetCDF); resumable")
-    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
-    parser.add_argument("--plot", metavar="DIR", help="write xi_drift_profiles.png and xi_drift_distribution.png")
-    add_cluster_options(parser)
-    parser.set_defaults(func=_cmd_compare)
-    return parser

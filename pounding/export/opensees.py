@@ -48,7 +48,6 @@ peaks (the cross-check tests and the benchmarks use it).
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import math
 import sys
@@ -56,10 +55,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .errors import PoundingError
+from pounding import __version__
+from pounding.errors import PoundingError
 
-__all__ = ["opensees_script", "run_opensees", "allow_tension", "register_cli", "DEFAULT_DT"]
+__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
 DEFAULT_DT = 1.0e-4
@@ -72,7 +71,7 @@ def allow_tension(model):
     term produces just before separation; a model compared with it must not
     either.
     """
-    from .contact import HertzDamp, Kelvin
+    from pounding.contact.laws import HertzDamp, Kelvin
 
     laws: dict[int, object] = {}
 
@@ -94,8 +93,8 @@ def _prepare(model, record=None, xi=None, duration=None):
     (processed and scaled as the model says, by :func:`pounding.simulation.record_for`);
     a :class:`~pounding.ground_motion.Record` is used as it is.
     """
-    from .ground_motion import Record
-    from .simulation import record_for
+    from pounding.records.record import Record
+    from pounding.simulation import record_for
 
     if xi is not None:
         model = model.with_xi(xi)
@@ -115,7 +114,7 @@ def _prepare(model, record=None, xi=None, duration=None):
 
 def _contact_material(law, gap: float) -> tuple[list, list[str]]:
     """OpenSees material arguments (after the tag) for one gap element, and warnings."""
-    from .contact import Hertz, HertzDamp, Linear
+    from pounding.contact.laws import Hertz, HertzDamp, Linear
 
     if isinstance(law, HertzDamp):
         notes = []
@@ -158,10 +157,10 @@ def opensees_script(model, record=None, *, dt: float = DEFAULT_DT, xi: str | Non
         Python source.  Run it (``python model.py [--dt DT] [-o peaks.json]``)
         or import it and call ``analyse()``, which returns the peaks as a dict.
     """
-    return _script(model, record, dt=dt, xi=xi, duration=duration)[0]
+    return opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)[0]
 
 
-def _script(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None = None,
+def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None = None,
             duration: float | None = None) -> tuple[str, list[str]]:
     """(script text, notes on what the export cannot reproduce exactly)."""
     if not (dt > 0.0 and math.isfinite(dt)):
@@ -476,7 +475,7 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
 
     if importlib.util.find_spec("openseespy") is None:  # pragma: no cover - depends on the environment
         raise PoundingError("OpenSeesPy is not available; pip install openseespy")
-    source, _notes = _script(model, record, dt=dt, xi=xi, duration=duration)
+    source, _notes = opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)
     with tempfile.TemporaryDirectory(prefix="pounding-opensees-") as folder:
         script = Path(folder) / f"{model.name}_opensees.py"
         peaks_file = Path(folder) / "peaks.json"
@@ -487,47 +486,3 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
             last = (done.stderr.strip().splitlines() or ["no output"])[-1]
             raise PoundingError(f"the OpenSees script for {model.name} failed (exit {done.returncode}): {last}")
         return json.loads(peaks_file.read_text(encoding="utf-8"))
-
-
-# --------------------------------------------------------------------------- #
-# Command line
-# --------------------------------------------------------------------------- #
-
-
-def _cmd_export_opensees(args: argparse.Namespace) -> int:
-    from .model import load_model
-
-    model = load_model(args.model)
-    source, notes = _script(model, args.record, dt=args.dt, xi=args.xi, duration=args.duration)
-    output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
-    if output.exists() and not args.overwrite:
-        raise PoundingError(f"{output} exists; pass --overwrite to replace it")
-    try:
-        output.write_text(source, encoding="utf-8")
-    except OSError as exc:
-        raise PoundingError(f"cannot write {output}: {exc.strerror}") from None
-    for note in notes:
-        print(f"pounding: note: {note}", file=sys.stderr)
-    print(f"wrote {output} (run: python {output} [--dt DT] [-o peaks.json])")
-    return 0
-
-
-def register_cli(subparsers) -> argparse.ArgumentParser:
-    """Add ``export opensees`` to *subparsers* (from ``add_subparsers``)."""
-    export = subparsers.add_parser("export", help="write a model for another simulator")
-    sub = export.add_subparsers(dest="export_format", required=True)
-    parser = sub.add_parser(
-        "opensees", help="standalone OpenSeesPy script of a model (the peer for cross-checks)",
-        description="Write a standalone OpenSeesPy script of the model: floor masses, zeroLength storey "
-                    "springs with per-building Rayleigh damping, Hertzdamp gap elements (xiNorm = p(e)), "
-                    "the record as Path/UniformExcitation, Newmark average acceleration + Newton at DT. "
-                    "Running it prints the peaks of our results schema as JSON.")
-    parser.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
-    parser.add_argument("--record", help="record spec (default: the model's ground motion)")
-    parser.add_argument("--duration", type=float, help="simulated time, s")
-    parser.add_argument("--dt", type=float, default=DEFAULT_DT, help="OpenSees time step, s (default 1e-4)")
-    parser.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
-    parser.add_argument("-o", "--output", help="script to write (default: MODEL-STEM_opensees.py)")
-    parser.add_argument("--overwrite", action="store_true", help="replace an existing script")
-    parser.set_defaults(func=_cmd_export_opensees)
-    return parser

@@ -1,6 +1,6 @@
 """Event-driven, error-controlled integrator for rows of pounding shear buildings.
 
-The equation of motion relative to the moving ground (physics.md §1),
+The equation of motion relative to the moving ground (docs/physics.md §1),
 
     M ü + C u̇ + K u + f_contact(u, u̇) = −M 1 a_g(t),
 
@@ -51,8 +51,8 @@ import numpy as np
 from numba import njit
 from numba.core.dispatcher import Dispatcher
 
-from . import contact as contact_laws
-from . import jit
+from pounding.contact import laws as contact_laws
+from pounding.solver import jit
 
 
 jit.load_registries_without_scipy()

@@ -77,9 +77,9 @@ from typing import Sequence
 import numpy as np
 import xarray as xr
 
-from . import contact
-from . import xi as xi_formulas
-from .errors import PoundingError, did_you_mean
+from pounding.contact import laws as contact
+from pounding.contact import xi as xi_formulas
+from pounding.errors import PoundingError, did_you_mean
 
 __all__ = [
     "TABLE_I",
@@ -533,7 +533,7 @@ def to_json(ds: xr.Dataset) -> dict:
 
 def cmd_verify(args: argparse.Namespace) -> int:
     """Handler of ``pounding verify``."""
-    from .archive import check_writable, save_run
+    from pounding.results.archive import check_writable, save_run
 
     if args.output:
         check_writable(args.output, overwrite=args.overwrite)  # before computing anything

@@ -34,11 +34,11 @@ from datetime import datetime, timezone
 import numpy as np
 import xarray as xr
 
-from . import __version__
-from . import contact as contact_laws
-from .ground_motion import Record
-from .model import Model
-from .solver import RawSolution, System
+from pounding import __version__
+from pounding.contact import laws as contact_laws
+from pounding.records.record import Record
+from pounding.model.model import Model
+from pounding.solver.integrator import RawSolution, System
 
 __all__ = ["to_dataset", "energy_closure", "REFERENCES"]
 

@@ -40,8 +40,8 @@ from typing import Any
 
 import numpy as np
 
-from .errors import RecordError, did_you_mean
-from .ground_motion import STANDARD_GRAVITY, UNITS, Record, normalise_units
+from pounding.errors import RecordError, did_you_mean
+from pounding.records.record import STANDARD_GRAVITY, UNITS, Record, normalise_units
 
 __all__ = [
     "Scaling", "Processing", "SpecProblem", "parse_scale", "parse_processing", "parse_acceleration",
@@ -411,7 +411,7 @@ def scale_record(record: Record, scaling: float | Scaling, *, period: float | No
         ``scale_description``, ``scale_factor`` and, for targets,
         ``scale_target_m_s2``, ``scale_period_s``, ``scale_damping``.
     """
-    from .spectra import spectral_acceleration
+    from pounding.records.spectra import spectral_acceleration
 
     if not isinstance(scaling, Scaling):
         scaling = Scaling("factor", factor=float(scaling))

@@ -1,0 +1,68 @@
+"""``pounding compare``: ξ formulas compared on storey drifts over a set of records."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from pounding.cli.sweep import add_cluster_options
+from pounding.errors import PoundingError
+from pounding.studies.compare import REFERENCE, compare, comparison_table, plot_comparison
+
+__all__ = ["register_cli"]
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from pounding.results.archive import check_writable
+    from pounding.studies.sweep.store import parts_dir
+
+    if args.workers is not None and args.workers < 1:
+        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
+    if args.output:
+        check_writable(args.output, overwrite=args.overwrite)
+    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
+        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
+    try:
+        ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,
+                     reference=args.reference, workers=args.workers, scheduler=args.scheduler,
+                     overwrite=args.overwrite, progress=not args.no_progress)
+    except KeyboardInterrupt:
+        if args.output:
+            print(f"pounding: interrupted; finished scenarios are kept in {parts_dir(args.output)}; run the same "
+                  "command again to finish the others", file=sys.stderr)
+        else:
+            print("pounding: interrupted", file=sys.stderr)
+        return 130
+    print(comparison_table(ds, args.reference))
+    if args.output:
+        print(f"wrote {args.output}")
+    if args.plot:
+        for png in plot_comparison(ds, args.plot, args.reference):
+            print(f"wrote {png}")
+    return 0
+
+
+def register_cli(subparsers) -> argparse.ArgumentParser:
+    """Add ``pounding compare`` to *subparsers*."""
+    parser = subparsers.add_parser(
+        "compare", help="compare xi formulas on storey drifts over a set of records",
+        description="Run MODEL once per xi formula and record (on all cores or a Dask cluster) and print, per "
+                    "building, the peak storey drift ratio profile of each formula and its difference from "
+                    "the reference formula (mean and max over records).")
+    parser.add_argument("model", help="YAML model with hertz-damp contacts, e.g. models/pair.yaml")
+    parser.add_argument("--xi", default="ye,lankarani-nikravesh,exact", metavar="LIST",
+                        help="comma-separated xi formulas (default ye,lankarani-nikravesh,exact; "
+                             "see `pounding xi list`)")
+    parser.add_argument("--records", metavar="SET|LIST",
+                        help="a record set (fema-p695:farfield, fema-p695:nearfield) or a comma-separated list "
+                             "of records (default: the model's record)")
+    parser.add_argument("--reference", default=REFERENCE, help="formula the others are compared with "
+                        "(default exact; added if not in --xi)")
+    parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")
+    parser.add_argument("-o", "--output", metavar="CMP.nc", help="also write the results (NetCDF); resumable")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    parser.add_argument("--plot", metavar="DIR", help="write xi_drift_profiles.png and xi_drift_distribution.png")
+    add_cluster_options(parser)
+    parser.set_defaults(func=_cmd_compare)
+    return parser

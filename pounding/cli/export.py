@@ -1,0 +1,51 @@
+"""``pounding export opensees``: a standalone OpenSeesPy script of a model."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from pounding.errors import PoundingError
+from pounding.export.opensees import DEFAULT_DT, opensees_script_and_notes
+
+__all__ = ["register_cli"]
+
+
+def _cmd_export_opensees(args: argparse.Namespace) -> int:
+    from pounding.model.model import load_model
+
+    model = load_model(args.model)
+    source, notes = opensees_script_and_notes(model, args.record, dt=args.dt, xi=args.xi, duration=args.duration)
+    output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
+    if output.exists() and not args.overwrite:
+        raise PoundingError(f"{output} exists; pass --overwrite to replace it")
+    try:
+        output.write_text(source, encoding="utf-8")
+    except OSError as exc:
+        raise PoundingError(f"cannot write {output}: {exc.strerror}") from None
+    for note in notes:
+        print(f"pounding: note: {note}", file=sys.stderr)
+    print(f"wrote {output} (run: python {output} [--dt DT] [-o peaks.json])")
+    return 0
+
+
+def register_cli(subparsers) -> argparse.ArgumentParser:
+    """Add ``export opensees`` to *subparsers* (from ``add_subparsers``)."""
+    export = subparsers.add_parser("export", help="write a model for another simulator")
+    sub = export.add_subparsers(dest="export_format", required=True)
+    parser = sub.add_parser(
+        "opensees", help="standalone OpenSeesPy script of a model (the peer for cross-checks)",
+        description="Write a standalone OpenSeesPy script of the model: floor masses, zeroLength storey "
+                    "springs with per-building Rayleigh damping, Hertzdamp gap elements (xiNorm = p(e)), "
+                    "the record as Path/UniformExcitation, Newmark average acceleration + Newton at DT. "
+                    "Running it prints the peaks of our results schema as JSON.")
+    parser.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
+    parser.add_argument("--record", help="record spec (default: the model's ground motion)")
+    parser.add_argument("--duration", type=float, help="simulated time, s")
+    parser.add_argument("--dt", type=float, default=DEFAULT_DT, help="OpenSees time step, s (default 1e-4)")
+    parser.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
+    parser.add_argument("-o", "--output", help="script to write (default: MODEL-STEM_opensees.py)")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing script")
+    parser.set_defaults(func=_cmd_export_opensees)
+    return parser

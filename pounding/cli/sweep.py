@@ -1,0 +1,95 @@
+"""``pounding sweep``: run a sweep file on all cores or a Dask cluster."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from pounding.errors import PoundingError
+from pounding.studies.sweep.execution import default_workers, run_sweep
+from pounding.studies.sweep.spec import load_sweep
+from pounding.studies.sweep.store import parts_dir
+
+__all__ = ["register_cli", "add_cluster_options", "summary_lines"]
+
+# --------------------------------------------------------------------------- #
+# Command line
+# --------------------------------------------------------------------------- #
+
+
+def add_cluster_options(parser: argparse.ArgumentParser) -> None:
+    """--workers / --scheduler, shared with ``pounding compare``."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--workers", type=int, metavar="N",
+                       help=f"worker processes of the local cluster (default: one per core, {default_workers()})")
+    group.add_argument("--scheduler", metavar="ADDRESS",
+                       help="use an existing Dask cluster, e.g. tcp://HOST:8786 (started with `dask scheduler` "
+                            "and `dask worker tcp://HOST:8786`)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def summary_lines(ds) -> list[str]:
+    """Counts and the first errors of a sweep results dataset."""
+    status = ds.status.values.ravel()
+    errors = [e for e in ds.error.values.ravel() if e]
+    lines = [f"{status.size} scenarios: {int((status == 'ok').sum())} ok, {int((status != 'ok').sum())} failed"]
+    shown = []
+    for message in errors:
+        if message not in shown:
+            shown.append(message)
+    for message in shown[:5]:
+        lines.append(f"  error: {message}")
+    if len(shown) > 5:
+        lines.append(f"  ... and {len(shown) - 5} more different errors (variable 'error' in the output)")
+    return lines
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    if args.workers is not None and args.workers < 1:
+        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
+    sweep = load_sweep(args.sweep)
+    output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
+    invalid = sweep.invalid_values()
+    if invalid and args.strict:
+        raise PoundingError(invalid[0])
+    for message in invalid:
+        print(f"pounding: warning: {message}; its scenarios will record this error", file=sys.stderr)
+    print(f"sweep '{sweep.name}': {sweep.size} scenarios = "
+          + " x ".join(f"{d.size} {d.name}" for d in sweep.dimensions), file=sys.stderr)
+    try:
+        ds = run_sweep(sweep, output, workers=args.workers, scheduler=args.scheduler,
+                       keep_histories=args.keep_histories, overwrite=args.overwrite, keep_parts=args.keep_parts,
+                       progress=not args.no_progress)
+    except KeyboardInterrupt:
+        store = parts_dir(output)
+        count = len(list(store.glob("*.json"))) if store.is_dir() else 0
+        print(f"pounding: interrupted; {count} finished scenarios are kept in {store}; run the same command "
+              "again to finish the others", file=sys.stderr)
+        return 130
+    for line in summary_lines(ds):
+        print(line)
+    rate = ds.attrs["n_run"] / ds.attrs["elapsed_time"] if ds.attrs["elapsed_time"] > 0 else float("nan")
+    if ds.attrs["n_run"]:
+        print(f"ran {ds.attrs['n_run']} scenarios in {ds.attrs['elapsed_time']:.1f} s ({rate:.2f} scenarios/s)")
+    print(f"wrote {output}")
+    return 0
+
+
+def register_cli(subparsers) -> argparse.ArgumentParser:
+    """Add ``pounding sweep`` to *subparsers*."""
+    parser = subparsers.add_parser(
+        "sweep", help="run a parameter sweep (sweeps/*.yaml) on all cores or a Dask cluster",
+        description="Run every scenario of a sweep file on a Dask cluster (one worker process per core by "
+                    "default) and write one NetCDF file of peaks. Finished scenarios are saved as they "
+                    "complete, so the same command resumes an interrupted sweep.")
+    parser.add_argument("sweep", help="sweep file, e.g. sweeps/gap_restitution.yaml")
+    parser.add_argument("-o", "--output", help="NetCDF results (default: SWEEP-STEM.nc)")
+    add_cluster_options(parser)
+    parser.add_argument("--keep-histories", metavar="DIR", help="also archive each scenario's full results in DIR")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    parser.add_argument("--keep-parts", action="store_true", help="keep OUTPUT.parts/ after writing OUTPUT")
+    parser.add_argument("--strict", action="store_true",
+                        help="stop if an axis value makes the model invalid (default: record the error)")
+    parser.set_defaults(func=_cmd_sweep)
+    return parser

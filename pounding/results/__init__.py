@@ -1,0 +1,6 @@
+"""Results of a run: the labelled xarray dataset, its NetCDF archive and its plots.
+
+``dataset``  solver output → ``xarray.Dataset`` with units and long names
+``archive``  atomic NetCDF writing, reopening
+``plots``    PNG figures of a run
+"""

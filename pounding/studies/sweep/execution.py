@@ -1,0 +1,263 @@
+"""Running a sweep on a Dask cluster: LocalCluster or an existing scheduler, batching, retries, progress."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+from pounding.errors import PoundingError
+from pounding.studies.sweep.dataset import build_dataset
+from pounding.studies.sweep.scenario import one_line, run_scenario
+from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario, Sweep
+from pounding.studies.sweep.store import history_name, load_parts, parts_dir, save_part
+
+__all__ = ["default_workers", "start_client", "run_sweep", "run_chunk"]
+
+# --------------------------------------------------------------------------- #
+# Running on Dask
+# --------------------------------------------------------------------------- #
+
+
+def default_workers() -> int:
+    """One worker per usable core."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:   # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def start_client(*, workers: int | None = None, scheduler: str | None = None):
+    """A dask Client: on an existing scheduler, else on a new LocalCluster.
+
+    Returns
+    -------
+    (client, cluster)
+        *cluster* is None with *scheduler* (the cluster is used unchanged).
+    """
+    import logging
+
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="20s"), None
+        except (OSError, TimeoutError) as exc:
+            raise PoundingError(f"cannot reach the Dask scheduler at {scheduler} ({one_line(exc)}); start one "
+                                "with `dask scheduler` and workers with `dask worker tcp://HOST:8786`") from None
+    n = workers or default_workers()
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                           silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers: int | None = None,
+              scheduler: str | None = None, client: Any = None, keep_histories: str | os.PathLike | None = None,
+              overwrite: bool = False, keep_parts: bool = False, progress: bool = True,
+              runner: Callable[[dict[str, Any]], dict[str, Any]] = run_scenario,
+              retries: int = 2, task_seconds: float = 0.5, log: Callable[[str], None] | None = None):
+    """Run every scenario of *sweep* and return the results dataset.
+
+    Parameters
+    ----------
+    sweep : Sweep
+        From :func:`load_sweep`.
+    output : path-like, optional
+        The NetCDF file; finished scenarios are kept in ``<output>.parts/``
+        meanwhile, so an interrupted run resumes.  Without it nothing is stored.
+    workers : int, optional
+        LocalCluster size (default: one per core).
+    scheduler : str, optional
+        Address of an existing scheduler (``tcp://host:8786``); used unchanged.
+    client : dask.distributed.Client, optional
+        An existing client (overrides *workers* and *scheduler*).
+    keep_histories : path-like, optional
+        Directory for each scenario's full results archive.
+    overwrite : bool
+        Replace an existing *output*.
+    keep_parts : bool
+        Keep ``<output>.parts/`` after the final file is written.
+    progress : bool
+        Show a tqdm progress bar on stderr.
+    runner : callable
+        The function run on workers for each task (default :func:`run_scenario`).
+    retries : int
+        Retries of a task whose worker died.
+    task_seconds : float
+        Scenarios are grouped into Dask tasks of about this many seconds once
+        their cost is known (the first tasks hold one scenario each); 0 keeps
+        one scenario per task.  Each result is still stored on its own.
+    log : callable, optional
+        Receives one-line notes (default: print to stderr).
+    """
+    from pounding.results.archive import check_writable, save_run
+
+    say = log or (lambda line: print(line, file=sys.stderr))
+    target = check_writable(output, overwrite=overwrite) if output is not None else None
+    histories = Path(keep_histories) if keep_histories is not None else None
+    if histories is not None:
+        histories.mkdir(parents=True, exist_ok=True)
+    store = parts_dir(target) if target is not None else None
+    if store is not None:
+        store.mkdir(exist_ok=True)
+    done = load_parts(store) if store is not None else {}
+
+    scenarios = sweep.scenarios()
+    results: dict[str, dict[str, Any]] = {}
+    todo: list[Scenario] = []
+    for scenario in scenarios:
+        if scenario.key in results:
+            continue
+        part = done.get(scenario.key)
+        history_missing = histories is not None and scenario.error is None and \
+            not (histories / history_name(scenario)).exists()
+        if part is not None and not history_missing:
+            results[scenario.key] = part
+        elif scenario.error is not None:
+            results[scenario.key] = {"key": scenario.key, "status": "error", "error": scenario.error,
+                                     "format": PARTS_FORMAT, "wall_time": 0.0}
+        else:
+            todo.append(scenario)
+    unique = len({s.key for s in scenarios})
+    skipped = sum(1 for k in {s.key for s in scenarios} if k in done)
+    if skipped:
+        say(f"{skipped} of {unique} scenarios already done (in {store}); running the other {len(todo)}")
+    transient: set[str] = set()
+    started = time.perf_counter()
+    if todo:
+        own = client is None
+        cluster = None
+        if own:
+            client, cluster = start_client(workers=workers, scheduler=scheduler)
+        try:
+            _run_on(client, sweep, todo, results, store=store, histories=histories, runner=runner,
+                    retries=retries, progress=progress, initial=len(results), total=len(results) + len(todo),
+                    transient=transient, task_seconds=task_seconds)
+        finally:
+            if own:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+    elapsed = time.perf_counter() - started
+    ds = build_dataset(sweep, results, elapsed=elapsed, ran=len(todo))
+    if histories is not None:
+        ds.attrs["histories"] = str(histories)
+    if target is not None:
+        save_run(ds, target, overwrite=overwrite)
+        if transient:
+            say(f"{len(transient)} scenarios could not run (their workers died); the others are kept in {store}: "
+                "rerun the same command with --overwrite to retry just those")
+        elif not keep_parts:
+            for entry in store.iterdir():
+                entry.unlink()
+            store.rmdir()
+    return ds
+
+
+def run_chunk(runner: Callable[[dict[str, Any]], dict[str, Any]], tasks: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Run a few scenarios in a row on one worker (what a Dask task does)."""
+    return [runner(task) for task in tasks]
+
+
+class _Batcher:
+    """How many scenarios go into the next task.
+
+    Starts at one scenario per task; after the first results, sizes tasks to
+    take about *task_seconds* on a worker (so the per-task overhead of Dask,
+    a few ms, stays around 1 %), never more than *max_batch*, and splits the
+    last scenarios evenly over the workers.
+    """
+
+    def __init__(self, task_seconds: float, max_batch: int):
+        self.task_seconds = task_seconds
+        self.max_batch = max_batch
+        self.per_scenario: float | None = None
+
+    def observe(self, results: list[dict[str, Any]]) -> None:
+        times = [r.get("wall_time") for r in results]
+        times = [t for t in times if isinstance(t, (int, float)) and math.isfinite(t)]
+        if times:
+            value = sum(times) / len(times)
+            self.per_scenario = value if self.per_scenario is None else 0.5 * (self.per_scenario + value)
+
+    def size(self, pending: int, slots: int) -> int:
+        if self.per_scenario is None or self.task_seconds <= 0:
+            return 1
+        wanted = int(self.task_seconds / max(self.per_scenario, 1e-6))
+        even = math.ceil(pending / max(1, 2 * slots))
+        return max(1, min(self.max_batch, wanted, even))
+
+
+def _run_on(client, sweep: Sweep, todo: list[Scenario], results: dict[str, dict[str, Any]], *, store: Path | None,
+            histories: Path | None, runner, retries: int, progress: bool, initial: int, total: int,
+            transient: set[str], task_seconds: float = 0.5, max_batch: int = 64) -> None:
+    """Submit the scenarios as tasks (a few in flight per worker thread) and store each result as it arrives."""
+    import uuid
+    from collections import deque
+
+    from dask.distributed import as_completed
+    from tqdm import tqdm
+
+    from pounding.results.archive import save_run
+
+    pending = deque(todo)
+    chunks: dict[str, list[Scenario]] = {}
+    batcher = _Batcher(task_seconds, max_batch)
+    completed = as_completed(loop=client.loop)
+    state = {"slots": 1, "checked": -1e9}
+
+    def slots() -> int:
+        now = time.monotonic()
+        if now - state["checked"] > 2.0:
+            try:
+                state["slots"] = max(1, sum(client.nthreads().values()))
+            except Exception:  # noqa: BLE001 - keep the last known size
+                pass
+            state["checked"] = now
+        return state["slots"]
+
+    def submit_more() -> None:
+        while pending and len(chunks) < 2 * slots() + 1:
+            size = batcher.size(len(pending), slots())
+            chunk = [pending.popleft() for _ in range(min(size, len(pending)))]
+            tasks = [s.task(sweep_label=sweep.label, name=sweep.model_name, keep_history=histories is not None)
+                     for s in chunk]
+            key = f"pounding-scenarios-{chunk[0].key[:16]}-{len(chunk)}-{uuid.uuid4().hex[:8]}"
+            future = client.submit(run_chunk, runner, tasks, key=key, retries=retries, pure=False)
+            chunks[future.key] = chunk
+            completed.add(future)
+
+    bar = tqdm(total=total, initial=initial, unit="scenario", desc=sweep.name, file=sys.stderr,
+               disable=not progress, dynamic_ncols=True, smoothing=0.1)
+    try:
+        submit_more()
+        for future in completed:
+            chunk = chunks.pop(future.key)
+            try:
+                outcomes = future.result()
+            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after the retries
+                outcomes = [{"key": s.key, "status": "error", "format": PARTS_FORMAT, "wall_time": float("nan"),
+                             "error": f"{sweep.label}: scenario {s.label}: {one_line(exc)}"} for s in chunk]
+                transient.update(s.key for s in chunk)
+            finally:
+                future.release()
+            batcher.observe(outcomes)
+            for scenario, result in zip(chunk, outcomes):
+                dataset = result.pop("dataset", None)
+                if dataset is not None and histories is not None:
+                    save_run(dataset, histories / history_name(scenario), overwrite=True)
+                if store is not None and scenario.key not in transient:
+                    save_part(store, result)
+                results[scenario.key] = result
+            bar.update(len(chunk))
+            submit_more()
+    except BaseException:
+        for future in list(completed.futures):
+            future.cancel()
+        raise
+    finally:
+        bar.close()
+

@@ -1,0 +1,69 @@
+"""One scenario of a sweep, run on a worker: a model document in, a small dict of peaks out."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from pounding.errors import ModelError, PoundingError
+from pounding.studies.sweep.spec import PARTS_FORMAT, strip_location
+
+__all__ = ["run_scenario", "one_line"]
+
+# --------------------------------------------------------------------------- #
+# One scenario (runs on a worker)
+# --------------------------------------------------------------------------- #
+
+
+def one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text if isinstance(exc, PoundingError) else f"{type(exc).__name__}: {text}"
+
+
+def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
+    """Simulate one scenario and return its peaks (a small dict of plain data).
+
+    Never raises for a problem of the scenario itself: the result then has
+    ``status = "error"`` and the message.  With ``task["keep_history"]`` the
+    full results dataset is returned under ``"dataset"``.
+    """
+    started = time.perf_counter()
+    result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT}
+    try:
+        from pounding.model.model import model_from_text
+        from pounding.simulation import simulate
+
+        try:
+            model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
+        except ModelError as exc:
+            raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
+        ds = simulate(model)
+        result.update({
+            "status": "ok",
+            "storey": [str(x) for x in ds.storey.values],
+            "storey_building": [str(x) for x in ds.storey_building.values],
+            "storey_level": [int(x) for x in ds.storey_level.values],
+            "height": [float(x) for x in ds.height.values],
+            "floor": [str(x) for x in ds.floor.values],
+            "building": [str(x) for x in ds.building.values],
+            "level": [int(x) for x in ds.level.values],
+            "elevation": [float(x) for x in ds.elevation.values],
+            "contact": [str(x) for x in ds.contact.values],
+            "building_left": [str(x) for x in ds.building_left.values],
+            "building_right": [str(x) for x in ds.building_right.values],
+            "level_left": [int(x) for x in ds.level_left.values],
+            "level_right": [int(x) for x in ds.level_right.values],
+            "peak_drift_ratio": [float(x) for x in ds.peak_drift_ratio.values],
+            "peak_displacement": [float(x) for x in ds.peak_displacement.values],
+            "peak_contact_force": [float(x) for x in ds.peak_contact_force.values],
+            "impact_count": [int(x) for x in ds.impact_count.values],
+            "energy_closure_error": float(ds.attrs["energy_closure_error"]),
+            "solver_wall_time": float(ds.attrs["wall_time"]),
+        })
+        if task.get("keep_history"):
+            result["dataset"] = ds
+    except Exception as exc:  # noqa: BLE001 - a failing scenario is a result, not a crash
+        result["error"] = f"{task.get('where', 'scenario')}: {one_line(exc)}"
+    result["wall_time"] = time.perf_counter() - started
+    return result
+
