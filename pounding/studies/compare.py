@@ -20,7 +20,7 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "comparison_table", "differences", "plot_comparison"]
+__all__ = ["compare", "comparison_table", "differences", "plot_comparison", "record_list"]
 
 REFERENCE = "exact"
 
@@ -47,7 +47,8 @@ def _formulas(text: str | list[str], reference: str) -> list[str]:
     return keys
 
 
-def _records(text: str | list[str] | None) -> list[str] | None:
+def record_list(text: str | list[str] | None) -> list[str] | None:
+    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given."""
     from pounding.studies.sweep.spec import expand_records
 
     if text is None:
@@ -82,7 +83,7 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: st
                             "law hertz-damp")
     keys = _formulas(formulas, reference)
     axes: dict[str, Any] = {"xi": keys}
-    listed = _records(records)
+    listed = record_list(records)
     if listed is not None:
         axes["records"] = [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
     document: dict[str, Any] = {"name": f"compare-{Path(path).stem}", "model": path, "axes": axes}

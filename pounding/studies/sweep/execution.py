@@ -58,7 +58,8 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
               scheduler: str | None = None, client: Any = None, keep_histories: str | os.PathLike | None = None,
               overwrite: bool = False, keep_parts: bool = False, progress: bool = True,
               runner: Callable[[dict[str, Any]], dict[str, Any]] = run_scenario,
-              retries: int = 2, task_seconds: float = 0.5, log: Callable[[str], None] | None = None):
+              retries: int = 2, task_seconds: float = 0.5, log: Callable[[str], None] | None = None,
+              assemble: Callable[..., Any] = build_dataset):
     """Run every scenario of *sweep* and return the results dataset.
 
     Parameters
@@ -84,6 +85,10 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
         Show a tqdm progress bar on stderr.
     runner : callable
         The function run on workers for each task (default :func:`run_scenario`).
+    assemble : callable
+        ``assemble(sweep, results, elapsed=, ran=)`` → the dataset that is
+        returned and written (default :func:`build_dataset`); a study with its
+        own runner (``pounding gap``) gives its own layout here.
     retries : int
         Retries of a task whose worker died.
     task_seconds : float
@@ -142,7 +147,7 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
                 if cluster is not None:
                     cluster.close()
     elapsed = time.perf_counter() - started
-    ds = build_dataset(sweep, results, elapsed=elapsed, ran=len(todo))
+    ds = assemble(sweep, results, elapsed=elapsed, ran=len(todo))
     if histories is not None:
         ds.attrs["histories"] = str(histories)
     if target is not None:

