@@ -692,6 +692,11 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 open_imp[c] = n_imp
                 n_imp += 1
                 continue
+            if rate < 0.0:
+                # A tangency located to round-off (δ̇ ~ −1e-17 m/s): a grazing touch, v0 = 0.
+                y[n + lf] -= rate * mass[rf] / (mass[lf] + mass[rf])
+                y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
+                rate = 0.0
             n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
                                     open_imp, mass)
             cmode[c] = contact_laws.onset_mode(claw[c], cprm[c], rate)
