@@ -24,7 +24,7 @@ from pounding.records.load import load_record
 from pounding.model.model import Model, model_from_text
 from pounding.results.archive import open_run
 from pounding.results.dataset import to_dataset
-from pounding.solver.integrator import STATUS_OK, STATUS_STEP_TOO_SMALL, System, integrate
+from pounding.solver.integrator import STATUS_MESSAGES, STATUS_OK, System, integrate
 
 __all__ = ["assemble", "simulate", "record_for", "rerun"]
 
@@ -187,10 +187,9 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
                     output_dt=settings.output_dt)
     wall = _time.perf_counter() - started
-    if raw.status == STATUS_STEP_TOO_SMALL:
-        raise PoundingError(f"the solver's step size fell below round-off at t = {raw.final_time:.6g} s; "
-                            "loosen solver.rtol/atol or check the model for unrealistic stiffness")
-    assert raw.status == STATUS_OK
+    if raw.status != STATUS_OK:
+        # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
+        raise PoundingError(STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     return to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
 
 

@@ -77,6 +77,43 @@ FORCE_SAMPLES = 6
 
 STATUS_OK = 0
 STATUS_STEP_TOO_SMALL = 1  # also the outcome of a non-finite state: such steps are rejected and shrunk
+STATUS_EVENT_LIMIT = 2     # more contact events inside one record step than EVENTS_PER_WINDOW allows
+STATUS_TABLE_LIMIT = 3     # the impact or trace table would exceed its row cap
+#: One-line explanation of every status, for error messages (``{t}``: the time the run stopped, s).
+STATUS_MESSAGES = {
+    STATUS_OK: "completed",
+    STATUS_STEP_TOO_SMALL: ("the solver's step size fell below round-off at t = {t:.6g} s; "
+                            "loosen solver.rtol/atol or check the model for unrealistic stiffness"),
+    STATUS_EVENT_LIMIT: ("more than the allowed number of contact events within one record step at t = {t:.6g} s "
+                         "(an impact sequence that does not end, e.g. chattering contacts); run stopped"),
+    STATUS_TABLE_LIMIT: ("the impact or contact-trace table reached its row cap at t = {t:.6g} s "
+                         "(too many impacts or closed-contact samples); run stopped"),
+}
+
+#: Event cap: a run stops with STATUS_EVENT_LIMIT when more than
+#: ``EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT·nc`` contact events
+#: (closures, separations, mode switches, releases) fall within one record step.
+#: A compliant impact has 2-4 events and lasts at least ~1e-5 s even for kh = 1e14
+#: and 1 kg floors, so 2000 per contact and record step is far above any real
+#: sequence, yet a sequence stuck at one instant reaches it in well under a second.
+EVENTS_PER_WINDOW_BASE = 1000
+EVENTS_PER_WINDOW_PER_CONTACT = 2000
+#: Row caps of the impact table (9 floats a row: 72 MB) and of the trace of closed
+#: contacts (4 floats a row: 256 MB); reaching one ends the run with STATUS_TABLE_LIMIT.
+IMPACT_ROW_LIMIT = 1 << 20
+TRACE_ROW_LIMIT = 1 << 23
+#: Grazing floor: an overlap smaller than this multiple of the round-off of
+#: δ = u_L − u_R − gap (``eps·(|u_L| + |u_R| + gap)``) is indistinguishable from zero and is
+#: not an impact; every larger overlap of the step's interpolant is found exactly.
+DELTA_ROUNDOFF = 8.0 * 2.220446049250313e-16
+#: First step inside a newly closed compliant contact: its duration estimate over this.
+STEPS_PER_CONTACT = 16.0
+#: A located event within this fraction of a step from its end is applied at the end.
+EVENT_END_TOLERANCE = 1e-9
+#: Retakes of one step to bring a located event to its end before it is accepted as is.
+MAX_RETAKES = 8
+# Kinds of contact events.
+EVENT_NONE, EVENT_CLOSE, EVENT_SEPARATE, EVENT_SWITCH0, EVENT_SWITCH1, EVENT_RELEASE = range(6)
 
 
 @dataclass(frozen=True)
@@ -171,8 +208,16 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, out, fbuf, forces):
-    """Time derivative of the state; contact forces are written to *forces*."""
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces):
+    """Time derivative of the state; contact forces are written to *forces*.
+
+    A closed compliant contact acts through its law in its current mode
+    (:func:`pounding.contact.mode_force`).  A persistent (stuck) contact of an
+    instantaneous law is a constraint ``δ̈ = 0``: its force is whatever keeps
+    the two floors moving together, found by Gauss–Seidel sweeps (exact in one
+    sweep when no two stuck contacts share a floor); it may come out tensile,
+    which the solver locates as the release event.
+    """
     n = mass.size
     nc = cgap.size
     # fbuf[:n] accumulates internal + damping forces (N); power is the
@@ -208,22 +253,45 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 acc += dvals[off + i * m + k] * y[n + s0 + k]
             fbuf[s0 + i] += acc
             power += acc * y[n + s0 + i]
+    n_stuck = 0
     for c in range(nc):
         f = 0.0
+        out[2 * n + 2 * nc + c] = 0.0
         if closed[c]:
+            if cmode[c] == contact_laws.MODE_STUCK:
+                n_stuck += 1
+                forces[c] = 0.0
+                continue
             delta = y[cl[c]] - y[cr[c]] - cgap[c]
             rate = y[n + cl[c]] - y[n + cr[c]]
             q = y[2 * n + 2 * nc + c]
-            f = contact_laws.force(claw[c], cprm[c], cconst[c], delta, rate, q)
-            out[2 * n + nc + c] = f * rate
-            out[2 * n + 2 * nc + c] = contact_laws.internal_rate(claw[c], cprm[c], delta, rate, q)
-        else:
-            out[2 * n + nc + c] = 0.0
-            out[2 * n + 2 * nc + c] = 0.0
+            f = contact_laws.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
+            out[2 * n + 2 * nc + c] = contact_laws.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
         forces[c] = f
-        out[2 * n + c] = f
         fbuf[cl[c]] += f
         fbuf[cr[c]] -= f
+    if n_stuck > 0:
+        # Constraint forces of stuck contacts: make δ̈ = 0 (a_g is common to both floors and cancels).
+        for _ in range(100):
+            largest = 0.0
+            scale = 0.0
+            for c in range(nc):
+                if closed[c] and cmode[c] == contact_laws.MODE_STUCK:
+                    lf = cl[c]
+                    rf = cr[c]
+                    relative = fbuf[rf] / mass[rf] - fbuf[lf] / mass[lf]
+                    change = relative / (1.0 / mass[lf] + 1.0 / mass[rf])
+                    forces[c] += change
+                    fbuf[lf] += change
+                    fbuf[rf] -= change
+                    largest = max(largest, abs(change))
+                    scale = max(scale, abs(forces[c]))
+            if largest <= 1e-13 * scale:
+                break
+    for c in range(nc):
+        f = forces[c]
+        out[2 * n + c] = f
+        out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
     e_in_rate = 0.0
     for j in range(n):
         out[j] = y[n + j]
@@ -275,43 +343,123 @@ def _extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> f
     return best
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward: bool) -> float:
-    """Fraction of the step where the Hermite cubic of δ first crosses zero.
+@njit(cache=True)  # with a Python wrapper: tested directly
+def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward: bool,
+                    threshold: float) -> float:
+    """Fraction of the step where the Hermite cubic of δ first crosses into the far side.
 
-    *upward* looks for δ going from ≤ 0 to > 0 (gap closure), otherwise from
-    ≥ 0 to < 0 (separation).  Returns −1 if there is none, 0 if the step
-    already starts on the far side moving further (a residual of an earlier
-    located event).  The root is bracketed on EVENT_SAMPLES sub-intervals and
-    refined by bisection to ~1e-15 of the step; the end of the bracket on the
-    far side is returned, so the retaken step ends just past the event.
+    The far side is ``δ > threshold`` for *upward* (gap closure), ``δ < −threshold``
+    otherwise (separation); *threshold* (m, ≥ 0) is the grazing floor.  An event
+    is a crossing **from the near side**: a step that starts on the far side
+    moving further in (``±r0 > 0``, the residual of an event located just
+    past its instant) returns 0, one that starts on the far side moving back
+    (an open contact still overlapping while it opens, e.g. just after an
+    instantaneous impact) has no event until it has returned to the near side.
+
+    Exact on the interpolant: the cubic is split at its interior stationary
+    points into monotone pieces, so an excursion to the far side of any
+    depth above *threshold* is found, however short; the root in the first
+    piece that ends on the far side is bisected to ~1e-15 of the step and the
+    end of the bracket on the far side is returned (the retaken step ends
+    just past the event).  Returns −1 if there is no event.
     """
     sign = 1.0 if upward else -1.0
-    if sign * d0 > 0.0:
-        if sign * r0 > 0.0:
-            return 0.0
+    f0 = sign * d0 - threshold
+    if f0 > 0.0 and sign * r0 > 0.0:
+        return 0.0
+    # Stationary points of the cubic (roots of its derivative, a quadratic in s).
+    qa = 6.0 * d0 + 3.0 * h * r0 - 6.0 * d1 + 3.0 * h * r1
+    qb = -6.0 * d0 - 4.0 * h * r0 + 6.0 * d1 - 2.0 * h * r1
+    qc = h * r0
+    s_a = 2.0
+    s_b = 2.0
+    if abs(qa) < 1e-300:
+        if abs(qb) > 1e-300:
+            s_a = -qc / qb
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
+            s_a = q / qa
+            s_b = qc / q if q != 0.0 else 2.0
+    if s_a > s_b:
+        s_a, s_b = s_b, s_a
+    near = f0 <= 0.0
+    lo = 0.0
+    for piece in range(3):
+        if piece == 0:
+            hi = s_a
+        elif piece == 1:
+            hi = s_b
+        else:
+            hi = 1.0
+        if not (lo < hi < 1.0) and piece < 2:
+            continue
+        f_hi = sign * (d1 if hi == 1.0 else _hermite(d0, r0, d1, r1, h, hi)) - threshold
+        if near and f_hi > 0.0:
+            a = lo
+            b = hi
+            for _ in range(80):
+                mid = 0.5 * (a + b)
+                if sign * _hermite(d0, r0, d1, r1, h, mid) - threshold > 0.0:
+                    b = mid
+                else:
+                    a = mid
+                if b - a < 1e-15:
+                    break
+            return b
+        if f_hi <= 0.0:
+            near = True
+        lo = hi
+    return -1.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _switch_crossing(claw, prm, const, mode, which, gap, yl0, vl0, yl1, vl1, al0, al1,
+                     yr0, vr0, yr1, vr1, ar0, ar1, q0, qr0, q1, qr1, h) -> float:
+    """Fraction of the step where switch function *which* of a closed contact's mode turns negative.
+
+    The function (:func:`pounding.contact.switch_value`) is evaluated on the
+    interpolants of δ, δ̇ and the internal state at EVENT_SAMPLES points; a
+    sign change from ≥ 0 to < 0 is bisected to ~1e-15 of the step and the end
+    of the bracket past the switch returned.  A mode entered at a located
+    switch starts with its function at 0 (round-off either side): the search
+    only counts a crossing after the function has been ≥ 0 in this step.
+    Returns −1 if there is none.
+    """
+    d = _hermite(yl0, vl0, yl1, vl1, h, 0.0) - _hermite(yr0, vr0, yr1, vr1, h, 0.0) - gap
+    g = contact_laws.switch_value(claw, prm, const, mode, which, d, vl0 - vr0, q0)
+    been_positive = g > 0.0
     prev_s = 0.0
     for i in range(1, EVENT_SAMPLES + 1):
         s = i / EVENT_SAMPLES
-        d = d1 if i == EVENT_SAMPLES else _hermite(d0, r0, d1, r1, h, s)
-        if sign * d > 0.0:
+        d = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
+        rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
+        g = contact_laws.switch_value(claw, prm, const, mode, which, d, rate, _hermite(q0, qr0, q1, qr1, h, s))
+        if g < 0.0 and been_positive:
             lo = prev_s
             hi = s
-            for _ in range(60):
+            for _ in range(80):
                 mid = 0.5 * (lo + hi)
-                if sign * _hermite(d0, r0, d1, r1, h, mid) > 0.0:
+                d = _hermite(yl0, vl0, yl1, vl1, h, mid) - _hermite(yr0, vr0, yr1, vr1, h, mid) - gap
+                rate = _hermite(vl0, al0, vl1, al1, h, mid) - _hermite(vr0, ar0, vr1, ar1, h, mid)
+                gm = contact_laws.switch_value(claw, prm, const, mode, which, d, rate,
+                                               _hermite(q0, qr0, q1, qr1, h, mid))
+                if gm < 0.0:
                     hi = mid
                 else:
                     lo = mid
                 if hi - lo < 1e-15:
                     break
             return hi
+        if g > 0.0:
+            been_positive = True
         prev_s = s
     return -1.0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
+def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0, al1,
                             yr0, vr0, yr1, vr1, ar0, ar1, q0, qr0, q1, qr1, h, fractions, deltas,
                             values) -> float:
     """Sample a closed contact over a step on the interpolant; return its peak force.
@@ -326,7 +474,7 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
         s = i / FORCE_SAMPLES
         delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
         rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-        f = contact_laws.force(claw, prm, const, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
+        f = contact_laws.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
         fractions[i] = s
         deltas[i] = delta
         values[i] = f
@@ -341,7 +489,7 @@ def _closed_contact_samples(claw, prm, const, gap, yl0, vl0, yl1, vl1, al0, al1,
             s = (best_i + offset) / FORCE_SAMPLES
             delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
             rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-            f = contact_laws.force(claw, prm, const, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
+            f = contact_laws.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
             if f > best:
                 best = f
     return best
@@ -364,14 +512,15 @@ def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _grown(table, rows, needed):
+def _grown(table, rows, needed, limit):
     """*table* if it has *needed* rows; else a copy of its first *rows* rows, NaN-padded to twice that.
 
+    Never more than *limit* rows (the caller checks ``needed <= limit``).
     Written as loops: numba's slice assignment and np.full add seconds of compilation.
     """
     if needed <= table.shape[0]:
         return table
-    bigger = np.empty((2 * needed, table.shape[1]))
+    bigger = np.empty((max(needed, min(2 * needed, limit)), table.shape[1]))
     for i in range(bigger.shape[0]):
         for j in range(table.shape[1]):
             bigger[i, j] = table[i, j] if i < rows else np.nan
@@ -448,6 +597,126 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     return n_imp
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _plastic_jump(c, y, n, cl, cr, mass):
+    """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
+
+    The impulse and its work (the energy lost, ½·m_eff·v0²) are added to the
+    contact's energy-audit states.
+    """
+    nc = (y.size - 2 * n - 2) // 3
+    lf = cl[c]
+    rf = cr[c]
+    v0 = y[n + lf] - y[n + rf]
+    impulse = mass[lf] * mass[rf] / (mass[lf] + mass[rf]) * v0
+    y[n + lf] -= impulse / mass[lf]
+    y[n + rf] += impulse / mass[rf]
+    y[2 * n + c] += impulse
+    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf]))
+    return impulse
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
+                  impacts, n_imp, open_imp):
+    """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
+
+    * Closure of a compliant contact: ξ (or the law's constant) from
+      ``v0 = δ̇``, the law's onset mode, a new impact row.
+    * Closure of an instantaneous (stereo-mechanical) contact: the velocity
+      jump with restitution e — unless ``v0`` is at most the law's rest
+      velocity and the floors are being pressed together (the constraint
+      force after a plastic impact is compressive): that is the
+      accumulation point of an impact sequence, and the contact becomes
+      **persistent** (a plastic impact, then a stuck contact that moves the
+      two floors together until its force would turn tensile).  The impact
+      row stays open while stuck.
+    * Separation (δ back to 0) or release of a stuck contact (its force
+      turning tensile): the impact row is closed.
+    * Mode switch: the next mode of the law, internal state put on its branch.
+
+    Returns ``(impacts, n_imp, n_applied, first_step_cap, status)``;
+    *first_step_cap* (s) is the duration estimate of the shortest newly
+    closed compliant contact over STEPS_PER_CONTACT (inf if none).
+    """
+    n = mass.size
+    nc = cgap.size
+    iq = 2 * n + 2 * nc
+    n_applied = 0
+    cap = np.inf
+    status = 0
+    for c in range(nc):
+        kind = kinds[c]
+        if kind == EVENT_NONE:
+            continue
+        n_applied += 1
+        lf = cl[c]
+        rf = cr[c]
+        rate = y[n + lf] - y[n + rf]
+        if kind == EVENT_CLOSE:
+            if n_imp + 1 > IMPACT_ROW_LIMIT:
+                status = STATUS_TABLE_LIMIT
+                break
+            impacts = _grown(impacts, n_imp, n_imp + 1, n_imp - n_imp + IMPACT_ROW_LIMIT)
+            if contact_laws.is_instantaneous(claw[c]):
+                if rate <= 0.0:
+                    n_applied -= 1  # touching without approach: no impact
+                    continue
+                stick = False
+                if rate <= contact_laws.rest_velocity(claw[c], cprm[c]):
+                    for i in range(y.size):
+                        scratch[i] = y[i]
+                    _plastic_jump(c, scratch, n, cl, cr, mass)
+                    closed[c] = True
+                    cmode[c] = contact_laws.MODE_STUCK
+                    _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces)
+                    stick = forces[c] > 0.0
+                    closed[c] = False
+                    cmode[c] = 0
+                if not stick:
+                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+                    continue
+                impacts[n_imp, IMP_CONTACT] = c
+                impacts[n_imp, IMP_TIME] = t
+                impacts[n_imp, IMP_VELOCITY] = rate
+                impacts[n_imp, IMP_CONSTANT] = np.nan
+                impacts[n_imp, IMP_PEAK_FORCE] = 0.0
+                impacts[n_imp, IMP_IMPULSE] = y[2 * n + c]
+                impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]
+                _plastic_jump(c, y, n, cl, cr, mass)
+                closed[c] = True
+                cmode[c] = contact_laws.MODE_STUCK
+                cconst[c] = 0.0
+                open_imp[c] = n_imp
+                n_imp += 1
+                continue
+            if rate < 0.0:
+                # A tangency located to round-off (δ̇ ~ −1e-17 m/s): a grazing touch, v0 = 0.
+                y[n + lf] -= rate * mass[rf] / (mass[lf] + mass[rf])
+                y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
+                rate = 0.0
+            n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
+                                    open_imp, mass)
+            cmode[c] = contact_laws.onset_mode(claw[c], cprm[c], rate)
+            m_eff = mass[lf] * mass[rf] / (mass[lf] + mass[rf])
+            duration = contact_laws.contact_duration(claw[c], cprm[c], rate, m_eff)
+            if duration > 0.0:
+                cap = min(cap, duration / STEPS_PER_CONTACT)
+        elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
+            n_imp = _switch_contact(c, False, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
+                                    open_imp, mass)
+            cmode[c] = 0
+        else:
+            which = kind - EVENT_SWITCH0
+            new_mode = contact_laws.next_mode(claw[c], cmode[c], which)
+            delta = y[lf] - y[rf] - cgap[c]
+            y[iq + c] = contact_laws.snapped_internal(claw[c], cprm[c], new_mode, delta, y[iq + c])
+            cmode[c] = new_mode
+    return impacts, n_imp, n_applied, cap, status
+
+
 # --------------------------------------------------------------------------- #
 # The integrator
 # --------------------------------------------------------------------------- #
@@ -482,6 +751,14 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     forces = np.zeros(nc)
     closed = np.zeros(nc, dtype=np.bool_)
     cconst = np.zeros(nc)
+    cmode = np.zeros(nc, dtype=np.int64)  # mode of each closed contact (pounding.contact.MODE_*)
+    event_s = np.empty(nc)                # fraction of the step where each contact's next event lies
+    event_kind = np.zeros(nc, dtype=np.int64)
+    pending = np.zeros(nc, dtype=np.int64)  # events the current (retaken) step was shortened to end at
+    forces_end = np.zeros(nc)
+    internal_tol = np.empty(nc)
+    for c in range(nc):
+        internal_tol[c] = contact_laws.internal_tolerance(claw[c], cprm[c], atol_u)
 
     out_time = np.empty(n_out)
     out_state = np.empty((n_out, S))
@@ -494,7 +771,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     peak_drift = np.zeros(n)
     peak_force = np.zeros(nc)
 
-    impacts = _grown(np.empty((zero, zero + 9)), zero, zero + 64)  # NaN-filled
+    impacts = _grown(np.empty((zero, zero + 9)), zero, zero + 64, zero + IMPACT_ROW_LIMIT)  # NaN-filled
     n_imp = zero
     # Full-resolution trace of closed contacts: time, contact, penetration, force.
     trace = np.empty((zero + 1024, zero + 4))
@@ -509,7 +786,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     t = 0.0
     seg = zero
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces)
     # First output sample at t = 0.
     out_time[0] = 0.0
     for i in range(S):
@@ -527,6 +804,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     n_rej = 0
     status = 0
     tiny = 1e-12 * max(dt_rec, 1.0)
+    event_cap = EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
+    window_start = 0.0
+    window_events = zero
 
     while t < t_end - tiny and i_out <= n_out:
         while (seg + 1) * dt_rec <= t + 1e-9 * dt_rec:
@@ -536,39 +816,42 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         h_try = h
         if h_try >= room or t + 1.01 * h_try >= seg_end:
             h_try = room
-        event_c = zero - 1
-        event_upward = zero < 0
+        h_before_events = h_try  # the error-controlled size a located event shortens
+        rejected = False
+        n_retake = zero
+        for c in range(nc):
+            pending[c] = EVENT_NONE
         while True:
             if h_try < 1e-14 * max(1.0, t):
-                status = 1
+                status = STATUS_STEP_TOO_SMALL
                 break
             # ---- Dormand–Prince stages -----------------------------------
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k2, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k3, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k4, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k5, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k6, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, k7, fbuf, forces)
-            # ---- error norm (max norm over displacements and velocities) --
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces)
+            # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
             for i in range(2 * n):
@@ -580,44 +863,112 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     break
                 if r > err:
                     err = r
-            if not finite:
+            for c in range(nc):
+                if internal_tol[c] > 0.0 and finite:
+                    i = iq + c
+                    e = h_try * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+                    r = abs(e) / (internal_tol[c] + rtol * max(abs(y[i]), abs(ynew[i])))
+                    if not (r < 1e300):
+                        finite = False
+                    elif r > err:
+                        err = r
+            if not finite or err > 1.0:
                 n_rej += 1
-                h_try *= MIN_FACTOR
-                event_c = zero - 1
-                continue
-            if err > 1.0:
-                n_rej += 1
-                h_try *= max(MIN_FACTOR, SAFETY * err ** -0.2)
-                event_c = zero - 1
-                continue
-            # ---- contact events inside the accepted step -------------------
-            if event_c < 0:
-                s_first = 2.0
+                rejected = True
+                h_try *= MIN_FACTOR if not finite else max(MIN_FACTOR, SAFETY * err ** -0.2)
+                h_before_events = h_try
+                n_retake = zero
                 for c in range(nc):
-                    lf = cl[c]
-                    rf = cr[c]
-                    d0 = y[lf] - y[rf] - cgap[c]
-                    r0 = y[n + lf] - y[n + rf]
-                    d1 = ynew[lf] - ynew[rf] - cgap[c]
-                    r1 = ynew[n + lf] - ynew[n + rf]
-                    s = _first_crossing(d0, r0, d1, r1, h_try, not closed[c])
-                    if s >= 0.0 and s < s_first:
+                    pending[c] = EVENT_NONE
+                continue
+            for c in range(nc):
+                forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
+            # ---- contact events inside the step ------------------------------
+            s_first = 2.0
+            for c in range(nc):
+                event_s[c] = -1.0
+                event_kind[c] = EVENT_NONE
+                lf = cl[c]
+                rf = cr[c]
+                d0 = y[lf] - y[rf] - cgap[c]
+                r0 = y[n + lf] - y[n + rf]
+                d1 = ynew[lf] - ynew[rf] - cgap[c]
+                r1 = ynew[n + lf] - ynew[n + rf]
+                floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
+                s = -1.0
+                kind = EVENT_NONE
+                if not closed[c]:
+                    s = _first_crossing(d0, r0, d1, r1, h_try, True, floor)
+                    kind = EVENT_CLOSE
+                elif cmode[c] == contact_laws.MODE_STUCK:
+                    kind = EVENT_RELEASE
+                    if forces_end[c] < 0.0:
+                        # The constraint force turns tensile inside the step: bisect on the interpolant.
+                        lo = 0.0
+                        hi = 1.0
+                        for _ in range(60):
+                            mid = 0.5 * (lo + hi)
+                            for i in range(S):
+                                ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
+                            _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
+                                 dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
+                                 fbuf, forces)
+                            if forces[c] < 0.0:
+                                hi = mid
+                            else:
+                                lo = mid
+                            if hi - lo < 1e-13:
+                                break
+                        s = hi
+                else:
+                    s = _first_crossing(d0, r0, d1, r1, h_try, False, floor)
+                    kind = EVENT_SEPARATE
+                    for which in range(contact_laws.switch_count(claw[c], cprm[c])):
+                        sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
+                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
+                                              y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
+                                              y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_try)
+                        if sw >= 0.0 and (s < 0.0 or sw < s):
+                            s = sw
+                            kind = EVENT_SWITCH0 + which
+                if s >= 0.0:
+                    event_s[c] = s
+                    event_kind[c] = kind
+                    if s < s_first:
                         s_first = s
-                        event_c = c
-                        event_upward = not closed[c]
-                if event_c >= 0 and s_first < 1.0 - 1e-12:
-                    h_event = s_first * h_try
-                    if h_event <= tiny:
-                        # The event is at the start of the step: switch now, redo the step.
-                        impacts = _grown(impacts, n_imp, n_imp + 1)
-                        n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
-                                                closed, cconst, impacts, n_imp, open_imp, mass)
-                        _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                             dvals, cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
-                        event_c = zero - 1
-                        continue
-                    h_try = h_event
-                    continue  # retake the step to end at the event
+            if s_first <= 1.0 and s_first * h_try <= tiny:
+                # Events at the very start of the step: apply them at t and redo the step.
+                for c in range(nc):
+                    if event_kind[c] != EVENT_NONE and event_s[c] * h_try > tiny:
+                        event_kind[c] = EVENT_NONE
+                impacts, n_imp, n_applied, cap, status = _apply_events(
+                    event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
+                    doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
+                    impacts, n_imp, open_imp)
+                if t - window_start > dt_rec:
+                    window_start = t
+                    window_events = zero
+                window_events += n_applied
+                if window_events > event_cap:
+                    status = STATUS_EVENT_LIMIT
+                if status != 0:
+                    break
+                _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
+                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces)
+                if cap < h_try:
+                    h_try = cap
+                    h_before_events = cap
+                for c in range(nc):
+                    pending[c] = EVENT_NONE
+                n_retake = zero
+                continue
+            if s_first < 1.0 - EVENT_END_TOLERANCE and n_retake < MAX_RETAKES:
+                # Retake the step to end at the first event; the retaken step is searched again.
+                for c in range(nc):
+                    pending[c] = event_kind[c] if event_kind[c] != EVENT_NONE and event_s[c] <= s_first else EVENT_NONE
+                h_try = s_first * h_try
+                n_retake += 1
+                continue
             break
         if status != 0:
             break
@@ -651,15 +1002,25 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if v > peak_drift[j]:
                     peak_drift[j] = v
         for c in range(nc):
-            if closed[c]:
+            if closed[c] and cmode[c] == contact_laws.MODE_STUCK:
+                fpk = forces_end[c]
+                if fpk > peak_force[c]:
+                    peak_force[c] = fpk
+                row = open_imp[c]
+                if row >= 0 and fpk > impacts[row, IMP_PEAK_FORCE]:
+                    impacts[row, IMP_PEAK_FORCE] = fpk
+            elif closed[c]:
                 lf = cl[c]
                 rf = cr[c]
-                fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cgap[c],
+                fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
                                               y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf],
                                               k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
                                               k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
-                trace = _grown(trace, n_trace, n_trace + FORCE_SAMPLES + 1)
+                if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
+                    status = STATUS_TABLE_LIMIT
+                    break
+                trace = _grown(trace, n_trace, n_trace + FORCE_SAMPLES + 1, zero + TRACE_ROW_LIMIT)
                 for i in range(FORCE_SAMPLES + 1):
                     if i == 0 and n_trace > 0 and trace[n_trace - 1, 1] == c and trace[n_trace - 1, 0] == t:
                         continue  # the previous step already recorded its end point
@@ -673,6 +1034,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 row = open_imp[c]
                 if row >= 0 and fpk > impacts[row, IMP_PEAK_FORCE]:
                     impacts[row, IMP_PEAK_FORCE] = fpk
+        if status != 0:
+            break
         # ---- output samples inside (t, t_new] ------------------------------
         while i_out < n_out and i_out * output_dt <= t_new + 1e-9 * output_dt:
             t_o = i_out * output_dt
@@ -683,7 +1046,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, k2, fbuf, forces)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -700,15 +1063,31 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             y[i] = ynew[i]
             k1[i] = k7[i]
         n_steps += 1
-        if event_c >= 0:
-            impacts = _grown(impacts, n_imp, n_imp + 1)
-            n_imp = _switch_contact(event_c, event_upward, t, y, n, cl, cr, claw, cprm,
-                                    closed, cconst, impacts, n_imp, open_imp, mass)
+        # Events at the step's end: those the retaken step was shortened to, and any other found there.
+        for c in range(nc):
+            if event_kind[c] == EVENT_NONE:
+                event_kind[c] = pending[c]
+        impacts, n_imp, n_applied, cap, status = _apply_events(
+            event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+            cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp)
+        if n_applied > 0:
+            if t - window_start > dt_rec:
+                window_start = t
+                window_events = zero
+            window_events += n_applied
+            if window_events > event_cap:
+                status = STATUS_EVENT_LIMIT
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, k1, fbuf, forces)
-            # Keep the step size the controller had before the event cut it short.
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces)
+            # The step the controller accepted before the event cut it short; a newly closed
+            # compliant contact starts at a fraction of its duration estimate instead.
+            h = min(h_before_events, cap)
+            if status != 0:
+                break
         else:
             factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err ** -0.2)
+            if rejected:
+                factor = min(factor, 1.0)  # no growth right after a rejection (Hairer et al. §II.4)
             h = h_used * factor
     # Impacts still open at the end: impulse so far, no end.
     for c in range(nc):
@@ -725,7 +1104,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, k2, fbuf, forces)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
@@ -736,7 +1115,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
 
 
-# The kernels inline contact.py's force laws: their cached code is stale when either file changes.
+# The kernels inline contact/laws.py's force laws: their cached code is stale when either file changes.
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
                               [__file__, contact_laws.__file__])
 jit.load_from_cache_without_refresh(_integrate)
