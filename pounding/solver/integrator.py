@@ -52,6 +52,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws as contact_laws
+from pounding.solver import kernels
 from pounding.solver import jit
 
 
@@ -258,15 +259,15 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         f = 0.0
         out[2 * n + 2 * nc + c] = 0.0
         if closed[c]:
-            if cmode[c] == contact_laws.MODE_STUCK:
+            if cmode[c] == kernels.MODE_STUCK:
                 n_stuck += 1
                 forces[c] = 0.0
                 continue
             delta = y[cl[c]] - y[cr[c]] - cgap[c]
             rate = y[n + cl[c]] - y[n + cr[c]]
             q = y[2 * n + 2 * nc + c]
-            f = contact_laws.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
-            out[2 * n + 2 * nc + c] = contact_laws.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
+            f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
+            out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
         forces[c] = f
         fbuf[cl[c]] += f
         fbuf[cr[c]] -= f
@@ -276,7 +277,7 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             largest = 0.0
             scale = 0.0
             for c in range(nc):
-                if closed[c] and cmode[c] == contact_laws.MODE_STUCK:
+                if closed[c] and cmode[c] == kernels.MODE_STUCK:
                     lf = cl[c]
                     rf = cr[c]
                     relative = fbuf[rf] / mass[rf] - fbuf[lf] / mass[lf]
@@ -428,14 +429,14 @@ def _switch_crossing(claw, prm, const, mode, which, gap, yl0, vl0, yl1, vl1, al0
     Returns −1 if there is none.
     """
     d = _hermite(yl0, vl0, yl1, vl1, h, 0.0) - _hermite(yr0, vr0, yr1, vr1, h, 0.0) - gap
-    g = contact_laws.switch_value(claw, prm, const, mode, which, d, vl0 - vr0, q0)
+    g = kernels.switch_value(claw, prm, const, mode, which, d, vl0 - vr0, q0)
     been_positive = g > 0.0
     prev_s = 0.0
     for i in range(1, EVENT_SAMPLES + 1):
         s = i / EVENT_SAMPLES
         d = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
         rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-        g = contact_laws.switch_value(claw, prm, const, mode, which, d, rate, _hermite(q0, qr0, q1, qr1, h, s))
+        g = kernels.switch_value(claw, prm, const, mode, which, d, rate, _hermite(q0, qr0, q1, qr1, h, s))
         if g < 0.0 and been_positive:
             lo = prev_s
             hi = s
@@ -443,7 +444,7 @@ def _switch_crossing(claw, prm, const, mode, which, gap, yl0, vl0, yl1, vl1, al0
                 mid = 0.5 * (lo + hi)
                 d = _hermite(yl0, vl0, yl1, vl1, h, mid) - _hermite(yr0, vr0, yr1, vr1, h, mid) - gap
                 rate = _hermite(vl0, al0, vl1, al1, h, mid) - _hermite(vr0, ar0, vr1, ar1, h, mid)
-                gm = contact_laws.switch_value(claw, prm, const, mode, which, d, rate,
+                gm = kernels.switch_value(claw, prm, const, mode, which, d, rate,
                                                _hermite(q0, qr0, q1, qr1, h, mid))
                 if gm < 0.0:
                     hi = mid
@@ -474,7 +475,7 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
         s = i / FORCE_SAMPLES
         delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
         rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-        f = contact_laws.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
+        f = kernels.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
         fractions[i] = s
         deltas[i] = delta
         values[i] = f
@@ -489,7 +490,7 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
             s = (best_i + offset) / FORCE_SAMPLES
             delta = _hermite(yl0, vl0, yl1, vl1, h, s) - _hermite(yr0, vr0, yr1, vr1, h, s) - gap
             rate = _hermite(vl0, al0, vl1, al1, h, s) - _hermite(vr0, ar0, vr1, ar1, h, s)
-            f = contact_laws.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
+            f = kernels.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
             if f > best:
                 best = f
     return best
@@ -502,7 +503,7 @@ def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
     total = 0.0
     for c in range(nc):
         delta = y[cl[c]] - y[cr[c]] - cgap[c]
-        total += contact_laws.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
+        total += kernels.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
     return total
 
 
@@ -541,7 +542,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     lf = cl[c]
     rf = cr[c]
     v0 = y[n + lf] - y[n + rf]
-    impulse = contact_laws.jump_impulse(claw[c], cprm[c], v0)
+    impulse = kernels.jump_impulse(claw[c], cprm[c], v0)
     y[n + lf] -= impulse / mass[lf]
     y[n + rf] += impulse / mass[rf]
     v_after = y[n + lf] - y[n + rf]
@@ -571,11 +572,11 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     rate = y[n + cl[c]] - y[n + cr[c]]
     nc = closed.size
     if upward:
-        if contact_laws.is_instantaneous(claw[c]):
+        if kernels.is_instantaneous(claw[c]):
             return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
         closed[c] = True
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
-        cconst[c] = contact_laws.onset_constant(claw[c], cprm[c], rate)
+        cconst[c] = kernels.onset_constant(claw[c], cprm[c], rate)
         impacts[n_imp, IMP_CONTACT] = c
         impacts[n_imp, IMP_TIME] = t
         impacts[n_imp, IMP_VELOCITY] = rate
@@ -659,17 +660,17 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 status = STATUS_TABLE_LIMIT
                 break
             impacts = _grown(impacts, n_imp, n_imp + 1, n_imp - n_imp + IMPACT_ROW_LIMIT)
-            if contact_laws.is_instantaneous(claw[c]):
+            if kernels.is_instantaneous(claw[c]):
                 if rate <= 0.0:
                     n_applied -= 1  # touching without approach: no impact
                     continue
                 stick = False
-                if rate <= contact_laws.rest_velocity(claw[c], cprm[c]):
+                if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
                         scratch[i] = y[i]
                     _plastic_jump(c, scratch, n, cl, cr, mass)
                     closed[c] = True
-                    cmode[c] = contact_laws.MODE_STUCK
+                    cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                          cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces)
                     stick = forces[c] > 0.0
@@ -687,7 +688,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]
                 _plastic_jump(c, y, n, cl, cr, mass)
                 closed[c] = True
-                cmode[c] = contact_laws.MODE_STUCK
+                cmode[c] = kernels.MODE_STUCK
                 cconst[c] = 0.0
                 open_imp[c] = n_imp
                 n_imp += 1
@@ -699,9 +700,9 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 rate = 0.0
             n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
                                     open_imp, mass)
-            cmode[c] = contact_laws.onset_mode(claw[c], cprm[c], rate)
+            cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
             m_eff = mass[lf] * mass[rf] / (mass[lf] + mass[rf])
-            duration = contact_laws.contact_duration(claw[c], cprm[c], rate, m_eff)
+            duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
                 cap = min(cap, duration / STEPS_PER_CONTACT)
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
@@ -710,9 +711,9 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
             cmode[c] = 0
         else:
             which = kind - EVENT_SWITCH0
-            new_mode = contact_laws.next_mode(claw[c], cmode[c], which)
+            new_mode = kernels.next_mode(claw[c], cmode[c], which)
             delta = y[lf] - y[rf] - cgap[c]
-            y[iq + c] = contact_laws.snapped_internal(claw[c], cprm[c], new_mode, delta, y[iq + c])
+            y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
 
@@ -758,7 +759,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     forces_end = np.zeros(nc)
     internal_tol = np.empty(nc)
     for c in range(nc):
-        internal_tol[c] = contact_laws.internal_tolerance(claw[c], cprm[c], atol_u)
+        internal_tol[c] = kernels.internal_tolerance(claw[c], cprm[c], atol_u)
 
     out_time = np.empty(n_out)
     out_state = np.empty((n_out, S))
@@ -900,7 +901,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if not closed[c]:
                     s = _first_crossing(d0, r0, d1, r1, h_try, True, floor)
                     kind = EVENT_CLOSE
-                elif cmode[c] == contact_laws.MODE_STUCK:
+                elif cmode[c] == kernels.MODE_STUCK:
                     kind = EVENT_RELEASE
                     if forces_end[c] < 0.0:
                         # The constraint force turns tensile inside the step: bisect on the interpolant.
@@ -923,7 +924,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 else:
                     s = _first_crossing(d0, r0, d1, r1, h_try, False, floor)
                     kind = EVENT_SEPARATE
-                    for which in range(contact_laws.switch_count(claw[c], cprm[c])):
+                    for which in range(kernels.switch_count(claw[c], cprm[c])):
                         sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
                                               y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
                                               y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
@@ -1002,7 +1003,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if v > peak_drift[j]:
                     peak_drift[j] = v
         for c in range(nc):
-            if closed[c] and cmode[c] == contact_laws.MODE_STUCK:
+            if closed[c] and cmode[c] == kernels.MODE_STUCK:
                 fpk = forces_end[c]
                 if fpk > peak_force[c]:
                     peak_force[c] = fpk
@@ -1115,9 +1116,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
 
 
-# The kernels inline contact/laws.py's force laws: their cached code is stale when either file changes.
+# The integrator inlines the kernels, and they inline the law ids and sizes of contact/laws.py:
+# its cached code is stale when any of the three files changes.
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
-                              [__file__, contact_laws.__file__])
+                              [__file__, kernels.__file__, contact_laws.__file__])
 jit.load_from_cache_without_refresh(_integrate)
 
 

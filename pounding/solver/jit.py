@@ -12,7 +12,7 @@ safe:
   which only compiling needs;
 * :func:`stamp_caches_with_sources` — a cached kernel is keyed on *every*
   source file compiled into it, not only its own: numba keys a cache entry
-  on the function's file alone, so editing ``contact.py`` (a new contact
+  on the function's file alone, so editing ``contact/laws.py`` or ``solver/kernels.py`` (a new contact
   law, a changed force) would otherwise leave the solver running the old
   contact kernels it inlined.
 

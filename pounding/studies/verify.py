@@ -24,18 +24,18 @@ Procedure (one call of :func:`ball_drop`)
    surface is a body of practically infinite mass, so every law that needs an
    effective mass gets ``m_eff = m·1e30/(m + 1e30) = m`` exactly in double
    precision.  The per-impact constant (ξ for Hertz-damp) is fixed once from
-   ``v0`` by :func:`pounding.contact.onset_constant`, exactly as the building
+   ``v0`` by :func:`pounding.solver.kernels.onset_constant`, exactly as the building
    solver does at a located closure.
 3. The contact phase is integrated with the compiled kernel
-   :func:`pounding.contact.force`; the bilinear law's internal state ``q``
+   :func:`pounding.solver.kernels.force`; the bilinear law's internal state ``q``
    (its hysteretic force, 0 at closure) is an extra ODE state advanced by
-   :func:`pounding.contact.internal_rate`.  The maximum penetration
+   :func:`pounding.solver.kernels.internal_rate`.  The maximum penetration
    (``δ̇ = 0``) and the separation (``δ`` back to 0 while rebounding) are
    located as events.  Tolerances: rtol 1e-12, atol 1e-12 times the scale of
    each state (Hertz ``δmax``, ``v0``, ``kh·δmax^1.5``) — i.e. ~4e-16 m on
    the penetration, finer than the ~1e-14 m an absolute 1e-14 would give.
 4. The stereo-mechanical model has no contact phase: ``e_post`` comes from
-   :func:`pounding.contact.jump_impulse`, the same velocity jump the solver
+   :func:`pounding.solver.kernels.jump_impulse`, the same velocity jump the solver
    applies (``e_post = e_pre`` identically).
 
 Models (keys)
@@ -78,6 +78,7 @@ import numpy as np
 import xarray as xr
 
 from pounding.contact import laws as contact
+from pounding.solver import kernels
 from pounding.contact import xi as xi_formulas
 from pounding.errors import PoundingError, did_you_mean
 
@@ -251,18 +252,18 @@ def ball_drop(model_key: str, e_pre: float, *, mass: float = 0.5, height: float 
     prm = law.kernel_parameters(mass, RIGID_MASS)
     law_id = law.law_id
 
-    if contact.is_instantaneous(law_id):
-        impulse = contact.jump_impulse(law_id, prm, v0)
+    if kernels.is_instantaneous(law_id):
+        impulse = kernels.jump_impulse(law_id, prm, v0)
         rebound = impulse / mass - v0  # velocity after the jump is v0 − impulse/m (downward positive)
         return _result(e_pre, rebound / v0, v0, 0.0, 0.0)
 
-    constant = contact.onset_constant(law_id, prm, v0)
+    constant = kernels.onset_constant(law_id, prm, v0)
     g = float(gravity)
 
     def rhs(t, state):
         delta, rate, q = state
-        f = contact.force(law_id, prm, constant, delta, rate, q)
-        return [rate, g - f / mass, contact.internal_rate(law_id, prm, delta, rate, q)]
+        f = kernels.force(law_id, prm, constant, delta, rate, q)
+        return [rate, g - f / mass, kernels.internal_rate(law_id, prm, delta, rate, q)]
 
     def separation(t, state):
         return state[0]

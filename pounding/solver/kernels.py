@@ -1,0 +1,317 @@
+"""Compiled contact-law kernels: force, internal rates, modes and switches of every registered law.
+
+The law classes (parameters, citations, packing into ``prm``) are in
+:mod:`pounding.contact.laws`; these are their numba kernels, one branch per
+law, inlined by the integrator (:mod:`pounding.solver.integrator`).  No
+Python objects inside.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numba.core.dispatcher import Dispatcher
+
+from pounding.contact import laws
+from pounding.solver import jit
+from pounding.contact.laws import LAW_BILINEAR, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_JANKOWSKI, LAW_KELVIN, LAW_LINEAR, LAW_STEREO, MIN_IMPACT_VELOCITY
+
+
+# --------------------------------------------------------------------------- #
+# Compiled kernels.  One branch per law; no Python objects inside.
+# --------------------------------------------------------------------------- #
+
+
+@njit(cache=True)
+def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
+    """Per-impact constant fixed at the located gap closure (ξ for Hertz-damp)."""
+    if law_id == LAW_HERTZ_DAMP:
+        return prm[1] * prm[0] / max(v0, prm[2])
+    return 0.0
+
+
+@njit(cache=True)
+def is_instantaneous(law_id: int) -> bool:
+    """True for laws applied as a velocity jump at closure (stereo-mechanical)."""
+    return law_id == LAW_STEREO
+
+
+@njit(cache=True)
+def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
+    """Impulse (N·s) of an instantaneous law for approach velocity *v0*: (1+e)·m_eff·v0."""
+    if law_id == LAW_STEREO:
+        return (1.0 + prm[0]) * prm[1] * v0
+    return 0.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
+def _bilinear_bounds(prm: np.ndarray, delta: float) -> tuple:
+    """Lower (K2·δ) and upper (K1·δy + K2·(δ − δy)) envelopes of the bilinear loop, N."""
+    k1, k2, dy = prm[0], prm[1], prm[2]
+    upper = k1 * delta if delta <= dy else k1 * dy + k2 * (delta - dy)
+    return k2 * delta, upper
+
+
+@njit(cache=True)
+def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
+          delta_rate: float, q: float) -> float:
+    """Contact force (N) for penetration *delta* (m), its rate (m/s) and internal state *q*."""
+    if delta <= 0.0:
+        return 0.0
+    if law_id == LAW_HERTZ_DAMP:
+        d15 = delta * math.sqrt(delta)
+        f = d15 * (prm[0] + impact_constant * delta_rate)
+        if prm[3] == 0.0 and f < 0.0:
+            return 0.0
+        return f
+    if law_id == LAW_HERTZ:
+        return prm[0] * delta * math.sqrt(delta)
+    if law_id == LAW_LINEAR:
+        return prm[0] * delta
+    if law_id == LAW_KELVIN:
+        f = prm[0] * delta + prm[1] * delta_rate
+        if prm[2] == 0.0 and f < 0.0:
+            return 0.0
+        return f
+    if law_id == LAW_JANKOWSKI:
+        f = prm[0] * delta * math.sqrt(delta)
+        if delta_rate > 0.0:
+            f += 2.0 * prm[1] * math.sqrt(prm[0] * math.sqrt(delta) * prm[2]) * delta_rate
+        return f
+    if law_id == LAW_BILINEAR:
+        lower, upper = _bilinear_bounds(prm, delta)
+        return min(max(q, lower), upper)
+    return 0.0
+
+
+@njit(cache=True)
+def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
+    """Rate of the internal state (N/s): the bilinear force follows K1, or K2 on an envelope."""
+    if law_id == LAW_BILINEAR:
+        if delta <= 0.0:
+            return 0.0
+        lower, upper = _bilinear_bounds(prm, delta)
+        if delta_rate > 0.0 and q >= upper:
+            return prm[1] * delta_rate if delta > prm[2] else prm[0] * delta_rate
+        if delta_rate < 0.0 and q <= lower:
+            return prm[1] * delta_rate
+        return prm[0] * delta_rate
+    return 0.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
+def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
+    """Elastic energy stored in the contact (J): what unloading would give back."""
+    if delta <= 0.0:
+        return 0.0
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI:
+        return prm[0] * delta * delta * math.sqrt(delta) / 2.5
+    if law_id == LAW_LINEAR or law_id == LAW_KELVIN:
+        return 0.5 * prm[0] * delta * delta
+    if law_id == LAW_BILINEAR:
+        k1, k2 = prm[0], prm[1]
+        f = force(law_id, prm, 0.0, delta, 0.0, q)
+        # Unloading: slope K1 from (δ, f) down to the line K2·δ at δ*, then that line to 0.
+        d_star = (k1 * delta - f) / (k1 - k2)
+        d_star = min(max(d_star, 0.0), delta)
+        return 0.5 * (f + k2 * d_star) * (delta - d_star) + 0.5 * k2 * d_star * d_star
+    return 0.0
+
+
+# --------------------------------------------------------------------------- #
+# Modes of a closed contact (the solver locates every switch as an event).
+#
+# A law whose force or internal rate changes formula inside a contact (the
+# tension clamp, Jankowski's approach/recede damping, the bilinear loop's
+# branches) carries an integer *mode* per closed contact.  Inside a step the
+# mode is fixed, so the force is smooth there and the error control sees it;
+# a mode ends where one of its switch functions ``switch_value(…, which)``
+# (positive while the mode holds) crosses zero, which the solver locates on
+# the step's interpolant and then applies ``next_mode`` / ``snapped_internal``.
+# --------------------------------------------------------------------------- #
+
+#: Hertz-damp / Kelvin: the law pushes (formula) or the clamp holds it at 0 N.
+MODE_PUSH = 0
+MODE_CLAMPED = 1
+#: Jankowski: damping term on while approaching (δ̇ > 0), off while receding.
+MODE_APPROACH = 0
+MODE_RECEDE = 1
+#: Bilinear loop, written as a spring K2 in parallel with an elastic-perfectly-plastic
+#: spring (K1 − K2) whose force lies in [0, (K1 − K2)·δy]: elastic (slope K1), yielding at
+#: the top (upper envelope, slope K2, loading) or at the bottom (line K2·δ, unloading).
+MODE_ELASTIC = 0
+MODE_YIELD_TOP = 1
+MODE_YIELD_BOTTOM = 2
+#: Stereo-mechanical persistent (resting) contact: a bilateral constraint δ̈ = 0
+#: whose force the solver computes; it ends where that force would turn tensile.
+MODE_STUCK = 3
+
+#: Number of switch functions per mode the solver evaluates.
+N_SWITCHES = 2
+
+
+@njit(cache=True)
+def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
+    """Mode of a contact at its located gap closure with approach velocity *v0* (m/s)."""
+    if law_id == LAW_JANKOWSKI:
+        return MODE_APPROACH if v0 > 0.0 else MODE_RECEDE
+    if law_id == LAW_STEREO:
+        return MODE_STUCK
+    return 0
+
+
+@njit(cache=True)
+def switch_count(law_id: int, prm: np.ndarray) -> int:
+    """How many switch functions the law has (0: the force is one formula while closed)."""
+    if law_id == LAW_HERTZ_DAMP:
+        return 1 if prm[3] == 0.0 else 0
+    if law_id == LAW_KELVIN:
+        return 1 if prm[2] == 0.0 else 0
+    if law_id == LAW_JANKOWSKI:
+        return 1
+    if law_id == LAW_BILINEAR:
+        return 2
+    return 0
+
+
+@njit(cache=True)
+def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, delta: float,
+               delta_rate: float, q: float) -> float:
+    """Contact force (N) of a closed contact in *mode* (no branch on the state inside a mode).
+
+    Equal to :func:`force` wherever the mode is the one the state implies;
+    the difference is that the formula does not switch before the located
+    event (just past an event the clamp still holds the force at ≥ 0).
+    """
+    if delta <= 0.0:
+        return 0.0
+    if law_id == LAW_HERTZ_DAMP:
+        if mode == MODE_CLAMPED:
+            return 0.0
+        f = delta * math.sqrt(delta) * (prm[0] + impact_constant * delta_rate)
+        if prm[3] == 0.0 and f < 0.0:
+            return 0.0
+        return f
+    if law_id == LAW_KELVIN:
+        if mode == MODE_CLAMPED:
+            return 0.0
+        f = prm[0] * delta + prm[1] * delta_rate
+        if prm[2] == 0.0 and f < 0.0:
+            return 0.0
+        return f
+    if law_id == LAW_JANKOWSKI:
+        f = prm[0] * delta * math.sqrt(delta)
+        if mode == MODE_APPROACH:
+            f += 2.0 * prm[1] * math.sqrt(prm[0] * math.sqrt(delta) * prm[2]) * delta_rate
+        return f
+    if law_id == LAW_BILINEAR:
+        return q
+    return force(law_id, prm, impact_constant, delta, delta_rate, q)
+
+
+@njit(cache=True)
+def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float) -> float:
+    """Rate of the internal state in *mode* (N/s): the bilinear force follows K1 (elastic) or K2 (yielding)."""
+    if law_id == LAW_BILINEAR:
+        if mode == MODE_ELASTIC:
+            return prm[0] * delta_rate
+        return prm[1] * delta_rate
+    return 0.0
+
+
+@njit(cache=True)
+def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, which: int, delta: float,
+                 delta_rate: float, q: float) -> float:
+    """Switch function *which* of *mode*: positive while the mode holds, crossing 0 where it ends.
+
+    Hertz-damp (clamped): ``kh + ξ·δ̇`` while pushing (the sign of the
+    unclamped force), its negative while clamped (a *reload* is its crossing).
+    Kelvin (clamped): ``k·δ + c·δ̇`` likewise.  Jankowski: ``±δ̇``.
+    Bilinear: elastic — distance to the top (``K2·δ + (K1 − K2)·δy − q``) and to
+    the bottom (``q − K2·δ``) of the loop; yielding — ``±δ̇``.  Units vary (only
+    the sign is used); 1.0 for a switch the mode does not have.
+    """
+    if law_id == LAW_HERTZ_DAMP and which == 0:
+        g = prm[0] + impact_constant * delta_rate
+        return g if mode == MODE_PUSH else -g
+    if law_id == LAW_KELVIN and which == 0:
+        g = prm[0] * delta + prm[1] * delta_rate
+        return g if mode == MODE_PUSH else -g
+    if law_id == LAW_JANKOWSKI and which == 0:
+        return delta_rate if mode == MODE_APPROACH else -delta_rate
+    if law_id == LAW_BILINEAR:
+        k1, k2, dy = prm[0], prm[1], prm[2]
+        if mode == MODE_ELASTIC:
+            if which == 0:
+                return k2 * delta + (k1 - k2) * dy - q
+            return q - k2 * delta
+        if which == 0:
+            return delta_rate if mode == MODE_YIELD_TOP else -delta_rate
+    return 1.0
+
+
+@njit(cache=True)
+def next_mode(law_id: int, mode: int, which: int) -> int:
+    """Mode entered when switch function *which* of *mode* crosses zero."""
+    if law_id == LAW_BILINEAR:
+        if mode == MODE_ELASTIC:
+            return MODE_YIELD_TOP if which == 0 else MODE_YIELD_BOTTOM
+        return MODE_ELASTIC
+    return 1 - mode
+
+
+@njit(cache=True)
+def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, q: float) -> float:
+    """Internal state put exactly on the branch *mode* starts on (removes the event's round-off)."""
+    if law_id == LAW_BILINEAR:
+        if mode == MODE_YIELD_TOP:
+            return prm[1] * delta + (prm[0] - prm[1]) * prm[2]
+        if mode == MODE_YIELD_BOTTOM:
+            return prm[1] * delta
+    return q
+
+
+@njit(cache=True)
+def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -> float:
+    """Absolute error tolerance of the internal state (N): K1·atol for the bilinear force, 0 if unused."""
+    if law_id == LAW_BILINEAR:
+        return prm[0] * atol_displacement
+    return 0.0
+
+
+@njit(cache=True)
+def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: float) -> float:
+    """Duration estimate (s) of a free impact at approach velocity *v0* (m/s); 0 for instantaneous laws.
+
+    Hertz-type laws: ``2.94·δmax/v0`` with ``δmax = (5·m·v0²/(4·kh))^(2/5)``
+    (physics.md §2); linear-type laws: the half period ``π·sqrt(m/k)`` (K1 for
+    the bilinear law).  Used only to choose the first step inside a contact.
+    """
+    v = max(v0, 1e-12)
+    m = effective_mass
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI:
+        dmax = (1.25 * m * v * v / prm[0]) ** 0.4
+        return 2.94 * dmax / v
+    if law_id == LAW_LINEAR or law_id == LAW_KELVIN or law_id == LAW_BILINEAR:
+        return math.pi * math.sqrt(m / prm[0])
+    return 0.0
+
+
+@njit(cache=True)
+def rest_velocity(law_id: int, prm: np.ndarray) -> float:
+    """Approach velocity (m/s) at or below which an instantaneous law's closure may become a resting contact.
+
+    :data:`MIN_IMPACT_VELOCITY` (1 mm/s), the same floor as Hertz-damp's v0:
+    what remains of a rigid impact sequence below it lasts at most
+    ``2·e·v/((1 − e)·a)`` and moves the floors by at most ``v·`` that.
+    """
+    if law_id == LAW_STEREO:
+        return MIN_IMPACT_VELOCITY
+    return 0.0
+
+
+# The kernels inline the law ids and sizes of contact/laws.py: their cached code is stale when it changes.
+jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
+                              [__file__, laws.__file__])
