@@ -164,8 +164,8 @@ CASES = {
         "{mass: abc, stiffness: 3.0e8, height: 3.2}", 5,
         "buildings[0].storeys[0].mass must be a number (got 'abc')"),
     "boolean is not a number": (
-        "gap: 0.04", "gap: yes", 17,
-        "contacts[0].gap must be a number (got yes)"),
+        "gap: 0.04", "gap: true", 17,
+        "contacts[0].gap must be a number (got true)"),
     "infinite number": (
         "kh: 1.0e10                                                      # 26", "kh: .inf", 26,
         "contacts[1].kh must be a finite number (got .inf)"),
