@@ -780,10 +780,8 @@ class ModelEntry(_Schema):
 
 #: The document's top-level keys (kept for the sweep's key lists).
 TopLevel = ModelEntry
-BuildingEntry.CHILDREN = {"storeys": StoreyEntry}
 ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "ground_motion": GroundMotionEntry,
                        "solver": SolverEntry}
-ContactEntry.CHILDREN = {}
 
 # --------------------------------------------------------------------------- #
 # Translating pydantic's errors to one line
@@ -962,7 +960,3 @@ def parse(text: str, label: str) -> tuple[ModelEntry, Document]:
     doc = parse_document(text, label)
     return validate(ModelEntry, doc.data, doc), doc
 
-
-def format_where(loc: Location) -> str:
-    """Alias of :func:`pounding.model.document.format_location`."""
-    return format_location(loc)
