@@ -264,6 +264,10 @@ class Document:
         return pairs
 
     # ----------------------------------------------------------- look-ups
+    def has(self, loc: Location) -> bool:
+        """True if the document has a value at *loc*."""
+        return loc in self.values
+
     def node(self, loc: Location) -> yaml.Node | None:
         """The value node at *loc*, or None if the location is absent."""
         return self.values.get(loc)
@@ -342,6 +346,9 @@ class DataSource(Document):
             except (KeyError, IndexError, TypeError):
                 return False, None
         return True, value
+
+    def has(self, loc: Location) -> bool:
+        return self._value(loc)[0]
 
     def line(self, loc: Location) -> int | None:
         return None

@@ -50,7 +50,7 @@ from pydantic_core import PydanticCustomError
 
 from pounding.contact.laws import LAWS, ContactLaw
 from pounding.errors import ModelError, did_you_mean
-from pounding.model.document import DataSource, Document, Location, format_location, parse_document, plural
+from pounding.model.document import Document, Location, parse_document, plural
 from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
 __all__ = [
@@ -850,12 +850,6 @@ def translate(exc: ValidationError, cls: type[BaseModel], source: Document, root
     return best[1]
 
 
-def _has(source: Document, loc: Location) -> bool:
-    if isinstance(source, DataSource):
-        return source._value(loc)[0]          # noqa: SLF001 - same family of classes
-    return loc in source.values
-
-
 def _translate(error: dict, cls: type[BaseModel], source: Document, root: Location) -> tuple[ModelError, Location, int]:
     kind = error["type"]
     raw = tuple(error["loc"])
@@ -865,7 +859,7 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
         ctx = error["ctx"]
         full = loc + tuple(ctx["at"])
         if ctx["fallback"]:
-            while not _has(source, full) and len(full) > len(loc) + 1:
+            while not source.has(full) and len(full) > len(loc) + 1:
                 full = full[:-1]
         line = None
         if ctx["line"] == "key":
