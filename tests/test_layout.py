@@ -24,7 +24,7 @@ PACKAGE = Path(pounding.__file__).parent
 #: Layers from the bottom up; a module may import from its own layer group's
 #: package or from any lower layer, never from a higher one or a sibling package.
 LAYERS: list[tuple[str, ...]] = [
-    ("pounding", "pounding.errors", "pounding.data"),
+    ("pounding", "pounding.errors", "pounding.data", "pounding.units"),
     ("pounding.records", "pounding.contact"),
     ("pounding.model",),
     ("pounding.solver",),

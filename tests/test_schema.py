@@ -164,8 +164,8 @@ CASES = {
         "{mass: abc, stiffness: 3.0e8, height: 3.2}", 5,
         "buildings[0].storeys[0].mass must be a number (got 'abc')"),
     "boolean is not a number": (
-        "gap: 0.04", "gap: yes", 17,
-        "contacts[0].gap must be a number (got yes)"),
+        "gap: 0.04", "gap: true", 17,
+        "contacts[0].gap must be a number (got true)"),
     "infinite number": (
         "kh: 1.0e10                                                      # 26", "kh: .inf", 26,
         "contacts[1].kh must be a finite number (got .inf)"),
@@ -581,3 +581,88 @@ def test_readme_documents_every_key():
     keys = {key for cls in classes for key in cls.model_fields if not (cls is LAWS["hertz-damp"] and key == "law")}
     missing = sorted(key for key in keys if f"| `{key}` |" not in readme)
     assert not missing, f"keys not in the README tables: {missing}"
+
+
+# --------------------------------------------------------------------------- #
+# Hardened reader (issue 17) and one units table (issue 12)
+# --------------------------------------------------------------------------- #
+
+
+def test_sexagesimal_is_not_a_number(tmp_path):
+    """YAML 1.2: ``1:30`` is text, not 90 (the YAML 1.1 base-60 integer)."""
+    text = edit("{mass: 2.5e5, stiffness: 3.0e8, height: 3.2}                # 5",
+                "{mass: 2.5e5, stiffness: 3.0e8, height: 1:30}")
+    assert_message(tmp_path, text, 5, "buildings[0].storeys[0].height must be a number (got '1:30')")
+
+
+def test_yaml_12_scalars():
+    from pounding.model.document import Document
+
+    data = Document("a: 0x1F\nb: 1_000\nc: yes\nd: off\ne: true\nf: 0o17\ng: 2.5e5\nh: 2001-12-14\n", "t").data
+    assert data == {"a": 31, "b": "1_000", "c": "yes", "d": "off", "e": True, "f": 15, "g": 250000.0,
+                    "h": "2001-12-14"}
+    with pytest.raises(ModelError, match=r"contacts\[0\]\.gap must be a number \(got 'on'\)"):
+        model_from_text(edit("gap: 0.04", "gap: on"))
+
+
+@pytest.mark.parametrize("byte", ["\x00", "\x07", "\x1b"])
+def test_control_bytes_are_one_line(tmp_path, byte):
+    text = edit("gap: 0.04", f"gap: 0.{byte}04")
+    error = assert_message(tmp_path, text, 17, f"invalid YAML: control character U+{ord(byte):04X} in column 12; "
+                                               "a model file is plain text: remove it (a NUL byte often means a "
+                                               "binary or UTF-16 file)")
+    assert error.line == 17
+
+
+def test_deep_nesting_is_one_line(tmp_path):
+    deep = "x: " + "[" * 5000 + "]" * 5000 + "\n"
+    error = assert_message(tmp_path, BASE + deep, 34, "invalid YAML: nesting deeper than 64 levels; a model file "
+                                                      "is a few levels deep (buildings[0].storeys[0].mass)")
+    assert "\n" not in str(error)
+
+
+def test_second_document_is_one_line(tmp_path):
+    assert_message(tmp_path, BASE + "---\nname: second\n", 34,
+                   "invalid YAML: but found another document (expected a single document in the stream "
+                   "on line 1)")
+
+
+def test_billion_laughs_fails_fast(tmp_path):
+    import time
+
+    lines = ['a0: &a0 ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]']
+    lines += [f"a{i}: &a{i} [" + ",".join([f"*a{i - 1}"] * 9) + "]" for i in range(1, 10)]
+    text = BASE + "\n".join(lines) + "\n"
+    started = time.perf_counter()
+    path = tmp_path / "laughs.yaml"
+    path.write_text(text)
+    with pytest.raises(ModelError) as info:
+        load_model(path)
+    assert time.perf_counter() - started < 0.5
+    assert "YAML aliases expand to too many values" in str(info.value)
+    assert "\n" not in str(info.value)
+
+
+def test_merge_chain_is_bounded(tmp_path):
+    lines = ["m0: &m0 {x: 1}"] + [f"m{i}: &m{i} {{<<: *m{i - 1}, y{i}: 1}}" for i in range(1, 30)]
+    text = BASE + "\n".join(lines) + "\n"
+    path = tmp_path / "merges.yaml"
+    path.write_text(text)
+    with pytest.raises(ModelError, match=r"'<<' merges are chained more than 20 deep"):
+        load_model(path)
+
+
+def test_huge_count_is_refused_with_the_cap(tmp_path):
+    assert_message(tmp_path, edit("{count: 5,", "{count: 1000000000,"), 9,
+                   "buildings[1].storeys.count must be <= 10000 (got 1000000000); a building has at most 10000 "
+                   "storeys (pounding.model.schema.MAX_STOREYS); check the number")
+
+
+def test_one_units_table_for_units_and_targets():
+    """``m/s/s`` is accepted as ground_motion.units as it is in a scale target."""
+    from pounding.model.model import GroundMotionSpec
+    from pounding.records.processing import parse_acceleration
+
+    assert GroundMotionSpec("x.txt", units="m/s/s", dt=0.01).units == "m/s2"
+    assert GroundMotionSpec("x.txt", units="CM/SEC/SEC", dt=0.01).units == "cm/s2"
+    assert parse_acceleration("3.9 m/s/s")[0] == 3.9

@@ -1,7 +1,7 @@
 """Building models: shear buildings in a row, joined by gap elements.
 
 A model file (YAML, see ``models/README.md``) is validated by
-:mod:`pounding.schema` and turned into a :class:`Model`: a tuple of
+:mod:`pounding.model.schema` (one pass) and turned into a :class:`Model`: a tuple of
 :class:`Building` objects (lumped floor masses, storey stiffnesses, damping),
 the :class:`GapElement` objects between adjacent floors, the ground-motion
 choice and the solver settings.  SI units throughout (kg, N/m, m, s).
@@ -24,16 +24,18 @@ import math
 import os
 from dataclasses import dataclass
 from functools import cached_property
-from pathlib import Path, PurePath
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
 from pounding.model import schema
+from pounding.model.document import DataSource
 from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
 from pounding.errors import ModelError, PoundingError, did_you_mean
+from pounding.records.catalogue import is_catalogued
 
 __all__ = [
     "Damping",
@@ -44,21 +46,28 @@ __all__ = [
     "Model",
     "load_model",
     "model_from_text",
+    "model_from_data",
+    "read_yaml_text",
 ]
 
 
-def _check_number(where: str, value: Any, *, low: float | None = 0.0, strict: bool = True,
-                  optional: bool = False) -> float | None:
-    """Validate one programmatic setting; ModelError ``<where> must be ... (got ...)``."""
-    if value is None and optional:
-        return None
-    try:
-        number = schema.as_number(value)
-    except schema._Problem as problem:
-        raise ModelError(f"{where} {problem.predicate} (got {value!r})") from None
-    if low is not None and (number <= low if strict else number < low):
-        raise ModelError(f"{where} must be {'>' if strict else '>='} {low:g} (got {value!r})")
-    return number
+def _checked(cls: type, data: Any, root: tuple = (), prefix: str = "") -> Any:
+    """Validate Python data with the model file's own schema class (one set of rules and words).
+
+    Raises
+    ------
+    ModelError
+        ``<where> <problem>`` as for a file, without file and line.
+    """
+    return schema.validate(cls, data, DataSource(data, root, prefix), root)
+
+
+def _trusted(cls: type, **values: Any) -> Any:
+    """An instance of dataclass *cls* from values already validated (no second check)."""
+    obj = cls.__new__(cls)
+    for key, value in values.items():
+        object.__setattr__(obj, key, value)
+    return obj
 
 
 # --------------------------------------------------------------------------- #
@@ -91,21 +100,23 @@ class Damping:
 
     def __post_init__(self) -> None:
         if self.kind == "rayleigh":
-            if self.ratio is None or not 0.0 <= float(self.ratio) < 1.0:
-                raise ModelError(f"damping ratio must be in [0, 1) (got {self.ratio!r})")
-            modes = tuple(int(m) for m in (self.modes or (1, 2)))
-            if len(modes) != 2 or modes[0] == modes[1] or min(modes) < 1:
-                raise ModelError(f"damping modes must be two different mode numbers >= 1 (got {self.modes!r})")
-            object.__setattr__(self, "ratio", float(self.ratio))
-            object.__setattr__(self, "modes", modes)
+            modes = list(self.modes) if isinstance(self.modes, (tuple, list)) else self.modes
+            entry = _checked(schema.RayleighEntry, {"ratio": self.ratio, "modes": (1, 2) if modes is None else modes},
+                             ("damping",))
+            object.__setattr__(self, "ratio", entry.ratio)
+            object.__setattr__(self, "modes", tuple(entry.modes))
         elif self.kind == "modal":
-            ratios = tuple(float(r) for r in (self.modal_ratios or ()))
-            if not ratios or not all(0.0 <= r < 1.0 for r in ratios):
-                raise ModelError(f"modal damping ratios must be a non-empty list of values in [0, 1) "
-                                 f"(got {self.modal_ratios!r})")
-            object.__setattr__(self, "modal_ratios", ratios)
+            ratios = self.modal_ratios
+            entry = _checked(schema.ModalEntry, {"modal": list(ratios) if isinstance(ratios, (tuple, list)) else ratios},
+                             ("damping",))
+            object.__setattr__(self, "modal_ratios", tuple(entry.modal))
         else:
             raise ModelError(f"damping kind must be 'rayleigh' or 'modal' (got {self.kind!r})")
+
+    def to_document(self) -> dict[str, Any]:
+        """The YAML mapping of this damping."""
+        return {"ratio": self.ratio, "modes": list(self.modes)} if self.kind == "rayleigh" \
+            else {"modal": list(self.modal_ratios)}
 
     def ratios(self, n_modes: int) -> np.ndarray | None:
         """Modal ratios for modes 1..n (``modal`` only; None for Rayleigh)."""
@@ -124,17 +135,6 @@ class Damping:
 # --------------------------------------------------------------------------- #
 # Building
 # --------------------------------------------------------------------------- #
-
-
-def _floor_array(name: str, what: str, values: Any) -> np.ndarray:
-    array = np.array(values, dtype=float).reshape(-1)
-    if array.size == 0:
-        raise ModelError(f"building {name}: {what} must list at least one storey")
-    if not np.all(np.isfinite(array)) or np.any(array <= 0):
-        bad = int(np.flatnonzero(~(np.isfinite(array) & (array > 0)))[0])
-        raise ModelError(f"building {name}: {what} of storey {bad + 1} must be > 0 (got {float(array[bad])!r})")
-    array.setflags(write=False)
-    return array
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,23 +163,17 @@ class Building:
     damping: Damping
 
     def __post_init__(self) -> None:
-        mass = _floor_array(self.name, "mass", self.mass)
-        stiffness = _floor_array(self.name, "stiffness", self.stiffness)
-        height = _floor_array(self.name, "height", self.height)
-        if not mass.size == stiffness.size == height.size:
+        arrays = [np.array(getattr(self, key), dtype=float).reshape(-1) for key in ("mass", "stiffness", "height")]
+        if not arrays[0].size == arrays[1].size == arrays[2].size:
             raise ModelError(f"building {self.name}: mass, stiffness and height must have the same length "
-                             f"(got {mass.size}, {stiffness.size}, {height.size})")
-        n = mass.size
-        d = self.damping
-        if d.kind == "rayleigh" and max(d.modes) > n:
-            raise ModelError(f"building {self.name}: Rayleigh mode {max(d.modes)} does not exist "
-                             f"(the building has {n} modes)")
-        if d.kind == "modal" and len(d.modal_ratios) > n:
-            raise ModelError(f"building {self.name}: modal damping lists {len(d.modal_ratios)} ratios "
-                             f"for {n} modes")
-        object.__setattr__(self, "mass", mass)
-        object.__setattr__(self, "stiffness", stiffness)
-        object.__setattr__(self, "height", height)
+                             f"(got {arrays[0].size}, {arrays[1].size}, {arrays[2].size})")
+        storeys = [{"mass": float(m), "stiffness": float(k), "height": float(h)} for m, k, h in zip(*arrays)]
+        damping = self.damping.to_document() if isinstance(self.damping, Damping) else self.damping
+        _checked(schema.BuildingEntry, {"name": self.name, "storeys": storeys, "damping": damping},
+                 prefix=f"building {self.name}:")
+        for key, array in zip(("mass", "stiffness", "height"), arrays):
+            array.setflags(write=False)
+            object.__setattr__(self, key, array)
 
     # ----------------------------------------------------------- geometry
     @property
@@ -301,36 +295,6 @@ class GapElement:
     law: ContactLaw
 
 
-def _record_needs_units(record: str) -> bool:
-    """True for a plain-text record file (not a catalogue reference or name, not .AT2)."""
-    return not schema.record_is_catalogued(record) and PurePath(record).suffix.lower() != ".at2"
-
-
-def _scale(value: Any) -> Any:
-    """``ground_motion.scale`` as a float or a :class:`pounding.processing.Scaling` (from a mapping)."""
-    from pounding.records.processing import Scaling, SpecProblem, parse_scale
-
-    if isinstance(value, Scaling):
-        return value.factor if value.method == "factor" else value
-    if isinstance(value, dict):
-        try:
-            return parse_scale(value)
-        except SpecProblem as problem:
-            raise ModelError(problem.message("ground_motion.scale", None if problem.kind != "must" else value)) \
-                from None
-    return _check_number("ground_motion.scale", value)
-
-
-def _processing(value: Any) -> Any:
-    from pounding.records.processing import SpecProblem, parse_processing
-
-    try:
-        return parse_processing(value)
-    except SpecProblem as problem:
-        raise ModelError(problem.message("ground_motion.processing", value if problem.kind == "must" else None)) \
-            from None
-
-
 @dataclass(frozen=True)
 class GroundMotionSpec:
     """Which record to apply and how.
@@ -368,29 +332,16 @@ class GroundMotionSpec:
     processing: Any = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.record, str) or not self.record.strip():
-            raise ModelError(f"ground_motion.record must be a record reference or a file path (got {self.record!r})")
-        object.__setattr__(self, "scale", _scale(self.scale))
-        object.__setattr__(self, "processing", _processing(self.processing))
-        object.__setattr__(self, "duration", _check_number("ground_motion.duration", self.duration, optional=True))
-        object.__setattr__(self, "dt", _check_number("ground_motion.dt", self.dt, optional=True))
-        if self.units is not None:
-            units = schema.normalise_units(self.units)
-            if units is None:
-                raise ModelError(f"ground_motion.units must be one of g, m/s2, cm/s2, gal (got {self.units!r})"
-                                 f"{did_you_mean(str(self.units).lower(), list(schema.UNITS))}")
-            object.__setattr__(self, "units", units)
-        if not schema.record_is_catalogued(self.record):
-            if PurePath(self.record).suffix.lower() == ".at2" and self.units not in (None, "g"):
-                raise ModelError(f"ground_motion.units must be g for a PEER .AT2 record (got {self.units!r})")
-            if _record_needs_units(self.record) and self.units is None:
-                raise ModelError(f"ground_motion: the plain-text record '{self.record}' needs units "
-                                 "(g, m/s2, cm/s2 or gal)")
+        data = {"record": self.record, "scale": self.scale, "processing": self.processing, "duration": self.duration,
+                "dt": self.dt, "units": self.units}
+        entry = _checked(schema.GroundMotionEntry, data, ("ground_motion",))
+        for key in data:
+            object.__setattr__(self, key, getattr(entry, key))
 
     @property
     def is_catalogue(self) -> bool:
         """True if ``record`` is a catalogue reference or name rather than a file."""
-        return schema.record_is_catalogued(self.record)
+        return is_catalogued(self.record)
 
     def describe_scale(self) -> str:
         """``x 1.5``, ``to pga 0.4g``, ``to sa 0.8g at T = 1 s, 5% damping``..."""
@@ -443,12 +394,9 @@ class SolverSettings:
     output_dt: float = 0.01
 
     def __post_init__(self) -> None:
-        rtol = _check_number("solver.rtol", self.rtol)
-        if rtol < schema.MIN_RTOL:
-            raise ModelError(f"solver.rtol must be >= {schema.MIN_RTOL:g} (got {self.rtol!r})")
-        object.__setattr__(self, "rtol", rtol)
-        for key in ("atol", "atol_velocity", "output_dt"):
-            object.__setattr__(self, key, _check_number(f"solver.{key}", getattr(self, key)))
+        entry = _checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
+        for key, value in entry.model_dump().items():
+            object.__setattr__(self, key, value)
 
 
 # --------------------------------------------------------------------------- #
@@ -490,21 +438,11 @@ class Model:
     def __post_init__(self) -> None:
         object.__setattr__(self, "buildings", tuple(self.buildings))
         object.__setattr__(self, "gaps", tuple(self.gaps))
-        names = [b.name for b in self.buildings]
-        if len(set(names)) != len(names):
-            raise ModelError(f"building names must be unique (got {', '.join(names)})")
         for gap in self.gaps:
             if not (0 <= gap.left < len(self.buildings) - 1 and gap.right == gap.left + 1):
                 raise ModelError(f"gap element joins buildings {gap.left} and {gap.right}, which are not "
                                  "adjacent in the row")
-            if not (1 <= gap.level_left <= self.buildings[gap.left].n_floors
-                    and 1 <= gap.level_right <= self.buildings[gap.right].n_floors):
-                raise ModelError(f"gap element joins floor {gap.level_left} to floor {gap.level_right}, "
-                                 "which do not both exist")
-        building = getattr(self.ground_motion.scale, "building", None)
-        if building is not None and building not in names:
-            raise ModelError(f"ground_motion.scale.period: unknown building '{building}'"
-                             f"{did_you_mean(building, names)}; buildings are: {', '.join(names)}")
+        _checked(schema.ModelEntry, self.plain_document())
 
     # ----------------------------------------------------------- helpers
     @property
@@ -603,12 +541,8 @@ class Model:
         """
         return self.to_yaml()
 
-    def to_yaml(self) -> str:
-        """A YAML document that :func:`model_from_text` turns back into this model.
-
-        Storeys are written out one by one and contact levels as explicit
-        pairs; floats are written with ``repr`` so they round-trip exactly.
-        """
+    def plain_document(self) -> dict[str, Any]:
+        """The model as plain data (what :meth:`to_yaml` writes): storeys one by one, explicit level pairs."""
         contacts = []
         for contact in sorted({g.contact for g in self.gaps}):
             gaps = [g for g in self.gaps if g.contact == contact]
@@ -620,22 +554,27 @@ class Model:
             }
             entry.update(first.law.model_dump(mode="json"))
             contacts.append(entry)
-        document = {
+        return {
             "name": self.name,
             "buildings": [_building_document(b) for b in self.buildings],
             "contacts": contacts,
             "ground_motion": self.ground_motion.to_document(),
             "solver": dataclasses.asdict(self.solver),
         }
+
+    def to_yaml(self) -> str:
+        """A YAML document that :func:`model_from_text` turns back into this model.
+
+        Storeys are written out one by one and contact levels as explicit
+        pairs; floats are written with ``repr`` so they round-trip exactly.
+        """
         header = (f"# Model '{self.name}' regenerated by pounding"
                   + (f" from {self.path}" if self.path else "") + " (comments are not kept).\n")
-        return header + yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100)
+        return header + yaml.safe_dump(self.plain_document(), sort_keys=False, default_flow_style=None, width=100)
 
 
 def _building_document(b: Building) -> dict[str, Any]:
-    d = b.damping
-    damping: dict[str, Any] = ({"ratio": d.ratio, "modes": list(d.modes)} if d.kind == "rayleigh"
-                               else {"modal": list(d.modal_ratios)})
+    damping = b.damping.to_document()
     storeys = [{"mass": float(m), "stiffness": float(k), "height": float(h)}
                for m, k, h in zip(b.mass, b.stiffness, b.height)]
     return {"name": b.name, "storeys": storeys, "damping": damping}
@@ -654,17 +593,28 @@ def _check_keys(section: str, changes: dict[str, Any], cls: type) -> None:
 # --------------------------------------------------------------------------- #
 
 
-def _build(parsed: schema.ParsedModel, *, name: str, text: str, path: str | None,
-           base_dir: str | None) -> Model:
-    buildings = tuple(
-        Building(b.name, np.array(b.mass), np.array(b.stiffness), np.array(b.height),
-                 Damping(b.damping_kind, b.ratio, b.modes, b.modal_ratios))
-        for b in parsed.buildings)
-    gaps = tuple(GapElement(c.index, c.left, c.right, a, r, c.gap, c.law)
-                 for c in parsed.contacts for a, r in c.pairs)
-    ground_motion = GroundMotionSpec(**parsed.ground_motion, base_dir=base_dir)
-    return Model(parsed.name or name, buildings, gaps, ground_motion, SolverSettings(**parsed.solver),
-                 text, path)
+def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, base_dir: str | None) -> Model:
+    """The domain objects of a validated model (no second check)."""
+    buildings = []
+    for b in entry.buildings:
+        d = b.damping
+        damping = (_trusted(Damping, kind="modal", ratio=None, modes=None, modal_ratios=tuple(d.modal))
+                   if isinstance(d, schema.ModalEntry) else
+                   _trusted(Damping, kind="rayleigh", ratio=d.ratio, modes=tuple(d.modes), modal_ratios=None))
+        arrays = {}
+        for key in ("mass", "stiffness", "height"):
+            array = np.array(b.column(key))
+            array.setflags(write=False)
+            arrays[key] = array
+        buildings.append(_trusted(Building, name=b.name, damping=damping, **arrays))
+    gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters)
+                 for index, c in enumerate(entry.contacts) for a, r in c.pairs)
+    gm = entry.ground_motion
+    ground_motion = _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
+                             units=gm.units, base_dir=base_dir, processing=gm.processing)
+    solver = _trusted(SolverSettings, **entry.solver.model_dump())
+    return _trusted(Model, name=entry.name or name, buildings=tuple(buildings), gaps=gaps,
+                    ground_motion=ground_motion, solver=solver, source=text, path=path)
 
 
 def model_from_text(text: str, *, name: str = "model", path: str | None = None,
@@ -688,8 +638,24 @@ def model_from_text(text: str, *, name: str = "model", path: str | None = None,
         ``<path>:<line>: <location> <problem>``.
     """
     label = path if path is not None else f"<{name}>"
-    parsed = schema.parse(text, label)
-    return _build(parsed, name=name, text=text, path=path, base_dir=base_dir)
+    entry, _ = schema.parse(text, label)
+    return _build(entry, name=name, text=text, path=path, base_dir=base_dir)
+
+
+def model_from_data(data: dict[str, Any], *, name: str = "model", source: str = "",
+                    base_dir: str | None = None) -> Model:
+    """Build a model from plain data (a parsed model document), validated by the same schema.
+
+    Used by sweeps, which change a validated document and validate it again
+    without writing and reading YAML text.
+
+    Raises
+    ------
+    ModelError
+        ``<location> <problem>`` (no file, no line).
+    """
+    entry = _checked(schema.ModelEntry, data)
+    return _build(entry, name=name, text=source, path=None, base_dir=base_dir)
 
 
 def read_yaml_text(path: str | os.PathLike, *, kind: str) -> str:

@@ -41,7 +41,8 @@ from pounding.records.readers import check_agrees, read_at2, read_text
 from pounding.records.record import normalise_units
 
 __all__ = ["SETS", "Entry", "catalogue_path", "load_catalogue", "get_entry", "load_entry", "make_key",
-           "key_for_source", "fema_entries", "is_catalogue_name"]
+           "key_for_source", "fema_entries", "is_catalogue_name",
+           "is_catalogue_reference", "is_catalogued", "CATALOGUE_REFERENCE"]
 
 #: Record sets of the catalogue, in listing order.
 SETS = ("farfield", "nearfield", "peer", "synthetic")
@@ -293,6 +294,24 @@ def fema_entries() -> dict[str, dict[str, Any]]:
 
 
 _CATALOGUE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
+
+#: ``<catalogue>:<record>``, e.g. ``fema-p695:farfield/1a``.  The catalogue name has two or more
+#: characters, so a Windows drive letter (``C:\\records\\x.AT2``, ``C:/x.AT2``) is a path.
+CATALOGUE_REFERENCE = re.compile(r"^(?P<catalogue>[A-Za-z0-9][A-Za-z0-9_.-]+):(?P<rest>[^/\\].*)$", re.DOTALL)
+
+
+def is_catalogue_reference(spec: str) -> bool:
+    """True for a catalogue reference such as ``fema-p695:farfield/1a`` (see :data:`CATALOGUE_REFERENCE`)."""
+    return isinstance(spec, str) and bool(CATALOGUE_REFERENCE.match(spec.strip()))
+
+
+def is_catalogued(spec: str) -> bool:
+    """True if *spec* names a catalogued record (a reference or a bare name), False for a file path.
+
+    This is the one test of the package: the model schema, the record loader
+    and the sweeps all ask it.
+    """
+    return is_catalogue_reference(spec) or is_catalogue_name(spec)
 
 
 def is_catalogue_name(spec: str) -> bool:

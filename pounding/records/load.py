@@ -14,18 +14,17 @@ Relative file paths are resolved against ``base_dir``.
 from __future__ import annotations
 
 import dataclasses
-import re
 from pathlib import Path
 
 from pounding.errors import RecordError
-from pounding.records.catalogue import is_catalogue_name, key_for_source, load_entry
+from pounding.records.catalogue import CATALOGUE_REFERENCE, is_catalogue_name, key_for_source, load_entry
 from pounding.records.fema import load_fema_record
 from pounding.records.readers import check_agrees, read_at2, read_text
 from pounding.records.record import Record
 
 __all__ = ["load_record", "CATALOGUE_REFERENCE"]
 
-CATALOGUE_REFERENCE = re.compile(r"^(?P<catalogue>[A-Za-z0-9][A-Za-z0-9_.-]+):(?P<rest>[^/\\].*)$")
+# CATALOGUE_REFERENCE lives in pounding.records.catalogue (one predicate for the package).
 
 
 def load_record(spec: str, *, base_dir: str | None = None, dt: float | None = None, units: str | None = None,

@@ -41,7 +41,8 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import RecordError, did_you_mean
-from pounding.records.record import STANDARD_GRAVITY, UNITS, Record, normalise_units
+from pounding.records.record import Record
+from pounding.units import NUMBER, NUMBER_TEXT, STANDARD_GRAVITY, UNIT_CHOICES, UNITS, canonical_unit, number_from_text
 
 __all__ = [
     "Scaling", "Processing", "SpecProblem", "parse_scale", "parse_processing", "parse_acceleration",
@@ -53,9 +54,8 @@ SCALE_METHODS = ("pga", "sa", "fema-p695")
 SCALE_KEYS = ("pga", "sa", "period", "damping", "fema-p695")
 PROCESSING_KEYS = ("trim", "baseline")
 TRIM_METHODS = ("significant-duration",)
-_ACCELERATION = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z][A-Za-z0-9/^*]*)\s*$")
-_NUMBER = re.compile(r"^\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*$")
-_PERIOD_SECONDS = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*s?\s*$")
+_ACCELERATION = re.compile(rf"^\s*({NUMBER})\s*([A-Za-z][A-Za-z0-9/^*]*)\s*$")
+_PERIOD_SECONDS = re.compile(rf"^\s*({NUMBER})\s*s?\s*$")
 _BUILDING = re.compile(r"^\s*building\s+(.+?)\s*$", re.IGNORECASE)
 
 
@@ -102,18 +102,17 @@ def parse_acceleration(value: Any, where: tuple = ()) -> tuple[float, str]:
     example = "e.g. 0.4g, 3.9 m/s2 or 390 gal"
     if isinstance(value, bool) or value is None:
         raise SpecProblem(where, f"must be an acceleration with units, {example}")
-    if isinstance(value, (int, float)) or (isinstance(value, str) and _NUMBER.match(value)):
+    if isinstance(value, (int, float)) or (isinstance(value, str) and NUMBER_TEXT.match(value)):
         raise SpecProblem(where, f"must be an acceleration with units, {example}",
                           hint="a number alone is ambiguous (g or m/s2?)")
     match = _ACCELERATION.match(str(value))
     if not match:
         raise SpecProblem(where, f"must be an acceleration with units, {example}")
     number = float(match[1])
-    try:
-        unit = normalise_units(match[2])
-    except RecordError:
+    unit = canonical_unit(match[2])
+    if unit is None:
         raise SpecProblem(where, "must be in g, m/s2, cm/s2 or gal",
-                          hint=did_you_mean(match[2].lower(), ["g", "m/s2", "cm/s2", "gal"]).strip()) from None
+                          hint=did_you_mean(match[2].lower(), list(UNIT_CHOICES)).strip())
     if not math.isfinite(number) or number <= 0:
         raise SpecProblem(where, "must be > 0")
     return number * UNITS[unit], str(value).strip()
@@ -202,9 +201,7 @@ def _as_number(value: Any) -> float | None:
         return None
     if isinstance(value, (int, float)):
         return float(value)
-    if isinstance(value, str) and _NUMBER.match(value):
-        return float(value)
-    return None
+    return number_from_text(value)
 
 
 def parse_scale(value: Any, buildings: Sequence[str] | None = None) -> float | Scaling:

@@ -14,12 +14,13 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import RecordError
-from pounding.records.record import DT_RTOL, STANDARD_GRAVITY, UNITS, Record, normalise_units, positive_value
+from pounding.records.record import DT_RTOL, Record, normalise_units, positive_value
+from pounding.units import FORTRAN_NUMBER, STANDARD_GRAVITY, UNITS, canonical_unit
 
 __all__ = ["read_at2", "read_text", "check_agrees"]
 
 # A real number as written in record files; D exponents (Fortran) included.
-_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?"
+_NUMBER = FORTRAN_NUMBER
 # A number must be followed by a separator, a sign (glued values such as
 # 1.234E-02-5.678E-03) or the end of the line; "1.2.3" is not two numbers.
 _NUMBER_TOKEN = re.compile(_NUMBER + r"(?=[\s,+-]|$)")
@@ -32,13 +33,6 @@ _NPTS_NEW_REVERSED = re.compile(r"DT\s*=\s*(" + _NUMBER + r")\s*(?:SEC)?\s*[,;]?
 _NPTS_OLD = re.compile(r"^\s*(\d+)\s*[,;]?\s+(" + _NUMBER + r")\s*[,;]?\s*NPTS\s*[,;]?\s*DT\b", re.IGNORECASE)
 _NPTS_EXPECTED = "expected 'NPTS= 3930, DT= .00500 SEC' or '3930 0.00500 NPTS, DT'"
 _AT2_UNITS = re.compile(r"UNITS\s+(?:OF|ARE|IN)\s*[:=]?\s*\(?\s*([A-Za-z][A-Za-z0-9/^*]*)", re.IGNORECASE)
-_AT2_UNIT_NAMES = {
-    "G": "g",
-    "CM/S/S": "cm/s2", "CM/SEC/SEC": "cm/s2", "CM/S^2": "cm/s2", "CM/S**2": "cm/s2", "CM/S2": "cm/s2",
-    "CM/SEC^2": "cm/s2", "CM/SEC**2": "cm/s2", "CM/SEC2": "cm/s2", "GAL": "cm/s2",
-    "M/S/S": "m/s2", "M/SEC/SEC": "m/s2", "M/S^2": "m/s2", "M/S**2": "m/s2", "M/S2": "m/s2",
-    "M/SEC^2": "m/s2", "M/SEC**2": "m/s2",
-}
 _DATE = re.compile(r"\b(\d{1,2}/\d{1,2}/\d{2,4})\b")
 
 
@@ -143,7 +137,7 @@ def read_at2(path: str | Path) -> Record:
             raise RecordError(f"this is a {other.lower()} time series; only acceleration records (.AT2) are "
                               "accepted", file=str(path), line=3)
     unit_match = _AT2_UNITS.search(lines[2])
-    units = _AT2_UNIT_NAMES.get(unit_match[1].upper()) if unit_match else None
+    units = canonical_unit(unit_match[1]) if unit_match else None
     if units is None:
         found = f"'{unit_match[1]}'" if unit_match else "none"
         raise RecordError(f"cannot tell the units (found {found}); expected 'ACCELERATION TIME SERIES IN UNITS OF G' "

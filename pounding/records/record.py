@@ -19,20 +19,12 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import RecordError, did_you_mean
+from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNITS, canonical_unit
 
 __all__ = ["STANDARD_GRAVITY", "UNITS", "DT_RTOL", "Record", "normalise_units", "record_sha256", "positive_value"]
 
-#: Standard gravity, m/s² (the "g" of PEER and FEMA P695 records).
-STANDARD_GRAVITY = 9.80665
-
-#: Factor from each canonical unit to m/s².
-UNITS: dict[str, float] = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}
-
-_UNIT_ALIASES = {
-    "g": "g",
-    "m/s2": "m/s2", "m/s^2": "m/s2", "m/s**2": "m/s2", "m/s/s": "m/s2",
-    "cm/s2": "cm/s2", "cm/s^2": "cm/s2", "cm/s**2": "cm/s2", "cm/s/s": "cm/s2", "gal": "cm/s2",
-}
+# STANDARD_GRAVITY and UNITS (factor from each canonical unit to m/s²) come
+# from pounding.units, the package's one units table.
 
 #: Relative tolerance on a uniform time step (two-column text, dt cross-checks).
 DT_RTOL = 1e-6
@@ -51,10 +43,11 @@ def normalise_units(name: str) -> str:
     RecordError
         For an unknown name, with the closest known spelling.
     """
+    unit = canonical_unit(str(name))
+    if unit is not None:
+        return unit
     key = str(name).strip().lower().replace(" ", "")
-    if key in _UNIT_ALIASES:
-        return _UNIT_ALIASES[key]
-    raise RecordError(f"unknown units '{name}'{did_you_mean(key, list(_UNIT_ALIASES))}; "
+    raise RecordError(f"unknown units '{name}'{did_you_mean(key, list(UNIT_ALIASES))}; "
                       "use one of g, m/s2, cm/s2, gal in the YAML ground_motion section")
 
 

@@ -30,11 +30,15 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT}
     try:
-        from pounding.model.model import model_from_text
+        from pounding.model.model import model_from_data, model_from_text
         from pounding.simulation import simulate
 
         try:
-            model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
+            if task.get("data") is not None:
+                model = model_from_data(task["data"], name=task.get("name", "model"), source=task["document"],
+                                        base_dir=task.get("base_dir"))
+            else:
+                model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
         except ModelError as exc:
             raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
         ds = simulate(model)

@@ -13,8 +13,9 @@ A sweep file names a base model and the axes to vary::
       - [gap, restitution]
 
 Every combination (Cartesian product; a ``zip`` group counts as one axis) is a
-*scenario*: the base model's plain document (:meth:`Model.to_document`) with
-the axis values written in by path, validated with :func:`model_from_text`.
+*scenario*: the base model's plain document (:meth:`Model.plain_document`) with
+the axis values written in by path, validated as data by the model schema
+(:func:`pounding.model.model.model_from_data`; no YAML is written or read per value).
 
 Paths
 -----
@@ -48,8 +49,8 @@ Running and storage
 -------------------
 Scenarios run on a ``dask.distributed`` cluster: a ``LocalCluster`` with one
 single-threaded worker process per core by default, or an existing cluster
-(``--scheduler tcp://host:8786``).  Workers receive the scenario's YAML text
-and return its peaks (once a scenario's cost is known, a few scenarios go into
+(``--scheduler tcp://host:8786``).  Workers receive the scenario's model document (plain data, with its YAML text
+for the key and the archive) and return its peaks (once a scenario's cost is known, a few scenarios go into
 one task of about half a second, to keep Dask's per-task overhead near 1 %);
 each finished scenario is written at once, atomically,
 to ``<output>.parts/<hash>.json`` (the hash covers the scenario's model
@@ -78,6 +79,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from pounding import __version__
 from pounding.model import schema
+from pounding.model.document import Document
+from pounding.records.catalogue import is_catalogue_reference, is_catalogued
 from pounding.errors import ModelError, PoundingError, did_you_mean
 
 __all__ = ["Axis", "Dimension", "Scenario", "Sweep", "load_sweep", "sweep_from_text", "expand_records",
@@ -232,7 +235,10 @@ def _set_leaf(node: dict, key: str, value: Any, schema_loc: tuple[str, ...]) -> 
     from pounding.contact.laws import LAWS
 
     if schema_loc == ("buildings",) and key in ("stiffness_scale", "mass_scale"):
-        factor = schema.as_number(value) if not isinstance(value, bool) else None
+        try:
+            factor = schema.as_number(value)
+        except schema.Problem:
+            factor = None
         if factor is None or factor <= 0:
             raise ModelError(f"{key} must be a number > 0 (got {value!r})")
         field_name = key.removesuffix("_scale")
@@ -347,17 +353,6 @@ def _catalogue_entries() -> dict[str, Any] | None:
         return dict(catalogue.load_catalogue())
     except Exception:   # noqa: BLE001 - the named catalogue is optional for sweeps
         return None
-
-
-def is_catalogued(spec: str) -> bool:
-    """True for a catalogue reference (``fema-p695:farfield/1a``) or a bare catalogue key (no file)."""
-    if schema.is_catalogue_reference(spec):
-        return True
-    try:
-        from pounding.records.catalogue import is_catalogue_name  # type: ignore[attr-defined]
-    except ImportError:
-        return False
-    return bool(is_catalogue_name(spec)) and not os.path.exists(spec)
 
 
 def expand_records(value: str) -> list[str]:
@@ -490,13 +485,15 @@ class Scenario:
     coords : dict
         Axis name → label of this scenario.
     document : str
-        The model YAML.
+        The model YAML (what the key hashes and an archive keeps).
     base_dir : str or None
         Directory for relative record paths.
     key : str
         SHA-256 of the document, base_dir, pounding version and part format.
     error : str or None
         Known problem (an invalid axis value), recorded without running.
+    data : dict or None
+        The same model as plain data: workers validate it directly (no YAML parse).
     """
 
     index: tuple[int, ...]
@@ -505,6 +502,7 @@ class Scenario:
     base_dir: str | None
     key: str
     error: str | None = None
+    data: dict | None = field(default=None, repr=False, compare=False)
 
     @property
     def label(self) -> str:
@@ -512,7 +510,7 @@ class Scenario:
 
     def task(self, *, sweep_label: str, name: str, keep_history: bool = False) -> dict[str, Any]:
         """What a worker receives (plain data, cheap to ship)."""
-        return {"key": self.key, "document": self.document, "base_dir": self.base_dir, "name": name,
+        return {"key": self.key, "document": self.document, "data": self.data, "base_dir": self.base_dir, "name": name,
                 "where": f"{sweep_label}: scenario {self.label}", "keep_history": keep_history}
 
 
@@ -588,7 +586,7 @@ class Sweep:
             text = yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100)
             # a scenario with an invalid value must not share the key of the valid one it resembles
             key = scenario_key(text if error is None else f"{text}\n# invalid: {error}", self.base_dir)
-            out.append(Scenario(index, coords, text, self.base_dir, key, error))
+            out.append(Scenario(index, coords, text, self.base_dir, key, error, document))
         self._scenarios = out
         return out
 
@@ -616,7 +614,7 @@ def _number_text_to_float(value: Any) -> Any:
     if isinstance(value, str):
         try:
             return schema.as_number(value)
-        except schema._Problem:
+        except schema.Problem:
             return value
     return value
 
@@ -655,13 +653,13 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
     """Validate sweep YAML *text*; relative paths are resolved against *base_dir*."""
     from pounding.model.model import load_model
 
-    doc = schema.Document(text, label)
+    doc = Document(text, label)
     if doc.data is None:
         raise ModelError("the file is empty; a sweep needs 'model' and 'axes'", file=label, line=1)
     if not isinstance(doc.data, dict):
         raise ModelError(f"the top level must be a mapping with keys model, set, axes, zip (got {doc.got(())})",
                          file=label, line=doc.line(()))
-    top = schema._validate(doc, SweepTop, (), doc.data)
+    top = schema.validate_mapping(doc, SweepTop, (), doc.data)
     name = top.name
     if name is not None and not isinstance(name, (str, int)):
         raise doc.must(("name",), "must be text")
@@ -678,15 +676,15 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
         raise doc.error(("model",), f"model file '{top.model}' not found (looked for {model_file})")
     model = load_model(model_file)
     model_dir = os.path.dirname(os.path.abspath(model_file))
-    document = yaml.safe_load(model.to_document())
+    document = model.plain_document()
     record = document.get("ground_motion", {}).get("record")
     if isinstance(record, str) and not is_catalogued(record) and not os.path.isabs(record):
         document["ground_motion"]["record"] = os.path.normpath(os.path.join(model_dir, record))
 
     def validate_document(candidate: dict) -> str | None:
-        from pounding.model.model import model_from_text
+        from pounding.model.model import model_from_data
         try:
-            model_from_text(yaml.safe_dump(candidate, sort_keys=False), name=model.name, base_dir=model_dir)
+            model_from_data(candidate, name=model.name, base_dir=model_dir)
         except ModelError as exc:
             return strip_location(str(exc))
         return None
@@ -730,7 +728,7 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
         values_loc = loc
         dim_name = labels = None
         if isinstance(entry, dict):
-            long = schema._validate(doc, AxisEntry, loc, entry)
+            long = schema.validate_mapping(doc, AxisEntry, loc, entry)
             entry, values_loc = long.values, loc + ("values",)
             dim_name, labels = long.name, long.labels
         kind = {"records": "record", "record": "record", "scale": "scale", "xi": "xi"}.get(key, "path")
@@ -848,7 +846,7 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
 
 def _check_record(spec: str) -> str | None:
     """Cheap check of a record spec: the file exists, the catalogue key is known."""
-    if schema.is_catalogue_reference(spec):
+    if is_catalogue_reference(spec):
         return None
     if is_catalogued(spec):
         entries = _catalogue_entries()
@@ -860,7 +858,7 @@ def _check_record(spec: str) -> str | None:
     return None
 
 
-def _zip_groups(doc: schema.Document, data: Any, axes: list[Axis]) -> tuple[Dimension, ...]:
+def _zip_groups(doc: Document, data: Any, axes: list[Axis]) -> tuple[Dimension, ...]:
     if data is None:
         return tuple(Dimension(a.name, (a,)) for a in axes)
     if not isinstance(data, list):
@@ -873,7 +871,7 @@ def _zip_groups(doc: schema.Document, data: Any, axes: list[Axis]) -> tuple[Dime
         loc: Location = ("zip", g)
         name = None
         if isinstance(entry, dict):
-            long = schema._validate(doc, ZipEntry, loc, entry)
+            long = schema.validate_mapping(doc, ZipEntry, loc, entry)
             entry, name = long.axes, long.name
             loc = loc + ("axes",)
         if not isinstance(entry, list) or len(entry) < 2:
