@@ -10,10 +10,12 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import stat
 import subprocess
 import sys
+import tempfile
 import tomllib
 import zipfile
 from pathlib import Path
@@ -162,3 +164,32 @@ def test_wheel_holds_every_shipped_file(tmp_path):
     assert f"Version: {pounding.__version__}" in metadata
     assert "Requires-Dist: numba<0.69,>=0.67" in metadata and "Requires-Dist: platformdirs" in metadata
     assert "pounding = pounding.cli:console_main" in entry_points
+
+
+def test_read_only_install_caches_compiled_code_in_the_user_cache(tmp_path, monkeypatch):
+    # A __pycache__ that is a file cannot be written, even by root: a stand-in for a read-only site-packages.
+    from numba.core import config
+
+    from pounding.numba_cache import use_writable_cache
+
+    monkeypatch.setattr(config, "CACHE_DIR", "")
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    package = tmp_path / "site-packages" / "pounding" / "contact"
+    package.mkdir(parents=True)
+    (package / "laws.py").write_text("")
+    assert use_writable_cache(package / "laws.py") is None and config.CACHE_DIR == ""  # writable: numba's own place
+    shutil.rmtree(package / "__pycache__")
+    (package / "__pycache__").write_text("read-only stand-in")
+    if sys.platform.startswith("linux"):
+        monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+        assert use_writable_cache(package / "laws.py") == str(tmp_path / "cache" / "pounding" / "numba")
+        assert config.CACHE_DIR == str(tmp_path / "cache" / "pounding" / "numba")
+        # No writable user cache either: a folder in the temporary directory, never numba's RuntimeError.
+        monkeypatch.setattr(config, "CACHE_DIR", "")
+        (tmp_path / "file").write_text("")
+        monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "file"))
+        monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+        assert use_writable_cache(package / "laws.py") == str(tmp_path / "tmp" / f"pounding-numba-{os.getuid()}")
+    # NUMBA_CACHE_DIR (numba's config) set by the user always wins.
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path / "mine"))
+    assert use_writable_cache(package / "laws.py") is None and config.CACHE_DIR == str(tmp_path / "mine")

@@ -43,6 +43,9 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from pounding.contact import xi as xi_formulas
 from pounding.errors import PoundingError, did_you_mean
+from pounding.numba_cache import use_writable_cache
+
+use_writable_cache(__file__)  # a read-only install caches its kernels in the user's cache folder
 
 __all__ = [
     "ContactLaw",
