@@ -13,11 +13,18 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 
-# A fresh process running the shipped pair, as `pounding run` does, in one of two modes:
-# "fast" keeps the solver's start-up shortcuts, "numba" restores numba's own cache loader.
+# A fresh process running the shipped pair, as `pounding run` does, in one of three modes:
+# "fast" keeps the solver's start-up shortcuts, "numba" restores numba's own cache loader,
+# "untested" takes the installed numba out of jit.TESTED_NUMBA before the solver is imported
+# (numba.__version__ itself is left alone: numba keys its cache index on it, so changing it
+# would recompile and rewrite the cache instead of testing the loader).
 STARTUP_PROBE = r"""
 import json, sys
 import numpy as np
+if sys.argv[2] == "untested":
+    from pounding.solver import jit
+    jit.TESTED_NUMBA = ((0, 1),)
+    assert not jit.shortcuts_supported()
 from pounding import load_model, simulate
 from pounding.solver.integrator import _integrate
 if sys.argv[2] == "numba":
@@ -29,6 +36,7 @@ from numba import njit
 def dot(a, b):  # needs BLAS, hence scipy.linalg, compiled after the run
     return np.dot(a, b)
 print(json.dumps({
+    "shortcut_loader": "load_overload" in vars(_integrate._cache),
     "scipy_linalg_during_run": scipy_linalg_during_run,
     "cache_hits": int(sum(_integrate.stats.cache_hits.values())),
     "dot": float(dot(np.arange(3.0), np.arange(3.0))),
@@ -66,6 +74,45 @@ def test_start_up_shortcuts_change_nothing_but_time():
     # without it), yet numba code compiled afterwards still gets BLAS.
     assert fast["scipy_linalg_during_run"] is False
     assert fast["dot"] == 5.0
+    assert fast["shortcut_loader"] is True
+
+
+def test_start_up_shortcuts_are_off_on_an_untested_numba():
+    # On a numba release outside jit.TESTED_NUMBA (and the pyproject pin) neither
+    # shortcut is applied: numba's own loader, numba's own BLAS probe.  The same
+    # cached machine code runs, so the results are bit-identical to the fast path.
+    from pounding.solver import jit
+
+    assert jit.shortcuts_supported()  # this machine's numba is a tested one (the pin says so)
+    untested = _probe("untested")
+    fast = _probe("fast")
+    assert untested["shortcut_loader"] is False and fast["shortcut_loader"] is True
+    assert untested["scipy_linalg_during_run"] is True  # numba probed for BLAS by itself
+    assert untested["cache_hits"] == 1
+    for key in ("peak_drift_ratio", "peak_contact_force", "impact_time", "impact_velocity"):
+        assert untested[key] == fast[key], key
+
+
+def test_shortcuts_are_on_only_for_tested_numba_releases(monkeypatch):
+    import numba
+
+    from pounding.solver import jit
+
+    for version, supported in (("0.68.1", True), ("0.67.0", True), ("0.69.0", False), ("0.66.0", False),
+                               ("1.0.0", False), ("0.68.0rc1", True), ("dev", False), ("", False)):
+        monkeypatch.setattr(numba, "__version__", version)
+        assert jit.shortcuts_supported() is supported, version
+
+
+def test_tested_numba_matches_the_pin():
+    # The releases the shortcuts are switched on for are exactly those pyproject.toml allows.
+    import re
+
+    from pounding.solver import jit
+
+    text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    low, high = re.search(r'"numba>=0\.(\d+),<0\.(\d+)"', text).groups()
+    assert set(jit.TESTED_NUMBA) == {(0, minor) for minor in range(int(low), int(high))}
 
 
 # A kernel (main.py) that inlines a function of another file (law.py), cached like the solver.

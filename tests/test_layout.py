@@ -24,7 +24,7 @@ PACKAGE = Path(pounding.__file__).parent
 #: Layers from the bottom up; a module may import from its own layer group's
 #: package or from any lower layer, never from a higher one or a sibling package.
 LAYERS: list[tuple[str, ...]] = [
-    ("pounding", "pounding.errors", "pounding.data", "pounding.units"),
+    ("pounding", "pounding.errors", "pounding.data", "pounding.units", "pounding.numba_cache"),
     ("pounding.records", "pounding.contact"),
     ("pounding.model",),
     ("pounding.solver",),
@@ -48,7 +48,9 @@ def _module_name(path: Path) -> str:
 
 
 def _modules() -> dict[str, Path]:
-    return {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+    # A .py file outside a package (no __init__.py beside it) is shipped data, not a module:
+    # pounding/data/examples/*.py, pounding/data/ground_motions/make_synthetic.py.
+    return {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py")) if (p.parent / "__init__.py").exists()}
 
 
 def _imports(name: str, path: Path) -> list[tuple[str, str, int]]:

@@ -21,7 +21,7 @@ __all__ = ["main", "console_main", "build_parser", "SUBCOMMAND_MODULES"]
 #: subcommand name; their heavy imports happen inside the handlers, not at registration.
 SUBCOMMAND_MODULES = {"verify": "pounding.studies.verify", "sweep": "pounding.cli.sweep",
                       "compare": "pounding.cli.compare", "records": "pounding.cli.records",
-                      "export": "pounding.cli.export", "gap": "pounding.cli.gap"}
+                      "export": "pounding.cli.export", "gap": "pounding.cli.gap", "init": "pounding.cli.init"}
 
 
 # --------------------------------------------------------------------------- #

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pounding.data import catalogue_file
 from pounding.errors import RecordError, did_you_mean
 from pounding.records.fema import fema_set, load_fema_record
 from pounding.records.readers import check_agrees, read_at2, read_text
@@ -51,11 +52,16 @@ _ENTRY_REQUIRED = ("set", "source")
 
 
 def catalogue_path() -> Path:
-    """``$POUNDING_CATALOGUE`` if set, else ``ground_motions/catalogue.yaml`` of the source tree."""
+    """``$POUNDING_CATALOGUE`` if set, else the catalogue shipped in the package.
+
+    The shipped one is ``pounding/data/ground_motions/catalogue.yaml`` (the
+    checkout's ``ground_motions/`` is a link to that folder); file sources in
+    a catalogue are relative to the catalogue's own folder.
+    """
     explicit = os.environ.get("POUNDING_CATALOGUE", "").strip()
     if explicit:
         return Path(explicit).expanduser()
-    return Path(__file__).resolve().parents[2] / "ground_motions" / "catalogue.yaml"
+    return catalogue_file()
 
 
 def _slug(text: str) -> str:
@@ -156,8 +162,11 @@ def load_catalogue() -> dict[str, Entry]:
     try:
         mtime = path.stat().st_mtime
     except OSError:
-        raise RecordError("the record catalogue is missing; it ships in the source tree as "
-                          "ground_motions/catalogue.yaml (or set POUNDING_CATALOGUE)", file=str(path)) from None
+        if os.environ.get("POUNDING_CATALOGUE", "").strip():
+            fix = "point POUNDING_CATALOGUE at an existing catalogue.yaml, or unset it to use the shipped one"
+        else:
+            fix = "the installation is incomplete: reinstall pounding (python3 -m pip install --force-reinstall pounding)"
+        raise RecordError(f"the record catalogue is missing; {fix}", file=str(path)) from None
     return _read(str(path), mtime)[0]
 
 

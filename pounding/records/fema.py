@@ -152,16 +152,20 @@ _FEMA_COMPONENT_FIELDS = ("ComponentName", "RecordSequenceNumber", "NumPoints", 
 def fema_cache_dir() -> Path | None:
     """Folder of the on-disk FEMA P695 cache, or None if caching is off.
 
-    ``$POUNDING_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/pounding``, else
-    ``~/.cache/pounding``; ``POUNDING_NO_CACHE=1`` turns the cache off.
+    ``$POUNDING_CACHE_DIR`` if set, else the platform's user cache folder
+    from :mod:`platformdirs` (``$XDG_CACHE_HOME/pounding`` or
+    ``~/.cache/pounding`` on Linux, ``~/Library/Caches/pounding`` on macOS,
+    ``%LOCALAPPDATA%\\pounding\\Cache`` on Windows); ``POUNDING_NO_CACHE=1``
+    turns the cache off.
     """
     if os.environ.get("POUNDING_NO_CACHE", "").strip() not in ("", "0"):
         return None
     explicit = os.environ.get("POUNDING_CACHE_DIR", "").strip()
     if explicit:
         return Path(explicit).expanduser()
-    base = os.environ.get("XDG_CACHE_HOME", "").strip() or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "pounding"
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("pounding", appauthor=False))
 
 
 def _fema_cache_file(set_name: str) -> Path | None:

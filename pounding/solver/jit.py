@@ -16,9 +16,13 @@ safe:
   law, a changed force) would otherwise leave the solver running the old
   contact kernels it inlined.
 
-The last two use numba internals that have been stable for years; if they
-are not found (another numba version), the dispatcher is left as numba
-made it — slower to start, never wrong.
+The first two change how numba loads code, through numba internals; they
+are applied only on the numba versions they were tested on
+(:data:`TESTED_NUMBA`, the same range as the ``numba`` pin in
+``pyproject.toml``).  On any other version, or if an internal is not found,
+numba is left to behave as it does by itself — slower to start, never wrong.
+The third only ever discards a cache index that numba would have kept, so
+it is applied whenever numba's cache file has the stamp it replaces.
 """
 
 from __future__ import annotations
@@ -27,8 +31,24 @@ import os
 import sys
 from typing import Iterable
 
-__all__ = ["load_registries_without_scipy", "load_from_cache_without_refresh", "stamp_caches_with_sources",
-           "source_stamp"]
+__all__ = ["TESTED_NUMBA", "shortcuts_supported", "load_registries_without_scipy", "load_from_cache_without_refresh",
+           "stamp_caches_with_sources", "source_stamp"]
+
+#: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with
+#: the ``numba`` pin in pyproject.toml, and widen both only after tests/test_jit.py passes.
+TESTED_NUMBA = ((0, 67), (0, 68))
+
+
+def shortcuts_supported() -> bool:
+    """True if the installed numba is one of :data:`TESTED_NUMBA` (read at each call)."""
+    import numba
+
+    parts = str(getattr(numba, "__version__", "")).split(".")
+    try:
+        release = (int(parts[0]), int(parts[1]))
+    except (IndexError, ValueError):
+        return False
+    return release in TESTED_NUMBA
 
 
 def load_registries_without_scipy() -> None:
@@ -41,8 +61,11 @@ def load_registries_without_scipy() -> None:
     module is imported; the marker is removed at once, so ``import
     scipy.linalg`` works normally afterwards, and numba functions that need
     BLAS (``np.dot``, ``np.linalg``) still import it when they are compiled.
-    Nothing is done if scipy.linalg or the registry module is already imported.
+    Nothing is done if scipy.linalg or the registry module is already imported,
+    or on a numba version outside :data:`TESTED_NUMBA`.
     """
+    if not shortcuts_supported():
+        return
     blas = "scipy.linalg.cython_blas"
     if "numba.np.arraymath" in sys.modules or blas in sys.modules:
         return
@@ -63,8 +86,11 @@ def load_from_cache_without_refresh(dispatcher) -> None:
     needs the compiled library and numba's runtime (NRT) symbols, so this
     loader initialises the runtime and loads the library.  On a cache miss
     nothing changes: numba's compiler refreshes the context itself before it
-    compiles (``CompilerBase.__init__``).
+    compiles (``CompilerBase.__init__``).  Nothing is done on a numba version
+    outside :data:`TESTED_NUMBA`.
     """
+    if not shortcuts_supported():
+        return
     try:
         from numba.core.runtime import rtsys
 

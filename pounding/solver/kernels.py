@@ -15,6 +15,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws
+from pounding.numba_cache import use_writable_cache
 from pounding.solver import jit
 from pounding.contact.laws import LAW_BILINEAR, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_JANKOWSKI, LAW_KELVIN, LAW_LINEAR, LAW_STEREO, MIN_IMPACT_VELOCITY
 
@@ -22,6 +23,9 @@ from pounding.contact.laws import LAW_BILINEAR, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_J
 # --------------------------------------------------------------------------- #
 # Compiled kernels.  One branch per law; no Python objects inside.
 # --------------------------------------------------------------------------- #
+
+
+use_writable_cache(__file__)  # a read-only install caches its kernels in the user's cache folder
 
 
 @njit(cache=True)
