@@ -7,7 +7,62 @@ import time
 from pathlib import Path
 
 
-__all__ = ["summary", "register_cli"]
+__all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP"]
+
+SCALE_HELP = ("factor on the record (0.8), or a target as in the YAML: a PGA (0.4g, 3.9m/s2, 390gal), "
+              "sa=0.8g@1.0 (Sa at 1.0 s, 5%% damping), sa=0.8g@A (at building A's first period), "
+              "sa=0.8g@1.0,damping=0.02, or fema-p695 (the FEMA P695 normalisation)")
+
+
+def parse_scale_option(text: str, buildings=None):
+    """``--scale`` text as the YAML's ``ground_motion.scale`` value: a factor or a target mapping.
+
+    ``0.8`` → 0.8; ``0.4g`` or ``pga=0.4g`` → ``{pga: 0.4g}``; ``sa=0.8g@1.0``
+    → ``{sa: 0.8g, period: 1.0}``; ``sa=0.8g@A`` → ``{sa: 0.8g, period:
+    building A}``; ``,damping=0.02`` adds the damping ratio; ``fema-p695`` →
+    ``{fema-p695: true}``.  The result is checked with
+    :func:`pounding.records.processing.parse_scale`.
+    """
+    from pounding.errors import PoundingError
+    from pounding.records.processing import SpecProblem, parse_scale
+
+    raw = str(text).strip()
+    value: object
+    try:
+        value = float(raw)
+    except ValueError:
+        lowered = raw.lower().replace(" ", "")
+        if lowered in ("fema-p695", "fema-p695=true"):
+            value = {"fema-p695": True}
+        elif "=" not in lowered:
+            value = {"pga": raw}
+        else:
+            value = {}
+            for part in raw.split(","):
+                key, _, item = part.partition("=")
+                key, item = key.strip().lower(), item.strip()
+                if key == "sa" and "@" in item:
+                    item, _, period = item.partition("@")
+                    period = period.strip()
+                    try:
+                        value["period"] = float(period.rstrip("sS"))
+                    except ValueError:
+                        value["period"] = period if period.lower().startswith("building") else f"building {period}"
+                if key == "damping":
+                    try:
+                        value[key] = float(item)
+                    except ValueError:
+                        value[key] = item
+                else:
+                    value[key] = item.strip()
+    try:
+        parse_scale(value, buildings)
+    except SpecProblem as problem:
+        detail = problem.message("--scale", None if problem.kind != "must" else raw)
+        raise PoundingError(f"{detail}; write --scale 0.8 (a factor), --scale 0.4g (a PGA), --scale sa=0.8g@1.0 "
+                            "(Sa at 1.0 s), --scale sa=0.8g@A (at building A's first period) or --scale fema-p695"
+                            ) from None
+    return value
 
 
 # --------------------------------------------------------------------------- #
@@ -66,6 +121,7 @@ def summary(ds) -> str:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from pounding.errors import PoundingError
     from pounding.results.archive import check_writable, save_run
     from pounding.model.model import load_model
     from pounding.results.plots import plot_run
@@ -75,8 +131,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
     check_writable(output, overwrite=args.overwrite)  # before computing anything
     model = load_model(args.model)
-    ds = simulate(model, record=args.record, xi=args.xi, scale=args.scale, duration=args.duration,
-                  rtol=args.rtol, output_dt=args.output_dt)
+    scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
+    if args.record is None and (args.units is not None or args.dt is not None):
+        raise PoundingError("--units and --dt describe a record file given with --record; the model's own record "
+                            "takes them from its YAML ground_motion section")
+    ds = simulate(model, record=args.record, xi=args.xi, scale=scale, duration=args.duration,
+                  rtol=args.rtol, output_dt=args.output_dt, record_units=args.units, record_dt=args.dt,
+                  where="cli")
     path = save_run(ds, output, overwrite=args.overwrite)
     print(summary(ds))
     print(f"wrote {path}")
@@ -142,8 +203,13 @@ def register_cli(sub) -> None:
     """Add ``run``, ``rerun``, ``info``, ``plot`` and ``xi`` to *sub* (from ``add_subparsers``)."""
     run = sub.add_parser("run", help="simulate a YAML model under a record and archive the results")
     run.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
-    run.add_argument("--record", help="record spec: file.AT2, file.txt or fema-p695:farfield/1a")
-    run.add_argument("--scale", type=float, help="factor on the record")
+    run.add_argument("--record", help="record instead of the model's: a catalogue name (pounding records list), "
+                     "fema-p695:farfield/1a, or a .AT2 / text file relative to the current directory")
+    run.add_argument("--units", help="units of a --record text file without a '# units: g' header "
+                     "(g, m/s2, cm/s2, gal)")
+    run.add_argument("--dt", type=float, metavar="S", help="time step of a one-column --record text file "
+                     "without a '# dt = 0.005 s' header, s")
+    run.add_argument("--scale", metavar="X", help=SCALE_HELP)
     run.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
     run.add_argument("--duration", type=float, help="simulated time, s")
     run.add_argument("--rtol", type=float, help="relative tolerance of the solver")
