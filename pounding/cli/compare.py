@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from pounding.cli.sweep import add_cluster_options
+from pounding.cli.sweep import add_cluster_options, raise_if_all_failed
 from pounding.errors import PoundingError
 from pounding.studies.compare import REFERENCE, compare, comparison_table, plot_comparison
 
@@ -34,6 +34,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         else:
             print("pounding: interrupted", file=sys.stderr)
         return 130
+    raise_if_all_failed(ds, args.output)
     print(comparison_table(ds, args.reference))
     if args.output:
         print(f"wrote {args.output}")

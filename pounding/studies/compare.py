@@ -146,7 +146,10 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
              + ", ".join(records[:4]) + (f", ... ({len(records)} in all)" if len(records) > 4 else "")]
     failed = int((~ok).sum())
     if failed:
-        lines.append(f"{failed} scenario(s) failed and are left out (see the 'error' variable)")
+        from pounding.studies.sweep.execution import failure_report
+
+        lines.append(f"{failed} of {ok.size} scenario(s) failed and are left out of the means below:")
+        lines += failure_report(ds)
     rel = differences(ds, reference)
     drift = ds.peak_drift_ratio
     for building in _buildings(ds):
