@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 
-__all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP"]
+__all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options"]
 
 SCALE_HELP = ("factor on the record (0.8), or a target as in the YAML: a PGA (0.4g, 3.9m/s2, 390gal), "
               "sa=0.8g@1.0 (Sa at 1.0 s, 5%% damping), sa=0.8g@A (at building A's first period), "
@@ -142,7 +142,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(summary(ds))
     print(f"wrote {path}")
     if args.plot:
-        for png in plot_run(ds, args.plot):
+        for png in plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation):
             print(f"wrote {png}")
     print(f"total wall time {time.perf_counter() - started:.2f} s")
     return 0
@@ -160,14 +160,73 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_info(args: argparse.Namespace) -> int:
+def open_archive(path) -> tuple[str, object]:
+    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``sweep``, ``compare`` or ``verify``."""
+    import xarray as xr
+
+    from pounding.errors import ArchiveError
     from pounding.results.archive import open_run
 
-    ds = open_run(args.run)
-    print(f"{args.run}: {ds.attrs['title']}")
-    print(f"  {ds.attrs['history']}")
+    source = Path(path)
+    if not source.exists():
+        raise ArchiveError(f"{source}: no such file")
+    try:
+        with xr.open_dataset(source, engine="netcdf4") as handle:
+            attrs = dict(handle.attrs)
+            names = set(handle.variables)
+    except (OSError, ValueError) as exc:
+        raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]})") from None
+    if "run_spec" in attrs:
+        return "run", open_run(source)
+    is_verify = {"e_pre", "e_post", "model"} <= names and "settings" in attrs
+    if not is_verify and not str(attrs.get("source", "")).startswith("pounding"):
+        raise ArchiveError(f"{source}: not a pounding archive (written by pounding run, rerun, sweep, compare or "
+                           "verify)")
+    with xr.open_dataset(source, engine="netcdf4") as handle:
+        ds = handle.load()
+    if "sweep_name" in attrs:
+        return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
+                else "sweep"), ds
+    if is_verify:
+        return "verify", ds
+    raise ArchiveError(f"{source}: a pounding file of an unknown kind (not from run, rerun, sweep, compare or "
+                       "verify); a newer pounding may read it")
+
+
+def _reference(ds) -> str:
+    """The formula a compare archive is compared with (``exact`` unless it was not run)."""
+    from pounding.studies.compare import REFERENCE
+
+    formulas = [str(x) for x in ds.xi.values]
+    reference = str(ds.attrs.get("reference_xi", REFERENCE))
+    return reference if reference in formulas else formulas[-1]
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    kind, ds = open_archive(args.run)
+    print(f"{args.run}: {ds.attrs.get('title', kind)} [{kind} archive]")
+    print("  " + str(ds.attrs.get("history", "")).replace("\n", "\n  "))
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
-    print(summary(ds))
+    if kind == "run":
+        print(summary(ds))
+    elif kind in ("sweep", "compare"):
+        from pounding.cli.sweep import summary_lines
+
+        for line in summary_lines(ds):
+            print(line)
+        if kind == "compare" and bool((ds.status == "ok").any()):
+            from pounding.studies.compare import comparison_table
+
+            print(comparison_table(ds, _reference(ds)))
+    else:
+        from pounding.studies.verify import format_models, format_table_i
+
+        table = format_table_i(ds)
+        if table:
+            print(table)
+            print()
+        print(format_models(ds))
     if args.variables:
         for name, var in ds.data_vars.items():
             print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")
@@ -175,11 +234,33 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from pounding.results.archive import open_run
-    from pounding.results.plots import plot_run
+    from pounding.errors import PoundingError
 
-    ds = open_run(args.run)
-    for png in plot_run(ds, args.output):
+    kind, ds = open_archive(args.run)
+    if kind in ("sweep", "compare") and not bool((ds.status == "ok").any()):
+        raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
+                            f"`pounding info {args.run}` lists the errors")
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise PoundingError(f"{out} is a file; -o needs a directory")
+    if kind == "run":
+        from pounding.results.plots import plot_run
+
+        written = plot_run(ds, out, drift_limit=args.drift_limit, elevation=args.elevation)
+    elif kind == "compare":
+        from pounding.studies.compare import plot_comparison
+
+        written = plot_comparison(ds, out, _reference(ds), drift_limit=args.drift_limit)
+    elif kind == "sweep":
+        from pounding.results.plots import plot_sweep
+
+        written = plot_sweep(ds, out)
+    else:
+        from pounding.studies.verify import plot_verification
+
+        out.mkdir(parents=True, exist_ok=True)
+        written = [plot_verification(ds, out / "verify.png")]
+    for png in written:
         print(f"wrote {png}")
     return 0
 
@@ -216,26 +297,42 @@ def register_cli(sub) -> None:
     run.add_argument("--output-dt", type=float, help="sampling of stored histories, s")
     run.add_argument("-o", "--output", help="NetCDF archive (default: MODEL-STEM.nc)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing archive")
-    run.add_argument("--plot", metavar="DIR", help="also write PNG plots to DIR")
+    run.add_argument("--plot", metavar="DIR", help="also write the four PNG figures to DIR (see pounding plot)")
+    add_plot_options(run)
     run.set_defaults(func=_cmd_run)
 
-    again = sub.add_parser("rerun", help="rerun an archived simulation from its archive")
+    again = sub.add_parser("rerun", help="rerun an archived simulation from its archive",
+                           description="Simulate again what a `pounding run` archive recorded (model, record, "
+                                       "scale); refuses if the record's samples no longer hash the same.")
     again.add_argument("run", help="archive written by `pounding run`")
     again.add_argument("-o", "--output", required=True, help="new NetCDF archive")
-    again.add_argument("--overwrite", action="store_true")
+    again.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     again.set_defaults(func=_cmd_rerun)
 
-    info = sub.add_parser("info", help="describe an archive")
-    info.add_argument("run")
+    info = sub.add_parser("info", help="describe an archive (run, sweep, compare or verify)",
+                          description="Print an archive's kind, history, dimensions and summary.")
+    info.add_argument("run", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare or verify")
     info.add_argument("--variables", action="store_true", help="list every variable with units")
     info.set_defaults(func=_cmd_info)
 
-    plot = sub.add_parser("plot", help="draw PNG plots of an archive")
-    plot.add_argument("run")
-    plot.add_argument("-o", "--output", required=True, metavar="DIR")
+    plot = sub.add_parser("plot", help="draw the PNG figures of an archive (run, sweep, compare or verify)",
+                          description="Redraw an archive's figures: a run's four figures, compare's two, a "
+                                      "sweep's peak drifts against each axis, verify's e_post against e_pre.")
+    plot.add_argument("run", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare or verify")
+    plot.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the PNG files "
+                      "(created if needed)")
+    add_plot_options(plot)
     plot.set_defaults(func=_cmd_plot)
 
     xi = sub.add_parser("xi", help="the catalogue of xi formulas")
-    xi_sub = xi.add_subparsers(dest="xi_command", required=True)
-    xi_list = xi_sub.add_parser("list", help="print the catalogue")
+    xi_sub = xi.add_subparsers(dest="xi_command", required=True, metavar="{list}")
+    xi_list = xi_sub.add_parser("list", help="print the catalogue: key, p(e), status, reference, aliases")
     xi_list.set_defaults(func=_cmd_xi_list)
+
+
+def add_plot_options(parser: argparse.ArgumentParser) -> None:
+    """``--drift-limit`` and ``--elevation`` for the drift-profile figures."""
+    parser.add_argument("--drift-limit", type=float, metavar="PCT",
+                        help="draw a drift-ratio limit line on the drift profiles, in %% (e.g. 2.0)")
+    parser.add_argument("--elevation", action="store_true",
+                        help="drift profiles against floor elevation (m) instead of storey number")
