@@ -279,7 +279,8 @@ def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
         ax.set_xticks(x)
         ax.set_xticklabels(labels, rotation=20 if max(len(t) for t in labels) > 6 else 0, ha="right"
                            if max(len(t) for t in labels) > 6 else "center", fontsize=7)
-        ax.set_xlabel(dim)
+        units = ds[dim].attrs.get("units", "")
+        ax.set_xlabel(f"{dim} ({units})" if units and units != "1" else dim)
         ax.set_ylabel("largest peak storey\ndrift ratio (%)", fontsize=8)
         ax.set_ylim(bottom=0.0)
         ax.grid(alpha=0.3)
