@@ -292,7 +292,7 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
             else:
                 ax.set_title(f"building {building}", fontsize=9)
     fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}"
-                 + (" (boxes: quartiles, whiskers: range)" if n_records >= 3 else " (one dot per record)"), fontsize=9)
+                 + (" (boxes: quartiles and median, whiskers: 1.5 IQR; dots: records)" if n_records >= 3 else " (one dot per record)"), fontsize=9)
     fig.tight_layout()
     distribution = out / "xi_drift_distribution.png"
     fig.savefig(distribution, dpi=110)
