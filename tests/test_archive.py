@@ -16,11 +16,12 @@ PAIR = "models/pair.yaml"
 
 VARIABLES = ["displacement", "velocity", "absolute_acceleration", "storey_drift", "drift_ratio",
              "contact_force", "penetration", "ground_acceleration", "peak_displacement",
-             "peak_drift_ratio", "peak_contact_force", "impact_count", "impact_time", "impact_contact",
+             "peak_drift_ratio", "peak_contact_force", "impact_count", "impact_contact",
              "impact_velocity", "impact_xi", "impact_peak_force", "impact_duration", "impact_impulse",
              "impact_restitution"]
 COORDS = {"floor": ["building", "level", "elevation"], "storey": ["storey_building", "storey_level", "height"],
-          "contact": ["building_left", "building_right", "level_left", "level_right", "gap"]}
+          "contact": ["building_left", "building_right", "level_left", "level_right", "gap"],
+          "impact": ["impact_time", "impact_contact_label"], "trace": ["trace_time", "trace_contact_label"]}
 ATTRS = ["Conventions", "title", "source", "history", "references", "model_yaml", "record_name",
          "record_metadata", "solver_rtol", "solver_atol", "solver_output_dt", "xi_formulas"]
 

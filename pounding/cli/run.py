@@ -7,7 +7,62 @@ import time
 from pathlib import Path
 
 
-__all__ = ["summary", "register_cli"]
+__all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options"]
+
+SCALE_HELP = ("factor on the record (0.8), or a target as in the YAML: a PGA (0.4g, 3.9m/s2, 390gal), "
+              "sa=0.8g@1.0 (Sa at 1.0 s, 5%% damping), sa=0.8g@A (at building A's first period), "
+              "sa=0.8g@1.0,damping=0.02, or fema-p695 (the FEMA P695 normalisation)")
+
+
+def parse_scale_option(text: str, buildings=None):
+    """``--scale`` text as the YAML's ``ground_motion.scale`` value: a factor or a target mapping.
+
+    ``0.8`` → 0.8; ``0.4g`` or ``pga=0.4g`` → ``{pga: 0.4g}``; ``sa=0.8g@1.0``
+    → ``{sa: 0.8g, period: 1.0}``; ``sa=0.8g@A`` → ``{sa: 0.8g, period:
+    building A}``; ``,damping=0.02`` adds the damping ratio; ``fema-p695`` →
+    ``{fema-p695: true}``.  The result is checked with
+    :func:`pounding.records.processing.parse_scale`.
+    """
+    from pounding.errors import PoundingError
+    from pounding.records.processing import SpecProblem, parse_scale
+
+    raw = str(text).strip()
+    value: object
+    try:
+        value = float(raw)
+    except ValueError:
+        lowered = raw.lower().replace(" ", "")
+        if lowered in ("fema-p695", "fema-p695=true"):
+            value = {"fema-p695": True}
+        elif "=" not in lowered:
+            value = {"pga": raw}
+        else:
+            value = {}
+            for part in raw.split(","):
+                key, _, item = part.partition("=")
+                key, item = key.strip().lower(), item.strip()
+                if key == "sa" and "@" in item:
+                    item, _, period = item.partition("@")
+                    period = period.strip()
+                    try:
+                        value["period"] = float(period.rstrip("sS"))
+                    except ValueError:
+                        value["period"] = period if period.lower().startswith("building") else f"building {period}"
+                if key == "damping":
+                    try:
+                        value[key] = float(item)
+                    except ValueError:
+                        value[key] = item
+                else:
+                    value[key] = item.strip()
+    try:
+        parse_scale(value, buildings)
+    except SpecProblem as problem:
+        detail = problem.message("--scale", None if problem.kind != "must" else raw)
+        raise PoundingError(f"{detail}; write --scale 0.8 (a factor), --scale 0.4g (a PGA), --scale sa=0.8g@1.0 "
+                            "(Sa at 1.0 s), --scale sa=0.8g@A (at building A's first period) or --scale fema-p695"
+                            ) from None
+    return value
 
 
 # --------------------------------------------------------------------------- #
@@ -66,6 +121,7 @@ def summary(ds) -> str:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from pounding.errors import PoundingError
     from pounding.results.archive import check_writable, save_run
     from pounding.model.model import load_model
     from pounding.results.plots import plot_run
@@ -75,15 +131,20 @@ def _cmd_run(args: argparse.Namespace) -> int:
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
     check_writable(output, overwrite=args.overwrite)  # before computing anything
     model = load_model(args.model)
-    ds = simulate(model, record=args.record, xi=args.xi, scale=args.scale, duration=args.duration,
-                  rtol=args.rtol, output_dt=args.output_dt)
+    scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
+    if args.record is None and (args.units is not None or args.dt is not None):
+        raise PoundingError("--units and --dt describe a record file given with --record; the model's own record "
+                            "takes them from its YAML ground_motion section")
+    ds = simulate(model, record=args.record, xi=args.xi, scale=scale, duration=args.duration,
+                  rtol=args.rtol, output_dt=args.output_dt, record_units=args.units, record_dt=args.dt,
+                  where="cli")
     path = save_run(ds, output, overwrite=args.overwrite)
     print(summary(ds))
     print(f"wrote {path}")
     if args.plot:
-        for png in plot_run(ds, args.plot):
+        for png in plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation):
             print(f"wrote {png}")
-    print(f"total wall time {time.perf_counter() - started:.2f} s")
+    print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return 0
 
 
@@ -99,14 +160,73 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_info(args: argparse.Namespace) -> int:
+def open_archive(path) -> tuple[str, object]:
+    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``sweep``, ``compare`` or ``verify``."""
+    import xarray as xr
+
+    from pounding.errors import ArchiveError
     from pounding.results.archive import open_run
 
-    ds = open_run(args.run)
-    print(f"{args.run}: {ds.attrs['title']}")
-    print(f"  {ds.attrs['history']}")
+    source = Path(path)
+    if not source.exists():
+        raise ArchiveError(f"{source}: no such file")
+    try:
+        with xr.open_dataset(source, engine="netcdf4") as handle:
+            attrs = dict(handle.attrs)
+            names = set(handle.variables)
+    except (OSError, ValueError) as exc:
+        raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]})") from None
+    if "run_spec" in attrs:
+        return "run", open_run(source)
+    is_verify = {"e_pre", "e_post", "model"} <= names and "settings" in attrs
+    if not is_verify and not str(attrs.get("source", "")).startswith("pounding"):
+        raise ArchiveError(f"{source}: not a pounding archive (written by pounding run, rerun, sweep, compare or "
+                           "verify)")
+    with xr.open_dataset(source, engine="netcdf4") as handle:
+        ds = handle.load()
+    if "sweep_name" in attrs:
+        return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
+                else "sweep"), ds
+    if is_verify:
+        return "verify", ds
+    raise ArchiveError(f"{source}: a pounding file of an unknown kind (not from run, rerun, sweep, compare or "
+                       "verify); a newer pounding may read it")
+
+
+def _reference(ds) -> str:
+    """The formula a compare archive is compared with (``exact`` unless it was not run)."""
+    from pounding.studies.compare import REFERENCE
+
+    formulas = [str(x) for x in ds.xi.values]
+    reference = str(ds.attrs.get("reference_xi", REFERENCE))
+    return reference if reference in formulas else formulas[-1]
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    kind, ds = open_archive(args.run)
+    print(f"{args.run}: {ds.attrs.get('title', kind)} [{kind} archive]")
+    print("  " + str(ds.attrs.get("history", "")).replace("\n", "\n  "))
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
-    print(summary(ds))
+    if kind == "run":
+        print(summary(ds))
+    elif kind in ("sweep", "compare"):
+        from pounding.cli.sweep import summary_lines
+
+        for line in summary_lines(ds):
+            print(line)
+        if kind == "compare" and bool((ds.status == "ok").any()):
+            from pounding.studies.compare import comparison_table
+
+            print(comparison_table(ds, _reference(ds)))
+    else:
+        from pounding.studies.verify import format_models, format_table_i
+
+        table = format_table_i(ds)
+        if table:
+            print(table)
+            print()
+        print(format_models(ds))
     if args.variables:
         for name, var in ds.data_vars.items():
             print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")
@@ -114,11 +234,33 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from pounding.results.archive import open_run
-    from pounding.results.plots import plot_run
+    from pounding.errors import PoundingError
 
-    ds = open_run(args.run)
-    for png in plot_run(ds, args.output):
+    kind, ds = open_archive(args.run)
+    if kind in ("sweep", "compare") and not bool((ds.status == "ok").any()):
+        raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
+                            f"`pounding info {args.run}` lists the errors")
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise PoundingError(f"{out} is a file; -o needs a directory")
+    if kind == "run":
+        from pounding.results.plots import plot_run
+
+        written = plot_run(ds, out, drift_limit=args.drift_limit, elevation=args.elevation)
+    elif kind == "compare":
+        from pounding.studies.compare import plot_comparison
+
+        written = plot_comparison(ds, out, _reference(ds), drift_limit=args.drift_limit)
+    elif kind == "sweep":
+        from pounding.results.plots import plot_sweep
+
+        written = plot_sweep(ds, out)
+    else:
+        from pounding.studies.verify import plot_verification
+
+        out.mkdir(parents=True, exist_ok=True)
+        written = [plot_verification(ds, out / "verify.png")]
+    for png in written:
         print(f"wrote {png}")
     return 0
 
@@ -142,34 +284,55 @@ def register_cli(sub) -> None:
     """Add ``run``, ``rerun``, ``info``, ``plot`` and ``xi`` to *sub* (from ``add_subparsers``)."""
     run = sub.add_parser("run", help="simulate a YAML model under a record and archive the results")
     run.add_argument("model", help="YAML building model, e.g. models/pair.yaml")
-    run.add_argument("--record", help="record spec: file.AT2, file.txt or fema-p695:farfield/1a")
-    run.add_argument("--scale", type=float, help="factor on the record")
+    run.add_argument("--record", help="record instead of the model's: a catalogue name (pounding records list), "
+                     "fema-p695:farfield/1a, or a .AT2 / text file relative to the current directory")
+    run.add_argument("--units", help="units of a --record text file without a '# units: g' header "
+                     "(g, m/s2, cm/s2, gal)")
+    run.add_argument("--dt", type=float, metavar="S", help="time step of a one-column --record text file "
+                     "without a '# dt = 0.005 s' header, s")
+    run.add_argument("--scale", metavar="X", help=SCALE_HELP)
     run.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
     run.add_argument("--duration", type=float, help="simulated time, s")
     run.add_argument("--rtol", type=float, help="relative tolerance of the solver")
     run.add_argument("--output-dt", type=float, help="sampling of stored histories, s")
     run.add_argument("-o", "--output", help="NetCDF archive (default: MODEL-STEM.nc)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing archive")
-    run.add_argument("--plot", metavar="DIR", help="also write PNG plots to DIR")
+    run.add_argument("--plot", metavar="DIR", help="also write the four PNG figures to DIR (see pounding plot)")
+    add_plot_options(run)
     run.set_defaults(func=_cmd_run)
 
-    again = sub.add_parser("rerun", help="rerun an archived simulation from its archive")
+    again = sub.add_parser("rerun", help="rerun an archived simulation from its archive",
+                           description="Simulate again what a `pounding run` archive recorded (model, record, "
+                                       "scale); refuses if the record's samples no longer hash the same.")
     again.add_argument("run", help="archive written by `pounding run`")
     again.add_argument("-o", "--output", required=True, help="new NetCDF archive")
-    again.add_argument("--overwrite", action="store_true")
+    again.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     again.set_defaults(func=_cmd_rerun)
 
-    info = sub.add_parser("info", help="describe an archive")
-    info.add_argument("run")
+    info = sub.add_parser("info", help="describe an archive (run, sweep, compare or verify)",
+                          description="Print an archive's kind, history, dimensions and summary.")
+    info.add_argument("run", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare or verify")
     info.add_argument("--variables", action="store_true", help="list every variable with units")
     info.set_defaults(func=_cmd_info)
 
-    plot = sub.add_parser("plot", help="draw PNG plots of an archive")
-    plot.add_argument("run")
-    plot.add_argument("-o", "--output", required=True, metavar="DIR")
+    plot = sub.add_parser("plot", help="draw the PNG figures of an archive (run, sweep, compare or verify)",
+                          description="Redraw an archive's figures: a run's four figures, compare's two, a "
+                                      "sweep's peak drifts against each axis, verify's e_post against e_pre.")
+    plot.add_argument("run", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare or verify")
+    plot.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the PNG files "
+                      "(created if needed)")
+    add_plot_options(plot)
     plot.set_defaults(func=_cmd_plot)
 
     xi = sub.add_parser("xi", help="the catalogue of xi formulas")
-    xi_sub = xi.add_subparsers(dest="xi_command", required=True)
-    xi_list = xi_sub.add_parser("list", help="print the catalogue")
+    xi_sub = xi.add_subparsers(dest="xi_command", required=True, metavar="{list}")
+    xi_list = xi_sub.add_parser("list", help="print the catalogue: key, p(e), status, reference, aliases")
     xi_list.set_defaults(func=_cmd_xi_list)
+
+
+def add_plot_options(parser: argparse.ArgumentParser) -> None:
+    """``--drift-limit`` and ``--elevation`` for the drift-profile figures."""
+    parser.add_argument("--drift-limit", type=float, metavar="PCT",
+                        help="draw a drift-ratio limit line on the drift profiles, in %% (e.g. 2.0)")
+    parser.add_argument("--elevation", action="store_true",
+                        help="drift profiles against floor elevation (m) instead of storey number")

@@ -7,11 +7,11 @@ import sys
 from pathlib import Path
 
 from pounding.errors import PoundingError
-from pounding.studies.sweep.execution import default_workers, run_sweep
+from pounding.studies.sweep.execution import default_workers, failure_report, run_sweep
 from pounding.studies.sweep.spec import load_sweep
 from pounding.studies.sweep.store import parts_dir
 
-__all__ = ["register_cli", "add_cluster_options", "summary_lines"]
+__all__ = ["register_cli", "add_cluster_options", "summary_lines", "raise_if_all_failed"]
 
 # --------------------------------------------------------------------------- #
 # Command line
@@ -30,19 +30,19 @@ def add_cluster_options(parser: argparse.ArgumentParser) -> None:
 
 
 def summary_lines(ds) -> list[str]:
-    """Counts and the first errors of a sweep results dataset."""
+    """Counts and each distinct error of a sweep results dataset, with the scenarios it hit."""
     status = ds.status.values.ravel()
-    errors = [e for e in ds.error.values.ravel() if e]
     lines = [f"{status.size} scenarios: {int((status == 'ok').sum())} ok, {int((status != 'ok').sum())} failed"]
-    shown = []
-    for message in errors:
-        if message not in shown:
-            shown.append(message)
-    for message in shown[:5]:
-        lines.append(f"  error: {message}")
-    if len(shown) > 5:
-        lines.append(f"  ... and {len(shown) - 5} more different errors (variable 'error' in the output)")
-    return lines
+    return lines + failure_report(ds)
+
+
+def raise_if_all_failed(ds, output) -> None:
+    """Print each distinct error on stderr and stop (status 2) when no scenario ran."""
+    if ds.status.size and not bool((ds.status == "ok").any()):
+        for line in failure_report(ds):
+            print(f"pounding: {line.strip()}", file=sys.stderr)
+        where = f"; the errors are also in the variable 'error' of {output}" if output else ""
+        raise PoundingError(f"all {ds.status.size} scenarios failed (errors above){where}")
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
@@ -67,6 +67,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print(f"pounding: interrupted; {count} finished scenarios are kept in {store}; run the same command "
               "again to finish the others", file=sys.stderr)
         return 130
+    raise_if_all_failed(ds, output)
     for line in summary_lines(ds):
         print(line)
     rate = ds.attrs["n_run"] / ds.attrs["elapsed_time"] if ds.attrs["elapsed_time"] > 0 else float("nan")

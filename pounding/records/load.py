@@ -28,7 +28,7 @@ __all__ = ["load_record", "CATALOGUE_REFERENCE"]
 
 
 def load_record(spec: str, *, base_dir: str | None = None, dt: float | None = None, units: str | None = None,
-                scale: float = 1.0, duration: float | None = None) -> Record:
+                scale: float = 1.0, duration: float | None = None, where: str = "yaml") -> Record:
     """Load a record by specification, then scale and truncate it.
 
     Parameters
@@ -48,6 +48,9 @@ def load_record(spec: str, *, base_dir: str | None = None, dt: float | None = No
         Factor on the accelerations (> 0).
     duration : float, optional
         Keep only the first *duration* seconds.
+    where : str
+        Where the record was named (``yaml``, ``cli`` or ``api``): how an
+        error about missing units or dt says to give them.
     """
     if not isinstance(spec, str) or not spec.strip():
         raise RecordError(f"ground_motion.record must be a catalogue reference such as fema-p695:farfield/1a "
@@ -72,7 +75,7 @@ def load_record(spec: str, *, base_dir: str | None = None, dt: float | None = No
             record = read_at2(path)
             check_agrees(record, path, dt=dt, units=units)
         else:
-            record = read_text(path, dt=dt, units=units)
+            record = read_text(path, dt=dt, units=units, where=where)
         record = dataclasses.replace(record, source=spec)
     if float(scale) != 1.0:
         record = record.scaled(scale)

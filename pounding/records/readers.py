@@ -17,7 +17,32 @@ from pounding.errors import RecordError
 from pounding.records.record import DT_RTOL, Record, normalise_units, positive_value
 from pounding.units import FORTRAN_NUMBER, STANDARD_GRAVITY, UNITS, canonical_unit
 
-__all__ = ["read_at2", "read_text", "check_agrees"]
+__all__ = ["read_at2", "read_text", "check_agrees", "text_header", "declared_in_header", "FIXES"]
+
+#: How to give a text record's units and time step, by where the record was named:
+#: in a model YAML (``yaml``), on the command line (``cli``) or to the Python API (``api``).
+FIXES = {
+    "yaml": {"units": "a text record needs its units; add 'units: g' (or m/s2, cm/s2, gal) to the YAML "
+                      "ground_motion section",
+             "dt": "a one-column record needs its time step; add 'dt: <seconds>' to the YAML ground_motion "
+                   "section (or add a time column)",
+             "dt_given": "ground_motion.dt",
+             "remove": "remove {what} from the YAML ground_motion section"},
+    "cli": {"units": "a text record needs its units; give them on the command line, e.g. --units g --dt 0.005 "
+                     "(units g, m/s2, cm/s2 or gal), or start the file with '# units: g; dt = 0.005 s'",
+            "dt": "a one-column record needs its time step; give it on the command line, e.g. --dt 0.005, or "
+                  "start the file with '# dt = 0.005 s' (or add a time column)",
+            "dt_given": "--dt",
+            "remove": "leave out --{what}"},
+    "api": {"units": "a text record needs its units; pass record_units='g' (or 'm/s2', 'cm/s2', 'gal'), or "
+                     "start the file with '# units: g; dt = 0.005 s'",
+            "dt": "a one-column record needs its time step; pass record_dt=<seconds>, or start the file with "
+                  "'# dt = 0.005 s' (or add a time column)",
+            "dt_given": "record_dt",
+            "remove": "leave out record_{what}"},
+}
+_HEADER_LINE = re.compile(r"#\s*(units|dt)\s*[:=]", re.IGNORECASE)
+_HEADER_FIELD = re.compile(r"\b(units|dt)\s*[:=]\s*([^;,]+)", re.IGNORECASE)
 
 # A real number as written in record files; D exponents (Fortran) included.
 _NUMBER = FORTRAN_NUMBER
@@ -227,19 +252,93 @@ def _at2_event(line: str) -> dict[str, str]:
 # --------------------------------------------------------------------------- #
 
 
-def read_text(path: str | Path, *, dt: float | None = None, units: str | None = None) -> Record:
+def text_header(lines: list[str], path: Path) -> dict[str, Any]:
+    """``units`` and ``dt`` declared in the leading comment lines of a text record.
+
+    A line such as ``# units: g; dt = 0.005 s`` (the shipped synthetic
+    records have one) declares them; fields are separated by ``;`` or ``,``
+    and a trailing ``s`` after dt is allowed.  Returns ``{"units": ..., "dt":
+    ..., "line": ...}`` with the fields found (none: an empty dict).
+    """
+    found: dict[str, Any] = {}
+    for lineno, raw in enumerate(lines, start=1):
+        stripped = raw.strip()
+        if not stripped:
+            continue
+        if not stripped.startswith("#"):
+            break
+        if not _HEADER_LINE.match(stripped):   # other comments may mention dt= in passing
+            continue
+        for match in _HEADER_FIELD.finditer(stripped[1:]):
+            key, value = match[1].lower(), match[2].strip()
+            if key == "units":
+                try:
+                    found["units"] = normalise_units(value)
+                except RecordError:
+                    raise RecordError(f"the header declares unknown units '{value}'; write '# units: g' (or m/s2, "
+                                      "cm/s2, gal)", file=str(path), line=lineno) from None
+            else:
+                number = re.sub(r"\s*(s|sec|seconds)\s*$", "", value, flags=re.IGNORECASE)
+                try:
+                    found["dt"] = float(number)
+                except ValueError:
+                    raise RecordError(f"the header declares dt = '{value}'; write '# dt = 0.005 s'",
+                                      file=str(path), line=lineno) from None
+                if not (math.isfinite(found["dt"]) and found["dt"] > 0):
+                    raise RecordError(f"the header declares dt = {value}; dt must be > 0", file=str(path),
+                                      line=lineno)
+            found.setdefault("line", lineno)
+    return found
+
+
+def declared_in_header(path: str | Path) -> dict[str, Any]:
+    """``units`` / ``dt`` declared by the header of a text record file; ``{}`` if none or unreadable.
+
+    Errors in the file are left for :func:`read_text` to report.
+    """
+    try:
+        lines = Path(path).read_bytes().decode("latin-1").splitlines()[:50]
+        return {k: v for k, v in text_header(lines, Path(path)).items() if k != "line"}
+    except (OSError, RecordError):
+        return {}
+
+
+def read_text(path: str | Path, *, dt: float | None = None, units: str | None = None,
+              where: str = "yaml") -> Record:
     """Read a plain-text record: one column (acceleration) or two (time, acceleration).
 
     Columns are separated by whitespace or commas; ``#`` starts a comment and
     one non-numeric first line (a CSV header) is skipped. One column needs
     *dt*; with two columns the step is taken from the (strictly increasing,
-    uniform within 1e-6 relative) time column. *units* is always required.
+    uniform within 1e-6 relative) time column. *units* is required unless the
+    file declares them in a leading comment, ``# units: g; dt = 0.005 s``
+    (see :func:`text_header`); a *units* or *dt* given as well must agree
+    with the header.  *where* (``yaml``, ``cli`` or ``api``) picks how the
+    error messages say to give missing units or dt (:data:`FIXES`).
     """
     path = Path(path)
+    fixes = FIXES.get(where, FIXES["yaml"])
     lines = _read_lines(path, "text record")
+    header = text_header(lines, path)
+    if units is None and "units" in header:
+        units = header["units"]
+    elif units is not None and "units" in header:
+        try:
+            given = normalise_units(units)
+        except RecordError as error:
+            raise RecordError(str(error), file=str(path)) from None
+        if given != header["units"]:
+            raise RecordError(f"the header declares units of {header['units']} but {units} was given; "
+                              + fixes["remove"].format(what="units"), file=str(path), line=header["line"])
+    if dt is None and "dt" in header:
+        dt = header["dt"]
+    elif dt is not None and "dt" in header:
+        given_dt = positive_value("dt", dt, str(path))
+        if abs(given_dt - header["dt"]) > DT_RTOL * header["dt"]:
+            raise RecordError(f"the header declares dt = {header['dt']:g} s but {given_dt:g} s was given; "
+                              + fixes["remove"].format(what="dt"), file=str(path), line=header["line"])
     if units is None:
-        raise RecordError("a text record needs its units; add 'units: g' (or m/s2, cm/s2, gal) to the YAML "
-                          "ground_motion section", file=str(path))
+        raise RecordError(fixes["units"], file=str(path))
     try:
         unit = normalise_units(units)
     except RecordError as error:
@@ -284,8 +383,7 @@ def read_text(path: str | Path, *, dt: float | None = None, units: str | None = 
     metadata: dict[str, Any] = {"format": f"text, {columns} column(s)"}
     if columns == 1:
         if dt is None:
-            raise RecordError("a one-column record needs its time step; add 'dt: <seconds>' to the YAML "
-                              "ground_motion section (or add a time column)", file=str(path))
+            raise RecordError(fixes["dt"], file=str(path))
         step = positive_value("dt", dt, str(path))
         acc = data[:, 0]
     else:
@@ -305,8 +403,8 @@ def read_text(path: str | Path, *, dt: float | None = None, units: str | None = 
         if dt is not None:
             given = positive_value("dt", dt, str(path))
             if abs(given - step) > DT_RTOL * step:
-                raise RecordError(f"ground_motion.dt is {given:g} s but the time column has a step of {step:g} s; "
-                                  "remove dt from the YAML ground_motion section", file=str(path))
+                raise RecordError(f"{fixes['dt_given']} is {given:g} s but the time column has a step of {step:g} s; "
+                                  + fixes["remove"].format(what="dt"), file=str(path))
         metadata["original_start_time"] = float(time[0])
     metadata.update({
         "original_units": unit,

@@ -65,11 +65,26 @@ def atomic_path(target: Path) -> Iterator[str]:
         yield temporary
         with open(temporary, "rb+") as handle:
             os.fsync(handle.fileno())
+        os.chmod(temporary, 0o666 & ~_umask())   # mkstemp makes 0600; give the mode any new file gets
         os.replace(temporary, target)
     except BaseException:
         if os.path.exists(temporary):
             os.unlink(temporary)
         raise
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it (other threads may be creating files)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)   # no /proc: the classic read-by-setting
+    os.umask(mask)
+    return mask
 
 
 def _encoding(ds: xr.Dataset) -> dict:

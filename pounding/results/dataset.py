@@ -16,10 +16,15 @@ Dimensions
     Every gap element (coords ``building_left``, ``building_right``,
     ``level_left``, ``level_right``, ``gap`` m, ``law``, ``xi``).
 ``impact``
-    One row per impact (gap closure), in time order.
+    One row per impact (gap closure), in time order (coords ``impact_time``
+    s, ``impact_contact_label`` e.g. ``A:3-B:3``).
 ``trace``
     Full-resolution samples (every solver step, on its interpolant) of every
-    closed contact: what force–penetration loops are drawn from.
+    closed contact: what force–penetration loops are drawn from (coords
+    ``trace_time`` s, ``trace_contact_label``).
+
+``impact`` and ``trace`` are ragged: their lengths differ from run to run,
+so two runs are combined with :func:`drop_ragged` first.
 
 Every variable carries ``units`` and ``long_name``.  Peaks and impact data
 are tracked by the solver at full resolution, not read off the decimated
@@ -40,7 +45,24 @@ from pounding.records.record import Record
 from pounding.model.model import Model
 from pounding.solver.integrator import RawSolution, System
 
-__all__ = ["to_dataset", "energy_closure", "REFERENCES"]
+__all__ = ["to_dataset", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
+
+#: Dimensions whose length depends on the run (impacts, full-resolution contact samples).
+RAGGED_DIMS = ("impact", "trace")
+
+
+def drop_ragged(ds: xr.Dataset) -> xr.Dataset:
+    """*ds* without the ``impact`` and ``trace`` dimensions and everything on them.
+
+    Runs of one model differ in the number of impacts and trace samples, so
+    ``xr.concat([a, b], dim="xi")`` needs them dropped first::
+
+        runs = [pounding.drop_ragged(pounding.simulate(model, xi=x)) for x in ("ye", "exact")]
+        both = xr.concat(runs, dim="xi", combine_attrs="drop_conflicts").assign_coords(xi=["ye", "exact"])
+
+    Peaks (``peak_*``) and ``impact_count`` stay.
+    """
+    return ds.drop_dims([d for d in RAGGED_DIMS if d in ds.dims])
 
 REFERENCES = (
     "Muthukumar, S. & DesRoches, R. (2006) EESD 35, 811-828; "
@@ -208,6 +230,14 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "energy_contact_strain": _var(("time",), contact_strain, "J", "elastic energy stored in the contacts"),
     }
     ds = xr.Dataset(variables, coords=coords)
+    # The ragged dims get their times and contact labels as coordinates, so that
+    # ds.trace_force.plot(x="trace_time") and groupby("trace_contact_label") work.
+    labels = np.asarray(ds.contact.values, dtype=object)
+    ds = ds.set_coords(["impact_time", "trace_time"]).assign_coords(
+        impact_contact_label=("impact", labels[raw.impact_contact] if nc else np.zeros(0, dtype=object),
+                              {"long_name": "gap element of the impact (label of impact_contact)"}),
+        trace_contact_label=("trace", labels[raw.trace_contact] if nc else np.zeros(0, dtype=object),
+                             {"long_name": "gap element of the sample (label of trace_contact)"}))
     closure = energy_closure(ds)
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     ds.attrs = {

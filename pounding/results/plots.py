@@ -25,7 +25,7 @@ import xarray as xr
 
 from pounding.errors import PoundingError
 
-__all__ = ["plot_run"]
+__all__ = ["plot_run", "plot_sweep", "pyplot", "storey_spans", "draw_drift_profile", "finish_drift_axes"]
 
 
 def pyplot():
@@ -72,50 +72,106 @@ def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
 def _contact_forces(plt, ds: xr.Dataset, path: Path) -> None:
     n = ds.sizes["contact"]
     fig, axes = _grid(plt, n)
+    output_dt = float(ds.attrs.get("solver_output_dt", 0.01))
     for i, ax in enumerate(axes[:n]):
         mask = ds.trace_contact.values == i
         # The trace holds every solver sample of a closed contact; join it with
         # zeros between impacts so the plot shows the true peaks.
         t = ds.trace_time.values[mask]
         f = ds.trace_force.values[mask]
-        if t.size:
-            order = np.argsort(t, kind="stable")
-            t, f = t[order], f[order]
-            breaks = np.flatnonzero(np.diff(t) > 2.0 * float(ds.attrs.get("solver_output_dt", 0.01)))
-            t = np.insert(t, breaks + 1, np.nan)
-            f = np.insert(f, breaks + 1, np.nan)
-        ax.plot(ds.time.values, ds.contact_force.values[:, i] / 1e6, lw=0.5, color="0.7",
-                label=f"sampled every {ds.attrs.get('solver_output_dt', '')} s")
-        ax.plot(t, f / 1e6, lw=0.9, color="C3", label="full resolution")
+        impacts = int(ds.impact_count.values[i])
+        if impacts == 0 or t.size == 0:
+            ax.text(0.5, 0.5, "no impacts: the gap never closed", ha="center", va="center",
+                    transform=ax.transAxes, fontsize=9, color="0.3")
+            ax.set_ylim(0.0, 1.0)
+            ax.set_xlim(0.0, float(ds.time.values[-1]))
+            ax.set_yticks([])
+            ax.set_title(f"{ds.contact.values[i]}: no impacts", fontsize=9)
+            continue
+        order = np.argsort(t, kind="stable")
+        t, f = t[order], f[order]
+        breaks = np.flatnonzero(np.diff(t) > 2.0 * output_dt)
+        t = np.insert(t, breaks + 1, np.nan)
+        f = np.insert(f, breaks + 1, np.nan)
+        # Only the trace (every solver step of a closed contact): impacts last a
+        # few ms, so contact_force, sampled every output_dt, misses most peaks.
+        ax.plot(t, f / 1e6, lw=0.8, color="C3")
+        ax.set_xlim(0.0, float(ds.time.values[-1]))
+        ax.set_ylim(bottom=0.0)
         ax.set_ylabel("force (MN)")
-        ax.set_title(f"{ds.contact.values[i]}: {int(ds.impact_count.values[i])} impacts, "
+        ax.set_title(f"{ds.contact.values[i]}: {impacts} impacts, "
                      f"peak {float(ds.peak_contact_force.values[i]) / 1e6:.3g} MN", fontsize=9)
-        ax.legend(fontsize=7, loc="upper right")
     if n == 0:
         axes[0].text(0.5, 0.5, "no contacts in this model", ha="center", transform=axes[0].transAxes)
     axes[-1].set_xlabel("time (s)")
+    fig.suptitle(f"contact forces — {ds.attrs.get('model_name', '')} under {ds.attrs.get('record_name', '')} "
+                 "(every solver step: trace_force)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
-def _drift_profiles(plt, ds: xr.Dataset, path: Path) -> None:
+def storey_spans(ds: xr.Dataset, building: str, *, elevation: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Bottom and top of each storey of *building* on a drift profile's vertical axis.
+
+    Storey k spans k−1 … k (storey numbers), or the elevations of the floors
+    below and above it, m (``elevation=True``).
+    """
+    mask = (ds.storey_building == building).values
+    if elevation:
+        top = np.cumsum(ds.height.values[mask].astype(float))
+        return np.r_[0.0, top[:-1]], top
+    levels = ds.storey_level.values[mask].astype(float)
+    return levels - 1.0, levels
+
+
+def draw_drift_profile(ax, bottom: np.ndarray, top: np.ndarray, ratio_pct: np.ndarray, **style) -> None:
+    """One drift profile: a vertical segment per storey at its drift ratio (%), joined, dot at mid-height."""
+    ax.plot(np.repeat(ratio_pct, 2), np.column_stack([bottom, top]).ravel(), **style)
+    ax.plot(ratio_pct, (bottom + top) / 2, "o", color=style.get("color"), ms=3.5)
+
+
+def finish_drift_axes(ax, bottom: np.ndarray, top: np.ndarray, *, elevation: bool = False,
+                      drift_limit: float | None = None, xlabel: str = "peak storey drift ratio (%)",
+                      ymax: float | None = None) -> None:
+    """Axes of a drift profile: x from 0, integer storey ticks (or elevation, m), optional limit line (%)."""
+    from matplotlib.ticker import MaxNLocator
+
+    ax.set_xlim(left=0.0)
+    if drift_limit is not None:
+        ax.axvline(drift_limit, color="C3", lw=1.2, ls="--", label=f"limit {drift_limit:g} %")
+        ax.set_xlim(0.0, max(ax.get_xlim()[1], 1.1 * drift_limit))
+    ax.set_ylim(0.0, float(top.max()) if ymax is None else ymax)
+    if elevation:
+        ax.set_ylabel("elevation (m)")
+    else:
+        n = top.size
+        step = max(1, int(np.ceil(n / 12)))   # at most about 12 labels
+        ticks = np.arange(1, n + 1)[::step]
+        ax.set_yticks(ticks - 0.5)
+        ax.set_yticklabels([str(k) for k in ticks])
+        ax.set_ylabel("storey")
+    ax.xaxis.set_major_locator(MaxNLocator(5))
+    ax.set_xlabel(xlabel)
+    ax.grid(alpha=0.3)
+
+
+def _drift_profiles(plt, ds: xr.Dataset, path: Path, *, drift_limit: float | None = None,
+                    elevation: bool = False) -> None:
     names = list(dict.fromkeys(ds.storey_building.values.tolist()))
-    fig, axes = plt.subplots(1, len(names), figsize=(3.2 * len(names), 4.5), squeeze=False, sharex=True)
+    fig, axes = plt.subplots(1, len(names), figsize=(3.2 * len(names) + 0.4, 4.5), squeeze=False, sharex=True)
+    tallest = max(float(storey_spans(ds, name, elevation=True)[1].max()) for name in names) if elevation else None
     for ax, name in zip(axes[0], names):
         sel = ds.peak_drift_ratio.where(ds.storey_building == name, drop=True)
-        levels = ds.storey_level.where(ds.storey_building == name, drop=True).values
-        # Storey k spans heights k−1 … k on the vertical axis: a vertical
-        # segment at its drift ratio, joined to the next storey's.
-        ratio = 100 * sel.values
-        ax.plot(np.repeat(ratio, 2), np.column_stack([levels - 1, levels]).ravel(), color="C0")
-        ax.plot(ratio, levels - 0.5, "o", color="C0", ms=4)
-        ax.set_title(f"building {name}", fontsize=9)
-        ax.set_xlabel("peak drift ratio (%)")
-        ax.set_ylim(0, levels.max())
-        ax.grid(alpha=0.3)
-    axes[0][0].set_ylabel("storey")
-    fig.suptitle(f"peak storey drift ratios — {ds.attrs.get('record_name', '')}", fontsize=9)
+        bottom, top = storey_spans(ds, name, elevation=elevation)
+        draw_drift_profile(ax, bottom, top, 100 * sel.values, color="C0", lw=1.4)
+        peak = 100 * float(sel.max())
+        ax.set_title(f"building {name}: max {peak:.2f} %", fontsize=9)
+        finish_drift_axes(ax, bottom, top, elevation=elevation, drift_limit=drift_limit, ymax=tallest)
+    if drift_limit is not None:
+        axes[0][-1].legend(fontsize=7, loc="lower right")
+    fig.suptitle(f"peak storey drift ratio — {ds.attrs.get('model_name', '')} under "
+                 f"{ds.attrs.get('record_name', '')}", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -135,14 +191,22 @@ def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
         pen = ds.trace_penetration.values[mask]
         force = ds.trace_force.values[mask]
         t = ds.trace_time.values[mask]
-        if pen.size:
-            breaks = np.flatnonzero(np.diff(t) > 2.0 * float(ds.attrs.get("solver_output_dt", 0.01)))
-            pen = np.insert(pen, breaks + 1, np.nan)
-            force = np.insert(force, breaks + 1, np.nan)
+        ax.set_title(str(ds.contact.values[i]), fontsize=9)
+        if int(ds.impact_count.values[i]) == 0 or pen.size == 0:
+            ax.text(0.5, 0.5, "no impacts", ha="center", va="center", transform=ax.transAxes, color="0.3")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            continue
+        breaks = np.flatnonzero(np.diff(t) > 2.0 * float(ds.attrs.get("solver_output_dt", 0.01)))
+        pen = np.insert(pen, breaks + 1, np.nan)
+        force = np.insert(force, breaks + 1, np.nan)
         ax.plot(1e3 * np.where(pen > 0, pen, 0.0), force / 1e6, lw=0.8)
+        ax.set_xlim(left=0.0)
+        ax.set_ylim(bottom=0.0)
         ax.set_xlabel("penetration (mm)")
         ax.set_ylabel("force (MN)")
-        ax.set_title(str(ds.contact.values[i]), fontsize=9)
+        ax.set_title(f"{ds.contact.values[i]}: peak {float(ds.peak_contact_force.values[i]) / 1e6:.3g} MN",
+                     fontsize=9)
         ax.grid(alpha=0.3)
     fig.suptitle("force-penetration loops (full solver resolution)", fontsize=9)
     fig.tight_layout()
@@ -150,25 +214,82 @@ def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
     plt.close(fig)
 
 
-def plot_run(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
+def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float | None = None,
+             elevation: bool = False) -> list[Path]:
     """Write the four standard figures of a run to *directory* (created if needed).
+
+    Parameters
+    ----------
+    drift_limit : float, optional
+        A drift-ratio limit, in %, drawn on the drift profiles.
+    elevation : bool
+        Drift profiles against floor elevation (m) instead of storey number.
 
     Returns
     -------
     list of pathlib.Path
         The PNG files written.
     """
-    out = Path(directory)
-    if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; --plot needs a directory")
-    out.mkdir(parents=True, exist_ok=True)
+    out = _directory(directory)
     plt = pyplot()
     written = []
     for name, draw in (("contact_displacements.png", _contact_displacements),
                        ("contact_forces.png", _contact_forces),
-                       ("drift_profiles.png", _drift_profiles),
+                       ("drift_profiles.png", lambda p, d, f: _drift_profiles(p, d, f, drift_limit=drift_limit,
+                                                                              elevation=elevation)),
                        ("force_penetration.png", _force_penetration)):
         path = out / name
         draw(plt, ds, path)
         written.append(path)
     return written
+
+
+def _directory(directory: str | os.PathLike) -> Path:
+    out = Path(directory)
+    if out.exists() and not out.is_dir():
+        raise PoundingError(f"{out} is a file; give a directory for the plots")
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
+    """``sweep_peak_drift.png``: each building's largest peak storey drift ratio against each sweep axis.
+
+    One row per sweep dimension (``record`` excluded when it has one value);
+    a line per building at the mean over the other dimensions, with a band
+    from their minimum to their maximum.  Failed scenarios are left out.
+    """
+    out = _directory(directory)
+    plt = pyplot()
+    names = list(dict.fromkeys(str(b) for b in ds.storey_building.values))
+    dims = [d for d in ds.status.dims if ds.sizes[d] > 1] or list(ds.status.dims[:1])
+    fig, axes = plt.subplots(len(dims), 1, figsize=(6.4, 2.6 * len(dims) + 0.6), squeeze=False)
+    drift = ds.peak_drift_ratio.where(ds.status == "ok") * 100
+    for ax, dim in zip(axes[:, 0], dims):
+        labels = [str(v) for v in ds[dim].values]
+        x = np.arange(len(labels))
+        for k, name in enumerate(names):
+            largest = drift.isel(storey=(ds.storey_building == name).values).max("storey", skipna=True)
+            others = [d for d in largest.dims if d != dim]
+            mean = largest.mean(others, skipna=True).values if others else largest.values
+            ax.plot(x, mean, "o-", color=f"C{k}", label=f"building {name}", ms=4)
+            if others:
+                ax.fill_between(x, largest.min(others, skipna=True).values, largest.max(others, skipna=True).values,
+                                color=f"C{k}", alpha=0.15, lw=0)
+        ax.set_xticks(x)
+        ax.set_xticklabels(labels, rotation=20 if max(len(t) for t in labels) > 6 else 0, ha="right"
+                           if max(len(t) for t in labels) > 6 else "center", fontsize=7)
+        units = ds[dim].attrs.get("units", "")
+        ax.set_xlabel(f"{dim} ({units})" if units and units != "1" else dim)
+        ax.set_ylabel("largest peak storey\ndrift ratio (%)", fontsize=8)
+        ax.set_ylim(bottom=0.0)
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    failed = int((ds.status != "ok").sum())
+    fig.suptitle(f"sweep '{ds.attrs.get('sweep_name', '')}': mean over the other dimensions, band = min-max"
+                 + (f"; {failed} failed scenario(s) left out" if failed else ""), fontsize=9)
+    fig.tight_layout()
+    path = out / "sweep_peak_drift.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return [path]

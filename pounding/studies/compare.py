@@ -147,7 +147,10 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
              + ", ".join(records[:4]) + (f", ... ({len(records)} in all)" if len(records) > 4 else "")]
     failed = int((~ok).sum())
     if failed:
-        lines.append(f"{failed} scenario(s) failed and are left out (see the 'error' variable)")
+        from pounding.studies.sweep.execution import failure_report
+
+        lines.append(f"{failed} of {ok.size} scenario(s) failed and are left out of the means below:")
+        lines += failure_report(ds)
     rel = differences(ds, reference)
     drift = ds.peak_drift_ratio
     for building in _buildings(ds):
@@ -189,9 +192,16 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
     return "\n".join(lines)
 
 
-def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE) -> list[Path]:
-    """Write ``xi_drift_profiles.png`` and ``xi_drift_distribution.png`` to *directory*."""
-    from pounding.results.plots import pyplot
+def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE, *,
+                    drift_limit: float | None = None) -> list[Path]:
+    """Write ``xi_drift_profiles.png`` and ``xi_drift_distribution.png`` to *directory*.
+
+    The profiles are drawn as ``pounding run --plot`` draws them (x from 0,
+    integer storey ticks); *drift_limit*, in %, adds a limit line.  With
+    fewer than 3 records the distribution is a strip plot (every record a
+    dot), not boxes.
+    """
+    from pounding.results.plots import draw_drift_profile, finish_drift_axes, pyplot, storey_spans
 
     out = Path(directory)
     if out.exists() and not out.is_dir():
@@ -209,37 +219,38 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
                              gridspec_kw={"height_ratios": [3, 2]})
     for col, building in enumerate(buildings):
         mask = (ds.storey_building == building).values
-        levels = ds.storey_level.values[mask].astype(float)
+        bottom, top = storey_spans(ds, building)
+        middle = (bottom + top) / 2
         d = ds.peak_drift_ratio.isel(storey=mask) * 100
         r = rel.isel(storey=mask)
         ax, low_ax = axes[0][col], axes[1][col]
         others = [f for f in formulas if f != reference]
         for k, f in enumerate(formulas):
             mean = d.sel(xi=f).mean("record", skipna=True).values
-            style = dict(color=colours[f], lw=1.6 if f == reference else 1.2, ls="--" if f == reference else "-")
-            ax.plot(np.repeat(mean, 2), np.column_stack([levels - 1, levels]).ravel(), label=f, **style)
-            ax.plot(mean, levels - 0.5, "o", color=colours[f], ms=3.5)
+            draw_drift_profile(ax, bottom, top, mean, label=f, color=colours[f],
+                               lw=1.6 if f == reference else 1.2, ls="--" if f == reference else "-")
             if f == reference:
                 continue
             # mean difference per storey, bar from min to max over the records
             shift = (others.index(f) - (len(others) - 1) / 2) * 0.12
             per = r.sel(xi=f)
             mean_r = per.mean("record", skipna=True).values
-            low_ax.plot(np.repeat(mean_r, 2), np.column_stack([levels - 1, levels]).ravel(), color=colours[f],
+            low_ax.plot(np.repeat(mean_r, 2), np.column_stack([bottom, top]).ravel(), color=colours[f],
                         lw=1.2, label=f)
             if n_records > 1:
-                low_ax.hlines(levels - 0.5 + shift, per.min("record", skipna=True).values,
+                low_ax.hlines(middle + shift, per.min("record", skipna=True).values,
                               per.max("record", skipna=True).values, color=colours[f], lw=0.8, alpha=0.7)
-            low_ax.plot(mean_r, levels - 0.5 + shift, "o", color=colours[f], ms=3)
+            low_ax.plot(mean_r, middle + shift, "o", color=colours[f], ms=3)
         ax.set_title(f"building {building}", fontsize=9)
-        ax.set_xlabel("peak storey drift ratio (%)")
-        ax.set_xlim(left=0)
+        finish_drift_axes(ax, bottom, top, drift_limit=drift_limit,
+                          xlabel="peak storey drift ratio (%), mean over records" if n_records > 1 else
+                          "peak storey drift ratio (%)")
         low_ax.axvline(0.0, color="k", lw=0.8, ls="--")
         low_ax.set_xlabel(f"difference from {reference} (% of {reference})")
-        for a in (ax, low_ax):
-            a.set_ylim(0, levels.max())
-            a.grid(alpha=0.3)
-        ax.set_ylabel("storey")
+        low_ax.set_ylim(0, top.max())
+        low_ax.set_yticks(ax.get_yticks())
+        low_ax.set_yticklabels([t.get_text() for t in ax.get_yticklabels()])
+        low_ax.grid(alpha=0.3)
         low_ax.set_ylabel("storey")
     axes[0][-1].legend(fontsize=7, loc="best", title="xi formula", title_fontsize=7)
     what = (f"mean over {n_records} records; lower panels: bars span the records" if n_records > 1
@@ -260,25 +271,29 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
         with np.errstate(invalid="ignore", divide="ignore"):
             rel = (peak - ref) / ref * 100
         for row, (data, label) in enumerate(((peak, "largest storey drift ratio (%)"),
-                                             (rel, f"its difference from {reference} (%)"))):
+                                             (rel, f"its difference from {reference}\n(% of {reference})"))):
             ax = axes[row][col]
             shown = formulas if row == 0 else [f for f in formulas if f != reference]
             series = [data.sel(xi=f).values[np.isfinite(data.sel(xi=f).values)] for f in shown]
             positions = np.arange(1, len(shown) + 1)
-            if n_records > 1:
+            if n_records >= 3:   # fewer records: a strip plot (a box of one or two values says nothing)
                 ax.boxplot([s if s.size else [np.nan] for s in series], positions=positions, widths=0.5,
                            showfliers=False, medianprops={"color": "0.3"})
             for p, f, s in zip(positions, shown, series):
-                ax.plot(p + rng.uniform(-0.12, 0.12, s.size), s, "o", ms=3, alpha=0.6, color=colours[f])
+                ax.plot(p + rng.uniform(-0.12, 0.12, s.size), s, "o", ms=3 if n_records >= 3 else 5,
+                        alpha=0.6 if n_records >= 3 else 0.9, color=colours[f])
+            ax.set_xlim(0.5, len(shown) + 0.5)
             ax.set_xticks(positions)
             ax.set_xticklabels(shown, rotation=25, ha="right", fontsize=7)
             ax.set_ylabel(label, fontsize=8)
+            ax.ticklabel_format(axis="y", style="plain", useOffset=False)
             ax.grid(alpha=0.3, axis="y")
             if row == 1:
                 ax.axhline(0.0, color="k", lw=0.7)
             else:
                 ax.set_title(f"building {building}", fontsize=9)
-    fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}", fontsize=9)
+    fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}"
+                 + (" (boxes: quartiles and median, whiskers: 1.5 IQR; dots: records)" if n_records >= 3 else " (one dot per record)"), fontsize=9)
     fig.tight_layout()
     distribution = out / "xi_drift_distribution.png"
     fig.savefig(distribution, dpi=110)

