@@ -57,7 +57,41 @@ def summary(ds) -> str:
     lines.append(f"energy closure error {ds.attrs['energy_closure_error']:.2e}; "
                  f"{ds.attrs['solver_steps']} steps ({ds.attrs['solver_rejected_steps']} rejected); "
                  f"solver wall time {ds.attrs['wall_time']:.3f} s")
+    status = str(ds.attrs.get("status", "ok"))
+    if status != "ok":
+        lines.append(f"WARNING: {status.removeprefix('warning: ')}")
     return "\n".join(lines)
+
+
+def _safe_summary(ds, source) -> str:
+    """:func:`summary` of an archive read from disk; a garbled value is a one-line damaged-archive error."""
+    from pounding.errors import ArchiveError
+
+    try:
+        return summary(ds)
+    except (KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+        raise ArchiveError(f"damaged archive: {source}: {type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]}") from None
+
+
+def _check_plot_dir(directory: str) -> None:
+    """Fail before any computation if --plot DIR cannot be created or written."""
+    import os
+
+    from pounding.errors import PoundingError
+
+    target = Path(directory)
+    if target.exists() and not target.is_dir():
+        raise PoundingError(f"{target} is a file; --plot needs a directory")
+    probe = target
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise PoundingError(f"--plot {target}: {probe} is a file, not a directory")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise PoundingError(f"--plot {target}: {probe} is not writable; choose another folder")
 
 
 # --------------------------------------------------------------------------- #
@@ -71,17 +105,29 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from pounding.results.plots import plot_run
     from pounding.simulation import simulate
 
+    from pounding.errors import PoundingError
+    from pounding.simulation import model_inputs
+
     started = time.perf_counter()
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
-    check_writable(output, overwrite=args.overwrite)  # before computing anything
+    check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
+    if args.plot:
+        _check_plot_dir(args.plot)
     model = load_model(args.model)
+    inputs = model_inputs(model if args.record is None else model.with_ground_motion(record=args.record))
+    check_writable(output, overwrite=args.overwrite, inputs=inputs)
     ds = simulate(model, record=args.record, xi=args.xi, scale=args.scale, duration=args.duration,
                   rtol=args.rtol, output_dt=args.output_dt)
     path = save_run(ds, output, overwrite=args.overwrite)
     print(summary(ds))
     print(f"wrote {path}")
     if args.plot:
-        for png in plot_run(ds, args.plot):
+        try:
+            written = plot_run(ds, args.plot)
+        except OSError as exc:
+            raise PoundingError(f"--plot {args.plot}: cannot write the plots ({exc.strerror or exc}); the archive "
+                                f"{path} is written") from None
+        for png in written:
             print(f"wrote {png}")
     print(f"total wall time {time.perf_counter() - started:.2f} s")
     return 0
@@ -91,7 +137,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     from pounding.results.archive import check_writable, save_run
     from pounding.simulation import rerun
 
-    check_writable(args.output, overwrite=args.overwrite)
+    check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
     ds = rerun(args.run)
     path = save_run(ds, args.output, overwrite=args.overwrite)
     print(summary(ds))
@@ -106,7 +152,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print(f"{args.run}: {ds.attrs['title']}")
     print(f"  {ds.attrs['history']}")
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
-    print(summary(ds))
+    print(_safe_summary(ds, args.run))
     if args.variables:
         for name, var in ds.data_vars.items():
             print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")
@@ -117,8 +163,18 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from pounding.results.archive import open_run
     from pounding.results.plots import plot_run
 
+    from pounding.errors import ArchiveError, PoundingError
+
+    _check_plot_dir(args.output)
     ds = open_run(args.run)
-    for png in plot_run(ds, args.output):
+    try:
+        written = plot_run(ds, args.output)
+    except OSError as exc:
+        raise PoundingError(f"{args.output}: cannot write the plots ({exc.strerror or exc})") from None
+    except (KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+        raise ArchiveError(f"damaged archive: {args.run}: {type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]}") from None
+    for png in written:
         print(f"wrote {png}")
     return 0
 
