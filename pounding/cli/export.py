@@ -15,7 +15,12 @@ __all__ = ["register_cli"]
 def _cmd_export_opensees(args: argparse.Namespace) -> int:
     from pounding.model.model import load_model
 
+    from pounding.results.archive import check_not_input
+    from pounding.simulation import model_inputs
+
     model = load_model(args.model)
+    output_path = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
+    check_not_input(output_path, [args.model] + model_inputs(model))
     source, notes = opensees_script_and_notes(model, args.record, dt=args.dt, xi=args.xi, duration=args.duration)
     output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
     if output.exists() and not args.overwrite:

@@ -75,9 +75,21 @@ def start_client(*, workers: int | None = None, scheduler: str | None = None):
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             raise PoundingError(f"cannot reach the Dask scheduler at {scheduler} ({one_line(exc)}); start one "
                                 "with `dask scheduler` and workers with `dask worker tcp://HOST:8786`") from None
+    import signal
+    import threading
+
     n = workers or default_workers()
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           silence_logs=logging.ERROR)
+    # Worker processes inherit an ignored SIGINT (an ignored disposition survives exec): a Ctrl-C at the
+    # terminal reaches the whole process group, and workers that took it printed their tracebacks; this
+    # process alone handles it and shuts the cluster down.
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=logging.ERROR)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
 
 
