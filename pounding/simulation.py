@@ -27,11 +27,20 @@ from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
 from pounding.model.model import Model, model_from_text
-from pounding.results.archive import open_run
+from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import to_dataset
 from pounding.solver.integrator import STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "simulate", "record_for", "rerun", "record_path"]
+__all__ = ["assemble", "simulate", "record_for", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
+           "estimate_memory", "available_memory", "check_memory", "model_inputs"]
+
+#: Energy closure error above which a run is flagged (attribute ``status``, summary
+#: line): converged runs of the shipped models close to ~1e-6, so 1e-3 is a
+#: thousand-fold margin and marks a run whose energies (and likely peaks) are wrong.
+ENERGY_CLOSURE_LIMIT = 1e-3
+
+#: A run may plan to use at most this fraction of the memory available to it.
+MEMORY_FRACTION = 0.5
 
 
 def record_path(spec: str) -> str:
@@ -224,11 +233,17 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     if end_time <= 0.0:
         raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
 
+    settings = model.solver
+    if settings.output_dt > end_time:
+        raise PoundingError(f"{_where(model)}solver.output_dt is {settings.output_dt:g} s, longer than the simulated "
+                            f"{end_time:g} s: no history (and no energy balance) would be stored; use an output_dt "
+                            f"well below the duration, e.g. {min(0.01, end_time / 100):g} s")
+    check_memory(estimate_memory(model, end_time, motion.time_step, settings.output_dt),
+                 what=f"{_where(model)}this run", fix="shorten ground_motion.duration or raise solver.output_dt")
     samples_needed = int(np.ceil(end_time / motion.time_step - 1e-9)) + 1
     ground = np.zeros(max(samples_needed, motion.acceleration.size))
     ground[: motion.acceleration.size] = motion.acceleration
 
-    settings = model.solver
     system = assemble(model)
     started = _time.perf_counter()
     raw = integrate(system, ground, motion.time_step, end_time, rtol=settings.rtol,
@@ -237,8 +252,109 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     wall = _time.perf_counter() - started
     if raw.status != STATUS_OK:
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
-        raise PoundingError(STATUS_MESSAGES[raw.status].format(t=raw.final_time))
-    return to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
+        raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
+    ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
+    mark_energy_status(ds)
+    return ds
+
+
+def mark_energy_status(ds: xr.Dataset) -> str:
+    """Set the archive attribute ``status``: ``ok``, or a warning when energy does not close.
+
+    A closure error above :data:`ENERGY_CLOSURE_LIMIT` (or not finite) means
+    the integration did not conserve energy to the tolerance asked: the run is
+    kept but marked, and the summary says so.
+    """
+    closure = float(ds.attrs.get("energy_closure_error", 0.0))
+    if np.isfinite(closure) and closure <= ENERGY_CLOSURE_LIMIT:
+        ds.attrs["status"] = "ok"
+    else:
+        ds.attrs["status"] = (f"warning: energy closure error {closure:.3g} exceeds {ENERGY_CLOSURE_LIMIT:g}; the "
+                              "results are not trustworthy (check masses, stiffnesses and solver tolerances)")
+    return ds.attrs["status"]
+
+
+    return ds.attrs["status"]
+
+
+def _where(model: Model) -> str:
+    """``'models/pair.yaml: '`` when the model came from a file, else ``''``."""
+    return f"{model.path}: " if getattr(model, "path", None) else ""
+
+
+def estimate_memory(model: Model, end_time: float, record_dt: float, output_dt: float) -> int:
+    """Bytes a run will hold at its peak, estimated before allocating anything.
+
+    Counts the ground-acceleration array (``end_time / record_dt`` samples),
+    the solver's output buffers (``end_time / output_dt`` samples of the state
+    and forces) and the results dataset built from them (histories of every
+    floor and contact, energies), with a factor 2 for the copies made while
+    the dataset is assembled and written.
+    """
+    n = sum(b.n_floors for b in model.buildings)
+    nc = len(model.gaps)
+    n_out = end_time / output_dt + 2 if output_dt > 0 else float("inf")
+    n_ground = end_time / record_dt + 2 if record_dt > 0 else float("inf")
+    per_sample = (2 * n + 3 * nc + 2) + n + nc + 3          # solver output buffers
+    per_sample += 5 * n + 2 * nc + 8                        # dataset histories and energies
+    total = 8.0 * (2 * per_sample * n_out + n_ground)
+    return int(min(total, 2 ** 62))
+
+
+def available_memory() -> int:
+    """Bytes this process can still use: the smaller of physical RAM and the address-space limit left."""
+    try:
+        ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        ram = 2 ** 40
+    try:
+        import resource
+
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if soft != resource.RLIM_INFINITY:
+            used = 0
+            with open("/proc/self/status") as handle:
+                for line in handle:
+                    if line.startswith("VmSize:"):
+                        used = int(line.split()[1]) * 1024
+            ram = min(ram, max(0, soft - used))
+    except (ImportError, OSError, ValueError):
+        pass
+    return int(ram)
+
+
+def _bytes(n: float) -> str:
+    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if n >= size:
+            return f"{n / size:.3g} {unit}"
+    return f"{n / 1e3:.3g} kB"
+
+
+def check_memory(needed: float, *, what: str, fix: str) -> None:
+    """Refuse, with the numbers and the fix, to start something that needs more than
+    :data:`MEMORY_FRACTION` of :func:`available_memory`."""
+    limit = MEMORY_FRACTION * available_memory()
+    if needed > limit:
+        raise PoundingError(f"{what} would need about {_bytes(needed)} of memory, more than "
+                            f"{MEMORY_FRACTION:.0%} of the {_bytes(limit / MEMORY_FRACTION)} available; {fix}")
+
+
+def model_inputs(model: Model) -> list[str]:
+    """Files a model run reads: the model file and, if it is a file, the record."""
+    found = [str(model.path)] if getattr(model, "path", None) else []
+    spec = model.ground_motion
+    record = getattr(spec, "record", None)
+    if isinstance(record, str) and record.strip():
+        from pathlib import Path
+
+        path = Path(record.strip()).expanduser()
+        if not path.is_absolute() and spec.base_dir is not None:
+            path = Path(spec.base_dir) / path
+        if path.exists():
+            found.append(str(path))
+    return found
+
+
 
 
 def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
@@ -253,6 +369,8 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     """
     ds = open_run(run) if not isinstance(run, xr.Dataset) else run
     name = str(run) if not isinstance(run, xr.Dataset) else "archive"
+    if isinstance(run, xr.Dataset):
+        check_archive(ds, name)
     spec = json.loads(ds.attrs["run_spec"])
     model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
                             path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))

@@ -79,7 +79,7 @@ def test_a_failed_write_leaves_no_partial_file(run, tmp_path, monkeypatch):
         raise RuntimeError("disk full")
 
     monkeypatch.setattr("xarray.Dataset.to_netcdf", crash)
-    with pytest.raises(RuntimeError):
+    with pytest.raises(ArchiveError, match="disk full"):
         save_run(run, path)
     assert list(tmp_path.iterdir()) == []
 

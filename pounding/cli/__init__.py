@@ -7,6 +7,7 @@ with exit status 2; ``--debug`` shows the traceback instead.
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import sys
@@ -96,13 +97,17 @@ def _subcommand(argv: Sequence[str]) -> str | None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pounding`` console script."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    _tolerant_streams()
     parser = build_parser(_subcommand(argv))
     args, extra = parser.parse_known_args(argv)
     if extra:  # reported with the usage of the subcommand concerned, not the top-level one
         getattr(args, "usage_parser", parser).error(f"unrecognized arguments: {' '.join(extra)}")
     func: Callable[[argparse.Namespace], int] = args.func
     try:
-        return func(args)
+        status = func(args)
+        if sys.stdout is not None:
+            sys.stdout.flush()  # a full or failing stdout shows here, not as a traceback at exit
+        return status
     except PoundingError as exc:
         if args.debug:
             raise
@@ -115,6 +120,36 @@ def main(argv: Sequence[str] | None = None) -> int:
         # The reader went away (`pounding records list | head`): stop quietly, as Unix tools do.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error when Python flushes stdout
         return 141  # 128 + SIGPIPE
+    except OSError as exc:
+        if args.debug or exc.errno not in _STREAM_ERRNOS:
+            raise
+        _silence_stdout()
+        print(f"pounding: error: cannot write the output ({exc.strerror or exc}); is standard output a full "
+              "disk or a closed file?", file=sys.stderr)
+        return 2
+
+
+#: errno of a failing standard output (full disk, I/O error, closed descriptor).
+_STREAM_ERRNOS = frozenset({errno.ENOSPC, errno.EIO, errno.EBADF, errno.EDQUOT, errno.EFBIG})
+
+
+def _tolerant_streams() -> None:
+    """Print names the locale cannot encode (non-UTF-8 locale, non-ASCII names) as escapes, not a traceback."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None and hasattr(stream, "reconfigure") and \
+                    str(getattr(stream, "encoding", "")).lower().replace("-", "") != "utf8":
+                stream.reconfigure(errors="backslashreplace")
+        except (OSError, ValueError):
+            pass
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that Python's final flush does not fail a second time."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 #: Subcommands that never use dask in their own process (everything but sweep/compare).

@@ -15,10 +15,15 @@ __all__ = ["register_cli"]
 def _cmd_export_opensees(args: argparse.Namespace) -> int:
     from pounding.model.model import load_model
 
+    from pounding.results.archive import check_not_input
+    from pounding.simulation import model_inputs
+
     model = load_model(args.model)
     from pounding.simulation import record_path
 
     record = None if args.record is None else record_path(args.record)   # relative to the current directory
+    output_path = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
+    check_not_input(output_path, [args.model] + model_inputs(model) + ([str(record)] if record is not None else []))
     source, notes = opensees_script_and_notes(model, record, dt=args.dt, xi=args.xi, duration=args.duration)
     output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
     if output.exists() and not args.overwrite:

@@ -112,7 +112,41 @@ def summary(ds) -> str:
     lines.append(f"energy closure error {ds.attrs['energy_closure_error']:.2e}; "
                  f"{ds.attrs['solver_steps']} steps ({ds.attrs['solver_rejected_steps']} rejected); "
                  f"solver wall time {ds.attrs['wall_time']:.3f} s")
+    status = str(ds.attrs.get("status", "ok"))
+    if status != "ok":
+        lines.append(f"WARNING: {status.removeprefix('warning: ')}")
     return "\n".join(lines)
+
+
+def _safe_summary(ds, source) -> str:
+    """:func:`summary` of an archive read from disk; a garbled value is a one-line damaged-archive error."""
+    from pounding.errors import ArchiveError
+
+    try:
+        return summary(ds)
+    except (KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+        raise ArchiveError(f"damaged archive: {source}: {type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]}") from None
+
+
+def _check_plot_dir(directory: str) -> None:
+    """Fail before any computation if --plot DIR cannot be created or written."""
+    import os
+
+    from pounding.errors import PoundingError
+
+    target = Path(directory)
+    if target.exists() and not target.is_dir():
+        raise PoundingError(f"{target} is a file; --plot needs a directory")
+    probe = target
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if probe.exists() and not probe.is_dir():
+        raise PoundingError(f"--plot {target}: {probe} is a file, not a directory")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise PoundingError(f"--plot {target}: {probe} is not writable; choose another folder")
 
 
 # --------------------------------------------------------------------------- #
@@ -125,16 +159,24 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from pounding.results.archive import check_writable, save_run
     from pounding.model.model import load_model
     from pounding.results.plots import plot_run
-    from pounding.simulation import simulate
+    from pounding.simulation import model_inputs, simulate
 
     started = time.perf_counter()
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
-    check_writable(output, overwrite=args.overwrite)  # before computing anything
+    check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
+    if args.plot:
+        _check_plot_dir(args.plot)
     model = load_model(args.model)
     scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
     if args.record is None and (args.units is not None or args.dt is not None):
         raise PoundingError("--units and --dt describe a record file given with --record; the model's own record "
                             "takes them from its YAML ground_motion section")
+    if args.record is not None:
+        from pounding.simulation import record_path
+
+        check_writable(output, overwrite=args.overwrite, inputs=[args.model, record_path(args.record)])
+    else:
+        check_writable(output, overwrite=args.overwrite, inputs=model_inputs(model))
     ds = simulate(model, record=args.record, xi=args.xi, scale=scale, duration=args.duration,
                   rtol=args.rtol, output_dt=args.output_dt, record_units=args.units, record_dt=args.dt,
                   where="cli")
@@ -142,7 +184,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(summary(ds))
     print(f"wrote {path}")
     if args.plot:
-        for png in plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation):
+        try:
+            written = plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation)
+        except OSError as exc:
+            raise PoundingError(f"--plot {args.plot}: cannot write the plots ({exc.strerror or exc}); the archive "
+                                f"{path} is written") from None
+        for png in written:
             print(f"wrote {png}")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return 0
@@ -152,7 +199,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     from pounding.results.archive import check_writable, save_run
     from pounding.simulation import rerun
 
-    check_writable(args.output, overwrite=args.overwrite)
+    check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
     ds = rerun(args.run)
     path = save_run(ds, args.output, overwrite=args.overwrite)
     print(summary(ds))
@@ -170,6 +217,8 @@ def open_archive(path) -> tuple[str, object]:
     source = Path(path)
     if not source.exists():
         raise ArchiveError(f"{source}: no such file")
+    if not source.is_file():   # a FIFO would block the open forever
+        raise ArchiveError(f"{source}: not a regular file; give the NetCDF archive itself")
     try:
         with xr.open_dataset(source, engine="netcdf4") as handle:
             attrs = dict(handle.attrs)
@@ -185,6 +234,8 @@ def open_archive(path) -> tuple[str, object]:
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
         ds = handle.load()
+    if attrs.get("study") == "gap":
+        return "gap", ds
     if "sweep_name" in attrs:
         return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
                 else "sweep"), ds
@@ -209,7 +260,11 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print("  " + str(ds.attrs.get("history", "")).replace("\n", "\n  "))
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
     if kind == "run":
-        print(summary(ds))
+        print(_safe_summary(ds, args.run))
+    elif kind == "gap":
+        from pounding.studies.gap import gap_table
+
+        print(gap_table(ds))
     elif kind in ("sweep", "compare"):
         from pounding.cli.sweep import summary_lines
 
@@ -236,30 +291,41 @@ def _cmd_info(args: argparse.Namespace) -> int:
 def _cmd_plot(args: argparse.Namespace) -> int:
     from pounding.errors import PoundingError
 
+    from pounding.errors import ArchiveError
+
     kind, ds = open_archive(args.run)
-    if kind in ("sweep", "compare") and not bool((ds.status == "ok").any()):
+    if kind in ("sweep", "compare", "gap") and not bool((ds.status == "ok").any()):
         raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
                             f"`pounding info {args.run}` lists the errors")
+    _check_plot_dir(args.output)
     out = Path(args.output)
-    if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; -o needs a directory")
-    if kind == "run":
-        from pounding.results.plots import plot_run
+    try:
+        if kind == "run":
+            from pounding.results.plots import plot_run
 
-        written = plot_run(ds, out, drift_limit=args.drift_limit, elevation=args.elevation)
-    elif kind == "compare":
-        from pounding.studies.compare import plot_comparison
+            written = plot_run(ds, out, drift_limit=args.drift_limit, elevation=args.elevation)
+        elif kind == "compare":
+            from pounding.studies.compare import plot_comparison
 
-        written = plot_comparison(ds, out, _reference(ds), drift_limit=args.drift_limit)
-    elif kind == "sweep":
-        from pounding.results.plots import plot_sweep
+            written = plot_comparison(ds, out, _reference(ds), drift_limit=args.drift_limit)
+        elif kind == "sweep":
+            from pounding.results.plots import plot_sweep
 
-        written = plot_sweep(ds, out)
-    else:
-        from pounding.studies.verify import plot_verification
+            written = plot_sweep(ds, out)
+        elif kind == "gap":
+            from pounding.studies.gap import plot_gap
 
-        out.mkdir(parents=True, exist_ok=True)
-        written = [plot_verification(ds, out / "verify.png")]
+            written = plot_gap(ds, out)
+        else:
+            from pounding.studies.verify import plot_verification
+
+            out.mkdir(parents=True, exist_ok=True)
+            written = [plot_verification(ds, out / "verify.png")]
+    except OSError as exc:
+        raise PoundingError(f"{args.output}: cannot write the plots ({exc.strerror or exc})") from None
+    except (KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+        raise ArchiveError(f"damaged archive: {args.run}: {type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:120]}") from None
     for png in written:
         print(f"wrote {png}")
     return 0

@@ -229,15 +229,39 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
     def rows(items) -> str:
         return "\n".join(f"    {tuple(item)!r}," for item in items)
 
-    summary = "\n".join("#   " + line for line in model.summary_lines())
-    note_text = "\n".join("# NOTE: " + n for n in notes)
+    summary = "\n".join("#   " + _inert(line) for line in model.summary_lines())
+    note_text = "\n".join("# NOTE: " + _inert(n) for n in notes)
     return _TEMPLATE.format(
-        version=__version__, name=model.name, summary=summary, notes=note_text,
-        record_name=motion.name, record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
+        version=__version__, name=_inert(model.name), name_literal=repr(str(model.name)), summary=summary,
+        notes=note_text, record_name=_inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
         duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
         floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
         dashpots=rows(dashpots), contacts=rows(contacts),
     ), notes
+
+
+def _inert(text: object) -> str:
+    """*text* made safe inside a docstring or a comment of the generated script.
+
+    Names come from the user's YAML; written raw, a name holding a triple
+    quote or a line break would end the docstring or comment and the rest of
+    it would run as code.  Backslashes, quotes, line breaks and every
+    non-printable or non-ASCII character are written as escapes (so the text
+    reads the same inside the docstring and cannot leave it); values used as
+    Python data are written with ``repr`` instead.
+    """
+    out = []
+    for char in str(text):
+        if char == "\\":
+            out.append("\\\\")
+        elif char in "\"'":
+            out.append("\\" + char)
+        elif char.isascii() and char.isprintable():
+            out.append(char)
+        else:
+            out.append(char.encode("unicode_escape").decode("ascii") if ord(char) > 0x7f or char in "\n\r\t"
+                       else f"\\x{ord(char):02x}")
+    return "".join(out)
 
 
 _TEMPLATE = '''#!/usr/bin/env python3
@@ -262,11 +286,11 @@ from array import array
 
 import openseespy.opensees as ops
 
-MODEL_NAME = {name!r}
+MODEL_NAME = {name_literal}
 UNBALANCE_TOLERANCE = {unbalance}  # N
 DT = {dt}
 DURATION = {duration}
-RECORD_NAME = {record_name!r}
+RECORD_NAME = {record_name_literal}
 RECORD_DT = {record_dt}
 RECORD = [  # ground acceleration, m/s^2, linear between samples, 0 after the last
 {record}
@@ -477,7 +501,7 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
         raise PoundingError("OpenSeesPy is not available; pip install openseespy")
     source, _notes = opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)
     with tempfile.TemporaryDirectory(prefix="pounding-opensees-") as folder:
-        script = Path(folder) / f"{model.name}_opensees.py"
+        script = Path(folder) / "model_opensees.py"  # not the model's name: it may hold '/' or '..'
         peaks_file = Path(folder) / "peaks.json"
         script.write_text(source, encoding="utf-8")
         done = subprocess.run([sys.executable, str(script), "-o", str(peaks_file)], capture_output=True,

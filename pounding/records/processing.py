@@ -51,6 +51,15 @@ __all__ = [
 ]
 
 SCALE_METHODS = ("pga", "sa", "fema-p695")
+
+#: Longest period of a spectral-acceleration target, s (ASCE 7 and NGA-West2
+#: spectra stop at 10-20 s; a period of 1e6 s asks for a factor of ~1e10).
+SA_PERIOD_MAX = 20.0
+
+#: A resolved scale factor (target PGA, Sa or FEMA P695) must lie within
+#: [1/SCALE_FACTOR_MAX, SCALE_FACTOR_MAX]: amplifying a record a thousand
+#: times means it cannot represent the target (usually wrong units).
+SCALE_FACTOR_MAX = 1000.0
 SCALE_KEYS = ("pga", "sa", "period", "damping", "fema-p695")
 PROCESSING_KEYS = ("trim", "baseline")
 TRIM_METHODS = ("significant-duration",)
@@ -417,6 +426,10 @@ def scale_record(record: Record, scaling: float | Scaling, *, period: float | No
     if scaling.method == "sa":
         if t is None or not t > 0:
             raise RecordError(f"scale {scaling.describe()}: the period is unknown; give period in seconds")
+        if t > SA_PERIOD_MAX:
+            raise RecordError(f"scale {scaling.describe(t)}: a period of {t:g} s is beyond {SA_PERIOD_MAX:g} s, the "
+                              "longest of published design and NGA spectra; give the period in seconds",
+                              file=record.source or None)
         extra.update(scale_period_s=float(t), scale_damping=float(scaling.damping))
         if scaling.building is not None:
             extra["scale_building"] = scaling.building
@@ -435,6 +448,11 @@ def scale_record(record: Record, scaling: float | Scaling, *, period: float | No
             factor = scaling.target / sa if sa > 0 else math.inf
         if not math.isfinite(factor):
             raise RecordError(f"cannot scale a record of zero amplitude to {scaling.describe(t)}",
+                              file=record.source or None)
+        if scaling.method != "factor" and not 1.0 / SCALE_FACTOR_MAX <= factor <= SCALE_FACTOR_MAX:
+            raise RecordError(f"scaling to {scaling.describe(t)} needs a factor of {factor:.3g}, beyond "
+                              f"{1.0 / SCALE_FACTOR_MAX:g}-{SCALE_FACTOR_MAX:g}; this record cannot represent that "
+                              "target: check the target's units, the period, or choose another record",
                               file=record.source or None)
     metadata = dict(record.metadata, scale_method=scaling.method, scale_description=scaling.describe(t),
                     scale_factor=float(factor), **extra)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import RecordError
-from pounding.records.record import DT_RTOL, Record, normalise_units, positive_value
+from pounding.records.record import DT_RTOL, Record, check_time_step, normalise_units, positive_value
 from pounding.units import FORTRAN_NUMBER, STANDARD_GRAVITY, UNITS, canonical_unit
 
 __all__ = ["read_at2", "read_text", "check_agrees", "text_header", "declared_in_header", "FIXES"]
@@ -180,6 +180,7 @@ def read_at2(path: str | Path) -> Record:
     npts, step = int(npts_text), _to_float(dt_text)
     if not math.isfinite(step) or step <= 0:
         raise RecordError(f"DT must be > 0 (got {dt_text}); fix the time step in the header", file=str(path), line=4)
+    step = check_time_step(step, str(path), line=4)
     if npts < 2:
         raise RecordError(f"NPTS must be at least 2 (got {npts}); fix the header", file=str(path), line=4)
 
@@ -384,7 +385,7 @@ def read_text(path: str | Path, *, dt: float | None = None, units: str | None = 
     if columns == 1:
         if dt is None:
             raise RecordError(fixes["dt"], file=str(path))
-        step = positive_value("dt", dt, str(path))
+        step = check_time_step(positive_value("dt", dt, str(path)), str(path))
         acc = data[:, 0]
     else:
         time, acc = data[:, 0], data[:, 1]

@@ -21,13 +21,28 @@ import numpy as np
 from pounding.errors import RecordError, did_you_mean
 from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNITS, canonical_unit
 
-__all__ = ["STANDARD_GRAVITY", "UNITS", "DT_RTOL", "Record", "normalise_units", "record_sha256", "positive_value"]
+__all__ = ["STANDARD_GRAVITY", "UNITS", "DT_RTOL", "DT_MIN", "DT_MAX", "PEAK_MAX_G", "Record", "normalise_units",
+           "record_sha256", "positive_value", "check_time_step"]
 
 # STANDARD_GRAVITY and UNITS (factor from each canonical unit to m/s²) come
 # from pounding.units, the package's one units table.
 
 #: Relative tolerance on a uniform time step (two-column text, dt cross-checks).
 DT_RTOL = 1e-6
+
+#: Plausible sample spacing of a ground-motion record, s.  Strong-motion
+#: instruments sample at 50-1000 Hz (dt 0.001-0.02 s) and synthetic records
+#: rarely go below 1e-4 s; 1e-5 s (100 kHz) to 1 s (1 Hz, below any structural
+#: frequency of interest) brackets every real record with margin.  Outside, the
+#: solver would take ~duration/dt steps for nothing (dt = 1e-300) or see no
+#: ground motion at all.
+DT_MIN, DT_MAX = 1e-5, 1.0
+
+#: Largest plausible |ground acceleration|, in g.  The largest recorded peaks are
+#: ~4 g (e.g. 2008 Iwate-Miyagi, 4.4 g); 100 g is far beyond any earthquake and
+#: catches unit mistakes (mm/s2 read as g) and absurd scale factors; beyond it
+#: the solver only spins (a sample of 1e30 g hangs it).
+PEAK_MAX_G = 100.0
 
 
 # --------------------------------------------------------------------------- #
@@ -103,9 +118,7 @@ class Record:
     metadata: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        dt = float(self.time_step)
-        if not math.isfinite(dt) or dt <= 0:
-            raise RecordError(f"time step must be > 0 (got {self.time_step!r})", file=self.source or None)
+        dt = check_time_step(self.time_step, self.source)
         acc = np.array(self.acceleration, dtype=np.float64, copy=True)
         if acc.ndim != 1 or acc.size < 2:
             raise RecordError(f"a record needs a 1-D series of at least 2 samples (got shape {acc.shape})",
@@ -113,6 +126,12 @@ class Record:
         if not np.all(np.isfinite(acc)):
             bad = int(np.flatnonzero(~np.isfinite(acc))[0])
             raise RecordError(f"sample {bad} is not finite ({acc[bad]}); fix the record",
+                              file=self.source or None)
+        if acc.size and float(np.max(np.abs(acc))) > PEAK_MAX_G * STANDARD_GRAVITY:
+            bad = int(np.argmax(np.abs(acc)))
+            scaled = f" after scaling by {float(self.scale):.6g}" if float(self.scale) != 1.0 else ""
+            raise RecordError(f"sample {bad} is {acc[bad] / STANDARD_GRAVITY:.3g} g{scaled}: beyond {PEAK_MAX_G:g} g, "
+                              "no ground motion is that strong; check the record's units and the scale",
                               file=self.source or None)
         acc.setflags(write=False)
         metadata = {str(k): _plain(v) for k, v in dict(self.metadata).items()}
@@ -155,6 +174,27 @@ class Record:
             return self
         metadata = dict(self.metadata, truncated_to_s=float(duration))
         return dataclasses.replace(self, acceleration=self.acceleration[:keep], metadata=metadata)
+
+
+def check_time_step(value: Any, source: str | None, *, line: int | None = None) -> float:
+    """A record's time step as a float within [:data:`DT_MIN`, :data:`DT_MAX`] s.
+
+    Raises
+    ------
+    RecordError
+        Not a number, not finite, or outside the plausible range.
+    """
+    try:
+        dt = float(value)
+    except (TypeError, ValueError):
+        dt = math.nan
+    if not math.isfinite(dt) or dt <= 0:
+        raise RecordError(f"time step must be > 0 (got {value!r})", file=source or None, line=line)
+    if not DT_MIN <= dt <= DT_MAX:
+        raise RecordError(f"time step {dt:g} s is outside the plausible range {DT_MIN:g}-{DT_MAX:g} s of a "
+                          "ground-motion record; check the DT / dt value and its units (seconds)",
+                          file=source or None, line=line)
+    return dt
 
 
 def positive_value(what: str, value: Any, source: str | None) -> float:

@@ -15,7 +15,12 @@ never leaves a truncated archive; an existing file is never replaced unless
 from __future__ import annotations
 
 import os
+import re
+import signal
+import stat
+import sys
 import tempfile
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
@@ -25,29 +30,147 @@ import xarray as xr
 
 from pounding.errors import ArchiveError
 
-__all__ = ["save_run", "open_run", "check_writable", "atomic_path"]
+__all__ = ["save_run", "open_run", "check_writable", "atomic_path", "check_not_input", "check_regular_file",
+           "check_archive", "clean_stale_temporaries", "INTERRUPT_GRACE", "REQUIRED_VARIABLES",
+           "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
+
+#: Seconds an interrupted archive write may still take before the process exits regardless.
+INTERRUPT_GRACE = 0.8
 
 _COMPRESSION = {"zlib": True, "complevel": 4}
 
 
-def check_writable(path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
+                   inputs: tuple | list = ()) -> Path:
     """Fail early (before any computation) if *path* cannot be written.
+
+    Parameters
+    ----------
+    inputs : sequence of path-like
+        Files the command reads (model, record, sweep file, archive): the
+        output must not be one of them, even with *overwrite*.
 
     Raises
     ------
     ArchiveError
-        If the file exists and *overwrite* is false, or its directory is missing.
+        If the file exists and *overwrite* is false, is not a regular file,
+        is one of *inputs*, or its directory is missing, not a directory or
+        not writable, or the name is too long.
     """
     target = Path(path)
-    if target.exists() and not overwrite:
-        raise ArchiveError(f"{target} already exists; pass --overwrite (overwrite=True) or choose another "
-                           "output file")
+    check_not_input(target, inputs)
     if target.is_dir():
         raise ArchiveError(f"{target} is a directory; give a file name such as {target / 'run.nc'}")
+    if target.exists() or target.is_symlink():
+        if not overwrite:
+            raise ArchiveError(f"{target} already exists; pass --overwrite (overwrite=True) or choose another "
+                               "output file")
+        if target.exists() and not stat.S_ISREG(os.stat(target).st_mode):
+            raise ArchiveError(f"{target} is not a regular file (a FIFO, device or socket); choose another "
+                               "output file")
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.exists():
         raise ArchiveError(f"{target}: directory {parent} does not exist; create it first")
+    if not parent.is_dir():
+        raise ArchiveError(f"{target}: {parent} is a file, not a directory; choose another output path")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ArchiveError(f"{target}: directory {parent} is not writable; choose another output folder")
+    try:
+        limit = os.pathconf(parent, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    # the temporary file is named .NAME.pounding-PID-RANDOM.tmp: ~40 more bytes than NAME
+    if len(os.fsencode(target.name)) + 40 > limit:
+        raise ArchiveError(f"{target}: the file name is too long ({len(os.fsencode(target.name))} bytes; this "
+                           f"file system allows {limit - 40} for an archive); choose a shorter name")
     return target
+
+
+def check_not_input(output: str | os.PathLike, inputs: tuple | list = ()) -> None:
+    """Refuse an *output* that is the same file as one of *inputs* (after resolving links and ``..``).
+
+    Raises
+    ------
+    ArchiveError
+        Naming the input the output would destroy.
+    """
+    out = Path(output)
+    for item in inputs:
+        if item is None:
+            continue
+        source = Path(item)
+        try:
+            same = (out.exists() and source.exists() and os.path.samefile(out, source)) or \
+                out.resolve() == source.resolve()
+        except (OSError, RuntimeError):
+            same = False
+        if same:
+            raise ArchiveError(f"{out} is an input of this command ({item}); writing there would destroy it: "
+                               "choose another output file")
+
+
+def check_regular_file(path: str | os.PathLike, what: str = "archive") -> Path:
+    """*path* as a Path if it is an existing regular file (not a FIFO, device, socket or folder).
+
+    Opening a FIFO blocks until a writer appears, so anything that is read
+    checks this first.
+
+    Raises
+    ------
+    ArchiveError
+        Missing, a folder, or not a regular file.
+    """
+    source = Path(path)
+    try:
+        mode = os.stat(source).st_mode
+    except FileNotFoundError:
+        raise ArchiveError(f"{source}: no such file") from None
+    except OSError as exc:
+        raise ArchiveError(f"{source}: cannot read ({exc.strerror})") from None
+    if stat.S_ISDIR(mode):
+        raise ArchiveError(f"{source} is a folder, not an {what} file")
+    if not stat.S_ISREG(mode):
+        raise ArchiveError(f"{source} is not a regular file (a FIFO, device or socket); give an {what} file")
+    return source
+
+
+_TEMPORARY = re.compile(r"^\..+\.pounding-(?P<pid>\d+)-[A-Za-z0-9_]+\.tmp$")
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True  # exists, owned by someone else
+    return True
+
+
+def clean_stale_temporaries(folder: str | os.PathLike) -> int:
+    """Remove temporary files of writers that died (killed mid-write); return how many.
+
+    Temporary files are named ``.NAME.pounding-PID-RANDOM.tmp``; one whose
+    writer process no longer exists is removed, live writers' files are left.
+    """
+    removed = 0
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return 0
+    for entry in entries:
+        match = _TEMPORARY.match(entry.name)
+        if match is None or _alive(int(match["pid"])):
+            continue
+        try:
+            if entry.is_file(follow_symlinks=False):
+                os.unlink(entry.path)
+                removed += 1
+        except OSError:
+            pass
+    return removed
 
 
 @contextmanager
@@ -56,17 +179,28 @@ def atomic_path(target: Path) -> Iterator[str]:
 
     On success the file is flushed to disk and renamed over *target* (an
     atomic replacement on POSIX); on any failure, including KeyboardInterrupt,
-    it is removed and *target* is left as it was.
+    it is removed and *target* is left as it was.  The temporary name carries
+    the writer's pid (``.NAME.pounding-PID-XXXX.tmp``) so that temporaries of
+    writers that were killed are removed by the next writer in that folder.
     """
     folder = target.parent if str(target.parent) else Path(".")
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
+    clean_stale_temporaries(folder)
+    try:
+        descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.pounding-{os.getpid()}-", suffix=".tmp",
+                                                 dir=folder)
+    except OSError as exc:
+        raise ArchiveError(f"cannot write {target}: {exc.strerror or exc}") from None
     os.close(descriptor)
     try:
         yield temporary
-        with open(temporary, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.chmod(temporary, 0o666 & ~_umask())   # mkstemp makes 0600; give the mode any new file gets
-        os.replace(temporary, target)
+        try:
+            with open(temporary, "rb+") as handle:
+                os.fsync(handle.fileno())
+            os.chmod(temporary, 0o666 & ~_umask())   # mkstemp makes 0600; give the mode any new file gets
+            os.replace(temporary, target)
+        except OSError as exc:
+            raise ArchiveError(f"cannot write {target}: {exc.strerror or exc}; the old file, if any, is "
+                               "unchanged") from None
     except BaseException:
         if os.path.exists(temporary):
             os.unlink(temporary)
@@ -85,6 +219,54 @@ def _umask() -> int:
     mask = os.umask(0o022)   # no /proc: the classic read-by-setting
     os.umask(mask)
     return mask
+
+
+@contextmanager
+def _interrupt_deferred(temporary: str) -> Iterator[None]:
+    """Hold Ctrl-C off while a C library writes *temporary*, then raise KeyboardInterrupt.
+
+    A KeyboardInterrupt raised inside netCDF/HDF5 leaves the library's lock
+    held and the close deadlocks.  Here SIGINT only marks the interrupt; the
+    write finishes (an archive takes well under a second) and the interrupt is
+    raised after it, so the caller removes the temporary and keeps the old
+    file.  If the write is still going :data:`INTERRUPT_GRACE` s later, or on
+    a second Ctrl-C, the temporary is removed and the process exits at once
+    with status 130.  Only in the main thread (signals are delivered there).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    state = {"interrupted": False, "writing": True}
+
+    def leave() -> None:
+        if state["writing"]:
+            try:
+                os.unlink(temporary)
+            except OSError:
+                pass
+            try:
+                sys.stderr.write("pounding: interrupted\n")
+                sys.stderr.flush()
+            except (OSError, ValueError):
+                pass
+            os._exit(130)
+
+    def handler(signum, frame):  # noqa: ARG001
+        if state["interrupted"]:
+            leave()
+        state["interrupted"] = True
+        timer = threading.Timer(INTERRUPT_GRACE, leave)
+        timer.daemon = True
+        timer.start()
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        state["writing"] = False
+        signal.signal(signal.SIGINT, previous)
+    if state["interrupted"]:
+        raise KeyboardInterrupt
 
 
 def _encoding(ds: xr.Dataset) -> dict:
@@ -114,27 +296,100 @@ def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False
     """
     target = check_writable(path, overwrite=overwrite)
     with atomic_path(target) as temporary:
-        ds.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
+        try:
+            with _interrupt_deferred(temporary):
+                ds.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
+        except (OSError, RuntimeError) as exc:   # disk full, file too large, HDF error
+            detail = getattr(exc, "strerror", None) or " ".join(str(exc).split())[:160]
+            raise ArchiveError(f"cannot write {target}: {detail} (is the disk full?); the old file, if any, "
+                               "is unchanged") from None
     return target
 
 
 def open_run(path: str | os.PathLike) -> xr.Dataset:
     """Open a results archive written by :func:`save_run` (loaded into memory).
 
+    The file must be a regular file (a FIFO would block the open forever) and
+    pass :func:`check_archive`.
+
     Raises
     ------
     ArchiveError
-        If the file is missing, not NetCDF, or not a pounding archive.
+        If the file is missing, not a regular file, not NetCDF, not a pounding
+        archive, or damaged (``damaged archive: …``).
     """
-    source = Path(path)
-    if not source.exists():
-        raise ArchiveError(f"{source}: no such file")
+    source = check_regular_file(path)
     try:
         with xr.open_dataset(source, engine="netcdf4") as handle:
             ds = handle.load()
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
         raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
                            f"{' '.join(str(exc).split())[:120]})") from None
     if not str(ds.attrs.get("source", "")).startswith("pounding") or "run_spec" not in ds.attrs:
         raise ArchiveError(f"{source}: not a pounding run archive (no 'run_spec' attribute)")
+    check_archive(ds, source)
     return ds
+
+
+#: Variables every run archive has (the summary, plots and rerun read them).
+REQUIRED_VARIABLES = ("displacement", "contact_force", "ground_acceleration", "peak_drift_ratio",
+                      "peak_displacement", "peak_contact_force", "impact_count", "impact_velocity",
+                      "impact_contact", "impact_time", "trace_contact", "trace_force", "trace_penetration",
+                      "trace_time", "storey_building", "storey_level", "contact", "law", "xi_formula",
+                      "building_left", "building_right", "level_left", "level_right", "gap", "time")
+#: Attributes, with the type they must have.
+REQUIRED_ATTRIBUTES = {"title": str, "history": str, "model_name": str, "record_name": str, "run_spec": str,
+                       "periods": str, "record_metadata": str, "record_scale": float, "duration": float,
+                       "energy_closure_error": float, "solver_steps": int, "solver_rejected_steps": int,
+                       "wall_time": float}
+#: Keys of the JSON ``run_spec`` attribute, with their types.
+RUN_SPEC_KEYS = {"model": str, "record": str, "scale": float, "duration": float}
+
+
+def _damaged(source, what: str) -> ArchiveError:
+    return ArchiveError(f"damaged archive: {source}: {what}; rerun the simulation to write it again")
+
+
+def check_archive(ds: xr.Dataset, source: str | os.PathLike = "archive") -> None:
+    """Check that an opened run archive has what the summary, plots and rerun read.
+
+    Raises
+    ------
+    ArchiveError
+        ``damaged archive: FILE: <what is missing or garbled>``.
+    """
+    import json
+
+    missing = [name for name in REQUIRED_VARIABLES if name not in ds.variables]
+    if missing:
+        raise _damaged(source, f"variable{'s' if len(missing) > 1 else ''} {', '.join(missing[:5])} missing")
+    for name, kind in REQUIRED_ATTRIBUTES.items():
+        value = ds.attrs.get(name)
+        if kind is str:
+            ok = isinstance(value, str)
+        elif kind is int:
+            ok = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+        else:
+            ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+        if not ok:
+            shown = "missing" if value is None else f"{type(value).__name__} {str(value)[:40]!r}"
+            raise _damaged(source, f"attribute '{name}' should be {kind.__name__} (found {shown})")
+    for name in ("run_spec", "periods", "record_metadata"):
+        try:
+            parsed = json.loads(ds.attrs[name])
+        except ValueError:
+            raise _damaged(source, f"attribute '{name}' is not JSON") from None
+        if not isinstance(parsed, dict):
+            raise _damaged(source, f"attribute '{name}' is not a JSON object")
+        if name == "run_spec":
+            for key, kind in RUN_SPEC_KEYS.items():
+                value = parsed.get(key)
+                ok = isinstance(value, str) if kind is str else \
+                    isinstance(value, (int, float)) and not isinstance(value, bool)
+                if not ok:
+                    raise _damaged(source, f"run_spec['{key}'] should be {kind.__name__} (found {value!r:.40})")
+        if name == "periods":
+            for building, values in parsed.items():
+                if not isinstance(values, list) or not all(isinstance(v, (int, float)) for v in values):
+                    raise _damaged(source, f"attribute 'periods' of building {building!r:.40} is not a list of "
+                                           "numbers")

