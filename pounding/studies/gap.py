@@ -232,9 +232,11 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     from pounding.model.model import model_from_text
     from pounding.simulation import simulate
     from pounding.studies.sweep.scenario import one_line
+    from pounding.studies.sweep.spec import PARTS_FORMAT
 
     started = time.perf_counter()
-    result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": GAP_PART}
+    result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": GAP_PART,
+                              "format": PARTS_FORMAT}
     try:
         model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
         ds = simulate(open_contacts(model))

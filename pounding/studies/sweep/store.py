@@ -105,6 +105,14 @@ def check_part(part: Any, key: str) -> str | None:
         return None if isinstance(part.get("error"), str) and part["error"] else "status error without a message"
     if status != "ok":
         return f"status {status!r}"
+    if part.get("study") is not None:   # another study's runner (pounding gap): one contact list length, finite
+        lists = {name: values for name, values in part.items() if isinstance(values, list)}
+        if not lists or len({len(values) for values in lists.values()}) > 1:
+            return "its lists are missing or differ in length"
+        for name, values in lists.items():
+            if any(isinstance(v, float) and not math.isfinite(v) for v in values):
+                return f"'{name}' holds a value that is not finite"
+        return None
     for group, names in _GROUPS.items():
         lengths = {}
         for name in names:
