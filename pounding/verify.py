@@ -145,7 +145,7 @@ ATOL_SCALE = 1.0e-12
 #: tightest rtol a model accepts (1e-12): there the solver hangs on 13 of the
 #: 20 ``kelvin-allow`` drops (closure and separation alternating at one
 #: instant; reported, tests/test_verify.py xfail).  At 1e-10 every model
-#: except ``bilinear`` agrees with the scipy path to ≤ 5e-9.
+#: except ``bilinear`` agrees with the scipy path to ≤ 2.2e-8.
 PRODUCTION_RTOL = 1.0e-10
 PRODUCTION_ATOL_SCALE = 1.0e-10
 
