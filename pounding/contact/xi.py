@@ -232,7 +232,7 @@ def carvalho_martins(e: float) -> float:
 
     Catalogue check: not found in the sources searched (no review or code
     quoting it).  Numerically it is a good fit of :func:`exact` for e ≳ 0.5
-    (the ball drop of :mod:`pounding.verify` gives e_post within 2e-4 of
+    (the ball drop of :mod:`pounding.studies.verify` gives e_post within 2e-4 of
     e_pre there) and drifts high below (0.303 at e = 0.3, 0.128 at 0.1).
     """
     return 1.5 * (1.0 - e) * (11.0 - e) / (1.0 + 9.0 * e)

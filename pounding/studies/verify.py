@@ -94,10 +94,13 @@ __all__ = [
     "make_law",
     "hertz_max_penetration",
     "ball_drop",
+    "ball_drop_production",
+    "production_system",
     "impact_velocity",
     "run_verification",
     "format_table_i",
     "format_models",
+    "format_production",
     "to_json",
     "cmd_verify",
     "register_cli",
@@ -136,6 +139,26 @@ BILINEAR_YIELD_RATIO = 0.1
 
 RTOL = 1.0e-12
 ATOL_SCALE = 1.0e-12
+
+#: Error control of the production path (:func:`ball_drop_production`): atol is
+#: this factor times the Hertz ``δmax`` (displacements, m) and times ``v0``
+#: (velocities, m/s), the same state scales as the scipy path.  Not the
+#: tightest rtol a model accepts (1e-12): there the solver hangs on 13 of the
+#: 20 ``kelvin-allow`` drops (closure and separation alternating at one
+#: instant; reported, tests/test_verify.py xfail).  At 1e-10 every model
+#: except ``bilinear`` agrees with the scipy path to ≤ 2.2e-8.
+PRODUCTION_RTOL = 1.0e-10
+PRODUCTION_ATOL_SCALE = 1.0e-10
+
+#: Sampling interval (s) of the constant "ground acceleration" record that
+#: carries gravity into the production solver.  0.01 s is the sampling of the
+#: FEMA P695 records: steps stop at every sample, as in a real run.
+PRODUCTION_RECORD_STEP = 0.01
+
+#: ω² = k_s/M (1/s²) of the spring that holds the surface body to the ground in
+#: the production set-up.  A power of two, so ``k_s·(g/ω²)`` reproduces ``M·g``
+#: exactly: the pre-compressed surface starts in exact equilibrium.
+SURFACE_OMEGA2 = 2.0**20
 
 
 def model_keys() -> list[str]:
@@ -289,6 +312,137 @@ def ball_drop(model_key: str, e_pre: float, *, mass: float = 0.5, height: float 
     return _result(e_pre, rebound / v0, v0, penetration, float(sol.t_events[0][0]))
 
 
+# --------------------------------------------------------------------------- #
+# The same drop through the production solver
+# --------------------------------------------------------------------------- #
+
+
+def production_system(law: contact.ContactLaw, *, mass: float, height: float, gravity: float):
+    """The ball drop as a :class:`pounding.solver.System`: a ball floor and a surface floor.
+
+    Floor 0 is the ball: mass *mass*, storey stiffness 0, no damping, so the
+    only forces on it are the "ground" inertia force and the contact.  Floor 1
+    is the rigid surface: mass :data:`RIGID_MASS` held to the ground by a
+    storey spring ``k_s = RIGID_MASS·SURFACE_OMEGA2``, also undamped.  One gap
+    element with gap *height* (m) joins them, ball on the left
+    (δ = u_ball − u_surface − height, the ball moving in +u towards the
+    surface), with the law's kernel parameters
+    taken with the floor masses ``(mass, RIGID_MASS)`` exactly as
+    :func:`pounding.simulation.assemble` takes them.
+
+    Returns
+    -------
+    (System, float)
+        The system and the surface's static displacement ``u_s* = g/ω²`` (m)
+        under the constant ground acceleration ``a_g = −g``; the caller starts
+        both floors there (see :func:`ball_drop_production`).
+    """
+    from pounding.solver.integrator import System
+
+    ints = lambda *a: np.array(a, dtype=np.int64)  # noqa: E731
+    stiffness = RIGID_MASS * SURFACE_OMEGA2
+    system = System(
+        mass=np.array([mass, RIGID_MASS]), storey_stiffness=np.array([0.0, stiffness]), below=ints(-1, -1),
+        rayleigh_mass=np.zeros(2), rayleigh_stiffness=np.zeros(2), dense_start=ints(0, 1),
+        dense_size=ints(0, 0), dense_offset=ints(0, 0), dense_values=np.zeros(0),
+        contact_left=ints(0), contact_right=ints(1), contact_gap=np.array([float(height)]),
+        contact_law=ints(law.law_id),
+        contact_parameters=np.ascontiguousarray(law.kernel_parameters(mass, RIGID_MASS)[None, :]))
+    return system, gravity * RIGID_MASS / stiffness
+
+
+def ball_drop_production(model_key: str, e_pre: float, *, mass: float = 0.5, height: float = 0.5,
+                         kh: float = 2.0e9, gravity: float = 9.81, rtol: float = PRODUCTION_RTOL,
+                         atol_scale: float = PRODUCTION_ATOL_SCALE) -> dict:
+    """The ball drop of :func:`ball_drop`, integrated by the production solver.
+
+    :func:`pounding.solver.integrate` (compiled Dormand–Prince 5(4), its step
+    control, its located gap closure and separation, ξ fixed at the located
+    closure) runs the whole drop — fall, contact, rebound — on the two-floor
+    system of :func:`production_system`:
+
+    * **Gravity** is the constant ground acceleration ``a_g = −g``.  The
+      solver's equation relative to the ground, ``M ü + K u + f = −M·1·a_g``,
+      gives the ball (no storey spring, no damping) ``m ü = m g − F``:
+      exactly ``m ÿ + F = m g`` with ``y`` the ball's displacement.
+    * **The rigid surface** is a body of mass ``M = 1e30 kg`` tied to the
+      ground by a spring ``k_s = M·ω²`` (ω² = 2^20 1/s²), started at rest at
+      its static position ``u_s* = g/ω²`` (≈ 9.4 μm), where ``k_s u_s*``
+      balances ``M g`` exactly in double precision: it does not move before
+      the impact.  During the contact the ball's force (≤ 2e4 N) moves it by
+      ``F/(M ω²)`` ≲ 1e-32 m and gives it a velocity ≲ ``J/M`` ≈ 3e-30 m/s,
+      nothing against a penetration of 4e-4 m and a velocity of 3 m/s; and
+      ``m_eff = m·M/(m + M) = m`` exactly, as in :func:`ball_drop`.
+    * **Geometry.** The ball starts at ``u = u_s*`` at rest, the gap is
+      ``h``: ``δ = u_ball − u_s* − h = y − h``, the penetration of the ball
+      drop.
+    * **Record.** ``a_g`` is a constant record sampled every
+      :data:`PRODUCTION_RECORD_STEP` (steps stop at every sample, as in a
+      real run), long enough for the fall and ~50 contact durations.
+    * ``gravity = 0``: ``a_g = 0`` and the ball starts at distance ``h`` with
+      the standard drop's impact velocity ``sqrt(2·9.81·h)`` (a free impact,
+      as in :func:`ball_drop`).
+
+    The law is built by :func:`make_law` with ``v0 = sqrt(2·g·h)`` (the
+    located scipy value agrees to 1e-13); ξ is then fixed by the solver at its
+    own located closure.  ``e_post`` is read from the solver's impact table
+    (what a user sees): separation velocity / approach velocity of the first
+    impact.
+
+    Parameters
+    ----------
+    model_key, e_pre, mass, height, kh, gravity
+        As in :func:`ball_drop` (kg, m, N/m^1.5, m/s²).
+    rtol : float
+        Solver relative tolerance (default :data:`PRODUCTION_RTOL`).
+    atol_scale : float
+        Absolute tolerances are ``atol_scale·δmax`` (m) and ``atol_scale·v0``
+        (m/s), ``δmax`` the elastic Hertz peak penetration.
+
+    Returns
+    -------
+    dict
+        ``e_pre``, ``e_post``, ``relative_error``, ``impact_velocity`` (m/s,
+        the solver's located approach velocity), ``separation_velocity``
+        (m/s), ``contact_duration`` (s, 0 for the stereo-mechanical jump),
+        ``impact_peak_force`` (N, NaN for the jump), ``n_steps`` and
+        ``n_rejected`` (the solver's accepted and rejected steps).
+    """
+    from pounding.solver.integrator import STATUS_OK, integrate
+
+    _check_settings(mass, height, kh, gravity)
+    g_fall = gravity if gravity > 0.0 else STANDARD_GRAVITY
+    v_setup = math.sqrt(2.0 * g_fall * height)
+    law = make_law(model_key, e_pre, mass=mass, kh=kh, v0=v_setup)
+    system, u_surface = production_system(law, mass=mass, height=height, gravity=float(gravity))
+    dmax = hertz_max_penetration(mass, v_setup, kh)
+    t_contact = 2.94 * dmax / v_setup
+    if gravity > 0.0:
+        t_fall = math.sqrt(2.0 * height / gravity)
+        velocity = np.zeros(2)
+    else:
+        t_fall = height / v_setup
+        velocity = np.array([v_setup, 0.0])
+    duration = t_fall + 50.0 * t_contact
+    dt = PRODUCTION_RECORD_STEP
+    record = np.full(int(math.ceil(duration / dt)) + 1, -float(gravity))
+    raw = integrate(system, record, dt, duration, rtol=rtol, atol=atol_scale * dmax,
+                    atol_velocity=atol_scale * v_setup, output_dt=duration,
+                    initial_displacement=np.array([u_surface, u_surface]), initial_velocity=velocity)
+    where = f"ball drop (production solver): {model_key} at e_pre={e_pre}"
+    if raw.status != STATUS_OK:
+        raise PoundingError(f"{where}: the solver stopped at t = {raw.final_time:.6g} s (status {raw.status})")
+    if raw.impact_time.size == 0 or not math.isfinite(raw.impact_end_time[0]):
+        raise PoundingError(f"{where}: no impact separated within {duration:.3g} s")
+    v0 = float(raw.impact_velocity[0])
+    rebound = float(raw.impact_separation_velocity[0])
+    out = _result(e_pre, rebound / v0, v0, float("nan"), float(raw.impact_end_time[0] - raw.impact_time[0]))
+    del out["max_penetration"]  # the solver reports sampled penetrations only (its trace), not a located peak
+    out.update(separation_velocity=rebound, impact_peak_force=float(raw.impact_peak_force[0]),
+               n_steps=int(raw.n_steps), n_rejected=int(raw.n_rejected))
+    return out
+
+
 def _result(e_pre: float, e_post: float, v0: float, penetration: float, duration: float) -> dict:
     return {"e_pre": float(e_pre), "e_post": float(e_post),
             "relative_error": abs(e_pre - e_post) / e_pre, "impact_velocity": float(v0),
@@ -322,16 +476,22 @@ def _law_description(key: str) -> str:
 
 def run_verification(e_pre: Sequence[float] = DEFAULT_E_PRE, models: Sequence[str] | None = None, *,
                      mass: float = 0.5, height: float = 0.5, kh: float = 2.0e9,
-                     gravity: float = 9.81) -> xr.Dataset:
+                     gravity: float = 9.81, production: bool = True) -> xr.Dataset:
     """Run :func:`ball_drop` for every model and e_pre; return an xarray Dataset.
 
     Dimensions ``model`` and ``e_pre``; variables ``e_post``,
     ``relative_error``, ``impact_velocity``, ``max_penetration``,
     ``contact_duration`` and the published Table I as
     ``e_post_published(model_published, e_pre)`` (NaN where the grid has no
-    published point; the LN misprint at 1.0 kept as printed, 0.0).  Every
-    numeric variable carries ``units`` and ``long_name``; label coordinates
-    carry ``long_name``.
+    published point; the LN misprint at 1.0 kept as printed, 0.0).  With
+    *production* (default) the same drops run through the production solver
+    (:func:`ball_drop_production`) and are stored as ``production_e_post``,
+    ``production_relative_error``, ``production_e_post_difference``
+    (production − scipy), ``production_impact_velocity``,
+    ``production_separation_velocity``, ``production_contact_duration``,
+    ``production_peak_force``, ``production_steps``.  Every numeric variable
+    carries ``units`` and ``long_name``; label coordinates carry
+    ``long_name``.
     """
     e_grid = np.array([float(e) for e in e_pre], dtype=float)
     if e_grid.size == 0:
@@ -349,6 +509,15 @@ def run_verification(e_pre: Sequence[float] = DEFAULT_E_PRE, models: Sequence[st
             row = ball_drop(key, float(e), mass=mass, height=height, kh=kh, gravity=gravity)
             for f in fields:
                 data[f][i, j] = row[f]
+    prod_fields = ("e_post", "relative_error", "impact_velocity", "separation_velocity", "contact_duration",
+                   "impact_peak_force", "n_steps")
+    prod = {f: np.full((len(keys), e_grid.size), np.nan) for f in prod_fields}
+    if production:
+        for i, key in enumerate(keys):
+            for j, e in enumerate(e_grid):
+                row = ball_drop_production(key, float(e), mass=mass, height=height, kh=kh, gravity=gravity)
+                for f in prod_fields:
+                    prod[f][i, j] = row[f]
     published = _published(e_grid)
     coords = {
         "model": ("model", np.array(keys, dtype=object), {"long_name": "model or xi-formula key"}),
@@ -375,6 +544,7 @@ def run_verification(e_pre: Sequence[float] = DEFAULT_E_PRE, models: Sequence[st
                               "comment": "as printed; lankarani-nikravesh at e_pre = 1.0 is printed 0.0000, "
                                          "a misprint for 1.0 (xi = 0, elastic rebound); ye at 0.8 printed "
                                          "0.7883 is a rounding of 0.78835"}),
+        **(_production_variables(dims, prod, data["e_post"]) if production else {}),
         "relative_error_published": (("model_published", "e_pre"),
                                      np.abs(e_grid[None, :] - published) / e_grid[None, :],
                                      {"units": "1", "long_name": "relative error of the published e_post"}),
@@ -390,11 +560,45 @@ def run_verification(e_pre: Sequence[float] = DEFAULT_E_PRE, models: Sequence[st
         "integrator": f"scipy solve_ivp DOP853, rtol {RTOL:g}, atol {ATOL_SCALE:g} x state scale; "
                       "closure, peak and separation located as events",
         "fall_gravity": gravity if gravity > 0.0 else STANDARD_GRAVITY,
+        **({"production_integrator": PRODUCTION_DESCRIPTION} if production else {}),
         "references": "Ye, K., Li, L. & Zhu, H. (2009). A note on the Hertz contact model with nonlinear "
                       "damping for pounding simulation. Earthquake Eng. Struct. Dyn. 38, 1135-1142 (Table I).",
         "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} pounding verify",
     }
     return xr.Dataset(variables, coords=coords, attrs=attrs)
+
+
+#: How the production path runs (archive attribute, text and JSON output).
+PRODUCTION_DESCRIPTION = (
+    f"pounding.solver.integrate (compiled Dormand-Prince 5(4), located gap closure and separation), "
+    f"rtol {PRODUCTION_RTOL:g}, atol {PRODUCTION_ATOL_SCALE:g} x (Hertz delta_max, v0); ball = floor of mass m "
+    f"with no storey spring and no damping, surface = floor of mass {RIGID_MASS:g} kg on a spring "
+    f"k = M x 2^20 1/s^2 pre-loaded by its weight, gravity = constant ground acceleration -g sampled every "
+    f"{PRODUCTION_RECORD_STEP:g} s; e_post = separation / approach velocity of the solver's impact table")
+
+
+def _production_variables(dims: tuple, prod: dict, scipy_e_post: np.ndarray) -> dict:
+    """The ``production_*`` variables of :func:`run_verification` with units and long names."""
+    return {
+        "production_e_post": (dims, prod["e_post"], {
+            "units": "1", "long_name": "coefficient of restitution produced by the production solver "
+                                       "(separation velocity / approach velocity of its impact table)"}),
+        "production_relative_error": (dims, prod["relative_error"], {
+            "units": "1", "long_name": "relative error |e_pre - production_e_post| / e_pre"}),
+        "production_e_post_difference": (dims, prod["e_post"] - scipy_e_post, {
+            "units": "1", "long_name": "production_e_post - e_post (production solver minus scipy reference)"}),
+        "production_impact_velocity": (dims, prod["impact_velocity"], {
+            "units": "m s-1", "long_name": "approach velocity at the gap closure located by the production solver"}),
+        "production_separation_velocity": (dims, prod["separation_velocity"], {
+            "units": "m s-1", "long_name": "rebound velocity at the separation located by the production solver"}),
+        "production_contact_duration": (dims, prod["contact_duration"], {
+            "units": "s", "long_name": "contact duration in the production solver (0 for a velocity jump)"}),
+        "production_peak_force": (dims, prod["impact_peak_force"], {
+            "units": "N", "long_name": "peak contact force of the impact in the production solver "
+                                       "(nan for a velocity jump)"}),
+        "production_steps": (dims, prod["n_steps"], {
+            "units": "1", "long_name": "accepted steps of the production solver for the whole drop"}),
+    }
 
 
 # --------------------------------------------------------------------------- #
@@ -519,17 +723,42 @@ def format_models(ds: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
+def format_production(ds: xr.Dataset) -> str:
+    """e_post from the production solver (rows: models), and max |production − scipy| per model."""
+    keys = [str(k) for k in ds.model.values]
+    width = max(len(k) for k in keys + ["model"])
+    lines = [f"e_post from the production solver (pounding.solver, rtol {PRODUCTION_RTOL:g}); "
+             "last column: max |production - scipy| over e_pre",
+             f"{'model':<{width}}" + "".join(f" {e:7.2f}" for e in ds.e_pre.values) + f" {'max diff':>9}"]
+    for key in keys:
+        diff = np.nanmax(np.abs(ds.production_e_post_difference.sel(model=key).values))
+        lines.append(f"{key:<{width}}" + "".join(f" {v:7.4f}" for v in ds.production_e_post.sel(model=key).values)
+                     + f" {diff:9.1e}")
+    return "\n".join(lines)
+
+
 def to_json(ds: xr.Dataset) -> dict:
-    """``{"settings": {...}, "results": {key: [{e_pre, e_post, relative_error}, ...]}}``."""
+    """``{"settings": {...}, "results": {key: [{e_pre, e_post, relative_error}, ...]}, "production": {...}}``.
+
+    ``"production"`` (present when *ds* holds the production runs) has the
+    shape of ``"results"``, from the production solver; ``settings`` then
+    also holds ``production_integrator``.
+    """
     settings = json.loads(ds.attrs["settings"])
     settings["e_pre"] = [float(e) for e in ds.e_pre.values]
     settings["models"] = [str(k) for k in ds.model.values]
-    results = {}
-    for key in settings["models"]:
-        results[key] = [{"e_pre": float(e), "e_post": float(p), "relative_error": float(r)}
-                        for e, p, r in zip(ds.e_pre.values, ds.e_post.sel(model=key).values,
-                                           ds.relative_error.sel(model=key).values)]
-    return {"settings": settings, "results": results}
+
+    def rows(e_post: str, error: str) -> dict:
+        return {key: [{"e_pre": float(e), "e_post": float(p), "relative_error": float(r)}
+                      for e, p, r in zip(ds.e_pre.values, ds[e_post].sel(model=key).values,
+                                         ds[error].sel(model=key).values)]
+                for key in settings["models"]}
+
+    out = {"settings": settings, "results": rows("e_post", "relative_error")}
+    if "production_e_post" in ds:
+        settings["production_integrator"] = ds.attrs["production_integrator"]
+        out["production"] = rows("production_e_post", "production_relative_error")
+    return out
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -551,6 +780,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
             print(table)
             print()
         print(format_models(ds))
+        if "production_e_post" in ds:
+            print()
+            print(format_production(ds))
     if args.output:
         path = save_run(ds, args.output, overwrite=args.overwrite)
         if not args.json:
