@@ -4,25 +4,17 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
-from pounding.cli.sweep import add_cluster_options, raise_if_all_failed
-from pounding.errors import PoundingError
+from pounding.cli.sweep import add_cluster_options, check_study_options, raise_if_all_failed
 from pounding.studies.compare import REFERENCE, compare, comparison_table, plot_comparison
 
 __all__ = ["register_cli"]
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable
     from pounding.studies.sweep.store import parts_dir
 
-    if args.workers is not None and args.workers < 1:
-        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
-    if args.output:
-        check_writable(args.output, overwrite=args.overwrite)
-    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
-        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
+    check_study_options(args)
     try:
         ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,
                      reference=args.reference, workers=args.workers, scheduler=args.scheduler,

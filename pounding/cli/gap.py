@@ -5,44 +5,20 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
-import yaml
-
-from pounding.cli.sweep import add_cluster_options
+from pounding.cli.run import SCALE_HELP, parse_scale_option
+from pounding.cli.sweep import add_cluster_options, check_study_options
 from pounding.errors import PoundingError
 
-__all__ = ["register_cli", "parse_scale_option"]
-
-
-def parse_scale_option(text: str | None):
-    """``--scale``: a factor (``1.5``) or a YAML scale mapping (``"{pga: 0.4g}"``, ``"{sa: 0.8g, period: 1.0}"``)."""
-    if text is None:
-        return None
-    try:
-        value = yaml.safe_load(text)
-    except yaml.YAMLError:
-        value = None
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return float(value)
-    if isinstance(value, dict):
-        return value
-    raise PoundingError(f"--scale must be a factor (1.5) or a mapping such as '{{pga: 0.4g}}' or "
-                        f"'{{sa: 0.8g, period: 1.0}}' (got {text!r})")
+__all__ = ["register_cli"]
 
 
 def _cmd_gap(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
     from pounding.studies.sweep.store import parts_dir
 
-    if args.workers is not None and args.workers < 1:
-        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
-    if args.output:
-        check_writable(args.output, overwrite=args.overwrite)
-    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
-        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
-    scale = parse_scale_option(args.scale)
+    check_study_options(args)
+    scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
         ds = gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
                        workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
@@ -89,8 +65,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                              "comma-separated list of records (default: the model's record); files are relative "
                              "to the current directory")
     parser.add_argument("--scale", metavar="SCALE",
-                        help="scale every record: a factor (1.5) or a mapping such as '{pga: 0.4g}' or "
-                             "'{sa: 0.8g, period: building A}' (default: the model's ground_motion.scale)")
+                        help="scale every record (default: the model's ground_motion.scale): " + SCALE_HELP)
     parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")
     parser.add_argument("-o", "--output", metavar="GAP.nc", help="also write the results (NetCDF); resumable")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")

@@ -11,7 +11,7 @@ from pounding.studies.sweep.execution import default_workers, failure_report, ru
 from pounding.studies.sweep.spec import load_sweep
 from pounding.studies.sweep.store import parts_dir
 
-__all__ = ["register_cli", "add_cluster_options", "summary_lines", "raise_if_all_failed"]
+__all__ = ["register_cli", "add_cluster_options", "check_study_options", "summary_lines", "raise_if_all_failed"]
 
 # --------------------------------------------------------------------------- #
 # Command line
@@ -27,6 +27,18 @@ def add_cluster_options(parser: argparse.ArgumentParser) -> None:
                        help="use an existing Dask cluster, e.g. tcp://HOST:8786 (started with `dask scheduler` "
                             "and `dask worker tcp://HOST:8786`)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def check_study_options(args: argparse.Namespace) -> None:
+    """Before a study runs (compare, gap): ``--workers`` >= 1, a writable ``-o``, a ``--plot`` that is no file."""
+    from pounding.results.archive import check_writable
+
+    if args.workers is not None and args.workers < 1:
+        raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
+    if args.output:
+        check_writable(args.output, overwrite=args.overwrite)
+    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
+        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
 
 
 def summary_lines(ds) -> list[str]:

@@ -674,7 +674,7 @@ def record_fingerprint(spec: Any, base_dir: str | None = None) -> str:
     if not isinstance(spec, str) or not spec.strip():
         return f"none:{spec!r}"
     text = spec.strip()
-    if schema.is_catalogue_reference(text):
+    if is_catalogue_reference(text):
         try:
             from importlib.metadata import version
 
