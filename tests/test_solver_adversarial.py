@@ -244,7 +244,8 @@ def test_simulate_reports_every_status_in_one_line(monkeypatch):
             simulation.simulate(model, duration=0.05)
         message = str(info.value)
         assert "\n" not in message and "1.25 s" in message
-        assert message == STATUS_MESSAGES[status].format(t=1.25)
+        # one line: the model file, then the status's own message (issue 17: solver failures name the model)
+        assert message == f"{model.path}: " + STATUS_MESSAGES[status].format(t=1.25)
 
 
 # --------------------------------------------------------------------------- #
