@@ -25,6 +25,9 @@ import pounding
 from pounding.contact import laws as contact
 from pounding.solver.integrator import STATUS_OK, System, integrate
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_solver import pairs  # noqa: E402  (one builder of independent one-storey pairs)
+
 GiB = 1 << 30
 
 HARNESS = r"""
@@ -67,22 +70,6 @@ def compiled():
 
 def ints(*a):
     return np.array(a, dtype=np.int64)
-
-
-def pairs(mass_left, mass_right, k_left, k_right, gaps, law) -> System:
-    """Independent pairs of one-storey buildings: pair i is floors (2i, 2i+1) joined by gap i."""
-    n = len(gaps)
-    mass = np.empty(2 * n)
-    stiffness = np.empty(2 * n)
-    mass[0::2], mass[1::2] = mass_left, mass_right
-    stiffness[0::2], stiffness[1::2] = k_left, k_right
-    prm = np.array([law.kernel_parameters(mass[2 * i], mass[2 * i + 1]) for i in range(n)])
-    return System(mass=mass, storey_stiffness=stiffness, below=np.full(2 * n, -1, dtype=np.int64),
-                  rayleigh_mass=np.zeros(2 * n), rayleigh_stiffness=np.zeros(2 * n), dense_start=ints(),
-                  dense_size=ints(), dense_offset=ints(), dense_values=np.zeros(0),
-                  contact_left=np.arange(0, 2 * n, 2), contact_right=np.arange(1, 2 * n, 2),
-                  contact_gap=np.asarray(gaps, dtype=float), contact_law=np.full(n, law.law_id, dtype=np.int64),
-                  contact_parameters=np.ascontiguousarray(prm))
 
 
 def two_buildings(n_left, n_right, law, gap, *, mass=2.5e5, k_left=3.5e8, k_right=4.5e8, damping=0.05) -> System:
