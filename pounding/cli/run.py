@@ -275,13 +275,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
             print(comparison_table(ds, _reference(ds)))
     else:
-        from pounding.studies.verify import format_models, format_table_i
+        from pounding.studies.verify import format_report
 
-        table = format_table_i(ds)
-        if table:
-            print(table)
-            print()
-        print(format_models(ds))
+        print(format_report(ds))
     if args.variables:
         for name, var in ds.data_vars.items():
             print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")

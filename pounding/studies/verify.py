@@ -100,6 +100,7 @@ __all__ = [
     "run_verification",
     "format_table_i",
     "format_models",
+    "format_report",
     "format_production",
     "to_json",
     "cmd_verify",
@@ -761,6 +762,14 @@ def to_json(ds: xr.Dataset) -> dict:
     return out
 
 
+def format_report(ds: xr.Dataset) -> str:
+    """The printed report of a verification: Table I (when run), every model, the production solver's results."""
+    parts = [format_table_i(ds), format_models(ds)]
+    if "production_e_post" in ds:
+        parts.append(format_production(ds))
+    return "\n\n".join(part for part in parts if part)
+
+
 def cmd_verify(args: argparse.Namespace) -> int:
     """Handler of ``pounding verify``."""
     from pounding.results.archive import check_writable, save_run
@@ -775,14 +784,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(to_json(ds), indent=2))
     else:
-        table = format_table_i(ds)
-        if table:
-            print(table)
-            print()
-        print(format_models(ds))
-        if "production_e_post" in ds:
-            print()
-            print(format_production(ds))
+        print(format_report(ds))
     if args.output:
         path = save_run(ds, args.output, overwrite=args.overwrite)
         if not args.json:
