@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from pounding import hysteresis
 from pounding.contact import laws as contact_laws
 from pounding.errors import PoundingError
 from pounding.errors import RecordError
@@ -29,7 +30,7 @@ from pounding.records.load import CATALOGUE_REFERENCE, load_record
 from pounding.model.model import Model, model_from_text
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import to_dataset
-from pounding.solver.integrator import STATUS_MESSAGES, STATUS_OK, System, integrate
+from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
 
 __all__ = ["assemble", "simulate", "record_for", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
@@ -92,6 +93,17 @@ def assemble(model: Model) -> System:
             dense_used += n * n
         offset += n
 
+    models, parameters, heights, p_delta = [], [], [], []
+    for building in model.buildings:
+        for law, k, h in zip(building.hysteresis, building.stiffness, building.height):
+            models.append(hysteresis.MODEL_ELASTIC if law is None else law.model_id)
+            parameters.append(np.zeros(hysteresis.N_HYSTERESIS_PARAMETERS) if law is None
+                              else law.kernel_parameters(k, h))
+        heights.append(building.height)
+        p_delta.append(building.p_delta_stiffness)
+    yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
+    storey_state = np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64)
+
     left, right, gaps, laws, params = [], [], [], [], []
     mass_all = np.concatenate(masses)
     for gap in model.gaps:
@@ -119,6 +131,12 @@ def assemble(model: Model) -> System:
         contact_law=np.asarray(laws, dtype=np.int64),
         contact_parameters=np.ascontiguousarray(
             np.array(params, dtype=float).reshape(len(params), contact_laws.N_PARAMETERS)),
+        storey_model=np.asarray(models, dtype=np.int64),
+        storey_parameters=np.ascontiguousarray(np.array(parameters, dtype=float)),
+        storey_state=storey_state,
+        p_delta_stiffness=np.ascontiguousarray(np.concatenate(p_delta), dtype=float),
+        storey_height=np.ascontiguousarray(np.concatenate(heights), dtype=float),
+        stop_drift_ratio=float(model.solver.stop_drift_ratio or 0.0),
     )
 
 
@@ -250,7 +268,7 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
                     output_dt=settings.output_dt)
     wall = _time.perf_counter() - started
-    if raw.status != STATUS_OK:
+    if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
         raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
@@ -259,7 +277,7 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
 
 
 def mark_energy_status(ds: xr.Dataset) -> str:
-    """Set the archive attribute ``status``: ``ok``, or a warning when energy does not close.
+    """Set the archive attribute ``energy_status``: ``ok``, or a warning when energy does not close.
 
     A closure error above :data:`ENERGY_CLOSURE_LIMIT` (or not finite) means
     the integration did not conserve energy to the tolerance asked: the run is
@@ -267,14 +285,11 @@ def mark_energy_status(ds: xr.Dataset) -> str:
     """
     closure = float(ds.attrs.get("energy_closure_error", 0.0))
     if np.isfinite(closure) and closure <= ENERGY_CLOSURE_LIMIT:
-        ds.attrs["status"] = "ok"
+        ds.attrs["energy_status"] = "ok"
     else:
-        ds.attrs["status"] = (f"warning: energy closure error {closure:.3g} exceeds {ENERGY_CLOSURE_LIMIT:g}; the "
+        ds.attrs["energy_status"] = (f"warning: energy closure error {closure:.3g} exceeds {ENERGY_CLOSURE_LIMIT:g}; the "
                               "results are not trustworthy (check masses, stiffnesses and solver tolerances)")
-    return ds.attrs["status"]
-
-
-    return ds.attrs["status"]
+    return ds.attrs["energy_status"]
 
 
 def _where(model: Model) -> str:

@@ -222,7 +222,7 @@ def test_energy_closure_beyond_the_limit_is_flagged(case, capsys):
     from pounding.simulation import mark_energy_status
 
     ds = open_run(case / "run.nc")
-    assert ds.attrs["status"] == "ok"
+    assert ds.attrs["energy_status"] == "ok"
     ds.attrs["energy_closure_error"] = 1e3
     assert mark_energy_status(ds).startswith("warning: energy closure error 1e+03 exceeds 0.001")
     assert "WARNING: energy closure error" in summary(ds)

@@ -98,6 +98,22 @@ def summary(ds) -> str:
     for name in periods:
         sel = ds.peak_drift_ratio.where(ds.storey_building == name, drop=True)
         lines.append(f"  {name}: " + " ".join(f"{100 * v:.3f}" for v in sel.values))
+    if "peak_ductility" in ds and bool(np.isfinite(ds.peak_ductility.values).any()):
+        lines.append("yielding storeys: peak ductility (peak drift / yield drift) and residual drift ratio (%):")
+        for name in periods:
+            mine = ds.storey_building == name
+            ductility = ds.peak_ductility.where(mine, drop=True).values
+            if not np.isfinite(ductility).any():
+                continue
+            residual = ds.residual_drift_ratio.where(mine, drop=True).values
+            lines.append(f"  {name} ductility: " + " ".join("-" if not np.isfinite(v) else f"{v:.2f}"
+                                                            for v in ductility))
+            lines.append(f"  {name} residual: " + " ".join(f"{100 * v:+.3f}" for v in residual))
+        energy = float(ds.energy_hysteretic.values[-1]) if "energy_hysteretic" in ds else 0.0
+        lines.append(f"  hysteretic energy dissipated: {energy / 1e3:.4g} kJ")
+    if ds.attrs.get("status") == "collapsed":
+        lines.append(f"COLLAPSED: storey {ds.attrs['collapse_storey']} passed drift ratio "
+                     f"{ds.attrs['stop_drift_ratio']:g} at t = {ds.attrs['collapse_time']:.4f} s; the run ended there")
     if ds.sizes.get("contact", 0):
         lines.append("contacts (gap element: impacts, peak force, formula):")
         for i in range(ds.sizes["contact"]):
@@ -112,7 +128,7 @@ def summary(ds) -> str:
     lines.append(f"energy closure error {ds.attrs['energy_closure_error']:.2e}; "
                  f"{ds.attrs['solver_steps']} steps ({ds.attrs['solver_rejected_steps']} rejected); "
                  f"solver wall time {ds.attrs['wall_time']:.3f} s")
-    status = str(ds.attrs.get("status", "ok"))
+    status = str(ds.attrs.get("energy_status", "ok"))
     if status != "ok":
         lines.append(f"WARNING: {status.removeprefix('warning: ')}")
     return "\n".join(lines)

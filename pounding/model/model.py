@@ -36,6 +36,7 @@ from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
 from pounding.errors import ModelError, PoundingError, did_you_mean
 from pounding.records.catalogue import is_catalogued
+from pounding.units import STANDARD_GRAVITY
 
 __all__ = [
     "Damping",
@@ -151,6 +152,12 @@ class Building:
     height : (n,) ndarray
         Storey heights, m.
     damping : Damping
+    hysteresis : tuple of (StoreyHysteresis or None), optional
+        Per storey, from the ground up: its yielding model, or None for a
+        linear elastic storey.  Empty (the default): every storey elastic.
+    p_delta : bool
+        Leaning-column P-Delta: storey i carries ``P_i = g·Σ_(j≥i) m_j`` and its
+        force gains ``−(P_i/h_i)·Δ_i`` (docs/physics.md §7).
 
     Arrays are read-only copies.  Equality is identity (arrays do not compare
     as booleans); compare the arrays to test two buildings for equal content.
@@ -161,19 +168,55 @@ class Building:
     stiffness: np.ndarray
     height: np.ndarray
     damping: Damping
+    hysteresis: tuple = ()
+    p_delta: bool = False
 
     def __post_init__(self) -> None:
         arrays = [np.array(getattr(self, key), dtype=float).reshape(-1) for key in ("mass", "stiffness", "height")]
         if not arrays[0].size == arrays[1].size == arrays[2].size:
             raise ModelError(f"building {self.name}: mass, stiffness and height must have the same length "
                              f"(got {arrays[0].size}, {arrays[1].size}, {arrays[2].size})")
-        storeys = [{"mass": float(m), "stiffness": float(k), "height": float(h)} for m, k, h in zip(*arrays)]
+        hysteresis = tuple(self.hysteresis) or (None,) * arrays[0].size
+        if len(hysteresis) != arrays[0].size:
+            raise ModelError(f"building {self.name}: hysteresis must have one entry (or None) per storey "
+                             f"(got {len(hysteresis)} for {arrays[0].size} storeys)")
+        storeys = [_storey_document(m, k, h, law) for m, k, h, law in zip(*arrays, hysteresis)]
         damping = self.damping.to_document() if isinstance(self.damping, Damping) else self.damping
-        _checked(schema.BuildingEntry, {"name": self.name, "storeys": storeys, "damping": damping},
-                 prefix=f"building {self.name}:")
+        entry = _checked(schema.BuildingEntry, {"name": self.name, "storeys": storeys, "damping": damping,
+                                                "p_delta": self.p_delta}, prefix=f"building {self.name}:")
         for key, array in zip(("mass", "stiffness", "height"), arrays):
             array.setflags(write=False)
             object.__setattr__(self, key, array)
+        object.__setattr__(self, "hysteresis", entry.column("hysteresis"))
+
+    # ----------------------------------------------------------- yielding and P-Delta
+    @property
+    def is_inelastic(self) -> bool:
+        """True if any storey has a hysteresis model."""
+        return any(law is not None for law in self.hysteresis)
+
+    @property
+    def yield_force(self) -> np.ndarray:
+        """(n,) storey yield forces F_y, N (NaN for an elastic storey)."""
+        return np.array([np.nan if law is None else law.yield_force_for(k, h)
+                         for law, k, h in zip(self.hysteresis, self.stiffness, self.height)])
+
+    @property
+    def yield_drift(self) -> np.ndarray:
+        """(n,) storey yield drifts u_y = F_y / k, m (NaN for an elastic storey)."""
+        return self.yield_force / self.stiffness
+
+    @property
+    def gravity_load(self) -> np.ndarray:
+        """(n,) axial load P_i = g·Σ_(j≥i) m_j carried by each storey, N."""
+        return STANDARD_GRAVITY * np.cumsum(self.mass[::-1])[::-1]
+
+    @property
+    def p_delta_stiffness(self) -> np.ndarray:
+        """(n,) geometric storey stiffness −P_i/h_i, N/m (zeros without ``p_delta``)."""
+        if not self.p_delta:
+            return np.zeros(self.n_floors)
+        return -self.gravity_load / self.height
 
     # ----------------------------------------------------------- geometry
     @property
@@ -386,12 +429,16 @@ class SolverSettings:
         Absolute tolerance on velocities, m/s.
     output_dt : float
         Sampling interval of the stored histories, s.
+    stop_drift_ratio : float or None
+        End the run (status ``collapsed``) when a storey's |drift ratio| first
+        exceeds this; None: never.
     """
 
     rtol: float = 1e-6
     atol: float = 1e-8
     atol_velocity: float = 1e-7
     output_dt: float = 0.01
+    stop_drift_ratio: float | None = None
 
     def __post_init__(self) -> None:
         entry = _checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
@@ -522,6 +569,11 @@ class Model:
             periods = ", ".join(f"{t:.3f}" for t in b.periods[:3])
             lines.append(f"{b.name}: {b.n_floors} floors, {b.elevation[-1]:g} m, "
                          f"T1..{min(3, b.n_floors)} = {periods} s, {b.damping.describe()}")
+            if b.is_inelastic or b.p_delta:
+                kinds = sorted({law.describe() for law in b.hysteresis if law is not None})
+                yielding = sum(law is not None for law in b.hysteresis)
+                lines.append(f"  {yielding} of {b.n_floors} storeys yield: {'; '.join(kinds) or 'none'}"
+                             + ("; P-Delta on" if b.p_delta else ""))
         for contact in sorted({g.contact for g in self.gaps}):
             gaps = [g for g in self.gaps if g.contact == contact]
             left, right = self.buildings[gaps[0].left].name, self.buildings[gaps[0].right].name
@@ -559,7 +611,7 @@ class Model:
             "buildings": [_building_document(b) for b in self.buildings],
             "contacts": contacts,
             "ground_motion": self.ground_motion.to_document(),
-            "solver": dataclasses.asdict(self.solver),
+            "solver": {k: v for k, v in dataclasses.asdict(self.solver).items() if v is not None},
         }
 
     def to_yaml(self) -> str:
@@ -573,11 +625,22 @@ class Model:
         return header + yaml.safe_dump(self.plain_document(), sort_keys=False, default_flow_style=None, width=100)
 
 
+def _storey_document(mass: float, stiffness: float, height: float, hysteresis: Any) -> dict[str, Any]:
+    """One storey as plain data; ``hysteresis`` only when the storey yields."""
+    storey: dict[str, Any] = {"mass": float(mass), "stiffness": float(stiffness), "height": float(height)}
+    if hysteresis is not None:
+        storey["hysteresis"] = (hysteresis.model_dump(mode="json", exclude_none=True)
+                                if hasattr(hysteresis, "model_dump") else hysteresis)
+    return storey
+
+
 def _building_document(b: Building) -> dict[str, Any]:
     damping = b.damping.to_document()
-    storeys = [{"mass": float(m), "stiffness": float(k), "height": float(h)}
-               for m, k, h in zip(b.mass, b.stiffness, b.height)]
-    return {"name": b.name, "storeys": storeys, "damping": damping}
+    storeys = [_storey_document(m, k, h, law) for m, k, h, law in zip(b.mass, b.stiffness, b.height, b.hysteresis)]
+    document = {"name": b.name, "storeys": storeys, "damping": damping}
+    if b.p_delta:
+        document["p_delta"] = True
+    return document
 
 
 def _check_keys(section: str, changes: dict[str, Any], cls: type) -> None:
@@ -606,7 +669,8 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
             array = np.array(b.column(key))
             array.setflags(write=False)
             arrays[key] = array
-        buildings.append(_trusted(Building, name=b.name, damping=damping, **arrays))
+        buildings.append(_trusted(Building, name=b.name, damping=damping, hysteresis=b.column("hysteresis"),
+                                  p_delta=b.p_delta, **arrays))
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters)
                  for index, c in enumerate(entry.contacts) for a, r in c.pairs)
     gm = entry.ground_motion

@@ -49,6 +49,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Di
 from pydantic_core import PydanticCustomError
 
 from pounding.contact.laws import LAWS, ContactLaw
+from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
 from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
@@ -318,14 +319,53 @@ class _Schema(BaseModel):
         return data
 
 
+HysteresisUnion = registry_union(HYSTERESES, "model", "hysteresis")
+
+
+def _hysteresis_parameters(value: Any) -> Any:
+    """A storey's ``hysteresis`` mapping checked for a known ``model``, number fields converted."""
+    if value is None or isinstance(value, StoreyHysteresis):
+        return value
+    if not isinstance(value, dict):
+        raise problem("must be a mapping, e.g. {model: bilinear, yield_drift_ratio: 0.01}", line="key")
+    name = value.get("model")
+    if name is None:
+        raise problem(f"missing required key 'model' (storey hysteresis: {', '.join(HYSTERESES)})",
+                      kind="error", line="key", rank=-1)
+    if not (isinstance(name, str) and name in HYSTERESES):
+        if isinstance(name, str):
+            raise problem(f"unknown hysteresis model '{name}'{did_you_mean(name, list(HYSTERESES))}; "
+                          f"choose one of: {', '.join(HYSTERESES)}", kind="error", at=("model",), rank=-1)
+        raise problem(f"must be one of {', '.join(HYSTERESES)}", at=("model",), rank=-1)
+    cls = HYSTERESES[name]
+    out = dict(value)
+    for key, item in value.items():
+        info = cls.model_fields.get(key)
+        if info is not None and key != "model" and item is not None:
+            try:
+                out[key] = as_number(item)
+            except Problem as failed:
+                raise problem(failed.predicate, at=(key,)) from None
+    return out
+
+
+def as_bool(value: Any) -> bool:
+    """``true`` or ``false`` (YAML booleans only: no 'yes', no 1)."""
+    if isinstance(value, bool):
+        return value
+    raise Problem("must be true or false")
+
+
 class StoreyEntry(_Schema):
-    """One storey: the floor mass on top, the storey stiffness and height."""
+    """One storey: the floor mass on top, the storey stiffness and height, optionally its hysteresis."""
 
     WHAT: ClassVar[str] = "a mapping {mass, stiffness, height}"
 
     mass: PositiveNumber = Field(description="floor mass, kg")
-    stiffness: PositiveNumber = Field(description="storey lateral stiffness, N/m")
+    stiffness: PositiveNumber = Field(description="storey lateral stiffness (elastic), N/m")
     height: PositiveNumber = Field(description="storey height, m")
+    hysteresis: Annotated[HysteresisUnion | None, BeforeValidator(_hysteresis_parameters)] = Field(  # type: ignore[valid-type]
+        None, description=f"storey yielding: {{model: {' | '.join(HYSTERESES)}, yield_force | yield_drift_ratio, ...}}")
 
 
 class StoreyShorthand(StoreyEntry):
@@ -413,9 +453,11 @@ class BuildingEntry(_Schema):
     storeys: Storeys = Field(description="a list of {mass, stiffness, height} from the ground up, "
                                          "or {count, mass, stiffness, height}")
     damping: Damping = Field(description="e.g. {ratio: 0.05, modes: [1, 2]} or {modal: [0.05, 0.05]}")
+    p_delta: Annotated[bool, BeforeValidator(_pydantic(as_bool))] = Field(
+        False, description="leaning-column P-Delta from the floor weights, true or false")
 
-    def column(self, key: str) -> tuple[float, ...]:
-        """Per-floor values of ``mass``, ``stiffness`` or ``height``, from the ground up."""
+    def column(self, key: str) -> tuple[Any, ...]:
+        """Per-floor values of ``mass``, ``stiffness``, ``height`` or ``hysteresis``, from the ground up."""
         if isinstance(self.storeys, StoreyShorthand):
             return (getattr(self.storeys, key),) * self.storeys.count
         return tuple(getattr(s, key) for s in self.storeys)
@@ -697,6 +739,8 @@ class SolverEntry(_Schema):
     atol: PositiveNumber = 1.0e-8
     atol_velocity: PositiveNumber = 1.0e-7
     output_dt: PositiveNumber = 0.01
+    stop_drift_ratio: OptionalPositiveNumber = Field(
+        None, description="end the run (status collapsed) when a storey's |drift ratio| exceeds this")
 
 
 def _buildings_shape(value: Any) -> Any:

@@ -44,6 +44,7 @@ from pounding.contact import laws as contact_laws
 from pounding.records.record import Record
 from pounding.model.model import Model
 from pounding.solver.integrator import RawSolution, System
+from pounding.solver.storeys import recoverable_energy
 
 __all__ = ["to_dataset", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
 
@@ -108,10 +109,43 @@ def _storey_drift(u: np.ndarray, below: np.ndarray) -> np.ndarray:
     return drift
 
 
+def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray) -> dict[str, np.ndarray]:
+    """Per storey: residual drift ratio, yield drift, peak ductility and dissipated energy at the end."""
+    n = system.n_floors
+    final = raw.final_state
+    displacement = final[:n]
+    below = system.below
+    drift = displacement - np.where(below >= 0, displacement[np.maximum(below, 0)], 0.0)
+    yielding = system.storey_state >= 0
+    yield_drift = np.where(yielding, system.storey_parameters[:, 0], np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ductility = raw.peak_drift / yield_drift
+    dissipated = np.zeros(n)
+    if yielding.any():
+        first = 2 * n + 3 * system.n_contacts + 2
+        nh = system.n_hysteretic
+        index = system.storey_state[yielding]
+        state = final[first + index]
+        work = final[first + nh + index]
+        recoverable = np.array([_recoverable(int(m), p, k, d, r) for m, p, k, d, r in zip(
+            system.storey_model[yielding], system.storey_parameters[yielding], system.storey_stiffness[yielding],
+            drift[yielding], state)])
+        dissipated[yielding] = work - recoverable
+    return {"residual": drift / heights, "yield_drift": yield_drift, "ductility": ductility,
+            "dissipated": dissipated}
+
+
+def _recoverable(model: int, parameters: np.ndarray, stiffness: float, drift: float, state: float) -> float:
+    """Recoverable energy of one storey (J), by the solver's own kernel."""
+    return float(recoverable_energy(model, parameters, stiffness, drift, state))
+
+
 def energy_closure(ds: xr.Dataset) -> float:
     """``max |E_in − Σ parts| / max |E_in|`` of a results dataset (dimensionless)."""
     parts = (ds.energy_kinetic + ds.energy_strain + ds.energy_damping
              + ds.energy_contact_dissipated + ds.energy_contact_strain)
+    if "energy_hysteretic" in ds:
+        parts = parts + ds.energy_hysteretic
     scale = float(np.abs(ds.energy_input).max())
     if scale == 0.0:
         return 0.0
@@ -137,7 +171,14 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                    - system.contact_gap)
 
     kinetic = 0.5 * np.einsum("ij,ij,j->i", v, v, system.mass)
-    strain = 0.5 * (drift * drift) @ system.storey_stiffness
+    # Recoverable storey energy (with the P-Delta potential), summed by the solver at each output time;
+    # a yielding storey's dissipated energy is its work ∫F dΔ minus its recoverable part.
+    strain = raw.storey_energy[:, 0]
+    nh = system.n_hysteretic
+    first_hysteretic = 2 * n + 3 * nc + 2
+    storey_work = raw.state[:, first_hysteretic + nh:first_hysteretic + 2 * nh]
+    hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
+    inelastic = _inelastic_summary(system, raw, heights)
     contact_strain = raw.contact_potential  # summed over contacts by the solver at each output time
     contact_work = work.sum(axis=1)
 
@@ -223,11 +264,23 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "trace_force": _var(("trace",), raw.trace_force, "N", "contact force at the full-resolution sample"),
         "energy_input": _var(("time",), e_input, "J", "input energy -integral a_g 1'M du/dt dt"),
         "energy_kinetic": _var(("time",), kinetic, "J", "kinetic energy (relative motion)"),
-        "energy_strain": _var(("time",), strain, "J", "elastic strain energy of the storeys"),
+        "energy_strain": _var(("time",), strain, "J",
+                              "recoverable strain energy of the storeys (with the P-Delta gravity potential)"),
         "energy_damping": _var(("time",), e_damping, "J", "energy dissipated by structural damping"),
         "energy_contact_dissipated": _var(("time",), contact_work - contact_strain, "J",
                                           "energy dissipated by the contacts"),
         "energy_contact_strain": _var(("time",), contact_strain, "J", "elastic energy stored in the contacts"),
+        "energy_hysteretic": _var(("time",), hysteretic, "J", "energy dissipated by yielding storeys"),
+        "storey_shear": _var(("time", "storey"), raw.storey_shear, "N",
+                             "storey restoring (column) shear, without P-Delta and damping"),
+        "residual_drift_ratio": _var(("storey",), inelastic["residual"], "1",
+                                     "signed storey drift ratio at the end of the run"),
+        "peak_ductility": _var(("storey",), inelastic["ductility"], "1",
+                               "peak absolute storey drift over yield drift (NaN for an elastic storey)"),
+        "yield_drift": _var(("storey",), inelastic["yield_drift"], "m",
+                            "storey yield drift u_y = F_y / k (NaN for an elastic storey)"),
+        "storey_hysteretic_energy": _var(("storey",), inelastic["dissipated"], "J",
+                                         "energy dissipated by the storey's hysteresis over the run"),
     }
     ds = xr.Dataset(variables, coords=coords)
     # The ragged dims get their times and contact labels as coordinates, so that
@@ -270,6 +323,13 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "solver_rejected_steps": int(raw.n_rejected),
         "wall_time": float(wall_time),
         "energy_closure_error": closure,
+        "status": "collapsed" if raw.collapse_storey >= 0 else "completed",
+        "collapse_time": float(raw.final_time) if raw.collapse_storey >= 0 else float("nan"),
+        "collapse_storey": floor_names[raw.collapse_storey] if raw.collapse_storey >= 0 else "",
+        "stop_drift_ratio": float(model.solver.stop_drift_ratio or 0.0),
+        "hysteresis": json.dumps({b.name: [None if law is None else law.describe() for law in b.hysteresis]
+                                  for b in model.buildings if b.is_inelastic}),
+        "p_delta": ", ".join(b.name for b in model.buildings if b.p_delta),
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }

@@ -31,8 +31,17 @@ Design
   impulse ``∫F dt`` and the work ``∫F δ̇ dt`` are integrated as extra states
   (excluded from the error norm: they are quadratures of a controlled solution).
 
-State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping]``
-(``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force).
+* **Yielding storeys.** A storey's hysteretic state (the plastic drift of a
+  bilinear storey, Bouc–Wen's z) is integrated with the motion and is part
+  of the error norm; a bilinear storey's yield onset and unloading are
+  located as events, like gap closure, so no step straddles a kink of its
+  force (:mod:`pounding.solver.storeys`).  P-Delta is a linear geometric
+  stiffness per storey.  A run stops, located, when a storey's drift ratio
+  first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED).
+
+State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh)]``
+(``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force; ``r``: each
+yielding storey's hysteretic state; ``W``: its work ∫F dΔ, J).
 
 References
 ----------
@@ -52,8 +61,10 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws as contact_laws
+from pounding import hysteresis
 from pounding.solver import kernels
 from pounding.solver import jit
+from pounding.solver import storeys
 
 
 jit.load_registries_without_scipy()
@@ -80,6 +91,7 @@ STATUS_OK = 0
 STATUS_STEP_TOO_SMALL = 1  # also the outcome of a non-finite state: such steps are rejected and shrunk
 STATUS_EVENT_LIMIT = 2     # more contact events inside one record step than EVENTS_PER_WINDOW allows
 STATUS_TABLE_LIMIT = 3     # the impact or trace table would exceed its row cap
+STATUS_COLLAPSED = 4       # a storey's drift ratio exceeded stop_drift_ratio: the run ended there (not an error)
 #: One-line explanation of every status, for error messages (``{t}``: the time the run stopped, s).
 STATUS_MESSAGES = {
     STATUS_OK: "completed",
@@ -89,6 +101,7 @@ STATUS_MESSAGES = {
                          "(an impact sequence that does not end, e.g. chattering contacts); run stopped"),
     STATUS_TABLE_LIMIT: ("the impact or contact-trace table reached its row cap at t = {t:.6g} s "
                          "(too many impacts or closed-contact samples); run stopped"),
+    STATUS_COLLAPSED: "collapsed: a storey's drift ratio exceeded solver.stop_drift_ratio at t = {t:.6g} s",
 }
 
 #: Event cap: a run stops with STATUS_EVENT_LIMIT when more than
@@ -115,6 +128,8 @@ EVENT_END_TOLERANCE = 1e-9
 MAX_RETAKES = 8
 # Kinds of contact events.
 EVENT_NONE, EVENT_CLOSE, EVENT_SEPARATE, EVENT_SWITCH0, EVENT_SWITCH1, EVENT_RELEASE = range(6)
+# Kinds of storey events (bilinear storeys).
+STOREY_NONE, STOREY_YIELD_POSITIVE, STOREY_YIELD_NEGATIVE, STOREY_UNLOAD = range(4)
 
 
 @dataclass(frozen=True)
@@ -135,6 +150,12 @@ class System:
     contact_gap : (nc,) m
     contact_law : (nc,) int, kernel branch (pounding.contact)
     contact_parameters : (nc, N_PARAMETERS) float
+    storey_model : (N,) int, hysteresis kernel branch of the storey under each floor (0: elastic)
+    storey_parameters : (N, N_HYSTERESIS_PARAMETERS) float, ``[u_y, α, n, β, γ, A]``
+    storey_state : (N,) int, index of the storey's hysteretic state among the nh yielding storeys, −1 if elastic
+    p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
+    storey_height : (N,) m
+    stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
     """
 
     mass: np.ndarray
@@ -151,6 +172,23 @@ class System:
     contact_gap: np.ndarray
     contact_law: np.ndarray
     contact_parameters: np.ndarray
+    storey_model: np.ndarray | None = None
+    storey_parameters: np.ndarray | None = None
+    storey_state: np.ndarray | None = None
+    p_delta_stiffness: np.ndarray | None = None
+    storey_height: np.ndarray | None = None
+    stop_drift_ratio: float = 0.0
+
+    def __post_init__(self) -> None:
+        # Storey fields left out: linear elastic storeys of unit height, no P-Delta, no collapse check.
+        n = int(self.mass.size)
+        defaults = {"storey_model": np.zeros(n, dtype=np.int64),
+                    "storey_parameters": np.zeros((n, hysteresis.N_HYSTERESIS_PARAMETERS)),
+                    "storey_state": np.full(n, -1, dtype=np.int64),
+                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n)}
+        for key, value in defaults.items():
+            if getattr(self, key) is None:
+                object.__setattr__(self, key, value)
 
     @property
     def n_floors(self) -> int:
@@ -159,6 +197,16 @@ class System:
     @property
     def n_contacts(self) -> int:
         return int(self.contact_gap.size)
+
+    @property
+    def n_hysteretic(self) -> int:
+        """Number of yielding storeys (each has a hysteretic state and a work state)."""
+        return int((self.storey_state >= 0).sum())
+
+    @property
+    def n_states(self) -> int:
+        """Length of the state vector."""
+        return 2 * self.n_floors + 3 * self.n_contacts + 2 + 2 * self.n_hysteretic
 
 
 @dataclass(frozen=True)
@@ -187,6 +235,10 @@ class RawSolution:
     trace_contact: np.ndarray        # (nr,) int
     trace_penetration: np.ndarray    # (nr,) m
     trace_force: np.ndarray          # (nr,) N
+    storey_shear: np.ndarray         # (nt, N) N, restoring (column) shear of each storey, without P-Delta
+    storey_energy: np.ndarray        # (nt, 2) J: recoverable energy of all storeys (with P-Delta), of the yielding ones
+    final_state: np.ndarray          # (S,) state at final_time
+    collapse_storey: int             # floor index of the storey that exceeded stop_drift_ratio, −1 if none
     n_steps: int
     n_rejected: int
     status: int
@@ -209,7 +261,8 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces):
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
+         smodel, sprm, sidx, kpd, smode, shear):
     """Time derivative of the state; contact forces are written to *forces*.
 
     A closed compliant contact acts through its law in its current mode
@@ -221,8 +274,12 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     """
     n = mass.size
     nc = cgap.size
+    nh = smode.size
+    ih = 2 * n + 3 * nc + 2  # first hysteretic state
     # fbuf[:n] accumulates internal + damping forces (N); power is the
-    # damping power v·C v (W), summed in the same loops.
+    # damping power v·C v (W), summed in the same loops.  A yielding storey's
+    # restoring force comes from its hysteresis kernel (pounding.solver.storeys);
+    # shear[j] receives each storey's restoring (column) shear.
     power = 0.0
     for j in range(n):
         v = y[n + j]
@@ -236,8 +293,17 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         else:
             du = y[j]
             dv = y[n + j]
+        hi = sidx[j]
+        if hi < 0:
+            restoring = kst[j] * du
+        else:
+            r = y[ih + hi]
+            restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
+            out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
+            out[ih + nh + hi] = restoring * dv
+        shear[j] = restoring
         damping = kst[j] * a1[j] * dv
-        s = kst[j] * du + damping
+        s = restoring + kpd[j] * du + damping
         power += damping * dv
         fbuf[j] += s
         if b >= 0:
@@ -507,6 +573,118 @@ def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
     return total
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out, row):
+    """Storey energies of state *y* into ``out[row]``: recoverable energy of every storey
+    (with the P-Delta potential ½·(−P/h)·Δ², J) and the recoverable energy of the yielding ones."""
+    ih = 2 * n + 3 * nc + 2
+    total = 0.0
+    yielding = 0.0
+    for j in range(n):
+        b = below[j]
+        du = y[j] - y[b] if b >= 0 else y[j]
+        hi = sidx[j]
+        r = y[ih + hi] if hi >= 0 else 0.0
+        energy = storeys.recoverable_energy(smodel[j], sprm[j], kst[j], du, r)
+        total += energy + 0.5 * kpd[j] * du * du
+        if hi >= 0:
+            yielding += energy
+    out[row, 0] = total
+    out[row, 1] = yielding
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _drift_interpolant(y, ynew, k1, k7, n, j, b):
+    """Drift and drift rate of the storey under floor *j* at both ends of a step, and their rates."""
+    if b >= 0:
+        return (y[j] - y[b], y[n + j] - y[n + b], ynew[j] - ynew[b], ynew[n + j] - ynew[n + b],
+                k1[n + j] - k1[n + b], k7[n + j] - k7[n + b])
+    return y[j], y[n + j], ynew[j], ynew[n + j], k1[n + j], k7[n + j]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, prm, mode, h):
+    """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
+
+    Elastic mode: ``Δ − Δ_p`` reaching ``+u_y`` or ``−u_y`` (Δ_p is constant, so
+    this is a crossing of the drift's Hermite cubic, found exactly by
+    :func:`_first_crossing`).  Yielding: the drift rate crossing 0 against
+    the yield direction (the cubic of Δ̇ from Δ̇ and Δ̈ at the ends).
+    """
+    if model != hysteresis.MODEL_BILINEAR:
+        return -1.0, STOREY_NONE
+    d0, r0, d1, r1, a0, a1 = _drift_interpolant(y, ynew, k1, k7, n, j, b)
+    ih = 2 * n + 3 * nc + 2
+    uy = prm[0]
+    if mode == storeys.ELASTIC:
+        plastic = y[ih + hi]
+        e0 = d0 - plastic
+        e1 = d1 - plastic
+        floor = DELTA_ROUNDOFF * (abs(d0) + abs(plastic) + uy)
+        s = _first_crossing(e0 - uy, r0, e1 - uy, r1, h, True, floor)
+        kind = STOREY_YIELD_POSITIVE
+        s2 = _first_crossing(e0 + uy, r0, e1 + uy, r1, h, False, floor)
+        if s2 >= 0.0 and (s < 0.0 or s2 < s):
+            s = s2
+            kind = STOREY_YIELD_NEGATIVE
+        return s, kind if s >= 0.0 else STOREY_NONE
+    floor = DELTA_ROUNDOFF * (abs(y[n + j]) + (abs(y[n + b]) if b >= 0 else 0.0))
+    s = _first_crossing(r0, a0, r1, a1, h, mode < 0, floor)
+    return s, STOREY_UNLOAD if s >= 0.0 else STOREY_NONE
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _apply_storey_events(kinds, y, n, nc, below, sfloor, sprm, smode):
+    """Apply located storey events ``kinds[h]`` (STOREY_*) to the state, in place; returns how many.
+
+    Yield onset puts the plastic drift on the yield surface (``Δ − Δ_p = ±u_y``
+    exactly) and enters the yield mode, unless the drift is not moving
+    outward there (a grazing touch of the surface: it stays elastic);
+    unloading returns to the elastic mode.
+    """
+    ih = 2 * n + 3 * nc + 2
+    applied = 0
+    for hi in range(smode.size):
+        kind = kinds[hi]
+        if kind == STOREY_NONE:
+            continue
+        applied += 1
+        j = sfloor[hi]
+        b = below[j]
+        drift = y[j] - y[b] if b >= 0 else y[j]
+        rate = y[n + j] - y[n + b] if b >= 0 else y[n + j]
+        uy = sprm[j, 0]
+        if kind == STOREY_YIELD_POSITIVE:
+            y[ih + hi] = drift - uy
+            smode[hi] = storeys.YIELD_POSITIVE if rate > 0.0 else storeys.ELASTIC
+        elif kind == STOREY_YIELD_NEGATIVE:
+            y[ih + hi] = drift + uy
+            smode[hi] = storeys.YIELD_NEGATIVE if rate < 0.0 else storeys.ELASTIC
+        else:
+            smode[hi] = storeys.ELASTIC
+    return applied
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio, h):
+    """First instant in a step where a storey's |drift| exceeds ``stop_ratio·height``: (fraction, floor)."""
+    best = -1.0
+    where = -1
+    for j in range(n):
+        d0, r0, d1, r1, a0, a1 = _drift_interpolant(y, ynew, k1, k7, n, j, below[j])
+        limit = stop_ratio * heights[j]
+        # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|r0| + |r1|) (its basis
+        # functions' bounds): search only where the limit is within reach.
+        if max(abs(d0), abs(d1)) + 0.25 * h * (abs(r0) + abs(r1)) < limit:
+            continue
+        for upward in (True, False):
+            s = _first_crossing(d0, r0, d1, r1, h, upward, limit)
+            if s >= 0.0 and (best < 0.0 or s < best):
+                best = s
+                where = j
+    return best, where
+
+
 # Columns of the impact table built during integration.
 (IMP_CONTACT, IMP_TIME, IMP_VELOCITY, IMP_CONSTANT, IMP_PEAK_FORCE, IMP_END, IMP_IMPULSE, IMP_SEPARATION,
  IMP_WORK) = range(9)
@@ -538,7 +716,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     energy-audit states.  The impact row (room made by the caller) opens and
     closes at once; returns the new row count.
     """
-    nc = (y.size - 2 * n - 2) // 3
+    nc = cl.size
     lf = cl[c]
     rf = cr[c]
     v0 = y[n + lf] - y[n + rf]
@@ -605,7 +783,7 @@ def _plastic_jump(c, y, n, cl, cr, mass):
     The impulse and its work (the energy lost, ½·m_eff·v0²) are added to the
     contact's energy-audit states.
     """
-    nc = (y.size - 2 * n - 2) // 3
+    nc = cl.size
     lf = cl[c]
     rf = cr[c]
     v0 = y[n + lf] - y[n + rf]
@@ -620,7 +798,7 @@ def _plastic_jump(c, y, n, cl, cr, mass):
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                   cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
-                  impacts, n_imp, open_imp):
+                  impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -672,7 +850,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces)
+                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
@@ -725,11 +903,16 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
 
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-               cl, cr, cgap, claw, cprm, ag, dt_rec, t_end, rtol, atol_u, atol_v,
-               output_dt, first_step, y_initial):
+               cl, cr, cgap, claw, cprm, smodel, sprm, sidx, kpd, heights, stop_ratio,
+               ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
-    S = 2 * n + 3 * nc + 2
+    nh = nc - nc
+    for j in range(n):
+        if sidx[j] >= 0:
+            nh += 1
+    S = 2 * n + 3 * nc + 2 + 2 * nh
+    ih = 2 * n + 3 * nc + 2  # first hysteretic state
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
 
@@ -760,6 +943,22 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     internal_tol = np.empty(nc)
     for c in range(nc):
         internal_tol[c] = kernels.internal_tolerance(claw[c], cprm[c], atol_u)
+    # Yielding storeys: floor of each state, mode, tolerance of the state (plastic drift in m;
+    # Bouc-Wen z is dimensionless, so its tolerance is atol over u_y), located events.
+    sfloor = np.empty(nh, dtype=np.int64)
+    smode = np.zeros(nh, dtype=np.int64)
+    storey_tol = np.empty(nh)
+    for j in range(n):
+        if sidx[j] >= 0:
+            sfloor[sidx[j]] = j
+            storey_tol[sidx[j]] = atol_u if smodel[j] == hysteresis.MODEL_BILINEAR else atol_u / sprm[j, 0]
+    sev_s = np.empty(nh)
+    sev_kind = np.zeros(nh, dtype=np.int64)
+    spending = np.zeros(nh, dtype=np.int64)
+    shear = np.zeros(n)
+    collapse_floor = zero - 1
+    collapse_s = -1.0
+    collapse_pending = False
 
     out_time = np.empty(n_out)
     out_state = np.empty((n_out, S))
@@ -767,6 +966,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     out_force = np.empty((n_out, nc))
     out_ag = np.empty(n_out)
     out_pot = np.empty(n_out)
+    out_shear = np.empty((n_out, n))
+    out_storey_energy = np.empty((n_out, 2))
 
     peak_u = np.zeros(n)
     peak_drift = np.zeros(n)
@@ -787,9 +988,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     t = 0.0
     seg = zero
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces)
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
     # First output sample at t = 0.
     out_time[0] = 0.0
+    for j in range(n):
+        out_shear[0, j] = shear[j]
+    _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, 0)
     for i in range(S):
         out_state[0, i] = y[i]
     for j in range(n):
@@ -822,6 +1026,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         n_retake = zero
         for c in range(nc):
             pending[c] = EVENT_NONE
+        for hi in range(nh):
+            spending[hi] = STOREY_NONE
+        collapse_pending = False
         while True:
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
@@ -830,28 +1037,28 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -873,6 +1080,15 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         finite = False
                     elif r > err:
                         err = r
+            for hi in range(nh):
+                if finite:
+                    i = ih + hi
+                    e = h_try * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+                    r = abs(e) / (storey_tol[hi] + rtol * max(abs(y[i]), abs(ynew[i])))
+                    if not (r < 1e300):
+                        finite = False
+                    elif r > err:
+                        err = r
             if not finite or err > 1.0:
                 n_rej += 1
                 rejected = True
@@ -881,6 +1097,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_retake = zero
                 for c in range(nc):
                     pending[c] = EVENT_NONE
+                for hi in range(nh):
+                    spending[hi] = STOREY_NONE
+                collapse_pending = False
                 continue
             for c in range(nc):
                 forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
@@ -913,7 +1132,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
-                                 fbuf, forces)
+                                 fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                             if forces[c] < 0.0:
                                 hi = mid
                             else:
@@ -937,15 +1156,38 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     event_kind[c] = kind
                     if s < s_first:
                         s_first = s
+            for hi in range(nh):
+                j = sfloor[hi]
+                s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j], smode[hi],
+                                        h_try)
+                sev_s[hi] = s
+                sev_kind[hi] = kind
+                if kind != STOREY_NONE and s < s_first:
+                    s_first = s
+            collapse_s = -1.0
+            if stop_ratio > 0.0:
+                collapse_s, collapse_at = _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio, h_try)
+                if collapse_s >= 0.0:
+                    collapse_floor = collapse_at
+                    if collapse_s < s_first:
+                        s_first = collapse_s
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 for c in range(nc):
                     if event_kind[c] != EVENT_NONE and event_s[c] * h_try > tiny:
                         event_kind[c] = EVENT_NONE
+                if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
+                    status = STATUS_COLLAPSED
+                    break
+                for hi in range(nh):
+                    if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
+                        sev_kind[hi] = STOREY_NONE
+                n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
-                    impacts, n_imp, open_imp)
+                    impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear)
+                n_applied += n_storey
                 if t - window_start > dt_rec:
                     window_start = t
                     window_events = zero
@@ -955,18 +1197,24 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if status != 0:
                     break
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces)
+                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
                 for c in range(nc):
                     pending[c] = EVENT_NONE
+                for hi in range(nh):
+                    spending[hi] = STOREY_NONE
+                collapse_pending = False
                 n_retake = zero
                 continue
             if s_first < 1.0 - EVENT_END_TOLERANCE and n_retake < MAX_RETAKES:
                 # Retake the step to end at the first event; the retaken step is searched again.
                 for c in range(nc):
                     pending[c] = event_kind[c] if event_kind[c] != EVENT_NONE and event_s[c] <= s_first else EVENT_NONE
+                for hi in range(nh):
+                    spending[hi] = sev_kind[hi] if sev_kind[hi] != STOREY_NONE and sev_s[hi] <= s_first else STOREY_NONE
+                collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
                 h_try = s_first * h_try
                 n_retake += 1
                 continue
@@ -1047,7 +1295,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1057,6 +1305,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_force[i_out, c] = forces[c]
             out_ag[i_out] = ag_o
             out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm)
+            for j in range(n):
+                out_shear[i_out, j] = shear[j]
+            _storey_energy(ystage, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i_out)
             i_out += 1
         # ---- accept ---------------------------------------------------------
         t = t_new
@@ -1068,9 +1319,18 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         for c in range(nc):
             if event_kind[c] == EVENT_NONE:
                 event_kind[c] = pending[c]
+        if collapse_s >= 0.0 or collapse_pending:
+            status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
+            break
+        for hi in range(nh):
+            if sev_kind[hi] == STOREY_NONE:
+                sev_kind[hi] = spending[hi]
+        n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-            cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp)
+            cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
+            smodel, sprm, sidx, kpd, smode, shear)
+        n_applied += n_storey
         if n_applied > 0:
             if t - window_start > dt_rec:
                 window_start = t
@@ -1079,7 +1339,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1105,21 +1365,28 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
+            for j in range(n):
+                out_shear[i2, j] = shear[j]
+            _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i2)
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
             out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
         i_out = n_out
+    if status != STATUS_COLLAPSED:
+        collapse_floor = zero - 1
     return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out], out_pot[:i_out],
             peak_u, peak_drift, peak_force,
-            impacts[:n_imp], trace[:n_trace], n_steps, n_rej, status, t)
+            impacts[:n_imp], trace[:n_trace], out_shear[:i_out], out_storey_energy[:i_out], y, collapse_floor,
+            n_steps, n_rej, status, t)
 
 
 # The integrator inlines the kernels, and they inline the law ids and sizes of contact/laws.py:
 # its cached code is stale when any of the three files changes.
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
-                              [__file__, kernels.__file__, contact_laws.__file__])
+                              [__file__, kernels.__file__, contact_laws.__file__, storeys.__file__,
+                               hysteresis.__file__])
 jit.load_from_cache_without_refresh(_integrate)
 
 
@@ -1162,14 +1429,17 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
                      system.dense_offset, system.dense_values, system.contact_left,
                      system.contact_right, system.contact_gap, system.contact_law,
-                     system.contact_parameters, ag, float(time_step), float(duration), float(rtol),
+                     system.contact_parameters, system.storey_model, system.storey_parameters,
+                     system.storey_state, system.p_delta_stiffness, system.storey_height,
+                     float(system.stop_drift_ratio), ag, float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
-    (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, n_steps, n_rej,
-     status, t_final) = raw
+    (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, shear,
+     storey_energy, final_state, collapse_floor, n_steps, n_rej, status, t_final) = raw
     return RawSolution(time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
                        impacts[:, IMP_VELOCITY], impacts[:, IMP_CONSTANT], impacts[:, IMP_PEAK_FORCE],
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],
                        impacts[:, IMP_WORK], trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
+                       shear, storey_energy, final_state.copy(), int(collapse_floor),
                        int(n_steps), int(n_rej), int(status), float(t_final))
