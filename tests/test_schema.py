@@ -572,12 +572,13 @@ def test_readme_example_loads():
 
 
 def test_readme_documents_every_key():
+    from pounding.hysteresis import HYSTERESES
     from pounding.model import schema
 
     readme = (MODELS / "README.md").read_text()
     classes = [schema.TopLevel, schema.BuildingEntry, schema.StoreyShorthand, schema.RayleighEntry,
                schema.ModalEntry, schema.ContactGeometry, schema.GroundMotionEntry, schema.SolverEntry,
-               LAWS["hertz-damp"]]
+               LAWS["hertz-damp"], HYSTERESES["bouc-wen"]]
     keys = {key for cls in classes for key in cls.model_fields if not (cls is LAWS["hertz-damp"] and key == "law")}
     missing = sorted(key for key in keys if f"| `{key}` |" not in readme)
     assert not missing, f"keys not in the README tables: {missing}"
