@@ -302,3 +302,21 @@ def test_every_bad_hysteresis_value_is_a_one_line_error(tmp_path, hyst, pdelta, 
     text = str(raised.value)
     assert "\n" not in text
     assert text.endswith(message) or text.startswith(str(path)) and message.split(":", 1)[1] in text, text
+
+
+def test_plots_add_storey_hysteresis_loops_only_when_storeys_yield(tmp_path):
+    from pounding.results.plots import plot_run
+
+    model = one_storey(tmp_path, "{model: bilinear, yield_force: 2.0e5, post_yield_ratio: 0.05}", duration=3.0)
+    written = {p.name for p in plot_run(pounding.simulate(model), tmp_path / "yielding")}
+    assert "storey_hysteresis.png" in written
+    assert (tmp_path / "yielding" / "storey_hysteresis.png").stat().st_size > 10_000
+    strong = one_storey(tmp_path, "{model: bilinear, yield_force: 2.0e9}", duration=3.0)
+    written = {p.name for p in plot_run(pounding.simulate(strong), tmp_path / "elastic")}
+    # A hysteresis model that never yields still has loops to show (peak ductility is finite) ...
+    assert "storey_hysteresis.png" in written
+    elastic = pounding.load_model("models/pair.yaml")
+    ds = pounding.simulate(elastic, duration=2.0)
+    # ... an elastic model has none.
+    assert "storey_hysteresis.png" not in {p.name for p in plot_run(ds, tmp_path / "pair")}
+    assert np.isnan(ds.peak_ductility.values).all() and np.all(ds.storey_hysteretic_energy.values == 0)

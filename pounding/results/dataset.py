@@ -279,6 +279,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                                "peak absolute storey drift over yield drift (NaN for an elastic storey)"),
         "yield_drift": _var(("storey",), inelastic["yield_drift"], "m",
                             "storey yield drift u_y = F_y / k (NaN for an elastic storey)"),
+        "yield_force": _var(("storey",), inelastic["yield_drift"] * system.storey_stiffness, "N",
+                            "storey yield force F_y (NaN for an elastic storey)"),
         "storey_hysteretic_energy": _var(("storey",), inelastic["dissipated"], "J",
                                          "energy dissipated by the storey's hysteresis over the run"),
     }

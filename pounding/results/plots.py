@@ -13,6 +13,10 @@
 ``force_penetration.png``
     Force against penetration for each gap element, from the full-resolution
     contact trace (the hysteresis loops of the impacts).
+``storey_hysteresis.png``
+    Only for a model with yielding storeys: storey shear against drift
+    ratio for the most-yielded storeys (largest peak ductility), yield
+    levels dashed; a collapse is marked.
 """
 
 from __future__ import annotations
@@ -214,9 +218,50 @@ def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
     plt.close(fig)
 
 
+#: Storeys shown in ``storey_hysteresis.png`` (the most yielded first).
+LOOPS_SHOWN = 6
+
+
+def _storey_hysteresis(plt, ds: xr.Dataset, path: Path) -> None:
+    ductility = np.nan_to_num(ds.peak_ductility.values, nan=-1.0)
+    order = [int(i) for i in np.argsort(-ductility, kind="stable") if ductility[i] >= 0][:LOOPS_SHOWN]
+    cols = min(len(order), 3)
+    rows = int(np.ceil(len(order) / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.2 * rows), squeeze=False)
+    for slot in range(rows * cols):
+        ax = axes[slot // cols][slot % cols]
+        if slot >= len(order):
+            ax.axis("off")
+            continue
+        i = order[slot]
+        height = float(ds.height.values[i])
+        ratio = 100.0 * ds.storey_drift.values[:, i] / height
+        shear = ds.storey_shear.values[:, i] / 1e6
+        ax.plot(ratio, shear, lw=0.7)
+        yield_force = float(ds.yield_force.values[i]) / 1e6
+        ax.axhline(yield_force, color="0.5", ls="--", lw=0.7)
+        ax.axhline(-yield_force, color="0.5", ls="--", lw=0.7)
+        ax.axhline(0.0, color="0.8", lw=0.6)
+        ax.axvline(0.0, color="0.8", lw=0.6)
+        ax.set_xlabel("storey drift ratio (%)")
+        ax.set_ylabel("storey shear (MN)")
+        ax.set_title(f"storey {ds.storey.values[i]}: ductility {ductility[i]:.2f}, "
+                     f"residual {100 * float(ds.residual_drift_ratio.values[i]):+.2f} %", fontsize=8)
+        ax.grid(alpha=0.3)
+    title = "storey hysteresis (column shear, without P-Delta and damping; dashed: yield force ±F_y)"
+    if ds.attrs.get("status") == "collapsed":
+        title += f" - COLLAPSED at {ds.attrs['collapse_time']:.2f} s (storey {ds.attrs['collapse_storey']})"
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float | None = None,
              elevation: bool = False) -> list[Path]:
-    """Write the four standard figures of a run to *directory* (created if needed).
+    """Write the standard figures of a run to *directory* (created if needed).
+
+    Four figures always; ``storey_hysteresis.png`` too when storeys yield.
 
     Parameters
     ----------
@@ -240,6 +285,10 @@ def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float
                        ("force_penetration.png", _force_penetration)):
         path = out / name
         draw(plt, ds, path)
+        written.append(path)
+    if "peak_ductility" in ds and bool(np.isfinite(ds.peak_ductility.values).any()):
+        path = out / "storey_hysteresis.png"
+        _storey_hysteresis(plt, ds, path)
         written.append(path)
     return written
 
