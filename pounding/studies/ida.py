@@ -1114,6 +1114,10 @@ def _curve(ds, i: int, r: int, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return levels[ok][order], drift[ok][order], collapsed[ok][order]
 
 
+def _im_label(ds) -> str:
+    return "PGA" if ds.attrs["im"] == "pga" else f"Sa(T1 of {ds.attrs['im_building']})"
+
+
 def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     """``ida_curves.png`` (IM against max drift ratio per record, median and 16/84 % stripes, per variant) and
     ``fragility.png`` (fitted curves with the stripe fractions as points), per building."""
@@ -1136,7 +1140,8 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     # IDA curves: one row per building, one column per variant
     fig, axes = plt.subplots(len(buildings), len(variants), figsize=(5.4 * len(variants), 4.2 * len(buildings)),
                              squeeze=False, sharey=True)
-    top = 1.15 * collapse_drift * 100
+    largest = float(np.nanmax(ds.max_drift_ratio.values, initial=0.0))
+    top = 115 * collapse_drift if largest >= 0.5 * collapse_drift else 120 * max(largest, 1e-6)
     for b, building in enumerate(buildings):
         for i, variant in enumerate(variants):
             ax = axes[b, i]
@@ -1155,7 +1160,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
                                  ds.max_drift_ratio.values[i, :, :, b])
                 ok = np.isin(ds.status.values[i], ("completed", "collapsed"))
                 levels = ds.level.values / STANDARD_GRAVITY
-                for q, style, name in ((50, "-", "median"), (16, "--", "16 %"), (84, "--", "84 %")):
+                for q, style, name in ((50, "-", "median"), (16, "--", "16 % and 84 %"), (84, "--", None)):
                     values = []
                     for j in range(levels.size):
                         column = drift[ok[:, j], j]
@@ -1168,7 +1173,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
             ax.set_xlim(0, top * 1.02)
             ax.set_ylim(bottom=0)
             ax.set_xlabel(f"max storey drift ratio of {building} (%)")
-            ax.set_ylabel(f"{ds.attrs['im'].upper()} level (g)")
+            ax.set_ylabel(f"{_im_label(ds)} level (g)")
             ax.set_title(f"building {building}, {titles.get(variant, variant)}", fontsize=10)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="lower right")
@@ -1181,7 +1186,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
 
     # Fragility curves: one panel per building, a colour per limit, solid with contacts, dashed without
     summary = ida_summary(ds)
-    fig, axes = plt.subplots(1, len(buildings), figsize=(5.6 * len(buildings), 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(buildings), figsize=(5.8 * len(buildings), 5.6), squeeze=False)
     labels = [str(x) for x in ds.fragility_limit.values]
     limits = [float(x) for x in ds.limit.values] + [None]
     if stripes:
@@ -1193,14 +1198,14 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
         ax = axes[0, b]
         for k, (label, limit) in enumerate(zip(labels, limits)):
             color = f"C{k}" if limit is not None else "k"
-            name = f"drift {100 * limit:g} %" if limit is not None else "collapse"
+            name = f"{100 * limit:g} %" if limit is not None else "collapse"
             for i, variant in enumerate(variants):
                 entry = summary["fragility"][variant][building][label]
                 style = "-" if variant == "with_contacts" else "--"
                 if entry["theta"] is not None:
                     ax.plot(x, ndtr(np.log(x / entry["theta"]) / entry["beta"]), style, color=color, lw=1.5,
-                            label=f"{name}, {'with' if i == 0 else 'without'} contacts "
-                                  f"(theta {entry['theta']:.2f} g, beta {entry['beta']:.2f})")
+                            label=f"{name}, {'contacts' if variant == 'with_contacts' else 'open'}: "
+                                  f"\u03b8 {entry['theta']:.2f} g, \u03b2 {entry['beta']:.2f}")
                 if stripes:
                     hit = _exceeds(ds, limit)[i, :, :, b]
                     n = np.sum(np.isfinite(hit), axis=0)
@@ -1210,12 +1215,16 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
                             mfc=color if variant == "with_contacts" else "white")
         ax.set_xlim(0, grid_top)
         ax.set_ylim(-0.02, 1.02)
-        ax.set_xlabel(f"{ds.attrs['im'].upper()} (g)")
+        ax.set_xlabel(f"{_im_label(ds)} (g)")
         ax.set_ylabel("P(exceed | IM)")
-        ax.set_title(f"building {building}" + ("; points: fraction of records at each stripe (filled: with "
-                                               "contacts)" if stripes else ""), fontsize=9)
+        ax.set_title(f"building {building}: max storey drift ratio > limit, or collapse"
+                     + ("\npoints: fraction of records at each stripe (filled: with contacts, open: without)"
+                        if stripes else "\nsolid: with contacts; dashed: contacts held open"), fontsize=9)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=6.5, loc="lower right")
+        handles, names = ax.get_legend_handles_labels()
+        if handles:   # below the axes
+            ax.legend(handles, names, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+                      frameon=False)
     fig.suptitle(f"fragility, {ds.record.size} records ({ds.attrs['method']})", fontsize=10)
     fig.tight_layout()
     path = out / "fragility.png"
