@@ -85,6 +85,8 @@ IM_NAMES = ("sa-t1", "pga")
 SCALINGS = ("auto", "record", "fema-p695")
 #: Most levels of a --levels range (a typo such as 0.1:300:0.1 would ask for 3000 stripes).
 MAX_LEVELS = 500
+#: Largest dispersion reported; a larger one means the data do not define a fragility.
+MAX_BETA = 5.0
 #: Damping ratio of Sa(T1).
 SA_DAMPING = 0.05
 
@@ -982,6 +984,9 @@ def ida_fragility(ds) -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
                         n = np.sum(np.isfinite(hit), axis=0)
                         z = np.nansum(hit, axis=0)
                         fit = fit_stripes(ds.level.values / STANDARD_GRAVITY, n, z)
+                        if not (0 < fit.theta < math.inf and fit.beta < MAX_BETA):
+                            raise PoundingError(f"the fraction exceeding hardly changes over the stripes (beta "
+                                                f"{fit.beta:.3g}): widen the range of levels")
                         entry.update(theta=fit.theta, beta=fit.beta, method="mle-stripes")
                     else:
                         levels = ds.level_value.values[i] / STANDARD_GRAVITY
