@@ -278,6 +278,8 @@ def test_a_hunt_resumes_from_its_parts_and_fits_the_collapse_intensities(in_proc
     assert code == 0
     second = xr.load_dataset(out)
     np.testing.assert_array_equal(second.max_drift_ratio.values, first.max_drift_ratio.values)
+    code, out_text, _ = _run(["info", str(out)], capsys)
+    assert code == 0 and "[ida archive]" in out_text and "hunt-and-fill" in out_text
 
 
 def test_an_interrupted_hunt_keeps_its_runs(in_process, tmp_path, capsys):

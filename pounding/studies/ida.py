@@ -887,6 +887,8 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "title": f"pounding IDA: {plan.model_name}",
         "source": f"pounding {__version__}",
         "study": "ida",
+        "history": f"{time.strftime('%Y-%m-%d %H:%M:%S')} pounding ida ({'stripes' if stripes else 'hunt-and-fill'}, "
+                   f"{nr} records, {len(entries)} runs)",
         "model_path": plan.model_path,
         "im": plan.im.name,
         "im_building": plan.im.building,
