@@ -250,8 +250,8 @@ def open_archive(path) -> tuple[str, object]:
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
         ds = handle.load()
-    if attrs.get("study") == "gap":
-        return "gap", ds
+    if attrs.get("study") in ("gap", "ida"):
+        return str(attrs["study"]), ds
     if "sweep_name" in attrs:
         return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
                 else "sweep"), ds
@@ -281,6 +281,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
         from pounding.studies.gap import gap_table
 
         print(gap_table(ds))
+    elif kind == "ida":
+        from pounding.studies.ida import ida_table
+
+        print(ida_table(ds))
     elif kind in ("sweep", "compare"):
         from pounding.cli.sweep import summary_lines
 
@@ -306,7 +310,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from pounding.errors import ArchiveError
 
     kind, ds = open_archive(args.run)
-    if kind in ("sweep", "compare", "gap") and not bool((ds.status == "ok").any()):
+    if kind in ("sweep", "compare", "gap", "ida") and \
+            not bool(ds.status.isin(["ok", "completed", "collapsed"]).any()):
         raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
                             f"`pounding info {args.run}` lists the errors")
     _check_plot_dir(args.output)
@@ -328,6 +333,10 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             from pounding.studies.gap import plot_gap
 
             written = plot_gap(ds, out)
+        elif kind == "ida":
+            from pounding.studies.ida import plot_ida
+
+            written = plot_ida(ds, out)
         else:
             from pounding.studies.verify import plot_verification
 

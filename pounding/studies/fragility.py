@@ -25,7 +25,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import ndtr, ndtri
+from scipy.special import log_ndtr, ndtr, ndtri
 
 from pounding.errors import PoundingError
 
@@ -119,7 +119,22 @@ def fit_stripes(intensity: np.ndarray, n_records: np.ndarray, n_exceed: np.ndarr
         weight = n * density * density / (p * (1 - p))
         score = design.T @ (density * (z - n * p) / (p * (1 - p)))
         information = design.T @ (design * weight[:, None])
-        step = np.linalg.solve(information, score)
+        try:
+            step = np.linalg.solve(information, score)
+        except np.linalg.LinAlgError:   # the weights underflowed: the data pin no finite (theta, beta)
+            raise PoundingError("fragility fit: the stripes do not define a lognormal fragility (the likelihood "
+                                "is flat or the fit runs off to beta -> 0 or infinity); add stripes") from None
+        if not np.all(np.isfinite(step)):
+            raise PoundingError("fragility fit: the stripes do not define a lognormal fragility (the likelihood "
+                                "is flat or the fit runs off to beta -> 0 or infinity); add stripes")
+        # Damped: halve the step until the likelihood does not fall (a full step from a poor start can
+        # overshoot into the tails, where the weights underflow).
+        before = _log_likelihood(design @ params, n, z)
+        for _ in range(60):
+            trial = params + step
+            if _log_likelihood(design @ trial, n, z) >= before - 1e-12 * (1 + abs(before)):
+                break
+            step = 0.5 * step
         params = params + step
         if np.max(np.abs(step)) < tolerance * (1 + np.max(np.abs(params))):
             break
@@ -129,6 +144,12 @@ def fit_stripes(intensity: np.ndarray, n_records: np.ndarray, n_exceed: np.ndarr
     if not b > 0:
         raise PoundingError("fragility fit: the exceedances do not increase with intensity (slope <= 0)")
     return Fragility(theta=float(math.exp(-a / b)), beta=float(1.0 / b), method="mle-stripes")
+
+
+def _log_likelihood(eta: np.ndarray, n: np.ndarray, z: np.ndarray) -> float:
+    """Σ z ln Φ(η) + (n − z) ln Φ(−η), computed in the tails without underflow."""
+    value = float(np.sum(z * log_ndtr(eta) + (n - z) * log_ndtr(-eta)))
+    return value if math.isfinite(value) else -math.inf
 
 
 def fit_intensities(intensities: np.ndarray) -> Fragility:

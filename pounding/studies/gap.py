@@ -260,7 +260,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "required": found["required"].tolist(),
             "peak_left": found["peak_left"].tolist(),
             "peak_right": found["peak_right"].tolist(),
-            "scale_factor": float(ds.attrs.get("scale_factor", 1.0)),
+            "scale_factor": float(ds.attrs.get("record_scale", 1.0)),
             "solver_wall_time": float(ds.attrs["wall_time"]),
         })
     except Exception as exc:  # noqa: BLE001 - a failing record is a result, not a crash

@@ -105,14 +105,20 @@ def check_part(part: Any, key: str) -> str | None:
         return None if isinstance(part.get("error"), str) and part["error"] else "status error without a message"
     if status != "ok":
         return f"status {status!r}"
-    if part.get("study") is not None:   # another study's runner (pounding gap): one contact list length, finite
-        lists = {name: values for name, values in part.items() if isinstance(values, list)}
-        if not lists or len({len(values) for values in lists.values()}) > 1:
-            return "its lists are missing or differ in length"
-        for name, values in lists.items():
-            if any(isinstance(v, float) and not math.isfinite(v) for v in values):
-                return f"'{name}' holds a value that is not finite"
-        return None
+    if part.get("study") is not None:
+        # another study's runner (pounding gap, pounding ida): its lists, at the top and in each group (a
+        # mapping of lists such as "storeys"), have one length per group; numbers are finite (None: no value)
+        groups = [("", part)] + [(f"{name}.", group) for name, group in part.items() if isinstance(group, dict)]
+        found = False
+        for prefix, group in groups:
+            lists = {name: values for name, values in group.items() if isinstance(values, list)}
+            found = found or bool(lists)
+            if len({len(values) for values in lists.values()}) > 1:
+                return f"its {prefix.rstrip('.') or 'top-level'} lists differ in length"
+            for name, values in lists.items():
+                if any(isinstance(v, float) and not math.isfinite(v) for v in values):
+                    return f"'{prefix}{name}' holds a value that is not finite"
+        return None if found else "its lists are missing"
     for group, names in _GROUPS.items():
         lengths = {}
         for name in names:
