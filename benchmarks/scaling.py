@@ -1,7 +1,12 @@
 """Cost of our solver against building height and record duration, and peak memory.
 
-    python benchmarks/scaling.py                 # tables, plot docs/scaling.png, memory run (~1 min)
-    python benchmarks/scaling.py --no-memory --plot ''
+    python benchmarks/scaling.py                 # tables, plot and JSON in the cache folder, memory run (~1 min)
+    python benchmarks/scaling.py --no-memory --no-plot
+    python benchmarks/scaling.py --update-docs   # also rewrite docs/scaling.png
+
+Files go to ``--out DIR`` (default ``<user cache>/pounding/benchmarks/scaling``:
+``scaling.png``, ``scaling.json``), never into the checkout unless
+``--update-docs`` is given (see ``benchmarks/_output.py``).
 
 Models: a pair of uniform shear buildings of n storeys each (A: 2.5e5 kg,
 3.5e8 N/m; B: 2.0e5 kg, 4.5e8 N/m; 3.2 m storeys; 5 % Rayleigh at modes 1
@@ -28,6 +33,7 @@ kh 1e10, e 0.65, Ye's ξ), so the number of contacts grows with n as well.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import statistics
@@ -43,9 +49,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
-from pounding.records.record import Record
-from pounding.records.load import load_record# noqa: E402
-from pounding.model.model import model_from_text# noqa: E402
+from pounding.records.record import Record  # noqa: E402
+from pounding.records.load import load_record  # noqa: E402
+from pounding.model.model import model_from_text  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _output import add_output_arguments, out_dir  # noqa: E402
+
+DOCS_FIGURE = ROOT / "docs" / "scaling.png"
 
 STOREYS = [5, 10, 20, 50, 100]
 DURATIONS = [10.0, 20.0, 30.0, 60.0, 90.0, 120.0]
@@ -196,19 +207,28 @@ def plot(storeys: list[dict], durations: list[dict], path: str) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5, help="runs per point (median)")
-    parser.add_argument("--plot", default=str(ROOT / "docs" / "scaling.png"), help="PNG to write ('' for none)")
+    parser.add_argument("--no-plot", action="store_true", help="draw no figure")
     parser.add_argument("--no-memory", action="store_true", help="skip the /usr/bin/time memory run")
+    add_output_arguments(parser, "scaling", owns=("docs/scaling.png",))
     args = parser.parse_args(argv)
+    if args.update_docs and args.no_plot:
+        parser.error("--update-docs rewrites docs/scaling.png: leave out --no-plot")
+    out = out_dir(args, "scaling")
     started = time.perf_counter()
     pounding.simulate(model_from_text(pair_yaml(5)), duration=1.0)
     print(f"pounding {pounding.__version__}; first simulate() (imports, cache load/compile, record): "
           f"{time.perf_counter() - started:.2f} s, excluded")
     storeys = by_storeys(args.repeat)
     durations = by_duration(args.repeat)
-    if args.plot:
-        plot(storeys, durations, args.plot)
+    result = {"storeys": storeys, "durations": durations}
+    if not args.no_plot:
+        plot(storeys, durations, str(out / "scaling.png"))
+        if args.update_docs:
+            plot(storeys, durations, str(DOCS_FIGURE))
     if not args.no_memory:
-        memory()
+        result["memory"] = memory()
+    (out / "scaling.json").write_text(json.dumps(result, indent=1))
+    print(f"wrote {out / 'scaling.json'}")
     return 0
 
 

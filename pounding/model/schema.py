@@ -40,7 +40,7 @@ registry (hysteresis models) gets its union the same way.
 from __future__ import annotations
 
 import math
-from pathlib import PurePath
+from pathlib import Path, PurePath
 from typing import Annotated, Any, Callable, ClassVar, Union
 
 import numpy as np
@@ -698,7 +698,7 @@ class GroundMotionEntry(_Schema):
         None, description="g, m/s2 or cm/s2 (gal)")
 
     @model_validator(mode="after")
-    def _record_fits(self) -> GroundMotionEntry:
+    def _record_fits(self, info: ValidationInfo) -> GroundMotionEntry:
         from pounding.records.catalogue import get_entry, is_catalogue_reference, is_catalogued
         from pounding.errors import RecordError
 
@@ -724,10 +724,31 @@ class GroundMotionEntry(_Schema):
         if PurePath(record).suffix.lower() == ".at2":
             if self.units not in (None, "g"):
                 raise problem("must be g for a PEER .AT2 record (AT2 files are in g)", at=("units",))
-        elif self.units is None:
-            raise problem(f"the plain-text record '{record}' needs ground_motion.units (g, m/s2, cm/s2 or gal)",
-                          kind="error", at=("record",))
+        elif self.units is None and _header_lacks_units(record, info.context):
+            raise problem(f"the plain-text record '{record}' needs ground_motion.units (g, m/s2, cm/s2 or gal), "
+                          "or a first line '# units: g; dt = 0.005 s' in the file", kind="error", at=("record",))
         return self
+
+
+def _header_lacks_units(record: str, context: Any) -> bool:
+    """True unless the text record file declares its units in a ``# units: g`` header.
+
+    A relative path is resolved against ``context["base_dir"]`` (the model
+    file's folder; ``None``: the current directory), as the record will be
+    read.  Without a context (a model rebuilt from data already checked, e.g.
+    ``Model.with_xi``), a relative path cannot be resolved and is left for
+    the reader, whose error names the file and the fix.  A malformed header
+    is left for the reader too: it reports the line.
+    """
+    from pounding.records.readers import header_declares_units
+
+    path = Path(record).expanduser()
+    if not path.is_absolute():
+        if not isinstance(context, dict) or "base_dir" not in context:
+            return False
+        if context["base_dir"] is not None:
+            path = Path(context["base_dir"]) / path
+    return header_declares_units(path) is False
 
 
 class SolverEntry(_Schema):
@@ -974,10 +995,15 @@ def _range_text(metadata: list, error: dict) -> str:
 # --------------------------------------------------------------------------- #
 
 
-def validate(cls: type[BaseModel], data: Any, source: Document, root: Location = ()) -> Any:
-    """``cls.model_validate(data)``, its first problem raised as one :class:`ModelError` line."""
+def validate(cls: type[BaseModel], data: Any, source: Document, root: Location = (),
+             context: dict[str, Any] | None = None) -> Any:
+    """``cls.model_validate(data)``, its first problem raised as one :class:`ModelError` line.
+
+    *context* reaches the validators (``base_dir``: the folder a relative
+    record path is relative to; see :func:`parse`).
+    """
     try:
-        return cls.model_validate(data)
+        return cls.model_validate(data, context=context)
     except ValidationError as exc:
         raise translate(exc, cls, source, root) from None
 
@@ -987,8 +1013,12 @@ def validate_mapping(doc: Document, cls: type[BaseModel], loc: Location, data: A
     return validate(cls, data, doc, loc)
 
 
-def parse(text: str, label: str) -> tuple[ModelEntry, Document]:
+def parse(text: str, label: str, base_dir: str | None = None) -> tuple[ModelEntry, Document]:
     """Read and validate model text completely (one pass).
+
+    *base_dir* is the folder a relative record path is relative to (the
+    model file's; ``None``: the current directory): a text record without
+    ``units`` must declare them in its header there.
 
     Raises
     ------
@@ -996,5 +1026,5 @@ def parse(text: str, label: str) -> tuple[ModelEntry, Document]:
         The first problem as one line ``<label>:<line>: <location> <problem>``.
     """
     doc = parse_document(text, label)
-    return validate(ModelEntry, doc.data, doc), doc
+    return validate(ModelEntry, doc.data, doc, context={"base_dir": base_dir}), doc
 

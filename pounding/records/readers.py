@@ -17,7 +17,8 @@ from pounding.errors import RecordError
 from pounding.records.record import DT_RTOL, Record, check_time_step, normalise_units, positive_value
 from pounding.units import FORTRAN_NUMBER, STANDARD_GRAVITY, UNITS, canonical_unit
 
-__all__ = ["read_at2", "read_text", "check_agrees", "text_header", "declared_in_header", "FIXES"]
+__all__ = ["read_at2", "read_text", "check_agrees", "text_header", "declared_in_header", "header_declares_units",
+           "FIXES"]
 
 #: How to give a text record's units and time step, by where the record was named:
 #: in a model YAML (``yaml``), on the command line (``cli``) or to the Python API (``api``).
@@ -298,10 +299,35 @@ def declared_in_header(path: str | Path) -> dict[str, Any]:
     Errors in the file are left for :func:`read_text` to report.
     """
     try:
-        lines = Path(path).read_bytes().decode("latin-1").splitlines()[:50]
-        return {k: v for k, v in text_header(lines, Path(path)).items() if k != "line"}
+        return {k: v for k, v in text_header(_first_lines(path), Path(path)).items() if k != "line"}
     except (OSError, RecordError):
         return {}
+
+
+def header_declares_units(path: str | Path) -> bool | None:
+    """Whether a text record file declares its units in a ``# units: g`` header line.
+
+    ``True`` if it does, ``False`` if the file has no such line or cannot be
+    read, ``None`` if the header is malformed (unknown units, bad dt): that
+    error is for :func:`read_text` to report, with its line.
+    """
+    try:
+        return "units" in text_header(_first_lines(path), Path(path))
+    except OSError:
+        return False
+    except RecordError:
+        return None
+
+
+def _first_lines(path: str | Path, count: int = 50) -> list[str]:
+    """The first *count* lines of a file (a header is short; the samples after it need not be read)."""
+    lines = []
+    with open(path, "rb") as handle:
+        for raw in handle:
+            lines.append(raw.decode("latin-1").rstrip("\r\n"))
+            if len(lines) >= count:
+                break
+    return lines
 
 
 def read_text(path: str | Path, *, dt: float | None = None, units: str | None = None,

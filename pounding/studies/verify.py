@@ -607,12 +607,58 @@ def _production_variables(dims: tuple, prod: dict, scipy_e_post: np.ndarray) -> 
 # --------------------------------------------------------------------------- #
 
 
+#: Colours of the curves of one panel, in drawing order: tab10 without its grey (the
+#: identity line is grey) and black (the ``exact`` reference), then navy and maroon, so
+#: that the ten ξ formulas besides ``exact`` each get their own colour.
+PLOT_COLORS: tuple[str, ...] = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                                "#bcbd22", "#17becf", "#000080", "#800000")
+PLOT_MARKERS: tuple[str, ...] = ("o", "s", "^", "v", "D", "P", "X", "<", ">", "*", "h")
+#: Two curves closer than this everywhere (in e_post, on a 0..1 axis about 5 inches
+#: tall: ~1 % of it, the width of a drawn line and its markers) cannot be told apart
+#: on the figure: one hides the other, and the figure says so.
+COINCIDE_TOLERANCE = 0.01
+IDENTITY = "identity line"
+
+
+def coinciding_curves(curves: dict[str, np.ndarray], tolerance: float = COINCIDE_TOLERANCE) -> list[list[str]]:
+    """Groups of curves that lie within *tolerance* of one another at every point.
+
+    *curves* maps a label to its values on a common abscissa, in drawing
+    order; groups are the connected components of "everywhere within
+    *tolerance*" (non-finite points are ignored; a curve with none finite
+    joins nothing).  Only groups of two or more are returned, each in
+    drawing order.
+    """
+    names = list(curves)
+    parent = {n: n for n in names}
+
+    def root(n: str) -> str:
+        while parent[n] != n:
+            n = parent[n]
+        return n
+
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            ya, yb = np.asarray(curves[a], float), np.asarray(curves[b], float)
+            ok = np.isfinite(ya) & np.isfinite(yb)
+            if ok.any() and np.max(np.abs(ya[ok] - yb[ok])) <= tolerance:
+                parent[root(b)] = root(a)
+    groups: dict[str, list[str]] = {}
+    for n in names:
+        groups.setdefault(root(n), []).append(n)
+    return [g for g in groups.values() if len(g) > 1]
+
+
 def plot_verification(ds: xr.Dataset, path) -> str:
     """e_post vs e_pre for every model (two panels), identity line, Table I markers.
 
-    Left: Hertz-damp, one curve per ξ formula (dashed = bounded formula,
-    thick black = ``exact``), with the published Table I points as hollow
-    markers (the LN misprint at e_pre = 1 left out).  Right: the other laws.
+    Left: Hertz-damp, one curve per ξ formula, each in its own colour and
+    marker (dashed = bounded formula, thick black = ``exact``), with the
+    published Table I points as hollow markers (the LN misprint at e_pre = 1
+    left out).  Right: the other laws.  Curves that lie on top of one another
+    (within :data:`COINCIDE_TOLERANCE` everywhere, the identity line
+    included) are named in a note in the panel and in the legend, so none is
+    hidden without a word.
     """
     import matplotlib
 
@@ -625,23 +671,36 @@ def plot_verification(ds: xr.Dataset, path) -> str:
     panels = [(formulas, "Hertz-damp, one curve per ξ formula"), (others, "other contact laws")]
     panels = [p for p in panels if p[0]]
     fig, axes = plt.subplots(1, len(panels), figsize=(6.0 * len(panels), 7.4), squeeze=False)
-    colors = [c for i, c in enumerate(plt.get_cmap("tab10").colors) if i != 7]  # no grey: the identity line is grey
-    markers = ["o", "s", "^", "v", "D", "P", "X", "<", ">", "*"]
     e = ds.e_pre.values
     show_markers = e.size <= 12
     for ax, (group, title) in zip(axes[0], panels):
+        curves = {IDENTITY: e.astype(float)}
+        curves.update({key: ds.e_post.sel(model=key).values for key in group})
+        together = coinciding_curves(curves)
+        shared = {name: [other for other in g if other != name] for g in together for name in g}
         ax.plot([0, 1], [0, 1], ":", color="0.5", lw=1.2, zorder=0, label="identity, e_post = e_pre")
         n = 0
         for key in group:
-            y = ds.e_post.sel(model=key).values
+            y = curves[key]
+            if key not in shared:
+                note = ""
+            elif IDENTITY in shared[key]:
+                note = " (on the identity line)"
+            else:
+                note = f" (= {', '.join(shared[key])})"
             if key == "exact":
-                ax.plot(e, y, "-", color="k", lw=2.6, zorder=3, label="exact (reference)")
+                ax.plot(e, y, "-", color="k", lw=2.6, zorder=3, label="exact (reference)" + note)
                 continue
             bounded = key in xi_formulas.FORMULAS and xi_formulas.FORMULAS[key].bounded
             style = "--" if bounded else ("-" if group is formulas else ["-", "--", ":", "-."][n % 4])
-            ax.plot(e, y, style, color=colors[n % len(colors)], lw=1.5, ms=4,
-                    marker=markers[n % len(markers)] if show_markers else None,
-                    label=key + (" (bounded)" if bounded else ""))
+            # A curve drawn over an earlier one gets hollow markers, so the one under it shows through.
+            under = key in shared and any(other in shared and group.index(other) < group.index(key)
+                                          for other in shared[key] if other != IDENTITY)
+            color = PLOT_COLORS[n % len(PLOT_COLORS)]
+            ax.plot(e, y, style, color=color, lw=1.5, ms=6 if under else 4.5,
+                    marker=PLOT_MARKERS[n % len(PLOT_MARKERS)] if show_markers else None,
+                    mfc="none" if under else color, mew=1.2,
+                    label=key + (" (bounded)" if bounded else "") + note)
             n += 1
         if group is formulas:
             for key, marker in zip(TABLE_I, ("o", "s")):
@@ -653,6 +712,11 @@ def plot_verification(ds: xr.Dataset, path) -> str:
                 if ok.any():
                     ax.plot(e[ok], published[ok], marker, ms=11, mfc="none", mec="k", mew=1.3, ls="none",
                             zorder=4, label=f"Ye et al. (2009) Table I: {key}")
+        if together:
+            lines = [f"On top of one another (within {COINCIDE_TOLERANCE:g} at every e_pre):"]
+            lines += ["• " + " = ".join(g) for g in together]
+            ax.text(0.98, 0.02, "\n".join(lines), transform=ax.transAxes, ha="right", va="bottom", fontsize=7.5,
+                    multialignment="left", bbox={"boxstyle": "round", "fc": "white", "ec": "0.7", "alpha": 0.9}, zorder=6)
         ax.set_xlim(0, 1.02)
         ax.set_ylim(0, 1.02)
         ax.set_aspect("equal")

@@ -1,0 +1,53 @@
+"""The benchmarks write outside the checkout unless asked (issue 13 §4): ``--out DIR``, ``--update-docs``.
+
+Only their command lines are checked here (``--help``, a few seconds); nothing
+is timed by the test suite.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCHMARKS = ROOT / "benchmarks"
+SCRIPTS = sorted(p for p in BENCHMARKS.glob("*.py") if not p.name.startswith("_"))
+#: The documentation files each benchmark may rewrite, with --update-docs only.
+OWNS = {"scaling.py": ["docs/scaling.png"], "vs_opensees.py": [], "sweep_scaling.py": []}
+
+
+def _output_module():
+    spec = importlib.util.spec_from_file_location("bench_output", BENCHMARKS / "_output.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_script_is_listed():
+    assert sorted(p.name for p in SCRIPTS) == sorted(OWNS)
+
+
+def test_default_output_folder_is_outside_the_checkout(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    output = _output_module()
+    for script in OWNS:
+        folder = output.default_out(Path(script).stem).resolve()
+        assert ROOT not in folder.parents and folder != ROOT
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
+def test_help_offers_out_and_update_docs_only_where_docs_are_owned(script):
+    env = dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="200")
+    done = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, env=env,
+                          cwd=ROOT, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "--out DIR" in done.stdout
+    owns = OWNS[script.name]
+    assert ("--update-docs" in done.stdout) == bool(owns)
+    for path in owns:
+        assert path in done.stdout
