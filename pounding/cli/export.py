@@ -45,7 +45,9 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser = sub.add_parser(
         "opensees", help="standalone OpenSeesPy script of a model (the peer for cross-checks)",
         description="Write a standalone OpenSeesPy script of the model: floor masses, zeroLength storey "
-                    "springs with per-building Rayleigh damping, Hertzdamp gap elements (xiNorm = p(e)), "
+                    "springs (Elastic, Steel01 for bilinear, BoucWen for bouc-wen storeys) with per-building "
+                    "Rayleigh damping on the initial stiffness, P-Delta as parallel Elastic(-P/h) springs "
+                    "without damping, Hertzdamp gap elements (xiNorm = p(e)), "
                     "the record as Path/UniformExcitation, Newmark average acceleration + Newton at DT. "
                     "Running it prints the peaks of our results schema as JSON.")
     parser.add_argument("model", help="YAML building model, e.g. models/pair.yaml")

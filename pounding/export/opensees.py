@@ -6,10 +6,24 @@ OpenSeesPy and runs it under the same record:
 
 * one node per floor (its mass) and one fixed ground node per building, all
   on one axis (``model basic -ndm 1 -ndf 1``);
-* each storey a ``zeroLength`` element with an ``Elastic`` material
-  (``k_i``) and ``-doRayleigh 1``; each Rayleigh-damped building gets its own
-  ``a0, a1`` through a ``region`` holding its storey elements and their nodes
-  (the nodes carry ``a0·M``, the elements ``a1·K``);
+* each storey a ``zeroLength`` element with ``-doRayleigh 1`` and the
+  storey's material: ``Elastic`` (``k_i``) for an elastic storey,
+  ``Steel01(F_y, k_i, α, 0, 1, 0, 1)`` (kinematic hardening, no isotropic
+  hardening) for a ``bilinear`` one, ``BoucWen(α, k_i, n, γ/u_yⁿ, β/u_yⁿ, A,
+  0, 0, 0)`` for a ``bouc-wen`` one (OpenSees' z is in length units, z_o =
+  u_y·z, and in its code ``gamma`` is the constant term and ``beta``
+  multiplies sgn(Δε·z): our γ goes to its ``gamma``, our β to its ``beta``;
+  its internal Newton tolerance on z_o is set to 1e-12·u_y);
+* each Rayleigh-damped building gets its own ``a0, a1`` through a ``region``
+  holding its storey elements and their nodes, with ``a1`` on the *initial*
+  stiffness (``-rayleigh a0 0 a1 0``: the nodes carry ``a0·M``, the storeys
+  ``a1·K_init``), as our solver damps on the elastic stiffness; a Bouc–Wen
+  storey with A ≠ 1 (initial tangent (α + (1 − α)A)·k, not k) gets a
+  parallel dashpot ``a1·(1 − α)(1 − A)·k`` that makes up the difference;
+* with ``p_delta: true`` each storey gets a parallel ``zeroLength`` with an
+  ``Elastic(−P_i/h_i)`` material (the leaning column's negative geometric
+  stiffness, P_i = g Σ_(j≥i) m_j) and ``-doRayleigh 0``, outside the
+  Rayleigh region: it adds no damping;
 * a building with modal damping gets its dense damping matrix ``C`` as a
   network of linear dashpots (``zeroLength`` + ``Elastic`` with ``E = 0``,
   ``eta = c``, ``-doRayleigh 0``): ``−C_ij`` between floors i and j and the
@@ -40,7 +54,9 @@ peer converges slowly once impacts start):
 * it never clamps tension: a model with ``tension: clamp`` exports with a
   warning; compare against ``tension: allow`` (:func:`allow_tension`);
 * peaks are read at the committed steps and an impact shorter than one step
-  can be missed.
+  can be missed;
+* the script always runs to the end: it does not stop at
+  ``solver.stop_drift_ratio`` (compare completed runs only).
 
 :func:`run_opensees` runs the generated script in-process and returns the
 peaks (the cross-check tests and the benchmarks use it).
@@ -131,6 +147,40 @@ def _contact_material(law, gap: float) -> tuple[list, list[str]]:
                         "(supported: hertz-damp, hertz, linear)")
 
 
+def _storey_material(law, stiffness: float, height: float) -> list:
+    """OpenSees material arguments (after the tag) of a storey: Elastic, Steel01 or BoucWen."""
+    from pounding.hysteresis import BilinearStorey, BoucWenStorey
+
+    k = float(stiffness)
+    if law is None:
+        return ["Elastic", k]
+    fy = float(law.yield_force_for(k, height))
+    alpha = float(law.post_yield_ratio)
+    if isinstance(law, BilinearStorey):
+        # Steel01 Fy E0 b a1 a2 a3 a4: a1 = a3 = 0 switch isotropic hardening off (kinematic only).
+        return ["Steel01", fy, k, alpha, 0.0, 1.0, 0.0, 1.0]
+    if isinstance(law, BoucWenStorey):
+        # BoucWen alpha ko n gamma beta Ao deltaA deltaNu deltaEta tol maxIter.  OpenSees integrates
+        # z_o = u_y z (m): dz_o/dε = Ao − |z_o|ⁿ (gamma + beta sgn(dε z_o)), so gamma = γ/u_yⁿ (the
+        # constant term) and beta = β/u_yⁿ (the one multiplying the sign); no degradation.
+        uy = fy / k
+        scale = uy ** float(law.n)
+        return ["BoucWen", alpha, k, float(law.n), float(law.gamma) / scale, float(law.beta) / scale,
+                float(law.A), 0.0, 0.0, 0.0, 1.0e-12 * uy, 100]
+    raise PoundingError(f"storey hysteresis '{law.name}' has no OpenSees counterpart in this exporter "
+                        "(supported: bilinear, bouc-wen)")
+
+
+def _initial_tangent(law, stiffness: float) -> float:
+    """The initial tangent OpenSees gives the storey material (what ``-rayleigh a0 0 a1 0`` damps)."""
+    from pounding.hysteresis import BoucWenStorey
+
+    if isinstance(law, BoucWenStorey):
+        alpha = float(law.post_yield_ratio)
+        return (alpha + (1.0 - alpha) * float(law.A)) * float(stiffness)
+    return float(stiffness)
+
+
 def _fmt(x: float) -> str:
     return repr(float(x))
 
@@ -173,9 +223,10 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
     element = 0
     floors = []        # (node, label, mass)
     grounds = []       # node
-    storeys = []       # (element, node below, node, k, label, height)
+    storeys = []       # (element, node below, node, k, label, height, material args)
     buildings = []     # (name, a0, a1, [storey elements], [nodes]) for Rayleigh buildings
     dashpots = []      # (element, node i, node j, c)
+    p_delta = []       # (element, node below, node, -P/h, label)
     floor_node: dict[tuple[int, int], int] = {}
     for b_index, b in enumerate(model.buildings):
         node += 1
@@ -191,12 +242,26 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         for level in range(1, b.n_floors + 1):
             element += 1
             below = ground if level == 1 else floor_node[(b_index, level - 1)]
-            storeys.append((element, below, floor_node[(b_index, level)], float(b.stiffness[level - 1]),
-                            f"{b.name}:{level}", float(b.height[level - 1])))
+            k, h, law = float(b.stiffness[level - 1]), float(b.height[level - 1]), b.hysteresis[level - 1]
+            storeys.append((element, below, floor_node[(b_index, level)], k, f"{b.name}:{level}", h,
+                            _storey_material(law, k, h)))
             elements.append(element)
+        if b.p_delta:
+            for level, kg in enumerate(b.p_delta_stiffness, start=1):
+                element += 1
+                below = ground if level == 1 else floor_node[(b_index, level - 1)]
+                p_delta.append((element, below, floor_node[(b_index, level)], float(kg), f"{b.name}:{level}"))
         if b.damping.kind == "rayleigh":
             a0, a1 = b.rayleigh_coefficients
             buildings.append((b.name, float(a0), float(a1), elements, nodes))
+            for level in range(1, b.n_floors + 1):
+                # Our solver damps a1·k; OpenSees damps a1·(initial tangent): make up any difference.
+                k = float(b.stiffness[level - 1])
+                missing = k - _initial_tangent(b.hysteresis[level - 1], k)
+                if missing != 0.0:
+                    element += 1
+                    below = ground if level == 1 else floor_node[(b_index, level - 1)]
+                    dashpots.append((element, below, floor_node[(b_index, level)], float(a1) * missing))
         else:
             c = np.asarray(b.damping_matrix(), dtype=float)
             n = b.n_floors
@@ -229,6 +294,10 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
     def rows(items) -> str:
         return "\n".join(f"    {tuple(item)!r}," for item in items)
 
+    if model.solver.stop_drift_ratio:
+        notes.append(f"solver.stop_drift_ratio {model.solver.stop_drift_ratio:g}: the OpenSees script does not "
+                     "stop at a collapse, it runs to the end (compare completed runs only)")
+
     summary = "\n".join("#   " + _inert(line) for line in model.summary_lines())
     note_text = "\n".join("# NOTE: " + _inert(n) for n in notes)
     return _TEMPLATE.format(
@@ -236,7 +305,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         notes=note_text, record_name=_inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
         duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
         floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
-        dashpots=rows(dashpots), contacts=rows(contacts),
+        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta),
     ), notes
 
 
@@ -302,15 +371,20 @@ FLOORS = [
 ]
 # fixed ground node of each building
 GROUNDS = {grounds}
-# (element, node below, node, storey stiffness N/m, storey label, storey height m)
+# (element, node below, node, storey stiffness N/m, storey label, storey height m, material args)
 STOREYS = [
 {storeys}
 ]
-# Rayleigh-damped buildings: (name, a0 1/s, a1 s, storey elements, nodes)
+# P-Delta (leaning column): (element, node below, node, -P/h N/m, storey label), no Rayleigh damping
+P_DELTA = [
+{p_delta}
+]
+# Rayleigh-damped buildings: (name, a0 1/s, a1 s on the initial stiffness, storey elements, nodes)
 RAYLEIGH = [
 {buildings}
 ]
-# dashpots carrying a modal damping matrix: (element, node i, node j, c N s/m)
+# linear dashpots (a modal damping matrix; the Rayleigh part a storey's initial tangent misses):
+# (element, node i, node j, c N s/m)
 DASHPOTS = [
 {dashpots}
 ]
@@ -332,9 +406,12 @@ def build(log_file=None):
     for tag, _label, mass in FLOORS:
         ops.node(tag, 0.0)
         ops.mass(tag, mass)
-    for ele, i, j, k, _label, _h in STOREYS:
-        ops.uniaxialMaterial("Elastic", ele, k)
+    for ele, i, j, _k, _label, _h, material in STOREYS:
+        ops.uniaxialMaterial(material[0], ele, *material[1:])
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 1)
+    for ele, i, j, k, _label in P_DELTA:
+        ops.uniaxialMaterial("Elastic", ele, k)
+        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
     for ele, i, j, c in DASHPOTS:
         ops.uniaxialMaterial("Elastic", ele, 0.0, c)
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
@@ -342,8 +419,9 @@ def build(log_file=None):
         ops.uniaxialMaterial(material[0], ele, *material[1:])
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
     for region, (_name, a0, a1, elements, nodes) in enumerate(RAYLEIGH, start=1):
-        # Each building its own a0 (on its nodes' masses) and a1 (on its storeys' stiffness).
-        ops.region(region, "-ele", *elements, "-rayleigh", a0, a1, 0.0, 0.0)
+        # Each building its own a0 (on its nodes' masses) and a1 (on its storeys' initial stiffness:
+        # alphaM betaK betaKinit betaKcomm, so a yielding storey keeps its elastic damping).
+        ops.region(region, "-ele", *elements, "-rayleigh", a0, 0.0, a1, 0.0)
     ops.timeSeries("Path", 1, "-dt", RECORD_DT, "-values", *RECORD, "-factor", 1.0)
     ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
 
