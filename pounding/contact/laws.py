@@ -52,6 +52,7 @@ __all__ = [
     "Jankowski",
     "Bilinear",
     "StereoMechanical",
+    "Bumper",
     "LAWS",
     "register",
     "law_from_mapping",
@@ -78,6 +79,7 @@ LAW_KELVIN = 3
 LAW_JANKOWSKI = 4
 LAW_BILINEAR = 5
 LAW_STEREO = 6
+LAW_BUMPER = 7
 
 Restitution = Annotated[float, Field(gt=0.0, le=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
@@ -371,6 +373,93 @@ class StereoMechanical(ContactLaw):
 
     def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
         return _pack(self.restitution, _effective_mass(mass_left, mass_right))
+
+
+@register
+class Bumper(ContactLaw):
+    """A rubber or polymer bumper of thickness ``t`` on the contact face, then the hard face.
+
+    While the layer is compressed by less than its limit ``δlim = max_compression·t``
+    the bumper alone acts, as a Hunt–Crossley (Hertz-damp) element of its own::
+
+        F_b = kb·δ^1.5 + ξb·δ^1.5·δ̇,      ξb = p(eb)·kb / max(v0, v_min)
+
+    with ``v0`` the approach velocity at the gap closure.  Once ``δ > δlim`` the
+    layer is spent and the hard contact of the face adds on, the Hertz-damp law
+    of the two structures with its own ξ::
+
+        F_h = kh·(δ − δlim)^1.5 + ξh·(δ − δlim)^1.5·δ̇,   ξh = p(e)·kh / max(v_lim, v_min)
+
+    where ``v_lim = δ̇`` at the located instant the layer is fully compressed
+    (the hard face's own impact velocity); ``F = F_b + F_h``.  ``p`` is the
+    chosen ξ formula (:mod:`pounding.xi`), shared by both parts.  With
+    ``tension: clamp`` (default) each part is clamped at 0 on its own (neither the
+    rubber nor the hard face pulls); ``tension: allow`` keeps both formulas.
+    The engagement of the hard face, its release and every clamp are located
+    as events (:mod:`pounding.solver.kernels`).  ``gap`` is the clear distance
+    to the bumper's surface.
+
+    The structure — the bumper's nonlinear impact law first, the structure-to-
+    structure law added once the rubber is compressed to a limit set by its
+    thickness — follows Polycarpou, Komodromos & Polycarpou (2013); their
+    paper's own equations and parameter values could not be consulted for this
+    implementation, so both parts use the Hunt–Crossley form of the existing
+    ``hertz-damp`` law (Hunt & Crossley 1975; ξ formulas of :mod:`pounding.xi`)
+    with the bumper's own stiffness and restitution, which the user supplies
+    from tests of the rubber.
+
+    References
+    ----------
+    Polycarpou, P.C., Komodromos, P. & Polycarpou, A.C. (2013). A nonlinear
+    impact model for simulating the use of rubber shock absorbers for
+    mitigating the effects of structural pounding during earthquakes.
+    Earthquake Eng. Struct. Dyn. 42, 81-100 (the layered structure).
+    Hunt, K.H. & Crossley, F.R.E. (1975), J. Appl. Mech. 42, 440-445 (both parts).
+    Muthukumar & DesRoches (2006), EESD 35, 811-828 (the hard face, as ``hertz-damp``).
+    """
+
+    name: ClassVar[str] = "bumper"
+    law_id: ClassVar[int] = LAW_BUMPER
+    reference: ClassVar[str] = ("Polycarpou, Komodromos & Polycarpou (2013), EESD 42, 81-100 (layered structure); "
+                                "Hunt & Crossley (1975), J. Appl. Mech. 42, 440-445")
+    dissipative: ClassVar[bool] = True
+
+    law: Literal["bumper"] = "bumper"
+    thickness: Positive = Field(description="thickness t of the rubber layer, m")
+    max_compression: Annotated[float, Field(gt=0.0, le=1.0)] = Field(
+        description="compression at which the layer is spent, as a fraction of its thickness, 0 < r <= 1")
+    bumper_kh: Positive = Field(description="Hertz stiffness of the rubber layer, N/m^1.5")
+    bumper_restitution: Restitution = Field(description="coefficient of restitution of the rubber, 0 < e <= 1")
+    kh: Positive = Field(description="Hertz stiffness of the hard face, N/m^1.5")
+    restitution: Restitution = Field(description="coefficient of restitution of the hard face, 0 < e <= 1")
+    xi: str = Field("exact", description="name of the xi formula (pounding.xi), for both parts")
+    tension: Literal["clamp", "allow"] = "clamp"
+    min_impact_velocity: Positive = Field(MIN_IMPACT_VELOCITY, description="floor on v0 and v_lim, m/s")
+
+    _known_formula = field_validator("xi")(HertzDamp._known_formula.__func__)
+
+    @property
+    def limit(self) -> float:
+        """δlim = max_compression·thickness (m): the penetration where the hard face engages."""
+        return self.max_compression * self.thickness
+
+    @property
+    def p_bumper(self) -> float:
+        """p(eb) of the chosen formula for the rubber."""
+        return xi_formulas.get(self.xi)(self.bumper_restitution)
+
+    @property
+    def p(self) -> float:
+        """p(e) of the chosen formula for the hard face."""
+        return xi_formulas.get(self.xi)(self.restitution)
+
+    def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
+        return _pack(self.bumper_kh, self.p_bumper, self.min_impact_velocity,
+                     1.0 if self.tension == "allow" else 0.0, self.kh, self.p, self.limit)
+
+    def damping_constant(self, v0: float) -> float:
+        """ξb (N·s/m^2.5) of the rubber for an approach velocity *v0* (m/s), with the floor applied."""
+        return self.p_bumper * self.bumper_kh / max(v0, self.min_impact_velocity)
 
 
 def law_from_mapping(fields: dict) -> ContactLaw:

@@ -127,7 +127,8 @@ EVENT_END_TOLERANCE = 1e-9
 #: Retakes of one step to bring a located event to its end before it is accepted as is.
 MAX_RETAKES = 8
 # Kinds of contact events.
-EVENT_NONE, EVENT_CLOSE, EVENT_SEPARATE, EVENT_SWITCH0, EVENT_SWITCH1, EVENT_RELEASE = range(6)
+# Switch events are EVENT_SWITCH0 + which, for which < kernels.N_SWITCHES: they come last.
+EVENT_NONE, EVENT_CLOSE, EVENT_SEPARATE, EVENT_RELEASE, EVENT_SWITCH0 = range(5)
 # Kinds of storey events (bilinear storeys).
 STOREY_NONE, STOREY_YIELD_POSITIVE, STOREY_YIELD_NEGATIVE, STOREY_UNLOAD = range(4)
 
@@ -891,7 +892,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)
             delta = y[lf] - y[rf] - cgap[c]
-            y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, y[iq + c])
+            y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
 

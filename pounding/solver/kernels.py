@@ -17,7 +17,8 @@ from numba.core.dispatcher import Dispatcher
 from pounding.contact import laws
 from pounding.numba_cache import use_writable_cache
 from pounding.solver import jit
-from pounding.contact.laws import LAW_BILINEAR, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_JANKOWSKI, LAW_KELVIN, LAW_LINEAR, LAW_STEREO, MIN_IMPACT_VELOCITY
+from pounding.contact.laws import (LAW_BILINEAR, LAW_BUMPER, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_JANKOWSKI, LAW_KELVIN,
+                                   LAW_LINEAR, LAW_STEREO, MIN_IMPACT_VELOCITY)
 
 
 # --------------------------------------------------------------------------- #
@@ -30,8 +31,8 @@ use_writable_cache(__file__)  # a read-only install caches its kernels in the us
 
 @njit(cache=True)
 def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
-    """Per-impact constant fixed at the located gap closure (ξ for Hertz-damp)."""
-    if law_id == LAW_HERTZ_DAMP:
+    """Per-impact constant fixed at the located gap closure (ξ for Hertz-damp, the rubber's ξb for a bumper)."""
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_BUMPER:
         return prm[1] * prm[0] / max(v0, prm[2])
     return 0.0
 
@@ -56,6 +57,29 @@ def _bilinear_bounds(prm: np.ndarray, delta: float) -> tuple:
     k1, k2, dy = prm[0], prm[1], prm[2]
     upper = k1 * delta if delta <= dy else k1 * dy + k2 * (delta - dy)
     return k2 * delta, upper
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
+def _bumper_force(prm: np.ndarray, xi_bumper: float, delta: float, delta_rate: float, xi_hard: float,
+                  bumper_on: bool, hard_engaged: bool, hard_on: bool) -> float:
+    """Bumper law: rubber ``δ^1.5·(kb + ξb·δ̇)`` plus, when engaged, the hard face on ``δ − δlim``, N.
+
+    With ``tension: clamp`` each part is at least 0; a part that is off (clamped
+    in its mode) contributes nothing.  *xi_hard* is ξh, the law's internal state.
+    """
+    clamp = prm[3] == 0.0
+    f = 0.0
+    if bumper_on:
+        f = delta * math.sqrt(delta) * (prm[0] + xi_bumper * delta_rate)
+        if clamp and f < 0.0:
+            f = 0.0
+    dh = delta - prm[6]
+    if hard_engaged and hard_on and dh > 0.0:
+        fh = dh * math.sqrt(dh) * (prm[4] + xi_hard * delta_rate)
+        if clamp and fh < 0.0:
+            fh = 0.0
+        f += fh
+    return f
 
 
 @njit(cache=True)
@@ -87,6 +111,8 @@ def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
     if law_id == LAW_BILINEAR:
         lower, upper = _bilinear_bounds(prm, delta)
         return min(max(q, lower), upper)
+    if law_id == LAW_BUMPER:
+        return _bumper_force(prm, impact_constant, delta, delta_rate, q, True, delta > prm[6], True)
     return 0.0
 
 
@@ -121,6 +147,12 @@ def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
         d_star = (k1 * delta - f) / (k1 - k2)
         d_star = min(max(d_star, 0.0), delta)
         return 0.5 * (f + k2 * d_star) * (delta - d_star) + 0.5 * k2 * d_star * d_star
+    if law_id == LAW_BUMPER:
+        energy = prm[0] * delta * delta * math.sqrt(delta) / 2.5
+        dh = delta - prm[6]
+        if dh > 0.0:
+            energy += prm[4] * dh * dh * math.sqrt(dh) / 2.5
+        return energy
     return 0.0
 
 
@@ -151,9 +183,14 @@ MODE_YIELD_BOTTOM = 2
 #: Stereo-mechanical persistent (resting) contact: a bilateral constraint δ̈ = 0
 #: whose force the solver computes; it ends where that force would turn tensile.
 MODE_STUCK = 3
+#: Bumper: bit flags (never the value MODE_STUCK): the rubber's clamp holds it at 0 N,
+#: the hard face is engaged (δ > δlim), the hard face's clamp holds it at 0 N.
+BUMPER_CLAMPED = 1
+BUMPER_HARD = 4
+BUMPER_HARD_CLAMPED = 8
 
-#: Number of switch functions per mode the solver evaluates.
-N_SWITCHES = 2
+#: Largest number of switch functions of one mode (the bumper's: hard face, two clamps).
+N_SWITCHES = 3
 
 
 @njit(cache=True)
@@ -177,6 +214,8 @@ def switch_count(law_id: int, prm: np.ndarray) -> int:
         return 1
     if law_id == LAW_BILINEAR:
         return 2
+    if law_id == LAW_BUMPER:
+        return 1 if prm[3] != 0.0 else 3
     return 0
 
 
@@ -212,6 +251,9 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
         return f
     if law_id == LAW_BILINEAR:
         return q
+    if law_id == LAW_BUMPER:
+        return _bumper_force(prm, impact_constant, delta, delta_rate, q, (mode & BUMPER_CLAMPED) == 0,
+                             (mode & BUMPER_HARD) != 0, (mode & BUMPER_HARD_CLAMPED) == 0)
     return force(law_id, prm, impact_constant, delta, delta_rate, q)
 
 
@@ -234,7 +276,9 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
     unclamped force), its negative while clamped (a *reload* is its crossing).
     Kelvin (clamped): ``k·δ + c·δ̇`` likewise.  Jankowski: ``±δ̇``.
     Bilinear: elastic — distance to the top (``K2·δ + (K1 − K2)·δy − q``) and to
-    the bottom (``q − K2·δ``) of the loop; yielding — ``±δ̇``.  Units vary (only
+    the bottom (``q − K2·δ``) of the loop; yielding — ``±δ̇``.  Bumper: 0 — the
+    hard face, ``±(δ − δlim)``; 1 — the rubber's clamp, ``±(kb + ξb·δ̇)``; 2 — the
+    hard face's clamp, ``±(kh + ξh·δ̇)`` (engaged modes only).  Units vary (only
     the sign is used); 1.0 for a switch the mode does not have.
     """
     if law_id == LAW_HERTZ_DAMP and which == 0:
@@ -253,6 +297,16 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
             return q - k2 * delta
         if which == 0:
             return delta_rate if mode == MODE_YIELD_TOP else -delta_rate
+    if law_id == LAW_BUMPER:
+        if which == 0:
+            g = delta - prm[6]
+            return g if (mode & BUMPER_HARD) != 0 else -g
+        if which == 1:
+            g = prm[0] + impact_constant * delta_rate
+            return -g if (mode & BUMPER_CLAMPED) != 0 else g
+        if which == 2 and (mode & BUMPER_HARD) != 0:
+            g = prm[4] + q * delta_rate
+            return -g if (mode & BUMPER_HARD_CLAMPED) != 0 else g
     return 1.0
 
 
@@ -263,12 +317,29 @@ def next_mode(law_id: int, mode: int, which: int) -> int:
         if mode == MODE_ELASTIC:
             return MODE_YIELD_TOP if which == 0 else MODE_YIELD_BOTTOM
         return MODE_ELASTIC
+    if law_id == LAW_BUMPER:
+        if which == 0:
+            return mode & BUMPER_CLAMPED if (mode & BUMPER_HARD) != 0 else mode | BUMPER_HARD
+        if which == 1:
+            return mode ^ BUMPER_CLAMPED
+        return mode ^ BUMPER_HARD_CLAMPED
     return 1 - mode
 
 
 @njit(cache=True)
-def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, q: float) -> float:
-    """Internal state put exactly on the branch *mode* starts on (removes the event's round-off)."""
+def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float, q: float) -> float:
+    """Internal state put exactly on the branch *mode* starts on (removes the event's round-off).
+
+    Bumper: the state is ξh of the hard face, set where the face engages from
+    its approach velocity ``δ̇`` (``p(e)·kh/max(δ̇, v_min)``), kept while engaged
+    (clamp switches) and reset to 0 where it disengages.
+    """
+    if law_id == LAW_BUMPER:
+        if (mode & BUMPER_HARD) == 0:
+            return 0.0
+        if q == 0.0:
+            return prm[5] * prm[4] / max(delta_rate, prm[2])
+        return q
     if law_id == LAW_BILINEAR:
         if mode == MODE_YIELD_TOP:
             return prm[1] * delta + (prm[0] - prm[1]) * prm[2]
@@ -290,12 +361,12 @@ def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: fl
     """Duration estimate (s) of a free impact at approach velocity *v0* (m/s); 0 for instantaneous laws.
 
     Hertz-type laws: ``2.94·δmax/v0`` with ``δmax = (5·m·v0²/(4·kh))^(2/5)``
-    (physics.md §2); linear-type laws: the half period ``π·sqrt(m/k)`` (K1 for
+    (physics.md §2; the rubber's kb for a bumper); linear-type laws: the half period ``π·sqrt(m/k)`` (K1 for
     the bilinear law).  Used only to choose the first step inside a contact.
     """
     v = max(v0, 1e-12)
     m = effective_mass
-    if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI:
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI or law_id == LAW_BUMPER:
         dmax = (1.25 * m * v * v / prm[0]) ** 0.4
         return 2.94 * dmax / v
     if law_id == LAW_LINEAR or law_id == LAW_KELVIN or law_id == LAW_BILINEAR:
