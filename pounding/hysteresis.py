@@ -32,6 +32,8 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from pounding.registry import add_unique
+
 __all__ = ["StoreyHysteresis", "BilinearStorey", "BoucWenStorey", "HYSTERESES", "register",
            "N_HYSTERESIS_PARAMETERS", "MODEL_ELASTIC", "MODEL_BILINEAR", "MODEL_BOUC_WEN"]
 
@@ -97,9 +99,7 @@ HYSTERESES: dict[str, type[StoreyHysteresis]] = {}
 
 def register(cls: type[StoreyHysteresis]) -> type[StoreyHysteresis]:
     """Class decorator: add a model to :data:`HYSTERESES` under ``cls.name`` (a name is taken once)."""
-    if cls.name in HYSTERESES:
-        raise ValueError(f"storey hysteresis '{cls.name}' is already registered")
-    HYSTERESES[cls.name] = cls
+    add_unique(HYSTERESES, cls.name, cls, "storey hysteresis")
     return cls
 
 

@@ -24,7 +24,8 @@ PACKAGE = Path(pounding.__file__).parent
 #: Layers from the bottom up; a module may import from its own layer group's
 #: package or from any lower layer, never from a higher one or a sibling package.
 LAYERS: list[tuple[str, ...]] = [
-    ("pounding", "pounding.errors", "pounding.data", "pounding.units", "pounding.numba_cache"),
+    ("pounding", "pounding.errors", "pounding.data", "pounding.units", "pounding.numba_cache",
+     "pounding.registry"),
     ("pounding.records", "pounding.contact", "pounding.hysteresis"),
     ("pounding.model",),
     ("pounding.solver",),
@@ -162,3 +163,22 @@ def test_the_checks_catch_a_violation(rule, monkeypatch):
     check = test_imports_point_down_the_data_flow if rule == "layers" else test_no_import_cycles
     with pytest.raises(AssertionError):
         check()
+
+
+def test_every_registry_refuses_a_name_taken_twice():
+    # Contact laws, xi formulas, storey hysteresis and separation rules all take entries through
+    # pounding.registry.add_unique: registering an existing name again is refused, not silently replaced.
+    import pytest
+
+    from pounding.contact import laws, xi
+    from pounding.hysteresis import HYSTERESES, register as register_hysteresis
+    from pounding.studies import gap
+
+    with pytest.raises(ValueError, match="contact law 'hertz-damp' is registered twice"):
+        laws.register(laws.LAWS["hertz-damp"])
+    with pytest.raises(ValueError, match="xi formula 'ye' is registered twice"):
+        xi.register("ye", "", "", "", bounded=True)(lambda e: e)
+    with pytest.raises(ValueError, match="storey hysteresis 'bilinear' is registered twice"):
+        register_hysteresis(HYSTERESES["bilinear"])
+    with pytest.raises(ValueError, match="separation rule 'srss' is registered twice"):
+        gap.register_rule(gap.RULES["srss"])

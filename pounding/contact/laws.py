@@ -42,6 +42,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from pounding.contact import xi as xi_formulas
 from pounding.errors import PoundingError, did_you_mean
+from pounding.registry import add_unique
 
 __all__ = [
     "ContactLaw",
@@ -123,8 +124,8 @@ LAWS: dict[str, type[ContactLaw]] = {}
 
 
 def register(cls: type[ContactLaw]) -> type[ContactLaw]:
-    """Class decorator: add a law to :data:`LAWS` under ``cls.name``."""
-    LAWS[cls.name] = cls
+    """Class decorator: add a law to :data:`LAWS` under ``cls.name`` (a name is taken once)."""
+    add_unique(LAWS, cls.name, cls, "contact law")
     return cls
 
 

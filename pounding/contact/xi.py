@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from pounding.errors import PoundingError, did_you_mean
+from pounding.registry import add_unique
 
 __all__ = [
     "XiFormula",
@@ -84,9 +85,9 @@ def register(key: str, expression: str, reference: str, status: str, *, bounded:
     """Decorator: register ``p(e)`` under *key* with its citation."""
 
     def wrap(function: Callable[[float], float]) -> Callable[[float], float]:
-        FORMULAS[key] = XiFormula(key, function, expression, reference, status, bounded)
+        add_unique(FORMULAS, key, XiFormula(key, function, expression, reference, status, bounded), "xi formula")
         for alias in aliases:
-            ALIASES[alias] = key
+            add_unique(ALIASES, alias, key, "xi formula alias")
         return function
 
     return wrap

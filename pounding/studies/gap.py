@@ -48,6 +48,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pounding.errors import PoundingError
+from pounding.registry import add_unique
 
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "open_contacts",
            "required_separations", "run_gap_scenario", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
@@ -92,9 +93,7 @@ RULES: dict[str, SeparationRule] = {}
 
 def register_rule(rule: SeparationRule) -> SeparationRule:
     """Add *rule* to :data:`RULES`; a key registered twice is refused."""
-    if rule.key in RULES:
-        raise ValueError(f"separation rule '{rule.key}' is registered twice")
-    RULES[rule.key] = rule
+    add_unique(RULES, rule.key, rule, "separation rule")
     return rule
 
 
