@@ -263,7 +263,7 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
-         smodel, sprm, sfloor, kpd, smode, shear):
+         smodel, sprm, sidx, kpd, smode, shear):
     """Time derivative of the state; contact forces are written to *forces*.
 
     A closed compliant contact acts through its law in its current mode
@@ -294,7 +294,14 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         else:
             du = y[j]
             dv = y[n + j]
-        restoring = kst[j] * du
+        hi = sidx[j]
+        if hi < 0:
+            restoring = kst[j] * du
+        else:
+            r = y[ih + hi]
+            restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
+            out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
+            out[ih + nh + hi] = restoring * dv
         shear[j] = restoring
         damping = kst[j] * a1[j] * dv
         s = restoring + kpd[j] * du + damping
@@ -302,26 +309,6 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         fbuf[j] += s
         if b >= 0:
             fbuf[b] -= s
-    # Yielding storeys (a separate loop keeps the elastic one above branch-free): replace k·Δ by the
-    # hysteresis law's force and give the hysteretic state and the storey work their rates.
-    for hi in range(nh):
-        j = sfloor[hi]
-        b = below[j]
-        if b >= 0:
-            du = y[j] - y[b]
-            dv = y[n + j] - y[n + b]
-        else:
-            du = y[j]
-            dv = y[n + j]
-        r = y[ih + hi]
-        restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
-        out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
-        out[ih + nh + hi] = restoring * dv
-        change = restoring - shear[j]
-        shear[j] = restoring
-        fbuf[j] += change
-        if b >= 0:
-            fbuf[b] -= change
     for bidx in range(dsize.size):
         m = dsize[bidx]
         if m == 0:
@@ -812,7 +799,7 @@ def _plastic_jump(c, y, n, cl, cr, mass):
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                   cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
-                  impacts, n_imp, open_imp, smodel, sprm, sfloor, kpd, smode, shear):
+                  impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -864,7 +851,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
@@ -1002,7 +989,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     t = 0.0
     seg = zero
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
     # First output sample at t = 0.
     out_time[0] = 0.0
     for j in range(n):
@@ -1051,28 +1038,28 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -1146,7 +1133,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
-                                 fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                                 fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                             if forces[c] < 0.0:
                                 hi = mid
                             else:
@@ -1200,7 +1187,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
-                    impacts, n_imp, open_imp, smodel, sprm, sfloor, kpd, smode, shear)
+                    impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear)
                 n_applied += n_storey
                 if t - window_start > dt_rec:
                     window_start = t
@@ -1211,7 +1198,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if status != 0:
                     break
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -1309,7 +1296,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1343,7 +1330,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
-            smodel, sprm, sfloor, kpd, smode, shear)
+            smodel, sprm, sidx, kpd, smode, shear)
         n_applied += n_storey
         if n_applied > 0:
             if t - window_start > dt_rec:
@@ -1353,7 +1340,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1379,7 +1366,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sfloor, kpd, smode, shear)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             for j in range(n):
