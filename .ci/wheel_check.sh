@@ -50,6 +50,10 @@ pounding run models/pair.yaml --duration 3 -o pair.nc
 test -s pair.nc
 pounding info pair.nc >/dev/null
 
+step "pounding run models/pair_inelastic.yaml (yielding storeys, P-Delta)"
+test -f models/pair_inelastic.yaml -a -f models/pair_bumper.yaml
+pounding run models/pair_inelastic.yaml --duration 3 -o inelastic.nc | grep -q "peak ductility"
+
 step "pounding records list / show"
 pounding records list --set peer
 test "$(pounding records list | tail -n 1)" = "105 records"
