@@ -529,6 +529,7 @@ class _JoinEntry(_Schema):
     #: Law registry of the entry, and what the YAML calls its entries (for messages).
     REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LAWS
     KIND: ClassVar[str] = "contact law"
+    SECTION: ClassVar[str] = "contacts"
     KEYS: ClassVar[tuple[str, ...]] = ContactGeometry.KEYS
 
     between: Any = Field(description="two adjacent building names, left first, e.g. [A, B]")
@@ -577,7 +578,7 @@ class _JoinEntry(_Schema):
         PydanticCustomError
             Located at this entry (*index* in ``contacts``).
         """
-        left, right = _between(index, self.between, buildings)
+        left, right = _between(index, self.between, buildings, self.SECTION)
         self._left, self._right = left, right
         self._pairs = tuple(_levels(index, self, buildings[left], buildings[right]))
 
@@ -598,13 +599,14 @@ class LinkEntry(_JoinEntry):
     WHAT: ClassVar[str] = "a mapping {between, levels, law, ...}"
     REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LINK_LAWS
     KIND: ClassVar[str] = "link law"
+    SECTION: ClassVar[str] = "links"
     KEYS: ClassVar[tuple[str, ...]] = ("between", "levels", "tolerance", "law")
 
     law: Any = Field(description=f"link law: {', '.join(LINK_LAWS)}")
     parameters: Annotated[LinkUnion | None, BeforeValidator(_parameters_of(LINK_LAWS))] = None  # type: ignore[valid-type]
 
 
-def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[int, int]:
+def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
     at: Location = (index, "between")
     if isinstance(value, tuple):
         value = list(value)
@@ -631,7 +633,7 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[in
         raise problem(f"{b} stands left of {a} (buildings are listed left to right); write between: [{b}, {a}]",
                       kind="error", at=at)
     if abs(left - right) != 1:
-        raise problem(f"{a} and {b} are not adjacent; contacts join neighbours in the row: {neighbours}",
+        raise problem(f"{a} and {b} are not adjacent; {what} join neighbours in the row: {neighbours}",
                       kind="error", at=at)
     return left, right
 
