@@ -568,6 +568,38 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _peak_magnitude(values) -> float:
+    """Largest |value| of equally spaced samples, refined by a parabola through the largest and its neighbours.
+
+    For a link's force over a step (it pulls as well as pushes): the samples
+    of :func:`_closed_contact_samples`.  A largest sample at either end of
+    the step uses the parabola through the three samples at that end, and its
+    vertex is accepted up to half a sample spacing beyond the step (a peak
+    that falls between two steps' end samples is found by one of them).
+    """
+    best = 0.0
+    best_i = 0
+    m = values.size
+    for i in range(m):
+        if abs(values[i]) > best:
+            best = abs(values[i])
+            best_i = i
+    if m < 3:
+        return best
+    centre = min(max(best_i, 1), m - 2)
+    fm, f0, fp = abs(values[centre - 1]), abs(values[centre]), abs(values[centre + 1])
+    denom = fm - 2.0 * f0 + fp
+    if denom < 0.0:
+        offset = 0.5 * (fm - fp) / denom
+        where = centre + offset
+        if -0.5 <= where <= m - 0.5:
+            top = f0 - 0.25 * (fm - fp) * offset
+            if top > best:
+                best = top
+    return best
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
@@ -1268,9 +1300,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                         y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
                                         y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_used, fractions, deltas,
                                         values)
-                for i in range(FORCE_SAMPLES + 1):
-                    if abs(values[i]) > peak_force[c]:
-                        peak_force[c] = abs(values[i])
+                fpk = _peak_magnitude(values)
+                if fpk > peak_force[c]:
+                    peak_force[c] = fpk
             elif closed[c] and cmode[c] == kernels.MODE_STUCK:
                 fpk = forces_end[c]
                 if fpk > peak_force[c]:
