@@ -7,7 +7,7 @@ right floor right, like a contact's) depends on the relative displacement
 well as pushes. One pydantic class per element, registered by name in
 :data:`LINK_LAWS` (the style of :mod:`pounding.contact.laws`); the compiled
 force, internal rate and stored energy are branches of
-:mod:`pounding.solver.kernels` (docs/physics.md §8).
+:mod:`pounding.solver.kernels` (docs/physics.md §9).
 
 Contract of a link law
 ----------------------
@@ -114,7 +114,7 @@ class MaxwellLink(LinkLaw):
 
     Its force q is the internal state: ``q̇ = k·(δ̇ − q/c)``, ``F = q``; the
     relaxation time is c/k. The standard model of a fluid viscous damper with
-    brace flexibility (OpenSees ``Maxwell`` material with exponent 1).
+    brace flexibility (OpenSees ``ViscousDamper`` with exponent 1).
 
     Reference: Constantinou, M.C. & Symans, M.D. (1993). Experimental study of
     seismic response of buildings with supplemental fluid dampers. Struct.

@@ -344,7 +344,7 @@ class GapElement:
 class Link:
     """A permanent link (damper) between floor ``level_left`` of building ``left``
     and floor ``level_right`` of building ``right = left + 1``: always engaged,
-    no gap, pulls as well as pushes (docs/physics.md §8).
+    no gap, pulls as well as pushes (docs/physics.md §9).
 
     Attributes
     ----------
