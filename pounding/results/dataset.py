@@ -41,10 +41,10 @@ import xarray as xr
 
 from pounding import __version__
 from pounding.contact import laws as contact_laws
+from pounding.contact import links as contact_links
 from pounding.records.record import Record
 from pounding.model.model import Model
 from pounding.solver.integrator import RawSolution, System
-from pounding.solver.kernels import potential
 from pounding.solver.storeys import recoverable_energy
 
 __all__ = ["to_dataset", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
@@ -111,7 +111,11 @@ def _storey_drift(u: np.ndarray, below: np.ndarray) -> np.ndarray:
 
 
 def _link_results(system: System, raw: RawSolution, ng: int) -> dict[str, np.ndarray]:
-    """Per link (the elements after the *ng* contacts): deformation, work and stored energy histories."""
+    """Per link (the elements after the *ng* contacts): deformation, work and stored energy histories.
+
+    Stored energy (docs/physics.md §9): ½kδ² in a Kelvin spring, q²/(2k) in a Maxwell spring, none
+    in a dashpot (the solver's ``kernels.potential`` of the same elements, vectorised here).
+    """
     n = system.n_floors
     nc = system.n_contacts
     u = raw.state[:, :n]
@@ -119,10 +123,13 @@ def _link_results(system: System, raw: RawSolution, ng: int) -> dict[str, np.nda
     deformation = np.take(u, left, axis=1) - np.take(u, right, axis=1)
     work = raw.state[:, 2 * n + nc + ng:2 * n + 2 * nc]
     internal = raw.state[:, 2 * n + 2 * nc + ng:2 * n + 3 * nc]
+    law = system.contact_law[ng:]
+    stiffness = system.contact_parameters[ng:, 0]
     stored = np.zeros_like(deformation)
-    for k in range(nc - ng):
-        law, prm = int(system.contact_law[ng + k]), system.contact_parameters[ng + k]
-        stored[:, k] = [potential(law, prm, float(d), float(q)) for d, q in zip(deformation[:, k], internal[:, k])]
+    kelvin = law == contact_links.LINK_KELVIN
+    maxwell = law == contact_links.LINK_MAXWELL
+    stored[:, kelvin] = 0.5 * stiffness[kelvin] * deformation[:, kelvin] ** 2
+    stored[:, maxwell] = 0.5 * internal[:, maxwell] ** 2 / stiffness[maxwell]
     return {"deformation": deformation, "work": work, "stored": stored}
 
 

@@ -155,7 +155,7 @@ def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float,
     return 0.0
 
 
-@njit(cache=True)  # with a Python wrapper: the results read the links' stored energy with it
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
 def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
     """Elastic energy stored in the contact (J): what unloading would give back.
 
