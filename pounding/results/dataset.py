@@ -331,6 +331,13 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "storey_hysteretic_energy": _var(("storey",), inelastic["dissipated"], "J",
                                          "energy dissipated by the storey's hysteresis over the run"),
     }
+    if not model.links:
+        # A model without links has no link dimension and no link variables (archives as before links).
+        for name in ("link", "link_law"):
+            del coords[name]
+        for name in ("energy_link_dissipated", "energy_link_strain", "link_force", "link_deformation",
+                     "peak_link_force", "link_dissipated_energy"):
+            del variables[name]
     ds = xr.Dataset(variables, coords=coords)
     # The ragged dims get their times and contact labels as coordinates, so that
     # ds.trace_force.plot(x="trace_time") and groupby("trace_contact_label") work.
