@@ -429,6 +429,10 @@ def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward
     f0 = sign * d0 - threshold
     if f0 > 0.0 and sign * r0 > 0.0:
         return 0.0
+    # ±δ stays below max(±d0, ±d1) + (4/27)·h·(|r0| + |r1|) on the step (the Hermite basis
+    # functions' bounds): a step that cannot reach the far side needs no search (most steps).
+    if max(sign * d0, sign * d1) + 0.25 * h * (abs(r0) + abs(r1)) <= threshold:
+        return -1.0
     # Stationary points of the cubic (roots of its derivative, a quadratic in s).
     qa = 6.0 * d0 + 3.0 * h * r0 - 6.0 * d1 + 3.0 * h * r1
     qb = -6.0 * d0 - 4.0 * h * r0 + 6.0 * d1 - 2.0 * h * r1
