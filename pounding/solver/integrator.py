@@ -39,9 +39,16 @@ Design
   stiffness per storey.  A run stops, located, when a storey's drift ratio
   first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED).
 
-State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh)]``
+State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]``
 (``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force; ``r``: each
-yielding storey's hysteretic state; ``W``: its work ∫F dΔ, J).
+yielding storey's hysteretic state; ``W``: its work ∫F dΔ, J; ``W_g``: the work ∫F·(u̇_g,L − u̇_g,R) dt
+of the contact forces on the differential ground motion, J, 0 with one common ground).
+
+* **Multiple supports.** Each building may stand on its own ground motion (a row of the
+  ground-acceleration array; a different record, or the same one lagged by wave passage).
+  Floors move relative to their own ground; contacts see total displacements, so the
+  differential ground displacement and velocity enter δ and δ̇ (:func:`_ground_offset`),
+  integrated exactly from the piecewise-linear accelerations.
 
 References
 ----------
@@ -157,6 +164,11 @@ class System:
     p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
     storey_height : (N,) m
     stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
+    floor_ground : (N,) int, row of the ground-acceleration array that moves each floor's building
+        (all 0 with one common ground motion)
+    contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
+        side of each gap element: their differential displacement enters the penetration
+        (:func:`ground_rows`, ``pounding.simulation.assemble``)
     """
 
     mass: np.ndarray
@@ -179,6 +191,9 @@ class System:
     p_delta_stiffness: np.ndarray | None = None
     storey_height: np.ndarray | None = None
     stop_drift_ratio: float = 0.0
+    floor_ground: np.ndarray | None = None
+    contact_ground_left: np.ndarray | None = None
+    contact_ground_right: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # Storey fields left out: linear elastic storeys of unit height, no P-Delta, no collapse check.
@@ -186,7 +201,10 @@ class System:
         defaults = {"storey_model": np.zeros(n, dtype=np.int64),
                     "storey_parameters": np.zeros((n, hysteresis.N_HYSTERESIS_PARAMETERS)),
                     "storey_state": np.full(n, -1, dtype=np.int64),
-                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n)}
+                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n),
+                    "floor_ground": np.zeros(n, dtype=np.int64),
+                    "contact_ground_left": np.zeros(self.contact_gap.size, dtype=np.int64),
+                    "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64)}
         for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)
@@ -206,8 +224,8 @@ class System:
 
     @property
     def n_states(self) -> int:
-        """Length of the state vector."""
-        return 2 * self.n_floors + 3 * self.n_contacts + 2 + 2 * self.n_hysteretic
+        """Length of the state vector (the last state: work of the differential ground motion on the contacts)."""
+        return 2 * self.n_floors + 3 * self.n_contacts + 2 + 2 * self.n_hysteretic + 1
 
 
 @dataclass(frozen=True)
@@ -218,7 +236,7 @@ class RawSolution:
     state: np.ndarray                # (nt, S) interpolated state at output times
     acceleration: np.ndarray         # (nt, N) relative floor acceleration, m/s²
     contact_force: np.ndarray        # (nt, nc) N
-    ground_acceleration: np.ndarray  # (nt,) m/s²
+    ground_acceleration: np.ndarray  # (nt,) m/s², ground row 0 (the common ground with one record)
     contact_potential: np.ndarray    # (nt,) J, elastic energy stored in all contacts
     peak_displacement: np.ndarray    # (N,) m
     peak_drift: np.ndarray           # (N,) m, storey under each floor
@@ -244,7 +262,7 @@ class RawSolution:
     n_rejected: int
     status: int
     final_time: float
-
+    support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row
 
 # --------------------------------------------------------------------------- #
 # Right-hand side
@@ -261,7 +279,43 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+def _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow):
+    """Ground acceleration, velocity and displacement of every support at time *t* into *gnow* (3, G).
+
+    ``gnow[0, g]`` is the piecewise-linear acceleration (m/s²) of ground *g*,
+    computed exactly as :func:`_ground`; when *differential* (more than one
+    ground), ``gnow[1, g]`` and ``gnow[2, g]`` are its velocity (m/s) and
+    displacement (m), the exact integrals from rest of that acceleration
+    (piecewise quadratic and cubic; *vg*, *ug* hold their values at the
+    samples).  Otherwise they stay 0: one common ground moves both sides of
+    every contact alike and drops out of the contact kinematics.
+    """
+    for g in range(ag.shape[0]):
+        row = ag[g]
+        gnow[0, g] = _ground(row, dt_rec, seg, t)
+        if differential:
+            k = min(seg, row.size - 1)
+            tau = t - k * dt_rec
+            a0 = row[k]
+            slope = (row[k + 1] - a0) / dt_rec if k + 1 < row.size else 0.0
+            gnow[1, g] = vg[g, k] + a0 * tau + 0.5 * slope * tau * tau
+            gnow[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _ground_offset(gnow, cgl, cgr, c, row):
+    """Differential ground motion of contact *c*: ground of its left side minus ground of its right side.
+
+    *row* 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²).  This
+    is the one place where the supports' motion enters the contact
+    kinematics: the penetration is ``δ = u_L − u_R + (u_g,L − u_g,R) − gap``
+    with ``u`` relative to each floor's own ground (0 with one common ground).
+    """
+    return gnow[row, cgl[c]] - gnow[row, cgr[c]]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
          smodel, sprm, sidx, kpd, smode, shear):
     """Time derivative of the state; contact forces are written to *forces*.
@@ -330,8 +384,8 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_stuck += 1
                 forces[c] = 0.0
                 continue
-            delta = y[cl[c]] - y[cr[c]] - cgap[c]
-            rate = y[n + cl[c]] - y[n + cr[c]]
+            delta = y[cl[c]] - y[cr[c]] + _ground_offset(gnow, cgl, cgr, c, 2) - cgap[c]
+            rate = y[n + cl[c]] - y[n + cr[c]] + _ground_offset(gnow, cgl, cgr, c, 1)
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
@@ -339,7 +393,8 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         fbuf[cl[c]] += f
         fbuf[cr[c]] -= f
     if n_stuck > 0:
-        # Constraint forces of stuck contacts: make δ̈ = 0 (a_g is common to both floors and cancels).
+        # Constraint forces of stuck contacts: make δ̈ = 0 (the total acceleration of a floor is −fbuf/m:
+        # each floor's own ground acceleration cancels).
         for _ in range(100):
             largest = 0.0
             scale = 0.0
@@ -356,17 +411,25 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     scale = max(scale, abs(forces[c]))
             if largest <= 1e-13 * scale:
                 break
+    ground_power = 0.0
     for c in range(nc):
         f = forces[c]
         out[2 * n + c] = f
-        out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
+        if closed[c]:
+            dvg = _ground_offset(gnow, cgl, cgr, c, 1)
+            out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]] + dvg)
+            ground_power += f * dvg
+        else:
+            out[2 * n + nc + c] = 0.0
     e_in_rate = 0.0
     for j in range(n):
+        ag_t = gnow[0, fground[j]]
         out[j] = y[n + j]
         out[n + j] = -fbuf[j] / mass[j] - ag_t
         e_in_rate -= ag_t * mass[j] * y[n + j]
     out[2 * n + 3 * nc] = e_in_rate
     out[2 * n + 3 * nc + 1] = power
+    out[out.size - 1] = ground_power
 
 
 # --------------------------------------------------------------------------- #
@@ -564,12 +627,12 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
+def _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
     total = 0.0
     for c in range(nc):
-        delta = y[cl[c]] - y[cr[c]] - cgap[c]
+        delta = y[cl[c]] - y[cr[c]] + _ground_offset(gnow, cgl, cgr, c, 2) - cgap[c]
         total += kernels.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
     return total
 
@@ -708,25 +771,28 @@ def _grown(table, rows, needed, limit):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
+def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
     The impulse ``J = (1+e)·m_eff·v0`` acts on the two floors (−J on the
     left, +J on the right); the work ``J·(v0 + v0')/2`` it does (the energy
     lost, ½·m_eff·(1−e²)·v0²) and the impulse are added to the contact's
     energy-audit states.  The impact row (room made by the caller) opens and
-    closes at once; returns the new row count.
+    closes at once; returns the new row count.  *dvg* (m/s) is the contact's
+    differential ground velocity: ``v0 = δ̇`` includes it, and the work
+    ``J·dvg`` it does goes to the ground-work state (the last one).
     """
     nc = cl.size
     lf = cl[c]
     rf = cr[c]
-    v0 = y[n + lf] - y[n + rf]
+    v0 = y[n + lf] - y[n + rf] + dvg
     impulse = kernels.jump_impulse(claw[c], cprm[c], v0)
     y[n + lf] -= impulse / mass[lf]
     y[n + rf] += impulse / mass[rf]
-    v_after = y[n + lf] - y[n + rf]
+    v_after = y[n + lf] - y[n + rf] + dvg
     y[2 * n + c] += impulse
     y[2 * n + nc + c] += impulse * 0.5 * (v0 + v_after)
+    y[y.size - 1] += impulse * dvg
     impacts[n_imp, IMP_CONTACT] = c
     impacts[n_imp, IMP_TIME] = t
     impacts[n_imp, IMP_VELOCITY] = v0
@@ -740,7 +806,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass):
+def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass, dvg):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
     Closure fixes the per-impact constant from the approach velocity
@@ -748,11 +814,11 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     row with the separation velocity and the impulse.  The caller makes room
     for one more row first (:func:`_grown`); returns the new row count.
     """
-    rate = y[n + cl[c]] - y[n + cr[c]]
+    rate = y[n + cl[c]] - y[n + cr[c]] + dvg
     nc = closed.size
     if upward:
         if kernels.is_instantaneous(claw[c]):
-            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg)
         closed[c] = True
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = kernels.onset_constant(claw[c], cprm[c], rate)
@@ -778,26 +844,28 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _plastic_jump(c, y, n, cl, cr, mass):
+def _plastic_jump(c, y, n, cl, cr, mass, dvg):
     """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
 
     The impulse and its work (the energy lost, ½·m_eff·v0²) are added to the
-    contact's energy-audit states.
+    contact's energy-audit states, ``J·dvg`` to the ground work (*dvg*: the
+    contact's differential ground velocity, m/s, part of ``v0 = δ̇``).
     """
     nc = cl.size
     lf = cl[c]
     rf = cr[c]
-    v0 = y[n + lf] - y[n + rf]
+    v0 = y[n + lf] - y[n + rf] + dvg
     impulse = mass[lf] * mass[rf] / (mass[lf] + mass[rf]) * v0
     y[n + lf] -= impulse / mass[lf]
     y[n + rf] += impulse / mass[rf]
     y[2 * n + c] += impulse
-    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf]))
+    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf] + dvg))
+    y[y.size - 1] += impulse * dvg
     return impulse
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+def _apply_events(kinds, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                   cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
                   impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
@@ -833,7 +901,8 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
         n_applied += 1
         lf = cl[c]
         rf = cr[c]
-        rate = y[n + lf] - y[n + rf]
+        dvg = _ground_offset(gnow, cgl, cgr, c, 1)
+        rate = y[n + lf] - y[n + rf] + dvg
         if kind == EVENT_CLOSE:
             if n_imp + 1 > IMPACT_ROW_LIMIT:
                 status = STATUS_TABLE_LIMIT
@@ -847,16 +916,16 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
                         scratch[i] = y[i]
-                    _plastic_jump(c, scratch, n, cl, cr, mass)
+                    _plastic_jump(c, scratch, n, cl, cr, mass, dvg)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
-                    _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                    _rhs(scratch, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                          cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
                 if not stick:
-                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg)
                     continue
                 impacts[n_imp, IMP_CONTACT] = c
                 impacts[n_imp, IMP_TIME] = t
@@ -865,7 +934,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 impacts[n_imp, IMP_PEAK_FORCE] = 0.0
                 impacts[n_imp, IMP_IMPULSE] = y[2 * n + c]
                 impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]
-                _plastic_jump(c, y, n, cl, cr, mass)
+                _plastic_jump(c, y, n, cl, cr, mass, dvg)
                 closed[c] = True
                 cmode[c] = kernels.MODE_STUCK
                 cconst[c] = 0.0
@@ -878,7 +947,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
                 rate = 0.0
             n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
-                                    open_imp, mass)
+                                    open_imp, mass, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
             m_eff = mass[lf] * mass[rf] / (mass[lf] + mass[rf])
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
@@ -886,12 +955,12 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 cap = min(cap, duration / STEPS_PER_CONTACT)
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
             n_imp = _switch_contact(c, False, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
-                                    open_imp, mass)
+                                    open_imp, mass, dvg)
             cmode[c] = 0
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)
-            delta = y[lf] - y[rf] - cgap[c]
+            delta = y[lf] - y[rf] + _ground_offset(gnow, cgl, cgr, c, 2) - cgap[c]
             y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
@@ -905,15 +974,20 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                cl, cr, cgap, claw, cprm, smodel, sprm, sidx, kpd, heights, stop_ratio,
-               ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
+               ag, ug, vg, fground, cgl, cgr, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
     nh = nc - nc
     for j in range(n):
         if sidx[j] >= 0:
             nh += 1
-    S = 2 * n + 3 * nc + 2 + 2 * nh
+    S = 2 * n + 3 * nc + 2 + 2 * nh + 1  # the last state: work of the differential ground motion on the contacts
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
+    n_ground = ag.shape[0]
+    differential = n_ground > 1
+    gnow = np.zeros((3, n_ground))  # ground acceleration, velocity, displacement of every support
+    g0 = np.zeros((3, n_ground))    # ... at the start of the step
+    g1 = np.zeros((3, n_ground))    # ... at its end
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
 
@@ -965,7 +1039,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     out_state = np.empty((n_out, S))
     out_acc = np.empty((n_out, n))
     out_force = np.empty((n_out, nc))
-    out_ag = np.empty(n_out)
+    out_ag = np.empty((n_out, n_ground))
     out_pot = np.empty(n_out)
     out_shear = np.empty((n_out, n))
     out_storey_energy = np.empty((n_out, 2))
@@ -988,7 +1062,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 
     t = 0.0
     seg = zero
-    _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+    _grounds(ag, ug, vg, dt_rec, seg, 0.0, differential, gnow)
+    _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
     # First output sample at t = 0.
     out_time[0] = 0.0
@@ -1001,8 +1076,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         out_acc[0, j] = k1[n + j]
     for c in range(nc):
         out_force[0, c] = 0.0
-    out_ag[0] = _ground(ag, dt_rec, seg, 0.0)
-    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
+    for g in range(n_ground):
+        out_ag[0, g] = gnow[0, g]
+    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
     i_out = 1
 
     h = first_step
@@ -1037,28 +1113,34 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             # ---- Dormand–Prince stages -----------------------------------
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+            _grounds(ag, ug, vg, dt_rec, seg, t + C2 * h_try, differential, gnow)
+            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+            _grounds(ag, ug, vg, dt_rec, seg, t + C3 * h_try, differential, gnow)
+            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+            _grounds(ag, ug, vg, dt_rec, seg, t + C4 * h_try, differential, gnow)
+            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+            _grounds(ag, ug, vg, dt_rec, seg, t + C5 * h_try, differential, gnow)
+            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
+            _grounds(ag, ug, vg, dt_rec, seg, t + h_try, differential, gnow)
+            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-            _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
+            _grounds(ag, ug, vg, dt_rec, seg, t + h_try, differential, gnow)
+            _rhs(ynew, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
@@ -1105,16 +1187,22 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
             # ---- contact events inside the step ------------------------------
+            # δ over the step is the Hermite cubic of the total displacements: each floor's
+            # displacement over its own ground plus the contact's differential ground motion
+            # (itself a cubic within a record step, so the interpolant stays exact for it).
+            if differential:
+                _grounds(ag, ug, vg, dt_rec, seg, t, differential, g0)
+                _grounds(ag, ug, vg, dt_rec, seg, t + h_try, differential, g1)
             s_first = 2.0
             for c in range(nc):
                 event_s[c] = -1.0
                 event_kind[c] = EVENT_NONE
                 lf = cl[c]
                 rf = cr[c]
-                d0 = y[lf] - y[rf] - cgap[c]
-                r0 = y[n + lf] - y[n + rf]
-                d1 = ynew[lf] - ynew[rf] - cgap[c]
-                r1 = ynew[n + lf] - ynew[n + rf]
+                d0 = y[lf] - y[rf] + _ground_offset(g0, cgl, cgr, c, 2) - cgap[c]
+                r0 = y[n + lf] - y[n + rf] + _ground_offset(g0, cgl, cgr, c, 1)
+                d1 = ynew[lf] - ynew[rf] + _ground_offset(g1, cgl, cgr, c, 2) - cgap[c]
+                r1 = ynew[n + lf] - ynew[n + rf] + _ground_offset(g1, cgl, cgr, c, 1)
                 floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
@@ -1131,7 +1219,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             mid = 0.5 * (lo + hi)
                             for i in range(S):
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
-                            _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
+                            _grounds(ag, ug, vg, dt_rec, seg, t + mid * h_try, differential, gnow)
+                            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
                                  fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                             if forces[c] < 0.0:
@@ -1146,7 +1235,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     kind = EVENT_SEPARATE
                     for which in range(kernels.switch_count(claw[c], cprm[c])):
                         sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
-                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
+                                              y[lf] + _ground_offset(g0, cgl, cgr, c, 2),
+                                              y[n + lf] + _ground_offset(g0, cgl, cgr, c, 1),
+                                              ynew[lf] + _ground_offset(g1, cgl, cgr, c, 2),
+                                              ynew[n + lf] + _ground_offset(g1, cgl, cgr, c, 1),
+                                              k1[n + lf] + _ground_offset(g0, cgl, cgr, c, 0),
+                                              k7[n + lf] + _ground_offset(g1, cgl, cgr, c, 0),
                                               y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
                                               y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_try)
                         if sw >= 0.0 and (s < 0.0 or sw < s):
@@ -1184,8 +1278,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
                         sev_kind[hi] = STOREY_NONE
                 n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
+                _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
                 impacts, n_imp, n_applied, cap, status = _apply_events(
-                    event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
+                    event_kind, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
                     impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear)
                 n_applied += n_storey
@@ -1197,7 +1292,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     status = STATUS_EVENT_LIMIT
                 if status != 0:
                     break
-                _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
+                _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+                _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff,
                      dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                 if cap < h_try:
                     h_try = cap
@@ -1263,8 +1359,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 lf = cl[c]
                 rf = cr[c]
                 fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
-                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf],
-                                              k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
+                                              y[lf] + _ground_offset(g0, cgl, cgr, c, 2),
+                                              y[n + lf] + _ground_offset(g0, cgl, cgr, c, 1),
+                                              ynew[lf] + _ground_offset(g1, cgl, cgr, c, 2),
+                                              ynew[n + lf] + _ground_offset(g1, cgl, cgr, c, 1),
+                                              k1[n + lf] + _ground_offset(g0, cgl, cgr, c, 0),
+                                              k7[n + lf] + _ground_offset(g1, cgl, cgr, c, 0), y[rf], y[n + rf], ynew[rf], ynew[n + rf],
                                               k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
@@ -1294,8 +1394,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             s = (t_o - t) / h_used
             for i in range(S):
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
-            ag_o = _ground(ag, dt_rec, seg, t_o)
-            _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+            _grounds(ag, ug, vg, dt_rec, seg, t_o, differential, gnow)
+            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             out_time[i_out] = t_o
             for i in range(S):
@@ -1304,8 +1404,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_acc[i_out, j] = k2[n + j]
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
-            out_ag[i_out] = ag_o
-            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm)
+            for g in range(n_ground):
+                out_ag[i_out, g] = gnow[0, g]
+            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
             for j in range(n):
                 out_shear[i_out, j] = shear[j]
             _storey_energy(ystage, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i_out)
@@ -1327,8 +1428,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if sev_kind[hi] == STOREY_NONE:
                 sev_kind[hi] = spending[hi]
         n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
+        _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
         impacts, n_imp, n_applied, cap, status = _apply_events(
-            event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+            event_kind, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
             smodel, sprm, sidx, kpd, smode, shear)
         n_applied += n_storey
@@ -1339,7 +1441,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             window_events += n_applied
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
-            _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+            _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+            _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
@@ -1365,15 +1468,17 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_state[i2, i] = y[i]
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
-            _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+            _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+            _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             for j in range(n):
                 out_shear[i2, j] = shear[j]
             _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i2)
-            out_ag[i2] = _ground(ag, dt_rec, seg, t)
-            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
+            for g in range(n_ground):
+                out_ag[i2, g] = gnow[0, g]
+            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
         i_out = n_out
     if status != STATUS_COLLAPSED:
         collapse_floor = zero - 1
@@ -1418,7 +1523,8 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         contacts start open.
     """
     # A fresh writable copy: a read-only array would compile a second specialisation.
-    ag = np.array(ground_acceleration, dtype=np.float64, copy=True)
+    ag = np.array(np.atleast_2d(ground_acceleration), dtype=np.float64, copy=True, order="C")
+    vg, ug = ground_kinematics(ag, float(time_step)) if ag.shape[0] > 1 else (np.zeros((1, 1)), np.zeros((1, 1)))
     # Independent of output_dt, so the step sequence (and every peak) is the same whatever the output sampling.
     first_step = 0.1 * time_step
     y_initial = np.zeros(2 * system.n_floors)
@@ -1432,15 +1538,42 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                      system.contact_right, system.contact_gap, system.contact_law,
                      system.contact_parameters, system.storey_model, system.storey_parameters,
                      system.storey_state, system.p_delta_stiffness, system.storey_height,
-                     float(system.stop_drift_ratio), ag, float(time_step), float(duration), float(rtol),
+                     float(system.stop_drift_ratio), ag, ug, vg, np.asarray(system.floor_ground, dtype=np.int64),
+                     np.asarray(system.contact_ground_left, dtype=np.int64),
+                     np.asarray(system.contact_ground_right, dtype=np.int64), float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
     (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, shear,
      storey_energy, final_state, collapse_floor, n_steps, n_rej, status, t_final) = raw
-    return RawSolution(time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force,
+    return RawSolution(time, state, acc, force, ag_out[:, 0].copy(), potential, peak_u, peak_drift, peak_force,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
                        impacts[:, IMP_VELOCITY], impacts[:, IMP_CONSTANT], impacts[:, IMP_PEAK_FORCE],
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],
                        impacts[:, IMP_WORK], trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
                        shear, storey_energy, final_state.copy(), int(collapse_floor),
-                       int(n_steps), int(n_rej), int(status), float(t_final))
+                       int(n_steps), int(n_rej), int(status), float(t_final), ag_out)
+
+
+def ground_kinematics(acceleration: np.ndarray, time_step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Ground velocity and displacement at the samples of piecewise-linear accelerations, from rest.
+
+    Parameters
+    ----------
+    acceleration : (G, ns) ndarray
+        Ground accelerations, m/s², one row per ground, uniform step *time_step* (s).
+
+    Returns
+    -------
+    velocity, displacement : (G, ns) ndarray
+        m/s and m: the exact integrals (trapezoid for the velocity; for the
+        displacement ``u_{k+1} = u_k + v_k·dt + dt²·(a_k/3 + a_{k+1}/6)``), so
+        that between samples the velocity is the quadratic and the
+        displacement the cubic the solver evaluates (:func:`_grounds`).
+    """
+    a = np.atleast_2d(np.asarray(acceleration, dtype=float))
+    dt = float(time_step)
+    velocity = np.zeros_like(a)
+    displacement = np.zeros_like(a)
+    velocity[:, 1:] = np.cumsum(0.5 * dt * (a[:, :-1] + a[:, 1:]), axis=1)
+    displacement[:, 1:] = np.cumsum(dt * velocity[:, :-1] + dt * dt * (a[:, :-1] / 3.0 + a[:, 1:] / 6.0), axis=1)
+    return velocity, displacement
