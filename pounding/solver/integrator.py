@@ -1577,3 +1577,36 @@ def ground_kinematics(acceleration: np.ndarray, time_step: float) -> tuple[np.nd
     velocity[:, 1:] = np.cumsum(0.5 * dt * (a[:, :-1] + a[:, 1:]), axis=1)
     displacement[:, 1:] = np.cumsum(dt * velocity[:, :-1] + dt * dt * (a[:, :-1] / 3.0 + a[:, 1:] / 6.0), axis=1)
     return velocity, displacement
+
+
+def ground_state_at(acceleration: np.ndarray, time_step: float, times: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Ground acceleration, velocity and displacement of every row at *times*, as the solver sees them.
+
+    Parameters
+    ----------
+    acceleration : (G, ns) ndarray
+        The ground-acceleration rows given to :func:`integrate`, m/s².
+    time_step : float
+        Their sampling interval, s.
+    times : (nt,) ndarray
+        s.
+
+    Returns
+    -------
+    acceleration, velocity, displacement : (nt, G) ndarray
+        m/s², m/s, m: piecewise linear, quadratic and cubic from rest (past the
+        last sample the last acceleration is held, as in the solver).
+    """
+    a = np.atleast_2d(np.asarray(acceleration, dtype=float))
+    velocity, displacement = ground_kinematics(a, time_step)
+    t = np.asarray(times, dtype=float)
+    k = np.minimum(np.floor(t / time_step + 1e-9).astype(np.int64), a.shape[1] - 1)
+    k = np.maximum(k, 0)
+    tau = (t - k * time_step)[:, None]
+    a0 = a[:, k].T
+    nxt = np.minimum(k + 1, a.shape[1] - 1)
+    slope = np.where((k + 1 < a.shape[1])[:, None], (a[:, nxt].T - a0) / time_step, 0.0)
+    acc = a0 + slope * tau
+    vel = velocity[:, k].T + a0 * tau + 0.5 * slope * tau ** 2
+    disp = displacement[:, k].T + velocity[:, k].T * tau + 0.5 * a0 * tau ** 2 + slope * tau ** 3 / 6.0
+    return acc, vel, disp
