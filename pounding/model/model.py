@@ -598,13 +598,19 @@ class Model:
     def with_ground_motion(self, **changes: Any) -> Model:
         """The same model with ground-motion fields changed (record, scale, duration, dt, units, base_dir).
 
+        With a record per building only ``duration`` may change (it applies to all).
+
         Raises
         ------
         ModelError
             The model gives each building its own record (one line).
         """
-        self.refuse_building_records("changing the ground motion (record, scale or duration)")
         _check_keys("ground_motion", changes, GroundMotionSpec)
+        if self.has_building_records and set(changes) == {"duration"}:
+            # The simulated time applies to every building's record alike.
+            own = tuple(dataclasses.replace(g, **changes) for g in self.building_ground_motions)
+            return self._derived(building_ground_motions=own, ground_motion=own[0])
+        self.refuse_building_records("changing the ground motion (record or scale)")
         return self._derived(ground_motion=dataclasses.replace(self.ground_motion, **changes))
 
     def with_solver(self, **changes: Any) -> Model:
