@@ -64,7 +64,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws as contact_laws
@@ -278,40 +279,112 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     return ag[seg] + (ag[seg + 1] - ag[seg]) * ((t - t0) / dt_rec)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow):
-    """Ground acceleration, velocity and displacement of every support at time *t* into *gnow* (3, G).
+# Ground motion of the supports.  One common ground (a 1-D acceleration array) and several
+# grounds (a 2-D array, one row per ground) are two compiled specialisations of the same
+# solver: the helpers below are chosen by numba at compile time from the argument types, so
+# with one ground the "ground state" is just the acceleration (a float), every differential
+# offset is the constant 0.0 and the single-record solver does no extra work.
 
-    ``gnow[0, g]`` is the piecewise-linear acceleration (m/s²) of ground *g*,
-    computed exactly as :func:`_ground`; when *differential* (more than one
-    ground), ``gnow[1, g]`` and ``gnow[2, g]`` are its velocity (m/s) and
-    displacement (m), the exact integrals from rest of that acceleration
-    (piecewise quadratic and cubic; *vg*, *ug* hold their values at the
-    samples).  Otherwise they stay 0: one common ground moves both sides of
-    every contact alike and drops out of the contact kinematics.
-    """
-    for g in range(ag.shape[0]):
-        row = ag[g]
-        gnow[0, g] = _ground(row, dt_rec, seg, t)
-        if differential:
+
+def _ground_buffer(ag):
+    """Storage for the ground state: 0.0 (one ground) or a (3, G) array (acceleration, velocity, displacement)."""
+    raise NotImplementedError  # compiled only (numba overload below)
+
+
+def _grounds(ag, ug, vg, dt_rec, seg, t, gnow):
+    """The ground state at time *t*: ``a_g`` (one ground), or *gnow* filled for every ground."""
+    raise NotImplementedError
+
+
+def _ground_offset(gnow, cgl, cgr, c, row):
+    """Differential ground motion of contact *c*: ground of its left side minus ground of its right side."""
+    raise NotImplementedError
+
+
+def _floor_ground_acceleration(gnow, fground, j):
+    """Ground acceleration under floor *j*, m/s²."""
+    raise NotImplementedError
+
+
+def _store_grounds(out, i, gnow):
+    """Write the ground accelerations of the state *gnow* into row *i* of *out* (nt, G)."""
+    raise NotImplementedError
+
+
+def _ground_count(ag):
+    """Number of grounds: 1 for a 1-D acceleration array, its rows for a 2-D one."""
+    raise NotImplementedError
+
+
+def _one_ground(ag) -> bool:
+    return isinstance(ag, types.Array) and ag.ndim == 1
+
+
+@overload(_ground_buffer, inline="always")
+def _ground_buffer_impl(ag):
+    if _one_ground(ag):
+        return lambda ag: 0.0
+    return lambda ag: np.zeros((3, ag.shape[0]))
+
+
+@overload(_ground_count, inline="always")
+def _ground_count_impl(ag):
+    if _one_ground(ag):
+        return lambda ag: 1
+    return lambda ag: ag.shape[0]
+
+
+@overload(_grounds, inline="always")
+def _grounds_impl(ag, ug, vg, dt_rec, seg, t, gnow):
+    if _one_ground(ag):
+        return lambda ag, ug, vg, dt_rec, seg, t, gnow: _ground(ag, dt_rec, seg, t)
+
+    def several(ag, ug, vg, dt_rec, seg, t, gnow):
+        # Acceleration as _ground; velocity and displacement: the exact integrals from rest of the
+        # piecewise-linear acceleration (quadratic and cubic in the record step; ug, vg at the samples).
+        for g in range(ag.shape[0]):
+            row = ag[g]
+            gnow[0, g] = _ground(row, dt_rec, seg, t)
             k = min(seg, row.size - 1)
             tau = t - k * dt_rec
             a0 = row[k]
             slope = (row[k + 1] - a0) / dt_rec if k + 1 < row.size else 0.0
             gnow[1, g] = vg[g, k] + a0 * tau + 0.5 * slope * tau * tau
             gnow[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
+        return gnow
+
+    return several
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _ground_offset(gnow, cgl, cgr, c, row):
-    """Differential ground motion of contact *c*: ground of its left side minus ground of its right side.
+@overload(_ground_offset, inline="always")
+def _ground_offset_impl(gnow, cgl, cgr, c, row):
+    # The one place where the supports' motion enters the contact kinematics:
+    # δ = u_L − u_R + (u_g,L − u_g,R) − gap, u relative to each floor's own ground;
+    # row 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²).  A wall or a link
+    # joining two grounds needs only its two ground rows in cgl / cgr.
+    if isinstance(gnow, types.Float):
+        return lambda gnow, cgl, cgr, c, row: 0.0
+    return lambda gnow, cgl, cgr, c, row: gnow[row, cgl[c]] - gnow[row, cgr[c]]
 
-    *row* 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²).  This
-    is the one place where the supports' motion enters the contact
-    kinematics: the penetration is ``δ = u_L − u_R + (u_g,L − u_g,R) − gap``
-    with ``u`` relative to each floor's own ground (0 with one common ground).
-    """
-    return gnow[row, cgl[c]] - gnow[row, cgr[c]]
+
+@overload(_floor_ground_acceleration, inline="always")
+def _floor_ground_acceleration_impl(gnow, fground, j):
+    if isinstance(gnow, types.Float):
+        return lambda gnow, fground, j: gnow
+    return lambda gnow, fground, j: gnow[0, fground[j]]
+
+
+@overload(_store_grounds, inline="always")
+def _store_grounds_impl(out, i, gnow):
+    if isinstance(gnow, types.Float):
+        def one(out, i, gnow):
+            out[i, 0] = gnow
+        return one
+
+    def several(out, i, gnow):
+        for g in range(gnow.shape[1]):
+            out[i, g] = gnow[0, g]
+    return several
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -423,7 +496,7 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
             out[2 * n + nc + c] = 0.0
     e_in_rate = 0.0
     for j in range(n):
-        ag_t = gnow[0, fground[j]]
+        ag_t = _floor_ground_acceleration(gnow, fground, j)
         out[j] = y[n + j]
         out[n + j] = -fbuf[j] / mass[j] - ag_t
         e_in_rate -= ag_t * mass[j] * y[n + j]
@@ -983,11 +1056,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             nh += 1
     S = 2 * n + 3 * nc + 2 + 2 * nh + 1  # the last state: work of the differential ground motion on the contacts
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
-    n_ground = ag.shape[0]
-    differential = n_ground > 1
-    gnow = np.zeros((3, n_ground))  # ground acceleration, velocity, displacement of every support
-    g0 = np.zeros((3, n_ground))    # ... at the start of the step
-    g1 = np.zeros((3, n_ground))    # ... at its end
+    n_ground = _ground_count(ag)
+    gnow = _ground_buffer(ag)  # ground state (acceleration; with several grounds also velocity, displacement)
+    g0 = _ground_buffer(ag)    # ... at the start of the step
+    g1 = _ground_buffer(ag)    # ... at its end
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
 
@@ -1062,7 +1134,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 
     t = 0.0
     seg = zero
-    _grounds(ag, ug, vg, dt_rec, seg, 0.0, differential, gnow)
+    gnow = _grounds(ag, ug, vg, dt_rec, seg, 0.0, gnow)
     _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
     # First output sample at t = 0.
@@ -1076,8 +1148,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         out_acc[0, j] = k1[n + j]
     for c in range(nc):
         out_force[0, c] = 0.0
-    for g in range(n_ground):
-        out_ag[0, g] = gnow[0, g]
+    _store_grounds(out_ag, 0, gnow)
     out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
     i_out = 1
 
@@ -1113,33 +1184,33 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             # ---- Dormand–Prince stages -----------------------------------
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
-            _grounds(ag, ug, vg, dt_rec, seg, t + C2 * h_try, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C2 * h_try, gnow)
             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
-            _grounds(ag, ug, vg, dt_rec, seg, t + C3 * h_try, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C3 * h_try, gnow)
             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-            _grounds(ag, ug, vg, dt_rec, seg, t + C4 * h_try, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C4 * h_try, gnow)
             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-            _grounds(ag, ug, vg, dt_rec, seg, t + C5 * h_try, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C5 * h_try, gnow)
             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
-            _grounds(ag, ug, vg, dt_rec, seg, t + h_try, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + h_try, gnow)
             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-            _grounds(ag, ug, vg, dt_rec, seg, t + h_try, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + h_try, gnow)
             _rhs(ynew, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
@@ -1190,9 +1261,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             # δ over the step is the Hermite cubic of the total displacements: each floor's
             # displacement over its own ground plus the contact's differential ground motion
             # (itself a cubic within a record step, so the interpolant stays exact for it).
-            if differential:
-                _grounds(ag, ug, vg, dt_rec, seg, t, differential, g0)
-                _grounds(ag, ug, vg, dt_rec, seg, t + h_try, differential, g1)
+            g0 = _grounds(ag, ug, vg, dt_rec, seg, t, g0)
+            g1 = _grounds(ag, ug, vg, dt_rec, seg, t + h_try, g1)
             s_first = 2.0
             for c in range(nc):
                 event_s[c] = -1.0
@@ -1219,7 +1289,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             mid = 0.5 * (lo + hi)
                             for i in range(S):
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
-                            _grounds(ag, ug, vg, dt_rec, seg, t + mid * h_try, differential, gnow)
+                            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + mid * h_try, gnow)
                             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
                                  fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
@@ -1278,7 +1348,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
                         sev_kind[hi] = STOREY_NONE
                 n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
-                _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+                gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
@@ -1292,7 +1362,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     status = STATUS_EVENT_LIMIT
                 if status != 0:
                     break
-                _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+                gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
                 _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff,
                      dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                 if cap < h_try:
@@ -1394,7 +1464,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             s = (t_o - t) / h_used
             for i in range(S):
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
-            _grounds(ag, ug, vg, dt_rec, seg, t_o, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t_o, gnow)
             _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             out_time[i_out] = t_o
@@ -1404,8 +1474,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_acc[i_out, j] = k2[n + j]
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
-            for g in range(n_ground):
-                out_ag[i_out, g] = gnow[0, g]
+            _store_grounds(out_ag, i_out, gnow)
             out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
             for j in range(n):
                 out_shear[i_out, j] = shear[j]
@@ -1428,7 +1497,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if sev_kind[hi] == STOREY_NONE:
                 sev_kind[hi] = spending[hi]
         n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
-        _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+        gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
@@ -1441,7 +1510,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             window_events += n_applied
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
-            _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
             _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # The step the controller accepted before the event cut it short; a newly closed
@@ -1468,7 +1537,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_state[i2, i] = y[i]
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
-            _grounds(ag, ug, vg, dt_rec, seg, t, differential, gnow)
+            gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
             _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for c in range(nc):
@@ -1476,8 +1545,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_shear[i2, j] = shear[j]
             _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i2)
-            for g in range(n_ground):
-                out_ag[i2, g] = gnow[0, g]
+            _store_grounds(out_ag, i2, gnow)
             out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
         i_out = n_out
     if status != STATUS_COLLAPSED:
@@ -1523,8 +1591,11 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         contacts start open.
     """
     # A fresh writable copy: a read-only array would compile a second specialisation.
-    ag = np.array(np.atleast_2d(ground_acceleration), dtype=np.float64, copy=True, order="C")
-    vg, ug = ground_kinematics(ag, float(time_step)) if ag.shape[0] > 1 else (np.zeros((1, 1)), np.zeros((1, 1)))
+    # One ground: a 1-D array (the single-record specialisation); several: one row each.
+    ag = np.array(ground_acceleration, dtype=np.float64, copy=True, order="C")
+    if ag.ndim == 2 and ag.shape[0] == 1:
+        ag = np.ascontiguousarray(ag[0])
+    vg, ug = ground_kinematics(ag, float(time_step)) if ag.ndim == 2 else (np.zeros((1, 1)), np.zeros((1, 1)))
     # Independent of output_dt, so the step sequence (and every peak) is the same whatever the output sampling.
     first_step = 0.1 * time_step
     y_initial = np.zeros(2 * system.n_floors)
