@@ -48,7 +48,9 @@ of the contact forces on the differential ground motion, J, 0 with one common gr
   ground-acceleration array; a different record, or the same one lagged by wave passage).
   Floors move relative to their own ground; contacts see total displacements, so the
   differential ground displacement and velocity enter δ and δ̇ (:func:`_ground_offset`),
-  integrated exactly from the piecewise-linear accelerations.
+  integrated exactly from the piecewise-linear accelerations.  Like *storey*, the *ground*
+  argument is None with one common ground, and every ``if ground is not None`` block is then
+  pruned at compile time: the single-record solver is the plain one.
 
 References
 ----------
@@ -64,8 +66,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
+from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws as contact_laws
@@ -169,7 +170,7 @@ class System:
         (all 0 with one common ground motion)
     contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
         side of each gap element: their differential displacement enters the penetration
-        (:func:`ground_rows`, ``pounding.simulation.assemble``)
+        (``pounding.simulation.assemble``)
     """
 
     mass: np.ndarray
@@ -263,7 +264,8 @@ class RawSolution:
     n_rejected: int
     status: int
     final_time: float
-    support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row
+    support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row (None: one ground)
+
 
 # --------------------------------------------------------------------------- #
 # Right-hand side
@@ -279,119 +281,56 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     return ag[seg] + (ag[seg + 1] - ag[seg]) * ((t - t0) / dt_rec)
 
 
-# Ground motion of the supports.  One common ground (a 1-D acceleration array) and several
-# grounds (a 2-D array, one row per ground) are two compiled specialisations of the same
-# solver: the helpers below are chosen by numba at compile time from the argument types, so
-# with one ground the "ground state" is just the acceleration (a float), every differential
-# offset is the constant 0.0 and the single-record solver does no extra work.
-
-
-def _ground_buffer(ag):
-    """Storage for the ground state: 0.0 (one ground) or a (3, G) array (acceleration, velocity, displacement)."""
-    raise NotImplementedError  # compiled only (numba overload below)
-
-
-def _grounds(ag, ug, vg, dt_rec, seg, t, gnow):
-    """The ground state at time *t*: ``a_g`` (one ground), or *gnow* filled for every ground."""
-    raise NotImplementedError
-
-
-def _ground_offset(gnow, cgl, cgr, c, row):
-    """Differential ground motion of contact *c*: ground of its left side minus ground of its right side."""
-    raise NotImplementedError
-
-
-def _floor_ground_acceleration(gnow, fground, j):
-    """Ground acceleration under floor *j*, m/s²."""
-    raise NotImplementedError
-
-
-def _store_grounds(out, i, gnow):
-    """Write the ground accelerations of the state *gnow* into row *i* of *out* (nt, G)."""
-    raise NotImplementedError
-
-
-def _ground_count(ag):
-    """Number of grounds: 1 for a 1-D acceleration array, its rows for a 2-D one."""
-    raise NotImplementedError
-
-
-def _one_ground(ag) -> bool:
-    return isinstance(ag, types.Array) and ag.ndim == 1
-
-
-@overload(_ground_buffer, inline="always")
-def _ground_buffer_impl(ag):
-    if _one_ground(ag):
-        return lambda ag: 0.0
-    return lambda ag: np.zeros((3, ag.shape[0]))
-
-
-@overload(_ground_count, inline="always")
-def _ground_count_impl(ag):
-    if _one_ground(ag):
-        return lambda ag: 1
-    return lambda ag: ag.shape[0]
-
-
-@overload(_grounds, inline="always")
-def _grounds_impl(ag, ug, vg, dt_rec, seg, t, gnow):
-    if _one_ground(ag):
-        return lambda ag, ug, vg, dt_rec, seg, t, gnow: _ground(ag, dt_rec, seg, t)
-
-    def several(ag, ug, vg, dt_rec, seg, t, gnow):
-        # Acceleration as _ground; velocity and displacement: the exact integrals from rest of the
-        # piecewise-linear acceleration (quadratic and cubic in the record step; ug, vg at the samples).
-        for g in range(ag.shape[0]):
-            row = ag[g]
-            gnow[0, g] = _ground(row, dt_rec, seg, t)
-            k = min(seg, row.size - 1)
-            tau = t - k * dt_rec
-            a0 = row[k]
-            slope = (row[k + 1] - a0) / dt_rec if k + 1 < row.size else 0.0
-            gnow[1, g] = vg[g, k] + a0 * tau + 0.5 * slope * tau * tau
-            gnow[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
-        return gnow
-
-    return several
-
-
-@overload(_ground_offset, inline="always")
-def _ground_offset_impl(gnow, cgl, cgr, c, row):
-    # The one place where the supports' motion enters the contact kinematics:
-    # δ = u_L − u_R + (u_g,L − u_g,R) − gap, u relative to each floor's own ground;
-    # row 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²).  A wall or a link
-    # joining two grounds needs only its two ground rows in cgl / cgr.
-    if isinstance(gnow, types.Float):
-        return lambda gnow, cgl, cgr, c, row: 0.0
-    return lambda gnow, cgl, cgr, c, row: gnow[row, cgl[c]] - gnow[row, cgr[c]]
-
-
-@overload(_floor_ground_acceleration, inline="always")
-def _floor_ground_acceleration_impl(gnow, fground, j):
-    if isinstance(gnow, types.Float):
-        return lambda gnow, fground, j: gnow
-    return lambda gnow, fground, j: gnow[0, fground[j]]
-
-
-@overload(_store_grounds, inline="always")
-def _store_grounds_impl(out, i, gnow):
-    if isinstance(gnow, types.Float):
-        def one(out, i, gnow):
-            out[i, 0] = gnow
-        return one
-
-    def several(out, i, gnow):
-        for g in range(gnow.shape[1]):
-            out[i, g] = gnow[0, g]
-    return several
+# Ground motion of several supports.  *ground* is None with one common ground (every
+# ``if ground is not None`` block is pruned at compile time), else the tuple built by
+# :func:`_ground_arguments`: (accelerations (G, ns), displacements and velocities at the
+# samples (G, ns), ground row of every floor (N,), of the left and the right side of every
+# contact (nc,), and three (3, G) ground states [acceleration, velocity, displacement]:
+# now, at the start of the step and at its end).
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
-         smodel, sprm, sidx, kpd, smode, shear):
+def _fill_grounds(ground, dt_rec, seg, t, gstate):
+    """Acceleration, velocity and displacement of every ground at time *t* into *gstate* (3, G).
+
+    The acceleration is piecewise linear as :func:`_ground`; velocity and displacement are its
+    exact integrals from rest (quadratic and cubic in a record step; their sample values in
+    ``ground[2]`` and ``ground[1]``).
+    """
+    ag = ground[0]
+    ug = ground[1]
+    vg = ground[2]
+    for g in range(ag.shape[0]):
+        row = ag[g]
+        gstate[0, g] = _ground(row, dt_rec, seg, t)
+        k = min(seg, row.size - 1)
+        tau = t - k * dt_rec
+        a0 = row[k]
+        slope = (row[k + 1] - a0) / dt_rec if k + 1 < row.size else 0.0
+        gstate[1, g] = vg[g, k] + a0 * tau + 0.5 * slope * tau * tau
+        gstate[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _ground_offset(ground, gstate, c, row):
+    """Differential ground motion of contact *c*: ground of its left side minus ground of its right side.
+
+    *row* 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²) of the ground state
+    *gstate*.  This is the one place where the supports' motion enters the contact kinematics:
+    ``δ = u_L − u_R + (u_g,L − u_g,R) − gap`` with ``u`` relative to each floor's own ground
+    (a wall or a link joining two grounds needs only its two rows in ``ground[4]``, ``ground[5]``).
+    """
+    return gstate[row, ground[4][c]] - gstate[row, ground[5][c]]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey, ground):
     """Time derivative of the state; contact forces are written to *forces*.
+
+    With several grounds (*ground* not None) each floor takes its own ground's
+    acceleration and the contacts the differential ground motion of ``ground[6]``
+    (the ground state at this time, filled by the caller); *ag_t* is then unused.
 
     A closed compliant contact acts through its law in its current mode
     (:func:`pounding.contact.mode_force`).  A persistent (stuck) contact of an
@@ -402,12 +341,10 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
     """
     n = mass.size
     nc = cgap.size
-    nh = smode.size
-    ih = 2 * n + 3 * nc + 2  # first hysteretic state
     # fbuf[:n] accumulates internal + damping forces (N); power is the
-    # damping power v·C v (W), summed in the same loops.  A yielding storey's
-    # restoring force comes from its hysteresis kernel (pounding.solver.storeys);
-    # shear[j] receives each storey's restoring (column) shear.
+    # damping power v·C v (W), summed in the same loops.  Storeys are linear
+    # elastic here; *storey* (None for a purely elastic row, which compiles
+    # without any of it) corrects the yielding ones and adds P-Delta.
     power = 0.0
     for j in range(n):
         v = y[n + j]
@@ -421,17 +358,8 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
         else:
             du = y[j]
             dv = y[n + j]
-        hi = sidx[j]
-        if hi < 0:
-            restoring = kst[j] * du
-        else:
-            r = y[ih + hi]
-            restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
-            out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
-            out[ih + nh + hi] = restoring * dv
-        shear[j] = restoring
         damping = kst[j] * a1[j] * dv
-        s = restoring + kpd[j] * du + damping
+        s = kst[j] * du + damping
         power += damping * dv
         fbuf[j] += s
         if b >= 0:
@@ -448,6 +376,8 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
                 acc += dvals[off + i * m + k] * y[n + s0 + k]
             fbuf[s0 + i] += acc
             power += acc * y[n + s0 + i]
+    if storey is not None:
+        _storey_forces(y, n, nc, below, kst, storey, out, fbuf)
     n_stuck = 0
     for c in range(nc):
         f = 0.0
@@ -457,8 +387,12 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
                 n_stuck += 1
                 forces[c] = 0.0
                 continue
-            delta = y[cl[c]] - y[cr[c]] + _ground_offset(gnow, cgl, cgr, c, 2) - cgap[c]
-            rate = y[n + cl[c]] - y[n + cr[c]] + _ground_offset(gnow, cgl, cgr, c, 1)
+            if ground is None:
+                delta = y[cl[c]] - y[cr[c]] - cgap[c]
+                rate = y[n + cl[c]] - y[n + cr[c]]
+            else:
+                delta = y[cl[c]] - y[cr[c]] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
+                rate = y[n + cl[c]] - y[n + cr[c]] + _ground_offset(ground, ground[6], c, 1)
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
@@ -466,8 +400,8 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
         fbuf[cl[c]] += f
         fbuf[cr[c]] -= f
     if n_stuck > 0:
-        # Constraint forces of stuck contacts: make δ̈ = 0 (the total acceleration of a floor is −fbuf/m:
-        # each floor's own ground acceleration cancels).
+        # Constraint forces of stuck contacts: make δ̈ = 0 (a floor's total acceleration is −fbuf/m:
+        # its own ground's acceleration cancels).
         for _ in range(100):
             largest = 0.0
             scale = 0.0
@@ -484,25 +418,39 @@ def _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, do
                     scale = max(scale, abs(forces[c]))
             if largest <= 1e-13 * scale:
                 break
-    ground_power = 0.0
-    for c in range(nc):
-        f = forces[c]
-        out[2 * n + c] = f
-        if closed[c]:
-            dvg = _ground_offset(gnow, cgl, cgr, c, 1)
-            out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]] + dvg)
-            ground_power += f * dvg
-        else:
-            out[2 * n + nc + c] = 0.0
     e_in_rate = 0.0
-    for j in range(n):
-        ag_t = _floor_ground_acceleration(gnow, fground, j)
-        out[j] = y[n + j]
-        out[n + j] = -fbuf[j] / mass[j] - ag_t
-        e_in_rate -= ag_t * mass[j] * y[n + j]
+    if ground is None:
+        for c in range(nc):
+            f = forces[c]
+            out[2 * n + c] = f
+            out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
+        for j in range(n):
+            out[j] = y[n + j]
+            out[n + j] = -fbuf[j] / mass[j] - ag_t
+            e_in_rate -= ag_t * mass[j] * y[n + j]
+    else:
+        # Several grounds: δ̇ includes the differential ground velocity; its work on the contact
+        # forces is the input W_g (the last state); each building from its own ground.
+        ground_power = 0.0
+        for c in range(nc):
+            f = forces[c]
+            out[2 * n + c] = f
+            if closed[c]:
+                dvg = _ground_offset(ground, ground[6], c, 1)
+                out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]] + dvg)
+                ground_power += f * dvg
+            else:
+                out[2 * n + nc + c] = 0.0
+        gnow = ground[6]
+        fground = ground[3]
+        for j in range(n):
+            ag_j = gnow[0, fground[j]]
+            out[j] = y[n + j]
+            out[n + j] = -fbuf[j] / mass[j] - ag_j
+            e_in_rate -= ag_j * mass[j] * y[n + j]
+        out[out.size - 1] = ground_power
     out[2 * n + 3 * nc] = e_in_rate
     out[2 * n + 3 * nc + 1] = power
-    out[out.size - 1] = ground_power
 
 
 # --------------------------------------------------------------------------- #
@@ -700,34 +648,78 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr) -> float:
+def _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
     total = 0.0
     for c in range(nc):
-        delta = y[cl[c]] - y[cr[c]] + _ground_offset(gnow, cgl, cgr, c, 2) - cgap[c]
+        delta = y[cl[c]] - y[cr[c]] - cgap[c]
+        if ground is not None:
+            delta = y[cl[c]] - y[cr[c]] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
         total += kernels.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
     return total
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out, row):
-    """Storey energies of state *y* into ``out[row]``: recoverable energy of every storey
-    (with the P-Delta potential ½·(−P/h)·Δ², J) and the recoverable energy of the yielding ones."""
-    ih = 2 * n + 3 * nc + 2
+def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
+    """Storey shears and energies of state *y* into ``shear[row]`` and ``energy[row]``.
+
+    ``shear[row, j]``: restoring (column) shear of the storey under floor j, N,
+    without P-Delta.  ``energy[row]``: recoverable energy of every storey (with
+    the P-Delta potential ½·(−P/h)·Δ², J) and the recoverable energy of the
+    yielding ones.  *storey* is None for linear elastic storeys without P-Delta.
+    """
     total = 0.0
     yielding = 0.0
     for j in range(n):
         b = below[j]
         du = y[j] - y[b] if b >= 0 else y[j]
-        hi = sidx[j]
-        r = y[ih + hi] if hi >= 0 else 0.0
-        energy = storeys.recoverable_energy(smodel[j], sprm[j], kst[j], du, r)
-        total += energy + 0.5 * kpd[j] * du * du
-        if hi >= 0:
-            yielding += energy
-    out[row, 0] = total
-    out[row, 1] = yielding
+        if storey is None:
+            shear[row, j] = kst[j] * du
+            total += 0.5 * kst[j] * du * du
+        else:
+            smodel, sprm, sidx, kpd = storey[0], storey[1], storey[2], storey[3]
+            hi = sidx[j]
+            r = y[2 * n + 3 * nc + 2 + hi] if hi >= 0 else 0.0
+            shear[row, j] = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
+            recoverable = storeys.recoverable_energy(smodel[j], sprm[j], kst[j], du, r)
+            total += recoverable + 0.5 * kpd[j] * du * du
+            if hi >= 0:
+                yielding += recoverable
+    energy[row, 0] = total
+    energy[row, 1] = yielding
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
+    """Add P-Delta and the yielding storeys' departure from ``kΔ`` to the floor forces *fbuf*, N.
+
+    Writes the rates of the hysteretic states and of the storeys' work
+    ∫F dΔ into *out*.  The caller has already applied ``kΔ`` to every storey.
+    """
+    smodel, sprm, kpd, smode, sfloor = storey[0], storey[1], storey[3], storey[6], storey[7]
+    nh = sfloor.size
+    ih = 2 * n + 3 * nc + 2  # first hysteretic state
+    for j in range(n):
+        if kpd[j] != 0.0:
+            b = below[j]
+            du = y[j] - y[b] if b >= 0 else y[j]
+            fbuf[j] += kpd[j] * du
+            if b >= 0:
+                fbuf[b] -= kpd[j] * du
+    for hi in range(nh):
+        j = sfloor[hi]
+        b = below[j]
+        du = y[j] - y[b] if b >= 0 else y[j]
+        dv = y[n + j] - y[n + b] if b >= 0 else y[n + j]
+        r = y[ih + hi]
+        restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
+        out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
+        out[ih + nh + hi] = restoring * dv
+        departure = restoring - kst[j] * du
+        fbuf[j] += departure
+        if b >= 0:
+            fbuf[b] -= departure
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -938,9 +930,9 @@ def _plastic_jump(c, y, n, cl, cr, mass, dvg):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _apply_events(kinds, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                   cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
-                  impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear):
+                  impacts, n_imp, open_imp, storey, ground):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -974,7 +966,9 @@ def _apply_events(kinds, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1
         n_applied += 1
         lf = cl[c]
         rf = cr[c]
-        dvg = _ground_offset(gnow, cgl, cgr, c, 1)
+        dvg = 0.0
+        if ground is not None:
+            dvg = _ground_offset(ground, ground[6], c, 1)
         rate = y[n + lf] - y[n + rf] + dvg
         if kind == EVENT_CLOSE:
             if n_imp + 1 > IMPACT_ROW_LIMIT:
@@ -992,8 +986,8 @@ def _apply_events(kinds, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1
                     _plastic_jump(c, scratch, n, cl, cr, mass, dvg)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
-                    _rhs(scratch, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                    _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, storey, ground)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
@@ -1033,7 +1027,9 @@ def _apply_events(kinds, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)
-            delta = y[lf] - y[rf] + _ground_offset(gnow, cgl, cgr, c, 2) - cgap[c]
+            delta = y[lf] - y[rf] - cgap[c]
+            if ground is not None:
+                delta = y[lf] - y[rf] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
             y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
@@ -1046,20 +1042,23 @@ def _apply_events(kinds, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1
 
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-               cl, cr, cgap, claw, cprm, smodel, sprm, sidx, kpd, heights, stop_ratio,
-               ag, ug, vg, fground, cgl, cgr, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
+               cl, cr, cgap, claw, cprm, storey, ground,
+               ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
+    # *storey* is None for linear elastic storeys without P-Delta or a collapse limit: every
+    # ``if storey is not None`` block below is then pruned at compile time, and the elastic
+    # row runs the plain elastic integrator.  Otherwise it is the tuple built by
+    # :func:`_storey_arguments`.
     nh = nc - nc
-    for j in range(n):
-        if sidx[j] >= 0:
-            nh += 1
+    if storey is not None:
+        nh = storey[7].size
     S = 2 * n + 3 * nc + 2 + 2 * nh + 1  # the last state: work of the differential ground motion on the contacts
+    # *ground* is None with one common ground (row 0 is *ag*); else the tuple of _ground_arguments.
+    n_ground = nc - nc + 1
+    if ground is not None:
+        n_ground = ground[0].shape[0]
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
-    n_ground = _ground_count(ag)
-    gnow = _ground_buffer(ag)  # ground state (acceleration; with several grounds also velocity, displacement)
-    g0 = _ground_buffer(ag)    # ... at the start of the step
-    g1 = _ground_buffer(ag)    # ... at its end
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
 
@@ -1090,19 +1089,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     internal_tol = np.empty(nc)
     for c in range(nc):
         internal_tol[c] = kernels.internal_tolerance(claw[c], cprm[c], atol_u)
-    # Yielding storeys: floor of each state, mode, tolerance of the state (plastic drift in m;
-    # Bouc-Wen z is dimensionless, so its tolerance is atol over u_y), located events.
-    sfloor = np.empty(nh, dtype=np.int64)
-    smode = np.zeros(nh, dtype=np.int64)
-    storey_tol = np.empty(nh)
-    for j in range(n):
-        if sidx[j] >= 0:
-            sfloor[sidx[j]] = j
-            storey_tol[sidx[j]] = atol_u if smodel[j] == hysteresis.MODEL_BILINEAR else atol_u / sprm[j, 0]
+    # Yielding storeys' located events (bilinear yield onset and unloading) and the collapse limit.
     sev_s = np.empty(nh)
     sev_kind = np.zeros(nh, dtype=np.int64)
     spending = np.zeros(nh, dtype=np.int64)
-    shear = np.zeros(n)
     collapse_floor = zero - 1
     collapse_s = -1.0
     collapse_pending = False
@@ -1111,7 +1101,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     out_state = np.empty((n_out, S))
     out_acc = np.empty((n_out, n))
     out_force = np.empty((n_out, nc))
-    out_ag = np.empty((n_out, n_ground))
+    out_ag = np.empty(n_out)
+    out_support = np.empty((n_out, n_ground))
     out_pot = np.empty(n_out)
     out_shear = np.empty((n_out, n))
     out_storey_energy = np.empty((n_out, 2))
@@ -1134,22 +1125,24 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 
     t = 0.0
     seg = zero
-    gnow = _grounds(ag, ug, vg, dt_rec, seg, 0.0, gnow)
-    _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+    if ground is not None:
+        _fill_grounds(ground, dt_rec, seg, 0.0, ground[6])
+    _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
     # First output sample at t = 0.
     out_time[0] = 0.0
-    for j in range(n):
-        out_shear[0, j] = shear[j]
-    _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, 0)
+    _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, 0)
     for i in range(S):
         out_state[0, i] = y[i]
     for j in range(n):
         out_acc[0, j] = k1[n + j]
     for c in range(nc):
         out_force[0, c] = 0.0
-    _store_grounds(out_ag, 0, gnow)
-    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
+    out_ag[0] = _ground(ag, dt_rec, seg, 0.0)
+    if ground is not None:
+        for g in range(n_ground):
+            out_support[0, g] = ground[6][0, g]
+    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground)
     i_out = 1
 
     h = first_step
@@ -1174,9 +1167,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         n_retake = zero
         for c in range(nc):
             pending[c] = EVENT_NONE
-        for hi in range(nh):
-            spending[hi] = STOREY_NONE
-        collapse_pending = False
+        if storey is not None:
+            for hi in range(nh):
+                spending[hi] = STOREY_NONE
+            collapse_pending = False
         while True:
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
@@ -1184,35 +1178,41 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             # ---- Dormand–Prince stages -----------------------------------
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C2 * h_try, gnow)
-            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C2 * h_try, ground[6])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C3 * h_try, gnow)
-            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C3 * h_try, ground[6])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C4 * h_try, gnow)
-            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C4 * h_try, ground[6])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + C5 * h_try, gnow)
-            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C5 * h_try, ground[6])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + h_try, gnow)
-            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
+            _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey, ground)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + h_try, gnow)
-            _rhs(ynew, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
+            _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey, ground)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -1234,8 +1234,11 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         finite = False
                     elif r > err:
                         err = r
-            for hi in range(nh):
-                if finite:
+            if storey is not None:
+                storey_tol = storey[8]
+                for hi in range(nh):
+                    if not finite:
+                        break
                     i = ih + hi
                     e = h_try * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
                     r = abs(e) / (storey_tol[hi] + rtol * max(abs(y[i]), abs(ynew[i])))
@@ -1251,28 +1254,43 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_retake = zero
                 for c in range(nc):
                     pending[c] = EVENT_NONE
-                for hi in range(nh):
-                    spending[hi] = STOREY_NONE
-                collapse_pending = False
+                if storey is not None:
+                    for hi in range(nh):
+                        spending[hi] = STOREY_NONE
+                    collapse_pending = False
                 continue
             for c in range(nc):
                 forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
             # ---- contact events inside the step ------------------------------
-            # δ over the step is the Hermite cubic of the total displacements: each floor's
-            # displacement over its own ground plus the contact's differential ground motion
-            # (itself a cubic within a record step, so the interpolant stays exact for it).
-            g0 = _grounds(ag, ug, vg, dt_rec, seg, t, g0)
-            g1 = _grounds(ag, ug, vg, dt_rec, seg, t + h_try, g1)
+            # With several grounds δ is the Hermite cubic of the total displacements: each floor's
+            # displacement over its own ground plus the contact's differential ground motion (itself
+            # a cubic within a record step, so the interpolant reproduces it exactly).
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t, ground[7])
+                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[8])
             s_first = 2.0
             for c in range(nc):
                 event_s[c] = -1.0
                 event_kind[c] = EVENT_NONE
                 lf = cl[c]
                 rf = cr[c]
-                d0 = y[lf] - y[rf] + _ground_offset(g0, cgl, cgr, c, 2) - cgap[c]
-                r0 = y[n + lf] - y[n + rf] + _ground_offset(g0, cgl, cgr, c, 1)
-                d1 = ynew[lf] - ynew[rf] + _ground_offset(g1, cgl, cgr, c, 2) - cgap[c]
-                r1 = ynew[n + lf] - ynew[n + rf] + _ground_offset(g1, cgl, cgr, c, 1)
+                od0 = ov0 = oa0 = od1 = ov1 = oa1 = 0.0
+                if ground is not None:
+                    od0 = _ground_offset(ground, ground[7], c, 2)
+                    ov0 = _ground_offset(ground, ground[7], c, 1)
+                    oa0 = _ground_offset(ground, ground[7], c, 0)
+                    od1 = _ground_offset(ground, ground[8], c, 2)
+                    ov1 = _ground_offset(ground, ground[8], c, 1)
+                    oa1 = _ground_offset(ground, ground[8], c, 0)
+                    d0 = y[lf] - y[rf] + od0 - cgap[c]
+                    r0 = y[n + lf] - y[n + rf] + ov0
+                    d1 = ynew[lf] - ynew[rf] + od1 - cgap[c]
+                    r1 = ynew[n + lf] - ynew[n + rf] + ov1
+                else:
+                    d0 = y[lf] - y[rf] - cgap[c]
+                    r0 = y[n + lf] - y[n + rf]
+                    d1 = ynew[lf] - ynew[rf] - cgap[c]
+                    r1 = ynew[n + lf] - ynew[n + rf]
                 floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
@@ -1289,10 +1307,11 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             mid = 0.5 * (lo + hi)
                             for i in range(S):
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
-                            gnow = _grounds(ag, ug, vg, dt_rec, seg, t + mid * h_try, gnow)
-                            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1,
+                            if ground is not None:
+                                _fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground[6])
+                            _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
-                                 fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                                 fbuf, forces, storey, ground)
                             if forces[c] < 0.0:
                                 hi = mid
                             else:
@@ -1305,12 +1324,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     kind = EVENT_SEPARATE
                     for which in range(kernels.switch_count(claw[c], cprm[c])):
                         sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
-                                              y[lf] + _ground_offset(g0, cgl, cgr, c, 2),
-                                              y[n + lf] + _ground_offset(g0, cgl, cgr, c, 1),
-                                              ynew[lf] + _ground_offset(g1, cgl, cgr, c, 2),
-                                              ynew[n + lf] + _ground_offset(g1, cgl, cgr, c, 1),
-                                              k1[n + lf] + _ground_offset(g0, cgl, cgr, c, 0),
-                                              k7[n + lf] + _ground_offset(g1, cgl, cgr, c, 0),
+                                              y[lf] + od0, y[n + lf] + ov0, ynew[lf] + od1, ynew[n + lf] + ov1,
+                                              k1[n + lf] + oa0, k7[n + lf] + oa1,
                                               y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
                                               y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_try)
                         if sw >= 0.0 and (s < 0.0 or sw < s):
@@ -1321,21 +1336,25 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     event_kind[c] = kind
                     if s < s_first:
                         s_first = s
-            for hi in range(nh):
-                j = sfloor[hi]
-                s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j], smode[hi],
-                                        h_try)
-                sev_s[hi] = s
-                sev_kind[hi] = kind
-                if kind != STOREY_NONE and s < s_first:
-                    s_first = s
             collapse_s = -1.0
-            if stop_ratio > 0.0:
-                collapse_s, collapse_at = _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio, h_try)
-                if collapse_s >= 0.0:
-                    collapse_floor = collapse_at
-                    if collapse_s < s_first:
-                        s_first = collapse_s
+            if storey is not None:
+                smodel, sprm, heights, stop_ratio, smode, sfloor = (storey[0], storey[1], storey[4], storey[5],
+                                                                    storey[6], storey[7])
+                for hi in range(nh):
+                    j = sfloor[hi]
+                    s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j],
+                                            smode[hi], h_try)
+                    sev_s[hi] = s
+                    sev_kind[hi] = kind
+                    if kind != STOREY_NONE and s < s_first:
+                        s_first = s
+                if stop_ratio > 0.0:
+                    collapse_s, collapse_at = _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio,
+                                                                 h_try)
+                    if collapse_s >= 0.0:
+                        collapse_floor = collapse_at
+                        if collapse_s < s_first:
+                            s_first = collapse_s
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 for c in range(nc):
@@ -1344,15 +1363,18 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
                     status = STATUS_COLLAPSED
                     break
-                for hi in range(nh):
-                    if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
-                        sev_kind[hi] = STOREY_NONE
-                n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
-                gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
+                n_storey = zero
+                if storey is not None:
+                    for hi in range(nh):
+                        if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
+                            sev_kind[hi] = STOREY_NONE
+                    n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+                if ground is not None:
+                    _fill_grounds(ground, dt_rec, seg, t, ground[6])
                 impacts, n_imp, n_applied, cap, status = _apply_events(
-                    event_kind, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize,
+                    event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
-                    impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear)
+                    impacts, n_imp, open_imp, storey, ground)
                 n_applied += n_storey
                 if t - window_start > dt_rec:
                     window_start = t
@@ -1362,26 +1384,30 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     status = STATUS_EVENT_LIMIT
                 if status != 0:
                     break
-                gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
-                _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                if ground is not None:
+                    _fill_grounds(ground, dt_rec, seg, t, ground[6])
+                _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
+                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
                 for c in range(nc):
                     pending[c] = EVENT_NONE
-                for hi in range(nh):
-                    spending[hi] = STOREY_NONE
-                collapse_pending = False
+                if storey is not None:
+                    for hi in range(nh):
+                        spending[hi] = STOREY_NONE
+                    collapse_pending = False
                 n_retake = zero
                 continue
             if s_first < 1.0 - EVENT_END_TOLERANCE and n_retake < MAX_RETAKES:
                 # Retake the step to end at the first event; the retaken step is searched again.
                 for c in range(nc):
                     pending[c] = event_kind[c] if event_kind[c] != EVENT_NONE and event_s[c] <= s_first else EVENT_NONE
-                for hi in range(nh):
-                    spending[hi] = sev_kind[hi] if sev_kind[hi] != STOREY_NONE and sev_s[hi] <= s_first else STOREY_NONE
-                collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
+                if storey is not None:
+                    for hi in range(nh):
+                        spending[hi] = (sev_kind[hi] if sev_kind[hi] != STOREY_NONE and sev_s[hi] <= s_first
+                                        else STOREY_NONE)
+                    collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
                 h_try = s_first * h_try
                 n_retake += 1
                 continue
@@ -1428,13 +1454,17 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             elif closed[c]:
                 lf = cl[c]
                 rf = cr[c]
+                od0 = ov0 = oa0 = od1 = ov1 = oa1 = 0.0
+                if ground is not None:
+                    od0 = _ground_offset(ground, ground[7], c, 2)
+                    ov0 = _ground_offset(ground, ground[7], c, 1)
+                    oa0 = _ground_offset(ground, ground[7], c, 0)
+                    od1 = _ground_offset(ground, ground[8], c, 2)
+                    ov1 = _ground_offset(ground, ground[8], c, 1)
+                    oa1 = _ground_offset(ground, ground[8], c, 0)
                 fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
-                                              y[lf] + _ground_offset(g0, cgl, cgr, c, 2),
-                                              y[n + lf] + _ground_offset(g0, cgl, cgr, c, 1),
-                                              ynew[lf] + _ground_offset(g1, cgl, cgr, c, 2),
-                                              ynew[n + lf] + _ground_offset(g1, cgl, cgr, c, 1),
-                                              k1[n + lf] + _ground_offset(g0, cgl, cgr, c, 0),
-                                              k7[n + lf] + _ground_offset(g1, cgl, cgr, c, 0), y[rf], y[n + rf], ynew[rf], ynew[n + rf],
+                                              y[lf] + od0, y[n + lf] + ov0, ynew[lf] + od1, ynew[n + lf] + ov1,
+                                              k1[n + lf] + oa0, k7[n + lf] + oa1, y[rf], y[n + rf], ynew[rf], ynew[n + rf],
                                               k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
@@ -1464,9 +1494,13 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             s = (t_o - t) / h_used
             for i in range(S):
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t_o, gnow)
-            _rhs(ystage, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            ag_o = _ground(ag, dt_rec, seg, t_o)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t_o, ground[6])
+                for g in range(n_ground):
+                    out_support[i_out, g] = ground[6][0, g]
+            _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1474,11 +1508,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_acc[i_out, j] = k2[n + j]
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
-            _store_grounds(out_ag, i_out, gnow)
-            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
-            for j in range(n):
-                out_shear[i_out, j] = shear[j]
-            _storey_energy(ystage, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i_out)
+            out_ag[i_out] = ag_o
+            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm, ground)
+            _storey_outputs(ystage, n, nc, below, kst, storey, out_shear, out_storey_energy, i_out)
             i_out += 1
         # ---- accept ---------------------------------------------------------
         t = t_new
@@ -1490,18 +1522,21 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         for c in range(nc):
             if event_kind[c] == EVENT_NONE:
                 event_kind[c] = pending[c]
-        if collapse_s >= 0.0 or collapse_pending:
-            status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
-            break
-        for hi in range(nh):
-            if sev_kind[hi] == STOREY_NONE:
-                sev_kind[hi] = spending[hi]
-        n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
-        gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
+        n_storey = zero
+        if storey is not None:
+            if collapse_s >= 0.0 or collapse_pending:
+                status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
+                break
+            for hi in range(nh):
+                if sev_kind[hi] == STOREY_NONE:
+                    sev_kind[hi] = spending[hi]
+            n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+        if ground is not None:
+            _fill_grounds(ground, dt_rec, seg, t, ground[6])
         impacts, n_imp, n_applied, cap, status = _apply_events(
-            event_kind, t, y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+            event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
-            smodel, sprm, sidx, kpd, smode, shear)
+            storey, ground)
         n_applied += n_storey
         if n_applied > 0:
             if t - window_start > dt_rec:
@@ -1510,9 +1545,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             window_events += n_applied
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
-            _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t, ground[6])
+            _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1537,20 +1573,23 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_state[i2, i] = y[i]
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
-            gnow = _grounds(ag, ug, vg, dt_rec, seg, t, gnow)
-            _rhs(y, gnow, fground, cgl, cgr, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t, ground[6])
+            _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
-            for j in range(n):
-                out_shear[i2, j] = shear[j]
-            _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i2)
-            _store_grounds(out_ag, i2, gnow)
-            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, gnow, cgl, cgr)
+            _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, i2)
+            out_ag[i2] = _ground(ag, dt_rec, seg, t)
+            if ground is not None:
+                for g in range(n_ground):
+                    out_support[i2, g] = ground[6][0, g]
+            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground)
         i_out = n_out
     if status != STATUS_COLLAPSED:
         collapse_floor = zero - 1
     return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out], out_pot[:i_out],
+            out_support[:i_out],
             peak_u, peak_drift, peak_force,
             impacts[:n_imp], trace[:n_trace], out_shear[:i_out], out_storey_energy[:i_out], y, collapse_floor,
             n_steps, n_rej, status, t)
@@ -1562,6 +1601,31 @@ jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Di
                               [__file__, kernels.__file__, contact_laws.__file__, storeys.__file__,
                                hysteresis.__file__])
 jit.load_from_cache_without_refresh(_integrate)
+
+
+def _storey_arguments(system: System, atol: float) -> tuple | None:
+    """The compiled integrator's *storey* argument: None for linear elastic storeys without
+    P-Delta or collapse limit (the integrator then compiles without any storey code), else
+    ``(model, parameters, state index, P-Delta stiffness, height, stop ratio, mode, floor of
+    each state, tolerance of each state)``.
+
+    A state's tolerance is atol for a bilinear storey's plastic drift (m) and atol/u_y for
+    Bouc–Wen's dimensionless z; its mode (a fresh array: the integrator changes it) starts elastic.
+    """
+    if system.n_hysteretic == 0 and not np.any(system.p_delta_stiffness) and system.stop_drift_ratio <= 0.0:
+        return None
+    floors = np.flatnonzero(system.storey_state >= 0)
+    state_floor = np.empty(floors.size, dtype=np.int64)
+    state_floor[system.storey_state[floors]] = floors
+    bilinear = system.storey_model[state_floor] == hysteresis.MODEL_BILINEAR
+    tolerance = np.where(bilinear, atol, atol / np.where(bilinear, 1.0, system.storey_parameters[state_floor, 0]))
+    return (np.ascontiguousarray(system.storey_model, dtype=np.int64),
+            np.ascontiguousarray(system.storey_parameters, dtype=np.float64),
+            np.ascontiguousarray(system.storey_state, dtype=np.int64),
+            np.ascontiguousarray(system.p_delta_stiffness, dtype=np.float64),
+            np.ascontiguousarray(system.storey_height, dtype=np.float64),
+            float(system.stop_drift_ratio), np.zeros(floors.size, dtype=np.int64), state_floor,
+            np.ascontiguousarray(tolerance, dtype=np.float64))
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,
@@ -1590,12 +1654,11 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         Initial state relative to the ground (m, m/s); default at rest.  All
         contacts start open.
     """
-    # A fresh writable copy: a read-only array would compile a second specialisation.
-    # One ground: a 1-D array (the single-record specialisation); several: one row each.
-    ag = np.array(ground_acceleration, dtype=np.float64, copy=True, order="C")
-    if ag.ndim == 2 and ag.shape[0] == 1:
-        ag = np.ascontiguousarray(ag[0])
-    vg, ug = ground_kinematics(ag, float(time_step)) if ag.ndim == 2 else (np.zeros((1, 1)), np.zeros((1, 1)))
+    # A fresh writable copy: a read-only array would compile a second specialisation.  One ground:
+    # a 1-D array (ground None: the single-record solver); several: one row each (row 0 also as *ag*).
+    rows = np.array(np.atleast_2d(ground_acceleration), dtype=np.float64, copy=True, order="C")
+    ag = np.ascontiguousarray(rows[0]).copy()
+    ground = _ground_arguments(system, rows, float(time_step)) if rows.shape[0] > 1 else None
     # Independent of output_dt, so the step sequence (and every peak) is the same whatever the output sampling.
     first_step = 0.1 * time_step
     y_initial = np.zeros(2 * system.n_floors)
@@ -1607,22 +1670,29 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
                      system.dense_offset, system.dense_values, system.contact_left,
                      system.contact_right, system.contact_gap, system.contact_law,
-                     system.contact_parameters, system.storey_model, system.storey_parameters,
-                     system.storey_state, system.p_delta_stiffness, system.storey_height,
-                     float(system.stop_drift_ratio), ag, ug, vg, np.asarray(system.floor_ground, dtype=np.int64),
-                     np.asarray(system.contact_ground_left, dtype=np.int64),
-                     np.asarray(system.contact_ground_right, dtype=np.int64), float(time_step), float(duration), float(rtol),
+                     system.contact_parameters, _storey_arguments(system, float(atol)), ground, ag, float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
-    (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, shear,
+    (time, state, acc, force, ag_out, potential, support, peak_u, peak_drift, peak_force, impacts, trace, shear,
      storey_energy, final_state, collapse_floor, n_steps, n_rej, status, t_final) = raw
-    return RawSolution(time, state, acc, force, ag_out[:, 0].copy(), potential, peak_u, peak_drift, peak_force,
+    return RawSolution(time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
                        impacts[:, IMP_VELOCITY], impacts[:, IMP_CONSTANT], impacts[:, IMP_PEAK_FORCE],
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],
                        impacts[:, IMP_WORK], trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
                        shear, storey_energy, final_state.copy(), int(collapse_floor),
-                       int(n_steps), int(n_rej), int(status), float(t_final), ag_out)
+                       int(n_steps), int(n_rej), int(status), float(t_final),
+                       None if ground is None else support)
+
+
+def _ground_arguments(system: System, rows: np.ndarray, time_step: float) -> tuple:
+    """The solver's *ground* tuple for several grounds (rows of *rows*, m/s², step *time_step* s)."""
+    velocity, displacement = ground_kinematics(rows, time_step)
+    n_ground = rows.shape[0]
+    return (rows, displacement, velocity, np.asarray(system.floor_ground, dtype=np.int64),
+            np.asarray(system.contact_ground_left, dtype=np.int64),
+            np.asarray(system.contact_ground_right, dtype=np.int64),
+            np.zeros((3, n_ground)), np.zeros((3, n_ground)), np.zeros((3, n_ground)))
 
 
 def ground_kinematics(acceleration: np.ndarray, time_step: float) -> tuple[np.ndarray, np.ndarray]:
