@@ -490,18 +490,16 @@ def check_memory(needed: float, *, what: str, fix: str) -> None:
 
 
 def model_inputs(model: Model) -> list[str]:
-    """Files a model run reads: the model file and, if it is a file, the record."""
+    """Files a model run reads: the model file and, if they are files, the records (one per building or one)."""
     found = [str(model.path)] if getattr(model, "path", None) else []
-    spec = model.ground_motion
-    record = getattr(spec, "record", None)
-    if isinstance(record, str) and record.strip():
-        from pathlib import Path
-
-        path = Path(record.strip()).expanduser()
-        if not path.is_absolute() and spec.base_dir is not None:
-            path = Path(spec.base_dir) / path
-        if path.exists():
-            found.append(str(path))
+    for spec in getattr(model, "building_ground_motions", ()) or (model.ground_motion,):
+        record = getattr(spec, "record", None)
+        if isinstance(record, str) and record.strip():
+            path = Path(record.strip()).expanduser()
+            if not path.is_absolute() and spec.base_dir is not None:
+                path = Path(spec.base_dir) / path
+            if path.exists() and str(path) not in found:
+                found.append(str(path))
     return found
 
 

@@ -372,3 +372,12 @@ def test_a_python_record_per_building_is_accepted():
     record = Record("pulse", "pulse", 0.01, np.r_[np.zeros(5), np.ones(10), np.zeros(5)])
     ds = pounding.simulate(model, record)
     assert float(ds.time[-1]) == pytest.approx(0.19 + 0.3, abs=1e-9)
+
+
+def test_every_building_record_file_is_an_input_of_the_run(tmp_path):
+    # The CLI refuses to write its archive over a file the run reads: each building's record counts.
+    from pounding.simulation import model_inputs
+
+    _records(tmp_path)
+    model = _model(tmp_path, gm_a="ground_motion: {record: a.txt}", gm_b="ground_motion: {record: b.txt}")
+    assert model_inputs(model) == [str(tmp_path / "small.yaml"), str(tmp_path / "a.txt"), str(tmp_path / "b.txt")]
