@@ -749,6 +749,10 @@ def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, prm, mode, h):
         plastic = y[ih + hi]
         e0 = d0 - plastic
         e1 = d1 - plastic
+        # The Hermite cubic stays within max(|e0|, |e1|) + (4/27)·h·(|r0| + |r1|) (its basis
+        # functions' bounds): most steps are far from the yield surface and need no search.
+        if max(abs(e0), abs(e1)) + 0.25 * h * (abs(r0) + abs(r1)) < uy:
+            return -1.0, STOREY_NONE
         floor = DELTA_ROUNDOFF * (abs(d0) + abs(plastic) + uy)
         s = _first_crossing(e0 - uy, r0, e1 - uy, r1, h, True, floor)
         kind = STOREY_YIELD_POSITIVE
