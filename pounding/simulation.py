@@ -124,6 +124,15 @@ def assemble(model: Model, building_ground: Any = None) -> System:
         gaps.append(gap.gap)
         laws.append(gap.law.law_id)
         params.append(gap.law.kernel_parameters(mass_all[lf], mass_all[rf]))
+    # Links follow the contacts in the same arrays: elements engaged from the start, gap 0, never open.
+    for link in model.links:
+        left.append(model.floor_offset(link.left) + link.level_left - 1)
+        right.append(model.floor_offset(link.right) + link.level_right - 1)
+        ground_left.append(rows[link.left])     # a link's ends move with their own buildings' grounds
+        ground_right.append(rows[link.right])
+        gaps.append(0.0)
+        laws.append(link.law.law_id)
+        params.append(link.law.kernel_parameters())
 
     return System(
         mass=np.ascontiguousarray(mass_all, dtype=float),

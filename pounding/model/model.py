@@ -34,6 +34,7 @@ from pounding.model import schema
 from pounding.model.document import DataSource
 from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
+from pounding.contact.links import LinkLaw
 from pounding.errors import ModelError, PoundingError, did_you_mean
 from pounding.records.catalogue import is_catalogued
 from pounding.units import STANDARD_GRAVITY
@@ -42,6 +43,7 @@ __all__ = [
     "Damping",
     "Building",
     "GapElement",
+    "Link",
     "GroundMotionSpec",
     "SolverSettings",
     "Model",
@@ -339,6 +341,31 @@ class GapElement:
 
 
 @dataclass(frozen=True)
+class Link:
+    """A permanent link (damper) between floor ``level_left`` of building ``left``
+    and floor ``level_right`` of building ``right = left + 1``: always engaged,
+    no gap, pulls as well as pushes (docs/physics.md §9).
+
+    Attributes
+    ----------
+    entry : int
+        Index of the YAML ``links`` entry it came from.
+    left, right : int
+        Building indices (left to right).
+    level_left, level_right : int
+        1-based floor numbers.
+    law : LinkLaw
+    """
+
+    entry: int
+    left: int
+    right: int
+    level_left: int
+    level_right: int
+    law: LinkLaw
+
+
+@dataclass(frozen=True)
 class GroundMotionSpec:
     """Which record to apply and how.
 
@@ -477,6 +504,8 @@ class Model:
         Left to right.
     gaps : tuple of GapElement
         One per joined floor pair, in ``contacts`` order.
+    links : tuple of Link
+        One per linked floor pair, in ``links`` order (default: none).
     ground_motion : GroundMotionSpec
     solver : SolverSettings
     source : str
@@ -502,11 +531,13 @@ class Model:
     source: str
     path: str | None = None
     building_ground_motions: tuple = ()
+    links: tuple[Link, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "buildings", tuple(self.buildings))
         object.__setattr__(self, "gaps", tuple(self.gaps))
-        for gap in self.gaps:
+        object.__setattr__(self, "links", tuple(self.links))
+        for gap in self.gaps + self.links:
             if not (0 <= gap.left < len(self.buildings) - 1 and gap.right == gap.left + 1):
                 raise ModelError(f"gap element joins buildings {gap.left} and {gap.right}, which are not "
                                  "adjacent in the row")
@@ -636,6 +667,12 @@ class Model:
             left, right = self.buildings[gaps[0].left].name, self.buildings[gaps[0].right].name
             pairs = ", ".join(f"{left}{g.level_left}-{right}{g.level_right}" for g in gaps)
             lines.append(f"contact {contact}: {pairs}; gap {gaps[0].gap:g} m, {gaps[0].law.describe()}")
+        for index in sorted({link.entry for link in self.links}):
+            mine = [link for link in self.links if link.entry == index]
+            left, right = self.buildings[mine[0].left].name, self.buildings[mine[0].right].name
+            pairs = ", ".join(f"{left}{k.level_left}-{right}{k.level_right}" for k in mine)
+            lines.append(f"link {index}: {pairs}; {mine[0].law.describe()}")
+
         def describe(gm: GroundMotionSpec) -> str:
             return (f"{gm.record} {gm.describe_scale()}"
                     + (f", processing {gm.processing.to_document()}" if gm.processing is not None else "")
@@ -673,8 +710,18 @@ class Model:
             }
             entry.update(first.law.model_dump(mode="json"))
             contacts.append(entry)
+        links = []
+        for index in sorted({link.entry for link in self.links}):
+            mine = [link for link in self.links if link.entry == index]
+            first = mine[0]
+            entry = {"between": [self.buildings[first.left].name, self.buildings[first.right].name],
+                     "levels": [[link.level_left, link.level_right] for link in mine]}
+            entry.update(first.law.model_dump(mode="json"))
+            links.append(entry)
         buildings = [_building_document(b) for b in self.buildings]
         document: dict[str, Any] = {"name": self.name, "buildings": buildings, "contacts": contacts}
+        if links:
+            document["links"] = links
         if self.building_ground_motions:
             for building, spec in zip(buildings, self.building_ground_motions):
                 building["ground_motion"] = spec.to_document()
@@ -742,6 +789,9 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
                                   p_delta=b.p_delta, **arrays))
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters)
                  for index, c in enumerate(entry.contacts) for a, r in c.pairs)
+    links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)
+                  for index, e in enumerate(entry.links) for a, r in e.pairs)
+
     def spec(gm: schema.GroundMotionEntry) -> GroundMotionSpec:
         return _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
                         units=gm.units, base_dir=base_dir, processing=gm.processing, wave_passage=gm.wave_passage)
@@ -751,7 +801,7 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
     solver = _trusted(SolverSettings, **entry.solver.model_dump())
     return _trusted(Model, name=entry.name or name, buildings=tuple(buildings), gaps=gaps,
                     ground_motion=ground_motion, solver=solver, source=text, path=path,
-                    building_ground_motions=own)
+                    building_ground_motions=own, links=links)
 
 
 def model_from_text(text: str, *, name: str = "model", path: str | None = None,

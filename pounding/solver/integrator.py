@@ -70,6 +70,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws as contact_laws
+from pounding.contact import links as contact_links
 from pounding import hysteresis
 from pounding.solver import kernels
 from pounding.solver import jit
@@ -395,7 +396,10 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 rate = y[n + cl[c]] - y[n + cr[c]] + _ground_offset(ground, ground[6], c, 1)
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
-            out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
+            if kernels.is_permanent(claw[c]):
+                out[2 * n + 2 * nc + c] = kernels.link_internal_rate(claw[c], cprm[c], rate, q)
+            else:
+                out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
         forces[c] = f
         fbuf[cl[c]] += f
         fbuf[cr[c]] -= f
@@ -644,6 +648,38 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
             f = kernels.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
             if f > best:
                 best = f
+    return best
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _peak_magnitude(values) -> float:
+    """Largest |value| of equally spaced samples, refined by a parabola through the largest and its neighbours.
+
+    For a link's force over a step (it pulls as well as pushes): the samples
+    of :func:`_closed_contact_samples`.  A largest sample at either end of
+    the step uses the parabola through the three samples at that end, and its
+    vertex is accepted up to half a sample spacing beyond the step (a peak
+    that falls between two steps' end samples is found by one of them).
+    """
+    best = 0.0
+    best_i = 0
+    m = values.size
+    for i in range(m):
+        if abs(values[i]) > best:
+            best = abs(values[i])
+            best_i = i
+    if m < 3:
+        return best
+    centre = min(max(best_i, 1), m - 2)
+    fm, f0, fp = abs(values[centre - 1]), abs(values[centre]), abs(values[centre + 1])
+    denom = fm - 2.0 * f0 + fp
+    if denom < 0.0:
+        offset = 0.5 * (fm - fp) / denom
+        where = centre + offset
+        if -0.5 <= where <= m - 0.5:
+            top = f0 - 0.25 * (fm - fp) * offset
+            if top > best:
+                best = top
     return best
 
 
@@ -1126,6 +1162,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     open_imp = np.empty(nc, dtype=np.int64)
     for c in range(nc):
         open_imp[c] = -1
+        closed[c] = kernels.is_permanent(claw[c])  # links are engaged from the start and never open
 
     t = 0.0
     seg = zero
@@ -1298,6 +1335,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
+                if kernels.is_permanent(claw[c]):
+                    continue  # a link has no events
                 if not closed[c]:
                     s = _first_crossing(d0, r0, d1, r1, h_try, True, floor)
                     kind = EVENT_CLOSE
@@ -1448,7 +1487,19 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if v > peak_drift[j]:
                     peak_drift[j] = v
         for c in range(nc):
-            if closed[c] and cmode[c] == kernels.MODE_STUCK:
+            if kernels.is_permanent(claw[c]):
+                # A link: peak |F| on the step's interpolant (no trace: it is engaged at every step).
+                lf = cl[c]
+                rf = cr[c]
+                _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
+                                        y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
+                                        y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
+                                        y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_used, fractions, deltas,
+                                        values)
+                fpk = _peak_magnitude(values)
+                if fpk > peak_force[c]:
+                    peak_force[c] = fpk
+            elif closed[c] and cmode[c] == kernels.MODE_STUCK:
                 fpk = forces_end[c]
                 if fpk > peak_force[c]:
                     peak_force[c] = fpk
@@ -1603,7 +1654,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 # its cached code is stale when any of the three files changes.
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
                               [__file__, kernels.__file__, contact_laws.__file__, storeys.__file__,
-                               hysteresis.__file__])
+                               hysteresis.__file__, contact_links.__file__])
 jit.load_from_cache_without_refresh(_integrate)
 
 
