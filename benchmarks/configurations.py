@@ -29,6 +29,9 @@ from _output import add_output_arguments, out_dir  # noqa: E402
 #: name → (model of the configuration, the plain model of the same size it is compared with)
 CASES: dict[str, tuple[str, str]] = {
     "pair_links": ("models/pair_links.yaml", "models/pair.yaml"),   # Maxwell links at A4-B4, A5-B5 (issue 16)
+    # Wave passage (issue 16 part 4): pair.yaml with B's ground lagged 0.3 s; the lagged run lasts 0.3 s
+    # longer (the whole record reaches B), about 1 % more simulated time.
+    "pair_wave_passage": ("models/pair_wave_passage.yaml", "models/pair.yaml"),
 }
 
 #: The criterion: a configuration may cost at most this many times its plain comparison.

@@ -12,6 +12,8 @@ from __future__ import annotations
 import json
 import os
 import time as _time
+import dataclasses
+from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -32,7 +34,8 @@ from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import run_peaks, to_dataset
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "simulate", "simulate_peaks", "record_for", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
+__all__ = ["assemble", "simulate", "simulate_peaks", "record_for", "support_motions", "SupportMotions", "rerun",
+           "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
 
 #: Energy closure error above which a run is flagged (attribute ``status``, summary
@@ -59,13 +62,18 @@ def record_path(spec: str) -> str:
     return os.path.abspath(os.path.expanduser(text))
 
 
-def assemble(model: Model) -> System:
+def assemble(model: Model, building_ground: Any = None) -> System:
     """Flatten a model into the arrays the compiled integrator works on.
 
     Floors of all buildings are concatenated left to right.  Rayleigh damping
     stays tridiagonal (``a0·M + a1·K`` acts storey by storey); modal damping
-    is stored as one dense block per building.
+    is stored as one dense block per building.  *building_ground* gives, per
+    building, its row of the ground-acceleration array (default: one common
+    ground, row 0); each gap element's two sides take the rows of their
+    buildings (``System.contact_ground_left/right``): the place where a new
+    kind of contact (a wall, a link) says which ground moves each of its ends.
     """
+    rows = [0] * len(model.buildings) if building_ground is None else [int(r) for r in building_ground]
     masses, stiffness, below, a0, a1 = [], [], [], [], []
     dense_start, dense_size, dense_offset, dense_values = [], [], [], []
     offset = 0
@@ -104,13 +112,15 @@ def assemble(model: Model) -> System:
     yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
     storey_state = np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64)
 
-    left, right, gaps, laws, params = [], [], [], [], []
+    left, right, gaps, laws, params, ground_left, ground_right = [], [], [], [], [], [], []
     mass_all = np.concatenate(masses)
     for gap in model.gaps:
         lf = model.floor_offset(gap.left) + gap.level_left - 1
         rf = model.floor_offset(gap.right) + gap.level_right - 1
         left.append(lf)
         right.append(rf)
+        ground_left.append(rows[gap.left])
+        ground_right.append(rows[gap.right])
         gaps.append(gap.gap)
         laws.append(gap.law.law_id)
         params.append(gap.law.kernel_parameters(mass_all[lf], mass_all[rf]))
@@ -118,6 +128,8 @@ def assemble(model: Model) -> System:
     for link in model.links:
         left.append(model.floor_offset(link.left) + link.level_left - 1)
         right.append(model.floor_offset(link.right) + link.level_right - 1)
+        ground_left.append(rows[link.left])     # a link's ends move with their own buildings' grounds
+        ground_right.append(rows[link.right])
         gaps.append(0.0)
         laws.append(link.law.law_id)
         params.append(link.law.kernel_parameters())
@@ -144,10 +156,14 @@ def assemble(model: Model) -> System:
         p_delta_stiffness=np.ascontiguousarray(np.concatenate(p_delta), dtype=float),
         storey_height=np.ascontiguousarray(np.concatenate(heights), dtype=float),
         stop_drift_ratio=float(model.solver.stop_drift_ratio or 0.0),
+        floor_ground=np.repeat(np.asarray(rows, dtype=np.int64), [b.n_floors for b in model.buildings]),
+        contact_ground_left=np.asarray(ground_left, dtype=np.int64),
+        contact_ground_right=np.asarray(ground_right, dtype=np.int64),
     )
 
 
-def record_for(model: Model, *, factor: float | None = None, where: str = "yaml") -> Record:
+def record_for(model: Model, *, factor: float | None = None, where: str = "yaml",
+               building: int | str | None = None) -> Record:
     """Load the ground motion a model names: read, process, scale.
 
     The record (file, catalogue name or reference, with its units and dt) is
@@ -169,10 +185,13 @@ def record_for(model: Model, *, factor: float | None = None, where: str = "yaml"
         Where the record was named: ``yaml`` (the model file), ``cli`` or
         ``api``; an error about a text record's missing units or dt says how
         to give them there.
+    building : int or str, optional
+        Load this building's own record (``buildings[i].ground_motion``);
+        default: the model-level one.
     """
     from pounding.records.processing import process, scale_record
 
-    spec = model.ground_motion
+    spec = model.ground_motion if building is None else model.ground_motion_of(building)
     record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where)
     record = process(record, spec.processing)
     period = None
@@ -180,6 +199,117 @@ def record_for(model: Model, *, factor: float | None = None, where: str = "yaml"
     if building is not None:
         period = float(model.buildings[model.building_index(building)].periods[0])
     return scale_record(record, spec.scale, period=period, factor=factor)
+
+
+@dataclass(frozen=True)
+class SupportMotions:
+    """The ground motion under every building, on one time grid.
+
+    Attributes
+    ----------
+    rows : (G, ns) ndarray
+        Ground accelerations, m/s², one row per distinct ground (G = 1 when
+        every building sees the same motion at the same time).
+    time_step : float
+        Their common sampling interval, s.
+    building_row : tuple of int
+        Row of each building, left to right.
+    records : tuple of Record
+        The record under each building (scaled and processed; before any lag or resampling).
+    lag_requested, lag : tuple of float
+        Per building: the wave-passage lag asked for, ``(d_b − min d)/c`` (s), and the
+        one applied, rounded to the record step (0 without wave passage).
+    end_time : float
+        Default simulated time, s: the longest record plus its lag.
+    """
+
+    rows: np.ndarray
+    time_step: float
+    building_row: tuple
+    records: tuple
+    lag_requested: tuple
+    lag: tuple
+    end_time: float
+
+
+def _common_step(records: list[Record], names: list[str]) -> float:
+    """The finest time step of *records*; every other must be a whole multiple of it (else one line)."""
+    finest = min(r.time_step for r in records)
+    for record, name in zip(records, names):
+        ratio = record.time_step / finest
+        if abs(ratio - round(ratio)) > 1e-6 * ratio:
+            raise PoundingError(f"the records under the buildings have time steps {finest:g} s and "
+                                f"{record.time_step:g} s (building {name}), not whole multiples of one another; "
+                                "resample one record to the other's step")
+    return finest
+
+
+def _on_step(record: Record, step: float) -> np.ndarray:
+    """*record*'s acceleration sampled every *step* s (a whole fraction of its own): exact for piecewise-linear data."""
+    ratio = int(round(record.time_step / step))
+    if ratio == 1:
+        return np.asarray(record.acceleration, dtype=float)
+    fine = np.arange((record.acceleration.size - 1) * ratio + 1) * step
+    return np.interp(fine, record.time, record.acceleration)
+
+
+def support_motions(model: Model, record: Record | list | tuple | None = None, *, where: str = "yaml") -> SupportMotions:
+    """Load the ground motion of every building and put them on one time grid.
+
+    One model-level record without ``wave_passage``: one row.  With
+    ``wave_passage``, building b receives the record ``a_g(t − τ_b)`` (zero
+    before τ_b), ``τ_b = (d_b − min d)/c`` rounded to the record step (so
+    that every ground shares the solver's breakpoints; error ≤ dt/2).  With
+    per-building records: one row each, on the finest of their time steps
+    (the others must be whole multiples of it: resampling a piecewise-linear
+    record on a finer grid that contains its samples is exact), the shorter
+    ones followed by zeros.  Grounds that come out identical share one row,
+    so a model whose buildings all see the same record at the same time runs
+    exactly as a single-record model.
+
+    *record*: a loaded Record (model-level form) or one Record per building
+    (per-building form) used instead of loading the model's.
+    """
+    names = [b.name for b in model.buildings]
+    if model.has_building_records:
+        if record is None:
+            records = [record_for(model, building=i, where=where) for i in range(len(names))]
+        elif isinstance(record, (list, tuple)) and len(record) == len(names):
+            records = list(record)
+        else:
+            raise PoundingError(f"model '{model.name}' gives each building its own record: pass one Record per "
+                                f"building ({len(names)}), or none to use the model's")
+        step = _common_step(records, names)
+        series = [_on_step(r, step) for r in records]
+        lag_requested = lags = [0.0] * len(names)
+        ends = [(model.ground_motion_of(i).duration or r.duration) for i, r in enumerate(records)]
+    else:
+        motion = record if isinstance(record, Record) else record_for(model, where=where)
+        step = motion.time_step
+        spec = model.ground_motion
+        lag_requested = [spec.lag(name) for name in names]
+        shifts = [int(round(lag / step)) for lag in lag_requested]
+        lags = [k * step for k in shifts]
+        base = np.asarray(motion.acceleration, dtype=float)
+        series = [np.concatenate([np.zeros(k), base]) if k else base for k in shifts]
+        records = [motion] * len(names)
+        ends = [(spec.duration or motion.duration + max(lags))] * len(names)
+    distinct: list[np.ndarray] = []
+    building_row = []
+    for values in series:
+        for row, known in enumerate(distinct):
+            if known.size == values.size and np.array_equal(known, values):
+                building_row.append(row)
+                break
+        else:
+            building_row.append(len(distinct))
+            distinct.append(values)
+    size = max(v.size for v in distinct)
+    rows = np.zeros((len(distinct), size))
+    for row, values in enumerate(distinct):
+        rows[row, :values.size] = values
+    return SupportMotions(rows, float(step), tuple(building_row), tuple(records), tuple(lag_requested),
+                          tuple(lags), float(max(ends)))
 
 
 def simulate(model: Model, record: Record | str | None = None, xi: str | None = None, *,
@@ -251,10 +381,14 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
         model = model.with_ground_motion(**gm_changes)
 
     if isinstance(record, Record):
-        motion = record if scale is None else record.scaled(scale / record.scale)
+        model.refuse_building_records("a record given to simulate()")
+        supports = support_motions(model, record if scale is None else record.scaled(scale / record.scale))
+    elif isinstance(record, (list, tuple)):
+        supports = support_motions(model, list(record))
     else:
-        motion = record_for(model, where=where if isinstance(record, str) else "yaml")
-    end_time = model.ground_motion.duration or motion.duration
+        supports = support_motions(model, where=where if isinstance(record, str) else "yaml")
+    motion = supports.records[0]
+    end_time = supports.end_time
     if end_time <= 0.0:
         raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
 
@@ -263,10 +397,12 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
         raise PoundingError(f"{_where(model)}solver.output_dt is {settings.output_dt:g} s, longer than the simulated "
                             f"{end_time:g} s: no history (and no energy balance) would be stored; use an output_dt "
                             f"well below the duration, e.g. {min(0.01, end_time / 100):g} s")
-    check_memory(estimate_memory(model, end_time, motion.time_step, settings.output_dt),
+    step = supports.time_step
+    check_memory(estimate_memory(model, end_time, step, settings.output_dt) * supports.rows.shape[0],
                  what=f"{_where(model)}this run", fix="shorten ground_motion.duration or raise solver.output_dt")
-    system, raw, wall = _solve(model, motion, end_time, settings.output_dt)
-    ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
+    system, raw, wall, rows = _solve(model, supports, end_time, settings.output_dt)
+    ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall,
+                    supports=dataclasses.replace(supports, rows=rows))
     mark_energy_status(ds)
     return ds
 
@@ -281,35 +417,42 @@ def simulate_peaks(model: Model) -> dict[str, Any]:
     :func:`simulate` (its step sequence does not depend on the output
     sampling), so every peak equals that of ``simulate(model)`` exactly; only
     the two end samples of the histories are stored, which skips the
-    per-sample work and the dataset.  Errors as :func:`simulate`.
+    per-sample work and the dataset.  Errors as :func:`simulate`; a wave
+    passage is applied as there.
     """
-    motion = record_for(model, where="yaml")
-    end_time = model.ground_motion.duration or motion.duration
+    supports = support_motions(model, where="yaml")
+    motion = supports.records[0]
+    end_time = supports.end_time
     if end_time <= 0.0:
         raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
-    system, raw, wall = _solve(model, motion, end_time, end_time)
+    system, raw, wall, _ = _solve(model, supports, end_time, end_time)
     peaks = run_peaks(model, system, raw)
     peaks.update(record_scale=float(motion.scale), wall_time=wall)
     return peaks
 
 
-def _solve(model: Model, motion: Record, end_time: float, output_dt: float):
-    """Integrate *model* under *motion* up to *end_time*: ``(system, raw solution, wall time in s)``."""
+def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: float):
+    """Integrate *model* on its *supports* up to *end_time*: ``(system, raw solution, wall time in s,
+    the ground rows as given to the solver (G, ns))``."""
     settings = model.solver
-    samples_needed = int(np.ceil(end_time / motion.time_step - 1e-9)) + 1
-    ground = np.zeros(max(samples_needed, motion.acceleration.size))
-    ground[: motion.acceleration.size] = motion.acceleration
+    step = supports.time_step
+    samples_needed = int(np.ceil(end_time / step - 1e-9)) + 1
+    ground = np.zeros((supports.rows.shape[0], max(samples_needed, supports.rows.shape[1])))
+    ground[:, : supports.rows.shape[1]] = supports.rows
+    rows = ground
+    if ground.shape[0] == 1:
+        ground = ground[0]
 
-    system = assemble(model)
+    system = assemble(model, supports.building_row)
     started = _time.perf_counter()
-    raw = integrate(system, ground, motion.time_step, end_time, rtol=settings.rtol,
+    raw = integrate(system, ground, step, end_time, rtol=settings.rtol,
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
                     output_dt=output_dt)
     wall = _time.perf_counter() - started
     if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
         raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
-    return system, raw, wall
+    return system, raw, wall, rows
 
 
 def mark_energy_status(ds: xr.Dataset) -> str:
@@ -391,18 +534,16 @@ def check_memory(needed: float, *, what: str, fix: str) -> None:
 
 
 def model_inputs(model: Model) -> list[str]:
-    """Files a model run reads: the model file and, if it is a file, the record."""
+    """Files a model run reads: the model file and, if they are files, the records (one per building or one)."""
     found = [str(model.path)] if getattr(model, "path", None) else []
-    spec = model.ground_motion
-    record = getattr(spec, "record", None)
-    if isinstance(record, str) and record.strip():
-        from pathlib import Path
-
-        path = Path(record.strip()).expanduser()
-        if not path.is_absolute() and spec.base_dir is not None:
-            path = Path(spec.base_dir) / path
-        if path.exists():
-            found.append(str(path))
+    for spec in getattr(model, "building_ground_motions", ()) or (model.ground_motion,):
+        record = getattr(spec, "record", None)
+        if isinstance(record, str) and record.strip():
+            path = Path(record.strip()).expanduser()
+            if not path.is_absolute() and spec.base_dir is not None:
+                path = Path(spec.base_dir) / path
+            if path.exists() and str(path) not in found:
+                found.append(str(path))
     return found
 
 
@@ -425,6 +566,11 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     spec = json.loads(ds.attrs["run_spec"])
     model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
                             path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
+    if model.has_building_records:
+        again = simulate(model, _archived_records(model, spec, name))
+        now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
+        return again
     model = model.with_ground_motion(record=spec["record"], duration=spec["duration"])
     record = record_for(model, factor=spec["scale"])
     expected = spec.get("record_sha256", "")
@@ -438,3 +584,15 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
     return again
+
+
+def _archived_records(model: Model, spec: dict, name: str) -> list[Record]:
+    """Each building's record of a per-building archive, with its archived factor and hash checked."""
+    records = []
+    for i, ground in enumerate(spec.get("grounds", [])):
+        record = record_for(model, building=i, factor=ground["scale"])
+        if ground.get("record_sha256") and record.metadata.get("sha256", "") != ground["record_sha256"]:
+            raise PoundingError(f"{name}: record {ground['record']} under building {ground['building']} has changed "
+                                "since the run was archived; restore the original file")
+        records.append(record)
+    return records

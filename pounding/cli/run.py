@@ -89,6 +89,12 @@ def summary(ds) -> str:
     event = ", ".join(str(meta[k]) for k in ("event", "year", "station", "component") if meta.get(k))
     lines.append(f"model '{ds.attrs['model_name']}' under {ds.attrs['record_name']} x{ds.attrs['record_scale']:g}"
                  f"{f' ({event})' if event else ''}, {ds.attrs['duration']:.2f} s")
+    if ds.attrs.get("multi_support") and "ground" in ds.dims:
+        lines.append(f"ground under each building ({ds.attrs['multi_support']}):")
+        for name in ds.ground.values:
+            g = ds.sel(ground=name)
+            lines.append(f"  {name}: {g.ground_record.item()} x{float(g.ground_scale):g}, lag {float(g.ground_lag):.3g} s, "
+                         f"peak ground displacement {float(np.abs(g.building_ground_displacement).max()):.3g} m")
     periods = json.loads(ds.attrs["periods"])
     lines.append("periods (s):")
     for name, values in periods.items():

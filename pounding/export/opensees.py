@@ -119,6 +119,11 @@ def _prepare(model, record=None, xi=None, duration=None):
     from pounding.records.record import Record
     from pounding.simulation import record_for
 
+    if model.is_multi_support:
+        where = f"{model.path}: " if model.path else ""
+        raise PoundingError(f"{where}the OpenSees export does not support multi-support excitation (a ground motion "
+                            "per building or wave_passage); export the model with one model-level ground_motion "
+                            "without wave_passage")
     if xi is not None:
         model = model.with_xi(xi)
     changes = {}

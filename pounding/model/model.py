@@ -391,6 +391,9 @@ class GroundMotionSpec:
     processing : Processing, optional
         Trimming and baseline correction before scaling
         (:class:`pounding.processing.Processing`; a mapping is parsed).
+    wave_passage : WavePassageEntry, optional
+        ``{apparent_velocity: c (m/s), position: {building: d (m)}}``: building
+        b receives the record with the lag ``(d_b − min d)/c`` (a mapping is parsed).
     """
 
     record: str
@@ -400,10 +403,11 @@ class GroundMotionSpec:
     units: str | None = None
     base_dir: str | None = None
     processing: Any = None
+    wave_passage: Any = None
 
     def __post_init__(self) -> None:
         data = {"record": self.record, "scale": self.scale, "processing": self.processing, "duration": self.duration,
-                "dt": self.dt, "units": self.units}
+                "dt": self.dt, "units": self.units, "wave_passage": self.wave_passage}
         entry = _checked(schema.GroundMotionEntry, data, ("ground_motion",), context={"base_dir": self.base_dir})
         for key in data:
             object.__setattr__(self, key, getattr(entry, key))
@@ -429,7 +433,18 @@ class GroundMotionSpec:
                 out[key] = getattr(self, key)
         if self.processing is not None:
             out["processing"] = self.processing.to_document()
+        if self.wave_passage is not None:
+            out["wave_passage"] = {"apparent_velocity": self.wave_passage.apparent_velocity,
+                                   "position": dict(self.wave_passage.position)}
         return out
+
+    def lag(self, building: str) -> float:
+        """Wave-passage time lag of *building*, s: ``(d_b − min d)/c``; 0 without ``wave_passage``."""
+        wave = self.wave_passage
+        if wave is None:
+            return 0.0
+        first = min(wave.position.values())
+        return (wave.position[building] - first) / wave.apparent_velocity
 
     @property
     def record_path(self) -> Path | None:
@@ -501,6 +516,11 @@ class Model:
         exactly with :func:`model_from_text`.
     path : str or None
         The model file as given by the user.
+    building_ground_motions : tuple of GroundMotionSpec
+        One record per building (``buildings[i].ground_motion`` in the YAML),
+        left to right; empty when one model-level ``ground_motion`` (possibly
+        with ``wave_passage``) moves every building.  With per-building
+        records ``ground_motion`` is the first building's, for display only.
     """
 
     name: str
@@ -510,6 +530,7 @@ class Model:
     solver: SolverSettings
     source: str
     path: str | None = None
+    building_ground_motions: tuple = ()
     links: tuple[Link, ...] = ()
 
     def __post_init__(self) -> None:
@@ -545,6 +566,29 @@ class Model:
         if not 0 <= index < len(names):
             raise ModelError(f"building index {index} is out of range (the model has {len(names)} buildings)")
         return index
+
+    @property
+    def has_building_records(self) -> bool:
+        """True if every building has its own ``ground_motion`` (rather than one for the model)."""
+        return bool(self.building_ground_motions)
+
+    @property
+    def is_multi_support(self) -> bool:
+        """True if the buildings may see different ground motions (own records or a wave-passage lag)."""
+        return self.has_building_records or self.ground_motion.wave_passage is not None
+
+    def ground_motion_of(self, building: int | str) -> GroundMotionSpec:
+        """The ground-motion section that moves *building* (its own, or the model's)."""
+        index = self.building_index(building)
+        return self.building_ground_motions[index] if self.building_ground_motions else self.ground_motion
+
+    def refuse_building_records(self, what: str) -> None:
+        """Raise a one-line ModelError if the model has per-building records: *what* needs one record."""
+        if self.has_building_records:
+            where = f"{self.path}: " if self.path else ""
+            raise ModelError(f"{where}{what} needs one model-level ground_motion, but model '{self.name}' gives "
+                             "each building its own record (buildings[i].ground_motion); edit the records in "
+                             "the model file instead")
 
     def floor_offset(self, b: int | str) -> int:
         """Index of building *b*'s floor 1 in the concatenated floor vector (left to right)."""
@@ -583,8 +627,21 @@ class Model:
         return self._derived(gaps=gaps)
 
     def with_ground_motion(self, **changes: Any) -> Model:
-        """The same model with ground-motion fields changed (record, scale, duration, dt, units, base_dir)."""
+        """The same model with ground-motion fields changed (record, scale, duration, dt, units, base_dir).
+
+        With a record per building only ``duration`` may change (it applies to all).
+
+        Raises
+        ------
+        ModelError
+            The model gives each building its own record (one line).
+        """
         _check_keys("ground_motion", changes, GroundMotionSpec)
+        if self.has_building_records and set(changes) == {"duration"}:
+            # The simulated time applies to every building's record alike.
+            own = tuple(dataclasses.replace(g, **changes) for g in self.building_ground_motions)
+            return self._derived(building_ground_motions=own, ground_motion=own[0])
+        self.refuse_building_records("changing the ground motion (record or scale)")
         return self._derived(ground_motion=dataclasses.replace(self.ground_motion, **changes))
 
     def with_solver(self, **changes: Any) -> Model:
@@ -615,10 +672,21 @@ class Model:
             left, right = self.buildings[mine[0].left].name, self.buildings[mine[0].right].name
             pairs = ", ".join(f"{left}{k.level_left}-{right}{k.level_right}" for k in mine)
             lines.append(f"link {index}: {pairs}; {mine[0].law.describe()}")
+
+        def describe(gm: GroundMotionSpec) -> str:
+            return (f"{gm.record} {gm.describe_scale()}"
+                    + (f", processing {gm.processing.to_document()}" if gm.processing is not None else "")
+                    + (f", first {gm.duration:g} s" if gm.duration is not None else ""))
+
+        if self.building_ground_motions:
+            for b, gm in zip(self.buildings, self.building_ground_motions):
+                lines.append(f"ground motion under {b.name}: {describe(gm)}")
+            return lines
         gm = self.ground_motion
-        lines.append(f"ground motion: {gm.record} {gm.describe_scale()}"
-                     + (f", processing {gm.processing.to_document()}" if gm.processing is not None else "")
-                     + (f", first {gm.duration:g} s" if gm.duration is not None else ""))
+        lines.append(f"ground motion: {describe(gm)}")
+        if gm.wave_passage is not None:
+            lags = ", ".join(f"{b.name} {gm.lag(b.name):.3g} s" for b in self.buildings)
+            lines.append(f"wave passage at {gm.wave_passage.apparent_velocity:g} m/s: lags {lags}")
         return lines
 
     def to_document(self) -> str:
@@ -650,15 +718,16 @@ class Model:
                      "levels": [[link.level_left, link.level_right] for link in mine]}
             entry.update(first.law.model_dump(mode="json"))
             links.append(entry)
-        document = {
-            "name": self.name,
-            "buildings": [_building_document(b) for b in self.buildings],
-            "contacts": contacts,
-            "ground_motion": self.ground_motion.to_document(),
-            "solver": {k: v for k, v in dataclasses.asdict(self.solver).items() if v is not None},
-        }
+        buildings = [_building_document(b) for b in self.buildings]
+        document: dict[str, Any] = {"name": self.name, "buildings": buildings, "contacts": contacts}
         if links:
             document["links"] = links
+        if self.building_ground_motions:
+            for building, spec in zip(buildings, self.building_ground_motions):
+                building["ground_motion"] = spec.to_document()
+        else:
+            document["ground_motion"] = self.ground_motion.to_document()
+        document["solver"] = {k: v for k, v in dataclasses.asdict(self.solver).items() if v is not None}
         return document
 
     def to_yaml(self) -> str:
@@ -722,12 +791,17 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
                  for index, c in enumerate(entry.contacts) for a, r in c.pairs)
     links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)
                   for index, e in enumerate(entry.links) for a, r in e.pairs)
-    gm = entry.ground_motion
-    ground_motion = _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
-                             units=gm.units, base_dir=base_dir, processing=gm.processing)
+
+    def spec(gm: schema.GroundMotionEntry) -> GroundMotionSpec:
+        return _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
+                        units=gm.units, base_dir=base_dir, processing=gm.processing, wave_passage=gm.wave_passage)
+
+    own = tuple(spec(b.ground_motion) for b in entry.buildings) if entry.ground_motion is None else ()
+    ground_motion = own[0] if own else spec(entry.ground_motion)
     solver = _trusted(SolverSettings, **entry.solver.model_dump())
     return _trusted(Model, name=entry.name or name, buildings=tuple(buildings), gaps=gaps,
-                    ground_motion=ground_motion, solver=solver, source=text, path=path, links=links)
+                    ground_motion=ground_motion, solver=solver, source=text, path=path,
+                    building_ground_motions=own, links=links)
 
 
 def model_from_text(text: str, *, name: str = "model", path: str | None = None,

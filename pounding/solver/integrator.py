@@ -39,9 +39,18 @@ Design
   stiffness per storey.  A run stops, located, when a storey's drift ratio
   first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED).
 
-State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh)]``
+State vector layout: ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]``
 (``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force; ``r``: each
-yielding storey's hysteretic state; ``W``: its work ∫F dΔ, J).
+yielding storey's hysteretic state; ``W``: its work ∫F dΔ, J; ``W_g``: the work ∫F·(u̇_g,L − u̇_g,R) dt
+of the contact forces on the differential ground motion, J, 0 with one common ground).
+
+* **Multiple supports.** Each building may stand on its own ground motion (a row of the
+  ground-acceleration array; a different record, or the same one lagged by wave passage).
+  Floors move relative to their own ground; contacts see total displacements, so the
+  differential ground displacement and velocity enter δ and δ̇ (:func:`_ground_offset`),
+  integrated exactly from the piecewise-linear accelerations.  Like *storey*, the *ground*
+  argument is None with one common ground, and every ``if ground is not None`` block is then
+  pruned at compile time: the single-record solver is the plain one.
 
 References
 ----------
@@ -158,6 +167,11 @@ class System:
     p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
     storey_height : (N,) m
     stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
+    floor_ground : (N,) int, row of the ground-acceleration array that moves each floor's building
+        (all 0 with one common ground motion)
+    contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
+        side of each gap element: their differential displacement enters the penetration
+        (``pounding.simulation.assemble``)
     """
 
     mass: np.ndarray
@@ -180,6 +194,9 @@ class System:
     p_delta_stiffness: np.ndarray | None = None
     storey_height: np.ndarray | None = None
     stop_drift_ratio: float = 0.0
+    floor_ground: np.ndarray | None = None
+    contact_ground_left: np.ndarray | None = None
+    contact_ground_right: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # Storey fields left out: linear elastic storeys of unit height, no P-Delta, no collapse check.
@@ -187,7 +204,10 @@ class System:
         defaults = {"storey_model": np.zeros(n, dtype=np.int64),
                     "storey_parameters": np.zeros((n, hysteresis.N_HYSTERESIS_PARAMETERS)),
                     "storey_state": np.full(n, -1, dtype=np.int64),
-                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n)}
+                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n),
+                    "floor_ground": np.zeros(n, dtype=np.int64),
+                    "contact_ground_left": np.zeros(self.contact_gap.size, dtype=np.int64),
+                    "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64)}
         for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)
@@ -207,8 +227,8 @@ class System:
 
     @property
     def n_states(self) -> int:
-        """Length of the state vector."""
-        return 2 * self.n_floors + 3 * self.n_contacts + 2 + 2 * self.n_hysteretic
+        """Length of the state vector (the last state: work of the differential ground motion on the contacts)."""
+        return 2 * self.n_floors + 3 * self.n_contacts + 2 + 2 * self.n_hysteretic + 1
 
 
 @dataclass(frozen=True)
@@ -219,7 +239,7 @@ class RawSolution:
     state: np.ndarray                # (nt, S) interpolated state at output times
     acceleration: np.ndarray         # (nt, N) relative floor acceleration, m/s²
     contact_force: np.ndarray        # (nt, nc) N
-    ground_acceleration: np.ndarray  # (nt,) m/s²
+    ground_acceleration: np.ndarray  # (nt,) m/s², ground row 0 (the common ground with one record)
     contact_potential: np.ndarray    # (nt,) J, elastic energy stored in all contacts
     peak_displacement: np.ndarray    # (N,) m
     peak_drift: np.ndarray           # (N,) m, storey under each floor
@@ -245,6 +265,7 @@ class RawSolution:
     n_rejected: int
     status: int
     final_time: float
+    support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row (None: one ground)
 
 
 # --------------------------------------------------------------------------- #
@@ -261,10 +282,56 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     return ag[seg] + (ag[seg + 1] - ag[seg]) * ((t - t0) / dt_rec)
 
 
+# Ground motion of several supports.  *ground* is None with one common ground (every
+# ``if ground is not None`` block is pruned at compile time), else the tuple built by
+# :func:`_ground_arguments`: (accelerations (G, ns), displacements and velocities at the
+# samples (G, ns), ground row of every floor (N,), of the left and the right side of every
+# contact (nc,), and three (3, G) ground states [acceleration, velocity, displacement]:
+# now, at the start of the step and at its end).
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _fill_grounds(ground, dt_rec, seg, t, gstate):
+    """Acceleration, velocity and displacement of every ground at time *t* into *gstate* (3, G).
+
+    The acceleration is piecewise linear as :func:`_ground`; velocity and displacement are its
+    exact integrals from rest (quadratic and cubic in a record step; their sample values in
+    ``ground[2]`` and ``ground[1]``).
+    """
+    ag = ground[0]
+    ug = ground[1]
+    vg = ground[2]
+    for g in range(ag.shape[0]):
+        row = ag[g]
+        gstate[0, g] = _ground(row, dt_rec, seg, t)
+        k = min(seg, row.size - 1)
+        tau = t - k * dt_rec
+        a0 = row[k]
+        slope = (row[k + 1] - a0) / dt_rec if k + 1 < row.size else 0.0
+        gstate[1, g] = vg[g, k] + a0 * tau + 0.5 * slope * tau * tau
+        gstate[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _ground_offset(ground, gstate, c, row):
+    """Differential ground motion of contact *c*: ground of its left side minus ground of its right side.
+
+    *row* 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²) of the ground state
+    *gstate*.  This is the one place where the supports' motion enters the contact kinematics:
+    ``δ = u_L − u_R + (u_g,L − u_g,R) − gap`` with ``u`` relative to each floor's own ground
+    (a wall or a link joining two grounds needs only its two rows in ``ground[4]``, ``ground[5]``).
+    """
+    return gstate[row, ground[4][c]] - gstate[row, ground[5][c]]
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey):
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey, ground):
     """Time derivative of the state; contact forces are written to *forces*.
+
+    With several grounds (*ground* not None) each floor takes its own ground's
+    acceleration and the contacts the differential ground motion of ``ground[6]``
+    (the ground state at this time, filled by the caller); *ag_t* is then unused.
 
     A closed compliant contact acts through its law in its current mode
     (:func:`pounding.contact.mode_force`).  A persistent (stuck) contact of an
@@ -321,8 +388,12 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_stuck += 1
                 forces[c] = 0.0
                 continue
-            delta = y[cl[c]] - y[cr[c]] - cgap[c]
-            rate = y[n + cl[c]] - y[n + cr[c]]
+            if ground is None:
+                delta = y[cl[c]] - y[cr[c]] - cgap[c]
+                rate = y[n + cl[c]] - y[n + cr[c]]
+            else:
+                delta = y[cl[c]] - y[cr[c]] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
+                rate = y[n + cl[c]] - y[n + cr[c]] + _ground_offset(ground, ground[6], c, 1)
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             if kernels.is_permanent(claw[c]):
@@ -333,7 +404,8 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         fbuf[cl[c]] += f
         fbuf[cr[c]] -= f
     if n_stuck > 0:
-        # Constraint forces of stuck contacts: make δ̈ = 0 (a_g is common to both floors and cancels).
+        # Constraint forces of stuck contacts: make δ̈ = 0 (a floor's total acceleration is −fbuf/m:
+        # its own ground's acceleration cancels).
         for _ in range(100):
             largest = 0.0
             scale = 0.0
@@ -350,15 +422,37 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     scale = max(scale, abs(forces[c]))
             if largest <= 1e-13 * scale:
                 break
-    for c in range(nc):
-        f = forces[c]
-        out[2 * n + c] = f
-        out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
     e_in_rate = 0.0
-    for j in range(n):
-        out[j] = y[n + j]
-        out[n + j] = -fbuf[j] / mass[j] - ag_t
-        e_in_rate -= ag_t * mass[j] * y[n + j]
+    if ground is None:
+        for c in range(nc):
+            f = forces[c]
+            out[2 * n + c] = f
+            out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
+        for j in range(n):
+            out[j] = y[n + j]
+            out[n + j] = -fbuf[j] / mass[j] - ag_t
+            e_in_rate -= ag_t * mass[j] * y[n + j]
+    else:
+        # Several grounds: δ̇ includes the differential ground velocity; its work on the contact
+        # forces is the input W_g (the last state); each building from its own ground.
+        ground_power = 0.0
+        for c in range(nc):
+            f = forces[c]
+            out[2 * n + c] = f
+            if closed[c]:
+                dvg = _ground_offset(ground, ground[6], c, 1)
+                out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]] + dvg)
+                ground_power += f * dvg
+            else:
+                out[2 * n + nc + c] = 0.0
+        gnow = ground[6]
+        fground = ground[3]
+        for j in range(n):
+            ag_j = gnow[0, fground[j]]
+            out[j] = y[n + j]
+            out[n + j] = -fbuf[j] / mass[j] - ag_j
+            e_in_rate -= ag_j * mass[j] * y[n + j]
+        out[out.size - 1] = ground_power
     out[2 * n + 3 * nc] = e_in_rate
     out[2 * n + 3 * nc + 1] = power
 
@@ -594,12 +688,14 @@ def _peak_magnitude(values) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
+def _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
     total = 0.0
     for c in range(nc):
         delta = y[cl[c]] - y[cr[c]] - cgap[c]
+        if ground is not None:
+            delta = y[cl[c]] - y[cr[c]] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
         total += kernels.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
     return total
 
@@ -784,25 +880,28 @@ def _grown(table, rows, needed, limit):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
+def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
     The impulse ``J = (1+e)·m_eff·v0`` acts on the two floors (−J on the
     left, +J on the right); the work ``J·(v0 + v0')/2`` it does (the energy
     lost, ½·m_eff·(1−e²)·v0²) and the impulse are added to the contact's
     energy-audit states.  The impact row (room made by the caller) opens and
-    closes at once; returns the new row count.
+    closes at once; returns the new row count.  *dvg* (m/s) is the contact's
+    differential ground velocity: ``v0 = δ̇`` includes it, and the work
+    ``J·dvg`` it does goes to the ground-work state (the last one).
     """
     nc = cl.size
     lf = cl[c]
     rf = cr[c]
-    v0 = y[n + lf] - y[n + rf]
+    v0 = y[n + lf] - y[n + rf] + dvg
     impulse = kernels.jump_impulse(claw[c], cprm[c], v0)
     y[n + lf] -= impulse / mass[lf]
     y[n + rf] += impulse / mass[rf]
-    v_after = y[n + lf] - y[n + rf]
+    v_after = y[n + lf] - y[n + rf] + dvg
     y[2 * n + c] += impulse
     y[2 * n + nc + c] += impulse * 0.5 * (v0 + v_after)
+    y[y.size - 1] += impulse * dvg
     impacts[n_imp, IMP_CONTACT] = c
     impacts[n_imp, IMP_TIME] = t
     impacts[n_imp, IMP_VELOCITY] = v0
@@ -816,7 +915,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass):
+def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass, dvg):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
     Closure fixes the per-impact constant from the approach velocity
@@ -824,11 +923,11 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     row with the separation velocity and the impulse.  The caller makes room
     for one more row first (:func:`_grown`); returns the new row count.
     """
-    rate = y[n + cl[c]] - y[n + cr[c]]
+    rate = y[n + cl[c]] - y[n + cr[c]] + dvg
     nc = closed.size
     if upward:
         if kernels.is_instantaneous(claw[c]):
-            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg)
         closed[c] = True
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = kernels.onset_constant(claw[c], cprm[c], rate)
@@ -854,28 +953,30 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _plastic_jump(c, y, n, cl, cr, mass):
+def _plastic_jump(c, y, n, cl, cr, mass, dvg):
     """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
 
     The impulse and its work (the energy lost, ½·m_eff·v0²) are added to the
-    contact's energy-audit states.
+    contact's energy-audit states, ``J·dvg`` to the ground work (*dvg*: the
+    contact's differential ground velocity, m/s, part of ``v0 = δ̇``).
     """
     nc = cl.size
     lf = cl[c]
     rf = cr[c]
-    v0 = y[n + lf] - y[n + rf]
+    v0 = y[n + lf] - y[n + rf] + dvg
     impulse = mass[lf] * mass[rf] / (mass[lf] + mass[rf]) * v0
     y[n + lf] -= impulse / mass[lf]
     y[n + rf] += impulse / mass[rf]
     y[2 * n + c] += impulse
-    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf]))
+    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf] + dvg))
+    y[y.size - 1] += impulse * dvg
     return impulse
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                   cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
-                  impacts, n_imp, open_imp, storey):
+                  impacts, n_imp, open_imp, storey, ground):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -909,7 +1010,10 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
         n_applied += 1
         lf = cl[c]
         rf = cr[c]
-        rate = y[n + lf] - y[n + rf]
+        dvg = 0.0
+        if ground is not None:
+            dvg = _ground_offset(ground, ground[6], c, 1)
+        rate = y[n + lf] - y[n + rf] + dvg
         if kind == EVENT_CLOSE:
             if n_imp + 1 > IMPACT_ROW_LIMIT:
                 status = STATUS_TABLE_LIMIT
@@ -923,16 +1027,16 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
                         scratch[i] = y[i]
-                    _plastic_jump(c, scratch, n, cl, cr, mass)
+                    _plastic_jump(c, scratch, n, cl, cr, mass, dvg)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, storey)
+                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, storey, ground)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
                 if not stick:
-                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg)
                     continue
                 impacts[n_imp, IMP_CONTACT] = c
                 impacts[n_imp, IMP_TIME] = t
@@ -941,7 +1045,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 impacts[n_imp, IMP_PEAK_FORCE] = 0.0
                 impacts[n_imp, IMP_IMPULSE] = y[2 * n + c]
                 impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]
-                _plastic_jump(c, y, n, cl, cr, mass)
+                _plastic_jump(c, y, n, cl, cr, mass, dvg)
                 closed[c] = True
                 cmode[c] = kernels.MODE_STUCK
                 cconst[c] = 0.0
@@ -954,7 +1058,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
                 rate = 0.0
             n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
-                                    open_imp, mass)
+                                    open_imp, mass, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
             m_eff = mass[lf] * mass[rf] / (mass[lf] + mass[rf])
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
@@ -962,12 +1066,14 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 cap = min(cap, duration / STEPS_PER_CONTACT)
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
             n_imp = _switch_contact(c, False, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
-                                    open_imp, mass)
+                                    open_imp, mass, dvg)
             cmode[c] = 0
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)
             delta = y[lf] - y[rf] - cgap[c]
+            if ground is not None:
+                delta = y[lf] - y[rf] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
             y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
@@ -980,7 +1086,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
 
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-               cl, cr, cgap, claw, cprm, storey,
+               cl, cr, cgap, claw, cprm, storey, ground,
                ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
@@ -991,7 +1097,11 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     nh = nc - nc
     if storey is not None:
         nh = storey[7].size
-    S = 2 * n + 3 * nc + 2 + 2 * nh
+    S = 2 * n + 3 * nc + 2 + 2 * nh + 1  # the last state: work of the differential ground motion on the contacts
+    # *ground* is None with one common ground (row 0 is *ag*); else the tuple of _ground_arguments.
+    n_ground = nc - nc + 1
+    if ground is not None:
+        n_ground = ground[0].shape[0]
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
@@ -1036,6 +1146,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     out_acc = np.empty((n_out, n))
     out_force = np.empty((n_out, nc))
     out_ag = np.empty(n_out)
+    out_support = np.empty((n_out, n_ground))
     out_pot = np.empty(n_out)
     out_shear = np.empty((n_out, n))
     out_storey_energy = np.empty((n_out, 2))
@@ -1059,8 +1170,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 
     t = 0.0
     seg = zero
+    if ground is not None:
+        _fill_grounds(ground, dt_rec, seg, 0.0, ground[6])
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey)
+         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
     # First output sample at t = 0.
     out_time[0] = 0.0
     _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, 0)
@@ -1071,7 +1184,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     for c in range(nc):
         out_force[0, c] = 0.0
     out_ag[0] = _ground(ag, dt_rec, seg, 0.0)
-    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
+    if ground is not None:
+        for g in range(n_ground):
+            out_support[0, g] = ground[6][0, g]
+    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground)
     i_out = 1
 
     h = first_step
@@ -1107,29 +1223,41 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             # ---- Dormand–Prince stages -----------------------------------
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C2 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C3 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C4 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + C5 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey, ground)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey)
+                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey, ground)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -1179,16 +1307,35 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
             # ---- contact events inside the step ------------------------------
+            # With several grounds δ is the Hermite cubic of the total displacements: each floor's
+            # displacement over its own ground plus the contact's differential ground motion (itself
+            # a cubic within a record step, so the interpolant reproduces it exactly).
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t, ground[7])
+                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[8])
             s_first = 2.0
             for c in range(nc):
                 event_s[c] = -1.0
                 event_kind[c] = EVENT_NONE
                 lf = cl[c]
                 rf = cr[c]
-                d0 = y[lf] - y[rf] - cgap[c]
-                r0 = y[n + lf] - y[n + rf]
-                d1 = ynew[lf] - ynew[rf] - cgap[c]
-                r1 = ynew[n + lf] - ynew[n + rf]
+                od0 = ov0 = oa0 = od1 = ov1 = oa1 = 0.0
+                if ground is not None:
+                    od0 = _ground_offset(ground, ground[7], c, 2)
+                    ov0 = _ground_offset(ground, ground[7], c, 1)
+                    oa0 = _ground_offset(ground, ground[7], c, 0)
+                    od1 = _ground_offset(ground, ground[8], c, 2)
+                    ov1 = _ground_offset(ground, ground[8], c, 1)
+                    oa1 = _ground_offset(ground, ground[8], c, 0)
+                    d0 = y[lf] - y[rf] + od0 - cgap[c]
+                    r0 = y[n + lf] - y[n + rf] + ov0
+                    d1 = ynew[lf] - ynew[rf] + od1 - cgap[c]
+                    r1 = ynew[n + lf] - ynew[n + rf] + ov1
+                else:
+                    d0 = y[lf] - y[rf] - cgap[c]
+                    r0 = y[n + lf] - y[n + rf]
+                    d1 = ynew[lf] - ynew[rf] - cgap[c]
+                    r1 = ynew[n + lf] - ynew[n + rf]
                 floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
@@ -1207,9 +1354,11 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             mid = 0.5 * (lo + hi)
                             for i in range(S):
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
+                            if ground is not None:
+                                _fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground[6])
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
-                                 fbuf, forces, storey)
+                                 fbuf, forces, storey, ground)
                             if forces[c] < 0.0:
                                 hi = mid
                             else:
@@ -1222,7 +1371,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     kind = EVENT_SEPARATE
                     for which in range(kernels.switch_count(claw[c], cprm[c])):
                         sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
-                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
+                                              y[lf] + od0, y[n + lf] + ov0, ynew[lf] + od1, ynew[n + lf] + ov1,
+                                              k1[n + lf] + oa0, k7[n + lf] + oa1,
                                               y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
                                               y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_try)
                         if sw >= 0.0 and (s < 0.0 or sw < s):
@@ -1266,10 +1416,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
                             sev_kind[hi] = STOREY_NONE
                     n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+                if ground is not None:
+                    _fill_grounds(ground, dt_rec, seg, t, ground[6])
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
-                    impacts, n_imp, open_imp, storey)
+                    impacts, n_imp, open_imp, storey, ground)
                 n_applied += n_storey
                 if t - window_start > dt_rec:
                     window_start = t
@@ -1279,8 +1431,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     status = STATUS_EVENT_LIMIT
                 if status != 0:
                     break
+                if ground is not None:
+                    _fill_grounds(ground, dt_rec, seg, t, ground[6])
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey)
+                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -1359,9 +1513,17 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             elif closed[c]:
                 lf = cl[c]
                 rf = cr[c]
+                od0 = ov0 = oa0 = od1 = ov1 = oa1 = 0.0
+                if ground is not None:
+                    od0 = _ground_offset(ground, ground[7], c, 2)
+                    ov0 = _ground_offset(ground, ground[7], c, 1)
+                    oa0 = _ground_offset(ground, ground[7], c, 0)
+                    od1 = _ground_offset(ground, ground[8], c, 2)
+                    ov1 = _ground_offset(ground, ground[8], c, 1)
+                    oa1 = _ground_offset(ground, ground[8], c, 0)
                 fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
-                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf],
-                                              k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
+                                              y[lf] + od0, y[n + lf] + ov0, ynew[lf] + od1, ynew[n + lf] + ov1,
+                                              k1[n + lf] + oa0, k7[n + lf] + oa1, y[rf], y[n + rf], ynew[rf], ynew[n + rf],
                                               k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
@@ -1392,8 +1554,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for i in range(S):
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t_o, ground[6])
+                for g in range(n_ground):
+                    out_support[i_out, g] = ground[6][0, g]
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1402,7 +1568,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
             out_ag[i_out] = ag_o
-            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm)
+            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm, ground)
             _storey_outputs(ystage, n, nc, below, kst, storey, out_shear, out_storey_energy, i_out)
             i_out += 1
         # ---- accept ---------------------------------------------------------
@@ -1424,10 +1590,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if sev_kind[hi] == STOREY_NONE:
                     sev_kind[hi] = spending[hi]
             n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+        if ground is not None:
+            _fill_grounds(ground, dt_rec, seg, t, ground[6])
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
-            storey)
+            storey, ground)
         n_applied += n_storey
         if n_applied > 0:
             if t - window_start > dt_rec:
@@ -1436,8 +1604,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             window_events += n_applied
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t, ground[6])
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1462,17 +1632,23 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_state[i2, i] = y[i]
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
+            if ground is not None:
+                _fill_grounds(ground, dt_rec, seg, t, ground[6])
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey)
+                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, i2)
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
-            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
+            if ground is not None:
+                for g in range(n_ground):
+                    out_support[i2, g] = ground[6][0, g]
+            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground)
         i_out = n_out
     if status != STATUS_COLLAPSED:
         collapse_floor = zero - 1
     return (out_time[:i_out], out_state[:i_out], out_acc[:i_out], out_force[:i_out], out_ag[:i_out], out_pot[:i_out],
+            out_support[:i_out],
             peak_u, peak_drift, peak_force,
             impacts[:n_imp], trace[:n_trace], out_shear[:i_out], out_storey_energy[:i_out], y, collapse_floor,
             n_steps, n_rej, status, t)
@@ -1537,8 +1713,11 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         Initial state relative to the ground (m, m/s); default at rest.  All
         contacts start open.
     """
-    # A fresh writable copy: a read-only array would compile a second specialisation.
-    ag = np.array(ground_acceleration, dtype=np.float64, copy=True)
+    # A fresh writable copy: a read-only array would compile a second specialisation.  One ground:
+    # a 1-D array (ground None: the single-record solver); several: one row each (row 0 also as *ag*).
+    rows = np.array(np.atleast_2d(ground_acceleration), dtype=np.float64, copy=True, order="C")
+    ag = np.ascontiguousarray(rows[0]).copy()
+    ground = _ground_arguments(system, rows, float(time_step)) if rows.shape[0] > 1 else None
     # Independent of output_dt, so the step sequence (and every peak) is the same whatever the output sampling.
     first_step = 0.1 * time_step
     y_initial = np.zeros(2 * system.n_floors)
@@ -1550,10 +1729,10 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
                      system.dense_offset, system.dense_values, system.contact_left,
                      system.contact_right, system.contact_gap, system.contact_law,
-                     system.contact_parameters, _storey_arguments(system, float(atol)), ag, float(time_step), float(duration), float(rtol),
+                     system.contact_parameters, _storey_arguments(system, float(atol)), ground, ag, float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
-    (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, shear,
+    (time, state, acc, force, ag_out, potential, support, peak_u, peak_drift, peak_force, impacts, trace, shear,
      storey_energy, final_state, collapse_floor, n_steps, n_rej, status, t_final) = raw
     return RawSolution(time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force,
                        impacts[:, IMP_CONTACT].astype(np.int64), impacts[:, IMP_TIME],
@@ -1561,4 +1740,73 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        impacts[:, IMP_END], impacts[:, IMP_IMPULSE], impacts[:, IMP_SEPARATION],
                        impacts[:, IMP_WORK], trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
                        shear, storey_energy, final_state.copy(), int(collapse_floor),
-                       int(n_steps), int(n_rej), int(status), float(t_final))
+                       int(n_steps), int(n_rej), int(status), float(t_final),
+                       None if ground is None else support)
+
+
+def _ground_arguments(system: System, rows: np.ndarray, time_step: float) -> tuple:
+    """The solver's *ground* tuple for several grounds (rows of *rows*, m/s², step *time_step* s)."""
+    velocity, displacement = ground_kinematics(rows, time_step)
+    n_ground = rows.shape[0]
+    return (rows, displacement, velocity, np.asarray(system.floor_ground, dtype=np.int64),
+            np.asarray(system.contact_ground_left, dtype=np.int64),
+            np.asarray(system.contact_ground_right, dtype=np.int64),
+            np.zeros((3, n_ground)), np.zeros((3, n_ground)), np.zeros((3, n_ground)))
+
+
+def ground_kinematics(acceleration: np.ndarray, time_step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Ground velocity and displacement at the samples of piecewise-linear accelerations, from rest.
+
+    Parameters
+    ----------
+    acceleration : (G, ns) ndarray
+        Ground accelerations, m/s², one row per ground, uniform step *time_step* (s).
+
+    Returns
+    -------
+    velocity, displacement : (G, ns) ndarray
+        m/s and m: the exact integrals (trapezoid for the velocity; for the
+        displacement ``u_{k+1} = u_k + v_k·dt + dt²·(a_k/3 + a_{k+1}/6)``), so
+        that between samples the velocity is the quadratic and the
+        displacement the cubic the solver evaluates (:func:`_grounds`).
+    """
+    a = np.atleast_2d(np.asarray(acceleration, dtype=float))
+    dt = float(time_step)
+    velocity = np.zeros_like(a)
+    displacement = np.zeros_like(a)
+    velocity[:, 1:] = np.cumsum(0.5 * dt * (a[:, :-1] + a[:, 1:]), axis=1)
+    displacement[:, 1:] = np.cumsum(dt * velocity[:, :-1] + dt * dt * (a[:, :-1] / 3.0 + a[:, 1:] / 6.0), axis=1)
+    return velocity, displacement
+
+
+def ground_state_at(acceleration: np.ndarray, time_step: float, times: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Ground acceleration, velocity and displacement of every row at *times*, as the solver sees them.
+
+    Parameters
+    ----------
+    acceleration : (G, ns) ndarray
+        The ground-acceleration rows given to :func:`integrate`, m/s².
+    time_step : float
+        Their sampling interval, s.
+    times : (nt,) ndarray
+        s.
+
+    Returns
+    -------
+    acceleration, velocity, displacement : (nt, G) ndarray
+        m/s², m/s, m: piecewise linear, quadratic and cubic from rest (past the
+        last sample the last acceleration is held, as in the solver).
+    """
+    a = np.atleast_2d(np.asarray(acceleration, dtype=float))
+    velocity, displacement = ground_kinematics(a, time_step)
+    t = np.asarray(times, dtype=float)
+    k = np.minimum(np.floor(t / time_step + 1e-9).astype(np.int64), a.shape[1] - 1)
+    k = np.maximum(k, 0)
+    tau = (t - k * time_step)[:, None]
+    a0 = a[:, k].T
+    nxt = np.minimum(k + 1, a.shape[1] - 1)
+    slope = np.where((k + 1 < a.shape[1])[:, None], (a[:, nxt].T - a0) / time_step, 0.0)
+    acc = a0 + slope * tau
+    vel = velocity[:, k].T + a0 * tau + 0.5 * slope * tau ** 2
+    disp = displacement[:, k].T + velocity[:, k].T * tau + 0.5 * a0 * tau ** 2 + slope * tau ** 3 / 6.0
+    return acc, vel, disp

@@ -78,6 +78,7 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: st
     from pounding.contact.laws import HertzDamp
 
     base = load_model(model)                # the model's own errors, with its file name
+    base.refuse_building_records("pounding compare (it runs the model under one record at a time)")
     if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
         raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only to "
                             "law hertz-damp")

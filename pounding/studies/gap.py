@@ -295,6 +295,7 @@ def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = 
     from pounding.studies.sweep.spec import sweep_from_text
 
     base = load_model(model)  # the model's own errors, with its file name
+    base.refuse_building_records("the gap study (it runs the model under one record at a time)")
     if not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: the model has no contacts; list the level pairs to check in "
                             "'contacts' (gap: 0 is fine: only the levels and buildings are used)")

@@ -369,6 +369,7 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
         raise PoundingError(f"--duration must be > 0 (got {duration:g})")
 
     base = load_model(model)   # the model's own errors, with its file name
+    base.refuse_building_records("pounding ida (it scales one record)")
     names = [b.name for b in base.buildings]
     if building is None:
         building = names[0]
