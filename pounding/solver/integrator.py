@@ -147,7 +147,8 @@ class System:
     rayleigh_mass, rayleigh_stiffness : (N,) Rayleigh a0 (1/s) and a1 (s) of the floor's building
     dense_start, dense_size, dense_offset : (B,) int, modal damping blocks (size 0 for Rayleigh)
     dense_values : flat float array of the dense damping blocks, N·s/m
-    contact_left, contact_right : (nc,) int, floor indices of each gap element
+    contact_left, contact_right : (nc,) int, floor index of each gap element's left and right side
+        (−1: a fixed wall; for a point of a column, the floor above it)
     contact_gap : (nc,) m
     contact_law : (nc,) int, kernel branch (pounding.contact)
     contact_parameters : (nc, N_PARAMETERS) float
@@ -157,6 +158,12 @@ class System:
     p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
     storey_height : (N,) m
     stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
+    contact_floors : (nc, SIDE_TERMS) int, optional
+        Floor terms of each contact ``[left, left, right, right]`` (−1: none, the ground or a wall);
+        default from ``contact_left`` / ``contact_right``: ``[left, −1, right, −1]``.
+    contact_weights : (nc, SIDE_TERMS) float, optional
+        Their weights: δ = Σ_k w_k·u[floor_k] − gap, the force enters floor_k as w_k·F (left
+        weights ≥ 0, right ≤ 0); default ``[1, 0, −1, 0]`` (−1 sides get weight 0).
     """
 
     mass: np.ndarray
@@ -179,8 +186,19 @@ class System:
     p_delta_stiffness: np.ndarray | None = None
     storey_height: np.ndarray | None = None
     stop_drift_ratio: float = 0.0
+    contact_floors: np.ndarray | None = None
+    contact_weights: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        nc = int(self.contact_gap.size)
+        if self.contact_floors is None:
+            left = np.asarray(self.contact_left, dtype=np.int64).reshape(nc)
+            right = np.asarray(self.contact_right, dtype=np.int64).reshape(nc)
+            none = np.full(nc, -1, dtype=np.int64)
+            object.__setattr__(self, "contact_floors", np.ascontiguousarray(np.stack([left, none, right, none], 1)))
+            weights = np.stack([(left >= 0) * 1.0, np.zeros(nc), (right >= 0) * -1.0, np.zeros(nc)], 1)
+            object.__setattr__(self, "contact_weights", np.ascontiguousarray(weights.reshape(nc, SIDE_TERMS)))
+
         # Storey fields left out: linear elastic storeys of unit height, no P-Delta, no collapse check.
         n = int(self.mass.size)
         defaults = {"storey_model": np.zeros(n, dtype=np.int64),
@@ -247,6 +265,82 @@ class RawSolution:
 
 
 # --------------------------------------------------------------------------- #
+# Contact sides: weighted floors (a floor, a point of a column, a fixed wall)
+# --------------------------------------------------------------------------- #
+# Contact c measures δ = Σ_k cw[c, k]·u[cf[c, k]] − gap over SIDE_TERMS terms
+# (the left side's weights positive, the right side's negative); a term with
+# cf < 0 is the ground or a fixed wall (zero displacement relative to the
+# ground) and contributes nothing.  The contact force F enters the floors with
+# the same weights (fbuf[cf] += cw·F), so its power is F·δ̇ exactly (virtual
+# work): a floor is the term (floor, ±1); a point at fraction ξ of a storey's
+# height the two terms (floor below, ±N1(ξ)) and (floor above, ±N2(ξ)).
+
+#: Terms per contact: two per side.
+SIDE_TERMS = 4
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _combo(y, offset, cf, cw, c) -> float:
+    """Σ_k cw[c, k]·y[offset + cf[c, k]] over the contact's floor terms (δ + gap for offset 0, δ̇ for n)."""
+    total = 0.0
+    for k in range(SIDE_TERMS):
+        f = cf[c, k]
+        if f >= 0:
+            total += cw[c, k] * y[offset + f]
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _combo_size(y, cf, cw, c) -> float:
+    """Σ_k |cw[c, k]·y[cf[c, k]]| (m): the scale of δ's round-off."""
+    total = 0.0
+    for k in range(SIDE_TERMS):
+        f = cf[c, k]
+        if f >= 0:
+            total += abs(cw[c, k] * y[f])
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _push(fbuf, cf, cw, c, force) -> None:
+    """Add contact force *force* (N, ≥ 0 pushes apart) to the floors' internal forces with the side weights."""
+    for k in range(SIDE_TERMS):
+        f = cf[c, k]
+        if f >= 0:
+            fbuf[f] += cw[c, k] * force
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _compliance(mass, cf, cw, c) -> float:
+    """Σ_k cw²/m (1/kg): δ̈ per unit contact force; 1/m_eff of the contact (a wall adds nothing)."""
+    total = 0.0
+    for k in range(SIDE_TERMS):
+        f = cf[c, k]
+        if f >= 0:
+            total += cw[c, k] * cw[c, k] / mass[f]
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _ground_weight(cf, cw, c) -> float:
+    """Σ_k cw over the floor terms: 0 between two buildings, ±1 against a wall (a_g's share in δ̈)."""
+    total = 0.0
+    for k in range(SIDE_TERMS):
+        if cf[c, k] >= 0:
+            total += cw[c, k]
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _kick(y, n, mass, cf, cw, c, impulse) -> None:
+    """Apply an impulse *impulse* (N·s, ≥ 0 pushes apart) of contact *c* to the floor velocities."""
+    for k in range(SIDE_TERMS):
+        f = cf[c, k]
+        if f >= 0:
+            y[n + f] -= cw[c, k] * impulse / mass[f]
+
+
+# --------------------------------------------------------------------------- #
 # Right-hand side
 # --------------------------------------------------------------------------- #
 
@@ -262,7 +356,7 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
+         cf, cw, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
          smodel, sprm, sidx, kpd, smode, shear):
     """Time derivative of the state; contact forces are written to *forces*.
 
@@ -330,28 +424,30 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_stuck += 1
                 forces[c] = 0.0
                 continue
-            delta = y[cl[c]] - y[cr[c]] - cgap[c]
-            rate = y[n + cl[c]] - y[n + cr[c]]
+            delta = _combo(y, 0, cf, cw, c) - cgap[c]
+            rate = _combo(y, n, cf, cw, c)
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
         forces[c] = f
-        fbuf[cl[c]] += f
-        fbuf[cr[c]] -= f
+        _push(fbuf, cf, cw, c, f)
     if n_stuck > 0:
-        # Constraint forces of stuck contacts: make δ̈ = 0 (a_g is common to both floors and cancels).
+        # Constraint forces of stuck contacts: make δ̈ = 0 (a_g is common to both floors of a pair
+        # and cancels; against a wall it stays: the wall moves with the ground).
         for _ in range(100):
             largest = 0.0
             scale = 0.0
             for c in range(nc):
                 if closed[c] and cmode[c] == kernels.MODE_STUCK:
-                    lf = cl[c]
-                    rf = cr[c]
-                    relative = fbuf[rf] / mass[rf] - fbuf[lf] / mass[lf]
-                    change = relative / (1.0 / mass[lf] + 1.0 / mass[rf])
+                    # δ̈ = Σ_k cw·(−fbuf/m − a_g) over the floor terms
+                    relative = -ag_t * _ground_weight(cf, cw, c)
+                    for k in range(SIDE_TERMS):
+                        f = cf[c, k]
+                        if f >= 0:
+                            relative -= cw[c, k] * (fbuf[f] / mass[f])
+                    change = relative / _compliance(mass, cf, cw, c)
                     forces[c] += change
-                    fbuf[lf] += change
-                    fbuf[rf] -= change
+                    _push(fbuf, cf, cw, c, change)
                     largest = max(largest, abs(change))
                     scale = max(scale, abs(forces[c]))
             if largest <= 1e-13 * scale:
@@ -359,7 +455,7 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     for c in range(nc):
         f = forces[c]
         out[2 * n + c] = f
-        out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
+        out[2 * n + nc + c] = f * _combo(y, n, cf, cw, c) if closed[c] else 0.0
     e_in_rate = 0.0
     for j in range(n):
         out[j] = y[n + j]
@@ -564,12 +660,12 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _contact_energy(y, n, cl, cr, cgap, claw, cprm) -> float:
+def _contact_energy(y, n, cf, cw, cgap, claw, cprm) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
     total = 0.0
     for c in range(nc):
-        delta = y[cl[c]] - y[cr[c]] - cgap[c]
+        delta = _combo(y, 0, cf, cw, c) - cgap[c]
         total += kernels.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
     return total
 
@@ -708,7 +804,7 @@ def _grown(table, rows, needed, limit):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
+def _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
     The impulse ``J = (1+e)·m_eff·v0`` acts on the two floors (−J on the
@@ -717,14 +813,11 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
     energy-audit states.  The impact row (room made by the caller) opens and
     closes at once; returns the new row count.
     """
-    nc = cl.size
-    lf = cl[c]
-    rf = cr[c]
-    v0 = y[n + lf] - y[n + rf]
+    nc = cf.shape[0]
+    v0 = _combo(y, n, cf, cw, c)
     impulse = kernels.jump_impulse(claw[c], cprm[c], v0)
-    y[n + lf] -= impulse / mass[lf]
-    y[n + rf] += impulse / mass[rf]
-    v_after = y[n + lf] - y[n + rf]
+    _kick(y, n, mass, cf, cw, c, impulse)
+    v_after = _combo(y, n, cf, cw, c)
     y[2 * n + c] += impulse
     y[2 * n + nc + c] += impulse * 0.5 * (v0 + v_after)
     impacts[n_imp, IMP_CONTACT] = c
@@ -740,7 +833,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass):
+def _switch_contact(c, upward, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
     Closure fixes the per-impact constant from the approach velocity
@@ -748,11 +841,11 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     row with the separation velocity and the impulse.  The caller makes room
     for one more row first (:func:`_grown`); returns the new row count.
     """
-    rate = y[n + cl[c]] - y[n + cr[c]]
+    rate = _combo(y, n, cf, cw, c)
     nc = closed.size
     if upward:
         if kernels.is_instantaneous(claw[c]):
-            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+            return _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass)
         closed[c] = True
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = kernels.onset_constant(claw[c], cprm[c], rate)
@@ -778,27 +871,24 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _plastic_jump(c, y, n, cl, cr, mass):
+def _plastic_jump(c, y, n, cf, cw, mass):
     """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
 
     The impulse and its work (the energy lost, ½·m_eff·v0²) are added to the
     contact's energy-audit states.
     """
-    nc = cl.size
-    lf = cl[c]
-    rf = cr[c]
-    v0 = y[n + lf] - y[n + rf]
-    impulse = mass[lf] * mass[rf] / (mass[lf] + mass[rf]) * v0
-    y[n + lf] -= impulse / mass[lf]
-    y[n + rf] += impulse / mass[rf]
+    nc = cf.shape[0]
+    v0 = _combo(y, n, cf, cw, c)
+    impulse = v0 / _compliance(mass, cf, cw, c)
+    _kick(y, n, mass, cf, cw, c, impulse)
     y[2 * n + c] += impulse
-    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf]))
+    y[2 * n + nc + c] += impulse * 0.5 * (v0 + _combo(y, n, cf, cw, c))
     return impulse
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
+                  cf, cw, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
                   impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
@@ -831,9 +921,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
         if kind == EVENT_NONE:
             continue
         n_applied += 1
-        lf = cl[c]
-        rf = cr[c]
-        rate = y[n + lf] - y[n + rf]
+        rate = _combo(y, n, cf, cw, c)
         if kind == EVENT_CLOSE:
             if n_imp + 1 > IMPACT_ROW_LIMIT:
                 status = STATUS_TABLE_LIMIT
@@ -847,16 +935,16 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
                         scratch[i] = y[i]
-                    _plastic_jump(c, scratch, n, cl, cr, mass)
+                    _plastic_jump(c, scratch, n, cf, cw, mass)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                         cf, cw, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
                 if not stick:
-                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass)
+                    n_imp = _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass)
                     continue
                 impacts[n_imp, IMP_CONTACT] = c
                 impacts[n_imp, IMP_TIME] = t
@@ -865,7 +953,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 impacts[n_imp, IMP_PEAK_FORCE] = 0.0
                 impacts[n_imp, IMP_IMPULSE] = y[2 * n + c]
                 impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]
-                _plastic_jump(c, y, n, cl, cr, mass)
+                _plastic_jump(c, y, n, cf, cw, mass)
                 closed[c] = True
                 cmode[c] = kernels.MODE_STUCK
                 cconst[c] = 0.0
@@ -874,24 +962,23 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 continue
             if rate < 0.0:
                 # A tangency located to round-off (δ̇ ~ −1e-17 m/s): a grazing touch, v0 = 0.
-                y[n + lf] -= rate * mass[rf] / (mass[lf] + mass[rf])
-                y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
+                _kick(y, n, mass, cf, cw, c, rate / _compliance(mass, cf, cw, c))
                 rate = 0.0
-            n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
+            n_imp = _switch_contact(c, True, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp,
                                     open_imp, mass)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
-            m_eff = mass[lf] * mass[rf] / (mass[lf] + mass[rf])
+            m_eff = 1.0 / _compliance(mass, cf, cw, c)
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
                 cap = min(cap, duration / STEPS_PER_CONTACT)
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
-            n_imp = _switch_contact(c, False, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
+            n_imp = _switch_contact(c, False, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp,
                                     open_imp, mass)
             cmode[c] = 0
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)
-            delta = y[lf] - y[rf] - cgap[c]
+            delta = _combo(y, 0, cf, cw, c) - cgap[c]
             y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
@@ -904,7 +991,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
 
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-               cl, cr, cgap, claw, cprm, smodel, sprm, sidx, kpd, heights, stop_ratio,
+               cf, cw, cgap, claw, cprm, smodel, sprm, sidx, kpd, heights, stop_ratio,
                ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
@@ -989,7 +1076,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     t = 0.0
     seg = zero
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+         cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
     # First output sample at t = 0.
     out_time[0] = 0.0
     for j in range(n):
@@ -1002,7 +1089,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     for c in range(nc):
         out_force[0, c] = 0.0
     out_ag[0] = _ground(ag, dt_rec, seg, 0.0)
-    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
+    out_pot[0] = _contact_energy(y, n, cf, cw, cgap, claw, cprm)
     i_out = 1
 
     h = first_step
@@ -1038,28 +1125,28 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -1109,13 +1196,11 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 event_s[c] = -1.0
                 event_kind[c] = EVENT_NONE
-                lf = cl[c]
-                rf = cr[c]
-                d0 = y[lf] - y[rf] - cgap[c]
-                r0 = y[n + lf] - y[n + rf]
-                d1 = ynew[lf] - ynew[rf] - cgap[c]
-                r1 = ynew[n + lf] - ynew[n + rf]
-                floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
+                d0 = _combo(y, 0, cf, cw, c) - cgap[c]
+                r0 = _combo(y, n, cf, cw, c)
+                d1 = _combo(ynew, 0, cf, cw, c) - cgap[c]
+                r1 = _combo(ynew, n, cf, cw, c)
+                floor = DELTA_ROUNDOFF * (_combo_size(y, cf, cw, c) + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
                 if not closed[c]:
@@ -1132,7 +1217,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             for i in range(S):
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
-                                 dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
+                                 dstart, dsize, doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2,
                                  fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                             if forces[c] < 0.0:
                                 hi = mid
@@ -1145,9 +1230,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     s = _first_crossing(d0, r0, d1, r1, h_try, False, floor)
                     kind = EVENT_SEPARATE
                     for which in range(kernels.switch_count(claw[c], cprm[c])):
+                        # The interpolants are linear in the data: δ's from the combined side data.
                         sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
-                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
-                                              y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
+                                              d0 + cgap[c], r0, d1 + cgap[c], r1, _combo(k1, n, cf, cw, c),
+                                              _combo(k7, n, cf, cw, c), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                                               y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_try)
                         if sw >= 0.0 and (s < 0.0 or sw < s):
                             s = sw
@@ -1186,7 +1272,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
-                    doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
+                    doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
                     impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear)
                 n_applied += n_storey
                 if t - window_start > dt_rec:
@@ -1198,7 +1284,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if status != 0:
                     break
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                     dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -1260,12 +1346,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if row >= 0 and fpk > impacts[row, IMP_PEAK_FORCE]:
                     impacts[row, IMP_PEAK_FORCE] = fpk
             elif closed[c]:
-                lf = cl[c]
-                rf = cr[c]
+                # The interpolants are linear in the data: δ's from the combined side data.
                 fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
-                                              y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf],
-                                              k7[n + lf], y[rf], y[n + rf], ynew[rf], ynew[n + rf],
-                                              k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
+                                              _combo(y, 0, cf, cw, c), _combo(y, n, cf, cw, c),
+                                              _combo(ynew, 0, cf, cw, c), _combo(ynew, n, cf, cw, c),
+                                              _combo(k1, n, cf, cw, c), _combo(k7, n, cf, cw, c),
+                                              0.0, 0.0, 0.0, 0.0, 0.0, 0.0, y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
                     status = STATUS_TABLE_LIMIT
@@ -1296,7 +1382,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1305,7 +1391,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
             out_ag[i_out] = ag_o
-            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm)
+            out_pot[i_out] = _contact_energy(ystage, n, cf, cw, cgap, claw, cprm)
             for j in range(n):
                 out_shear[i_out, j] = shear[j]
             _storey_energy(ystage, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i_out)
@@ -1329,7 +1415,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-            cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
+            cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
             smodel, sprm, sidx, kpd, smode, shear)
         n_applied += n_storey
         if n_applied > 0:
@@ -1340,7 +1426,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1366,14 +1452,14 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             for j in range(n):
                 out_shear[i2, j] = shear[j]
             _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i2)
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
-            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm)
+            out_pot[i2] = _contact_energy(y, n, cf, cw, cgap, claw, cprm)
         i_out = n_out
     if status != STATUS_COLLAPSED:
         collapse_floor = zero - 1
@@ -1428,8 +1514,8 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         y_initial[system.n_floors:] = initial_velocity
     raw = _integrate(system.mass, system.storey_stiffness, system.below, system.rayleigh_mass,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
-                     system.dense_offset, system.dense_values, system.contact_left,
-                     system.contact_right, system.contact_gap, system.contact_law,
+                     system.dense_offset, system.dense_values, system.contact_floors,
+                     system.contact_weights, system.contact_gap, system.contact_law,
                      system.contact_parameters, system.storey_model, system.storey_parameters,
                      system.storey_state, system.p_delta_stiffness, system.storey_height,
                      float(system.stop_drift_ratio), ag, float(time_step), float(duration), float(rtol),
