@@ -179,4 +179,4 @@ def test_walls_on_both_sides_of_one_building_round_trip():
     again = model_from_text(model.to_yaml())
     assert [(g.left, g.right, g.level_left, g.level_right, g.gap) for g in again.gaps] == \
         [(0, -1, 1, 0, 0.01), (0, -1, 3, 0, 0.01), (-1, 0, 0, 2, 0.02)]
-    assert "A:1-wall, A:3-wall" in "\n".join(model.summary_lines())
+    assert "A1-wall, A3-wall" in "\n".join(model.summary_lines())

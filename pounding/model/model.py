@@ -634,8 +634,8 @@ class Model:
                              + ("; P-Delta on" if b.p_delta else ""))
         for contact in sorted({g.contact for g in self.gaps}):
             gaps = [g for g in self.gaps if g.contact == contact]
-            names = [b.name for b in self.buildings]
-            pairs = ", ".join(g.label(names) for g in gaps)
+            pairs = ", ".join(f"{schema.side_text(self.buildings, g.left, g.level_left, g.at_left)}-"
+                              f"{schema.side_text(self.buildings, g.right, g.level_right, g.at_right)}" for g in gaps)
             lines.append(f"contact {contact}: {pairs}; gap {gaps[0].gap:g} m, {gaps[0].law.describe()}")
         gm = self.ground_motion
         lines.append(f"ground motion: {gm.record} {gm.describe_scale()}"

@@ -616,8 +616,7 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[in
             continue
         if name not in names:
             raise problem(f"unknown building '{name}'{did_you_mean(name, names + [WALL_NAME])}; buildings are: "
-                          f"{', '.join(names)} (or '{WALL_NAME}' at an end of the row)", kind="error",
-                          at=at + (position,))
+                          f"{', '.join(names)}", kind="error", at=at + (position,))
         indices.append(names.index(name))
     left, right = indices
     if WALL in indices:
