@@ -680,7 +680,7 @@ def _side_item(value: Any, building: BuildingEntry, at: Location) -> tuple[int, 
         except Problem as failed:
             raise problem(failed.predicate, at=at + ("at",)) from None
         if not 0.0 < fraction < 1.0:
-            hint = (f"; at 0 or 1 the point is a floor: write the floor number ({storey - 1 if fraction <= 0 else storey})"
+            hint = (f"at 0 or 1 the point is a floor: write the floor number ({storey - 1 if fraction <= 0 else storey})"
                     if fraction in (0.0, 1.0) and (fraction == 1.0 or storey > 1) else "")
             raise problem("must be in (0, 1), the fraction of the storey height above the floor below", hint=hint,
                           at=at + ("at",))
