@@ -23,7 +23,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
-from pounding.model.model import model_from_text  # noqa: E402
 
 #: Plain comparison of isolated_moat.yaml: an elastic 3 + 2 storey pair (5 floors) with two
 #: floor-to-floor hertz-damp contacts (the moat model: 5 floors, two wall contacts).

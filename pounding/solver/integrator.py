@@ -292,13 +292,6 @@ def _combo(y, offset, cf, cw, c) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _combo_size(y, cf, cw, c) -> float:
-    """Σ_k |cw[4 * c + k]·y[cf[4 * c + k]]| (m): the scale of δ's round-off."""
-    return (abs(cw[4 * c + 0] * y[cf[4 * c + 0]]) + abs(cw[4 * c + 1] * y[cf[4 * c + 1]])
-            + abs(cw[4 * c + 2] * y[cf[4 * c + 2]]) + abs(cw[4 * c + 3] * y[cf[4 * c + 3]]))
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _push(fbuf, cf, cw, c, force) -> None:
     """Add contact force *force* (N, ≥ 0 pushes apart) to the floors' internal forces with the side weights."""
     for k in range(SIDE_TERMS):
