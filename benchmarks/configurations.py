@@ -8,12 +8,15 @@ the comparison a plain model of the same size (same floors and contacts,
 without the feature).  A comparison given as YAML text is written to a
 temporary folder; nothing is written into the checkout.  Printed: the median
 solver wall time (``attrs['wall_time']``, JIT excluded by a warm-up run) of
-each, and their ratio (the developers' criterion: at most 2).
+each, and their ratio (the developers' criterion: at most 2); the same in
+``configurations.json`` in ``--out DIR`` (default: the user cache, see
+``benchmarks/_output.py``).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import sys
 import tempfile
@@ -23,6 +26,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _output import add_output_arguments, out_dir  # noqa: E402
 
 #: Plain comparison of isolated_moat.yaml: an elastic 3 + 2 storey pair (5 floors) with two
 #: floor-to-floor hertz-damp contacts (the moat model: 5 floors, two wall contacts).
@@ -71,7 +77,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("cases", nargs="*", default=list(CASES), help=f"cases to run: {', '.join(CASES)}")
     parser.add_argument("--repeat", type=int, default=5, help="timed runs per model (median)")
+    add_output_arguments(parser, "configurations")
     args = parser.parse_args(argv)
+    results = {}
     with tempfile.TemporaryDirectory(prefix="pounding-bench-") as folder:
         for name in args.cases:
             model_spec, comparison_spec = CASES[name]
@@ -82,6 +90,10 @@ def main(argv=None) -> int:
             print(f"{name}: {ours:.4f} s vs plain {plain.name} {base:.4f} s "
                   f"({model.n_floors_total} vs {plain.n_floors_total} floors, {len(model.gaps)} vs "
                   f"{len(plain.gaps)} contacts): ratio {ours / base:.2f} (median of {args.repeat})")
+            results[name] = {"wall_time": ours, "plain_wall_time": base, "ratio": ours / base, "repeat": args.repeat}
+    path = out_dir(args, "configurations") / "configurations.json"
+    path.write_text(json.dumps(results, indent=2) + "\n")
+    print(f"wrote {path}")
     return 0
 
 
