@@ -29,10 +29,11 @@ from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
 from pounding.model.model import WALL, Model, column_weights, model_from_text
 from pounding.results.archive import check_archive, open_run
-from pounding.results.dataset import to_dataset
+from pounding.results.dataset import run_peaks, to_dataset
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "contact_side_terms", "simulate", "record_for", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
+__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "rerun", "record_path",
+           "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
 
 #: Energy closure error above which a run is flagged (attribute ``status``, summary
@@ -287,6 +288,37 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
                             f"well below the duration, e.g. {min(0.01, end_time / 100):g} s")
     check_memory(estimate_memory(model, end_time, motion.time_step, settings.output_dt),
                  what=f"{_where(model)}this run", fix="shorten ground_motion.duration or raise solver.output_dt")
+    system, raw, wall = _solve(model, motion, end_time, settings.output_dt)
+    ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
+    mark_energy_status(ds)
+    return ds
+
+
+def simulate_peaks(model: Model) -> dict[str, Any]:
+    """Run *model* under its own ground motion and keep only its peaks (no histories, no dataset).
+
+    What an IDA or a sweep of many runs keeps of each: the values
+    :func:`pounding.results.dataset.run_peaks` documents, plus
+    ``record_scale`` (the factor on the record as stored) and ``wall_time``
+    (s, the compiled integration).  The solver takes the same steps as
+    :func:`simulate` (its step sequence does not depend on the output
+    sampling), so every peak equals that of ``simulate(model)`` exactly; only
+    the two end samples of the histories are stored, which skips the
+    per-sample work and the dataset.  Errors as :func:`simulate`.
+    """
+    motion = record_for(model, where="yaml")
+    end_time = model.ground_motion.duration or motion.duration
+    if end_time <= 0.0:
+        raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
+    system, raw, wall = _solve(model, motion, end_time, end_time)
+    peaks = run_peaks(model, system, raw)
+    peaks.update(record_scale=float(motion.scale), wall_time=wall)
+    return peaks
+
+
+def _solve(model: Model, motion: Record, end_time: float, output_dt: float):
+    """Integrate *model* under *motion* up to *end_time*: ``(system, raw solution, wall time in s)``."""
+    settings = model.solver
     samples_needed = int(np.ceil(end_time / motion.time_step - 1e-9)) + 1
     ground = np.zeros(max(samples_needed, motion.acceleration.size))
     ground[: motion.acceleration.size] = motion.acceleration
@@ -295,14 +327,12 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     started = _time.perf_counter()
     raw = integrate(system, ground, motion.time_step, end_time, rtol=settings.rtol,
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
-                    output_dt=settings.output_dt)
+                    output_dt=output_dt)
     wall = _time.perf_counter() - started
     if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
         raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
-    ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall)
-    mark_energy_status(ds)
-    return ds
+    return system, raw, wall
 
 
 def mark_energy_status(ds: xr.Dataset) -> str:

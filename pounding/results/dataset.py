@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import json
 from datetime import datetime, timezone
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -47,7 +48,7 @@ from pounding.model.schema import WALL_NAME
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver.storeys import recoverable_energy
 
-__all__ = ["to_dataset", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
+__all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
 
 #: Dimensions whose length depends on the run (impacts, full-resolution contact samples).
 RAGGED_DIMS = ("impact", "trace")
@@ -228,6 +229,37 @@ def energy_closure(ds: xr.Dataset) -> float:
     return float(np.abs(ds.energy_input - parts).max()) / scale
 
 
+def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
+    """The peaks and end-of-run state of one simulation, as plain arrays (what studies keep of a run).
+
+    The same values :func:`to_dataset` stores under the same names: storey and
+    contact labels, ``peak_drift_ratio`` and ``residual_drift_ratio`` (storey,
+    1), ``impact_count`` and ``peak_contact_force`` (contact, N), ``status``
+    (``completed`` or ``collapsed``), ``collapse_time`` (s, NaN if none) and
+    ``collapse_storey`` (label, ``""`` if none).  They do not depend on the
+    output sampling: the solver tracks peaks at every step.
+    """
+    labels = _labels(model)
+    heights = labels["height"]
+    nc = system.n_contacts
+    floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
+    building_names = [b.name for b in model.buildings]
+    collapsed = raw.collapse_storey >= 0
+    return {
+        "storey": floor_names,
+        "storey_building": [str(b) for b in labels["building"]],
+        "contact": [g.label(building_names) for g in model.gaps],
+        "peak_drift_ratio": raw.peak_drift / heights,
+        "residual_drift_ratio": _inelastic_summary(system, raw, heights)["residual"],
+        "impact_count": (np.bincount(raw.impact_contact, minlength=nc).astype(np.int32) if nc
+                         else np.zeros(0, np.int32)),
+        "peak_contact_force": raw.peak_contact_force,
+        "status": "collapsed" if collapsed else "completed",
+        "collapse_time": float(raw.final_time) if collapsed else float("nan"),
+        "collapse_storey": floor_names[raw.collapse_storey] if collapsed else "",
+    }
+
+
 def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *,
                end_time: float, wall_time: float) -> xr.Dataset:
     """Build the results dataset of one simulation."""
@@ -254,16 +286,16 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     storey_work = raw.state[:, first_hysteretic + nh:first_hysteretic + 2 * nh]
     hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
     inelastic = _inelastic_summary(system, raw, heights)
+    peaks = run_peaks(model, system, raw)
     contact_strain = raw.contact_potential  # summed over contacts by the solver at each output time
     contact_work = work.sum(axis=1)
 
-    floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
+    floor_names = peaks["storey"]
     building_names = [b.name for b in model.buildings]
     gaps = model.gaps
-    contact_names = [g.label(building_names) for g in gaps]
+    contact_names = peaks["contact"]
+    impact_count = peaks["impact_count"]
     side_names = building_names + [WALL_NAME]  # index WALL (−1) is the wall
-
-    impact_count = np.bincount(raw.impact_contact, minlength=nc).astype(np.int32) if nc else np.zeros(0, np.int32)
     with np.errstate(invalid="ignore", divide="ignore"):
         restitution = raw.impact_separation_velocity / raw.impact_velocity
     is_hertz_damp = np.array([g.law.law_id == contact_laws.LAW_HERTZ_DAMP for g in gaps], dtype=bool)
@@ -312,8 +344,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "peak_displacement": _var(("floor",), raw.peak_displacement, "m",
                                   "peak absolute floor displacement relative to the ground"),
         "peak_storey_drift": _var(("storey",), raw.peak_drift, "m", "peak absolute storey drift"),
-        "peak_drift_ratio": _var(("storey",), raw.peak_drift / heights, "1", "peak absolute storey drift ratio"),
-        "peak_contact_force": _var(("contact",), raw.peak_contact_force, "N", "peak contact force"),
+        "peak_drift_ratio": _var(("storey",), peaks["peak_drift_ratio"], "1", "peak absolute storey drift ratio"),
+        "peak_contact_force": _var(("contact",), peaks["peak_contact_force"], "N", "peak contact force"),
         "impact_count": _var(("contact",), impact_count, "1", "number of impacts (gap closures)"),
         "impact_time": _var(("impact",), raw.impact_time, "s", "time of gap closure (located event)"),
         "impact_contact": _var(("impact",), raw.impact_contact.astype(np.int32), "1",
@@ -348,7 +380,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "energy_hysteretic": _var(("time",), hysteretic, "J", "energy dissipated by yielding storeys"),
         "storey_shear": _var(("time", "storey"), raw.storey_shear, "N",
                              "storey restoring (column) shear, without P-Delta and damping"),
-        "residual_drift_ratio": _var(("storey",), inelastic["residual"], "1",
+        "residual_drift_ratio": _var(("storey",), peaks["residual_drift_ratio"], "1",
                                      "signed storey drift ratio at the end of the run"),
         "peak_ductility": _var(("storey",), inelastic["ductility"], "1",
                                "peak absolute storey drift over yield drift (NaN for an elastic storey)"),
@@ -403,9 +435,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "solver_rejected_steps": int(raw.n_rejected),
         "wall_time": float(wall_time),
         "energy_closure_error": closure,
-        "status": "collapsed" if raw.collapse_storey >= 0 else "completed",
-        "collapse_time": float(raw.final_time) if raw.collapse_storey >= 0 else float("nan"),
-        "collapse_storey": floor_names[raw.collapse_storey] if raw.collapse_storey >= 0 else "",
+        "status": peaks["status"],
+        "collapse_time": peaks["collapse_time"],
+        "collapse_storey": peaks["collapse_storey"],
         "stop_drift_ratio": float(model.solver.stop_drift_ratio or 0.0),
         "hysteresis": json.dumps({b.name: [None if law is None else law.describe() for law in b.hysteresis]
                                   for b in model.buildings if b.is_inelastic}),

@@ -286,7 +286,7 @@ SIDE_TERMS = 4
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _combo(y, offset, cf, cw, c) -> float:
-    """Σ_k cw[4 * c + k]·y[offset + cf[4 * c + k]] over the contact's floor terms (δ + gap for offset 0, δ̇ for n)."""
+    """Σ_k w_k·y[offset + f_k] over the contact's floor terms (δ + gap for offset 0, δ̇ for offset n)."""
     return (cw[4 * c + 0] * y[offset + cf[4 * c + 0]] + cw[4 * c + 1] * y[offset + cf[4 * c + 1]]
             + cw[4 * c + 2] * y[offset + cf[4 * c + 2]] + cw[4 * c + 3] * y[offset + cf[4 * c + 3]])
 
@@ -340,8 +340,7 @@ def _stuck_constraints(ag_t, mass, cf, cw, closed, cmode, fbuf, forces):
 
     Gauss–Seidel sweeps, exact in one when no two stuck contacts share a floor.
     a_g is common to both floors of a pair and cancels; against a wall it
-    stays (the wall moves with the ground).  Kept out of :func:`_rhs`, which
-    stays small enough to be inlined into the integrator's loop.
+    stays (the wall moves with the ground).  Kept out of :func:`_rhs` (rarely needed).
     """
     nc = forces.size
     for _ in range(100):
@@ -364,8 +363,7 @@ def _stuck_constraints(ag_t, mass, cf, cw, closed, cmode, fbuf, forces):
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cf, cw, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces,
-         smodel, sprm, sidx, kpd, smode, shear):
+         cf, cw, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey):
     """Time derivative of the state; contact forces are written to *forces*.
 
     A closed compliant contact acts through its law in its current mode
@@ -377,12 +375,10 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     """
     n = mass.size
     nc = cgap.size
-    nh = smode.size
-    ih = 2 * n + 3 * nc + 2  # first hysteretic state
     # fbuf[:n] accumulates internal + damping forces (N); power is the
-    # damping power v·C v (W), summed in the same loops.  A yielding storey's
-    # restoring force comes from its hysteresis kernel (pounding.solver.storeys);
-    # shear[j] receives each storey's restoring (column) shear.
+    # damping power v·C v (W), summed in the same loops.  Storeys are linear
+    # elastic here; *storey* (None for a purely elastic row, which compiles
+    # without any of it) corrects the yielding ones and adds P-Delta.
     power = 0.0
     for j in range(n):
         v = y[n + j]
@@ -396,17 +392,8 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         else:
             du = y[j]
             dv = y[n + j]
-        hi = sidx[j]
-        if hi < 0:
-            restoring = kst[j] * du
-        else:
-            r = y[ih + hi]
-            restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
-            out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
-            out[ih + nh + hi] = restoring * dv
-        shear[j] = restoring
         damping = kst[j] * a1[j] * dv
-        s = restoring + kpd[j] * du + damping
+        s = kst[j] * du + damping
         power += damping * dv
         fbuf[j] += s
         if b >= 0:
@@ -423,19 +410,22 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 acc += dvals[off + i * m + k] * y[n + s0 + k]
             fbuf[s0 + i] += acc
             power += acc * y[n + s0 + i]
+    if storey is not None:
+        _storey_forces(y, n, nc, below, kst, storey, out, fbuf)
     n_stuck = 0
     for c in range(nc):
         f = 0.0
         out[2 * n + 2 * nc + c] = 0.0
         out[2 * n + nc + c] = 0.0  # δ̇ of a closed contact for now; its power F·δ̇ below
         if closed[c]:
-            # Loops over the terms, no helper taking the arrays: _rhs stays small enough for
-            # LLVM to inline it into the integrator (measured: a third faster on pair.yaml).
-            delta = -cgap[c]
+            # Loops over the terms, no helper taking the arrays (each call would reference-count
+            # them); the gap last, so a floor pair's δ is u_L − u_R − gap to the bit, as before.
+            delta = 0.0
             rate = 0.0
             for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
                 delta += cw[k] * y[cf[k]]
                 rate += cw[k] * y[n + cf[k]]
+            delta -= cgap[c]
             out[2 * n + nc + c] = rate
             if cmode[c] == kernels.MODE_STUCK:
                 n_stuck += 1
@@ -669,23 +659,65 @@ def _contact_energy(y, n, cf, cw, cgap, claw, cprm) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out, row):
-    """Storey energies of state *y* into ``out[row]``: recoverable energy of every storey
-    (with the P-Delta potential ½·(−P/h)·Δ², J) and the recoverable energy of the yielding ones."""
-    ih = 2 * n + 3 * nc + 2
+def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
+    """Storey shears and energies of state *y* into ``shear[row]`` and ``energy[row]``.
+
+    ``shear[row, j]``: restoring (column) shear of the storey under floor j, N,
+    without P-Delta.  ``energy[row]``: recoverable energy of every storey (with
+    the P-Delta potential ½·(−P/h)·Δ², J) and the recoverable energy of the
+    yielding ones.  *storey* is None for linear elastic storeys without P-Delta.
+    """
     total = 0.0
     yielding = 0.0
     for j in range(n):
         b = below[j]
         du = y[j] - y[b] if b >= 0 else y[j]
-        hi = sidx[j]
-        r = y[ih + hi] if hi >= 0 else 0.0
-        energy = storeys.recoverable_energy(smodel[j], sprm[j], kst[j], du, r)
-        total += energy + 0.5 * kpd[j] * du * du
-        if hi >= 0:
-            yielding += energy
-    out[row, 0] = total
-    out[row, 1] = yielding
+        if storey is None:
+            shear[row, j] = kst[j] * du
+            total += 0.5 * kst[j] * du * du
+        else:
+            smodel, sprm, sidx, kpd = storey[0], storey[1], storey[2], storey[3]
+            hi = sidx[j]
+            r = y[2 * n + 3 * nc + 2 + hi] if hi >= 0 else 0.0
+            shear[row, j] = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
+            recoverable = storeys.recoverable_energy(smodel[j], sprm[j], kst[j], du, r)
+            total += recoverable + 0.5 * kpd[j] * du * du
+            if hi >= 0:
+                yielding += recoverable
+    energy[row, 0] = total
+    energy[row, 1] = yielding
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
+    """Add P-Delta and the yielding storeys' departure from ``kΔ`` to the floor forces *fbuf*, N.
+
+    Writes the rates of the hysteretic states and of the storeys' work
+    ∫F dΔ into *out*.  The caller has already applied ``kΔ`` to every storey.
+    """
+    smodel, sprm, kpd, smode, sfloor = storey[0], storey[1], storey[3], storey[6], storey[7]
+    nh = sfloor.size
+    ih = 2 * n + 3 * nc + 2  # first hysteretic state
+    for j in range(n):
+        if kpd[j] != 0.0:
+            b = below[j]
+            du = y[j] - y[b] if b >= 0 else y[j]
+            fbuf[j] += kpd[j] * du
+            if b >= 0:
+                fbuf[b] -= kpd[j] * du
+    for hi in range(nh):
+        j = sfloor[hi]
+        b = below[j]
+        du = y[j] - y[b] if b >= 0 else y[j]
+        dv = y[n + j] - y[n + b] if b >= 0 else y[n + j]
+        r = y[ih + hi]
+        restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
+        out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
+        out[ih + nh + hi] = restoring * dv
+        departure = restoring - kst[j] * du
+        fbuf[j] += departure
+        if b >= 0:
+            fbuf[b] -= departure
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -715,6 +747,10 @@ def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, prm, mode, h):
         plastic = y[ih + hi]
         e0 = d0 - plastic
         e1 = d1 - plastic
+        # The Hermite cubic stays within max(|e0|, |e1|) + (4/27)·h·(|r0| + |r1|) (its basis
+        # functions' bounds): most steps are far from the yield surface and need no search.
+        if max(abs(e0), abs(e1)) + 0.25 * h * (abs(r0) + abs(r1)) < uy:
+            return -1.0, STOREY_NONE
         floor = DELTA_ROUNDOFF * (abs(d0) + abs(plastic) + uy)
         s = _first_crossing(e0 - uy, r0, e1 - uy, r1, h, True, floor)
         kind = STOREY_YIELD_POSITIVE
@@ -887,7 +923,7 @@ def _plastic_jump(c, y, n, cf, cw, mass):
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                   cf, cw, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
-                  impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear):
+                  impacts, n_imp, open_imp, storey):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -937,7 +973,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cf, cw, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                         cf, cw, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, storey)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
@@ -989,14 +1025,17 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
 
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-               cf, cw, cgap, claw, cprm, smodel, sprm, sidx, kpd, heights, stop_ratio,
+               cf, cw, cgap, claw, cprm, storey,
                ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
+    # *storey* is None for linear elastic storeys without P-Delta or a collapse limit: every
+    # ``if storey is not None`` block below is then pruned at compile time, and the elastic
+    # row runs the plain elastic integrator.  Otherwise it is the tuple built by
+    # :func:`_storey_arguments`.
     nh = nc - nc
-    for j in range(n):
-        if sidx[j] >= 0:
-            nh += 1
+    if storey is not None:
+        nh = storey[7].size
     S = 2 * n + 3 * nc + 2 + 2 * nh
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
@@ -1029,19 +1068,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     internal_tol = np.empty(nc)
     for c in range(nc):
         internal_tol[c] = kernels.internal_tolerance(claw[c], cprm[c], atol_u)
-    # Yielding storeys: floor of each state, mode, tolerance of the state (plastic drift in m;
-    # Bouc-Wen z is dimensionless, so its tolerance is atol over u_y), located events.
-    sfloor = np.empty(nh, dtype=np.int64)
-    smode = np.zeros(nh, dtype=np.int64)
-    storey_tol = np.empty(nh)
-    for j in range(n):
-        if sidx[j] >= 0:
-            sfloor[sidx[j]] = j
-            storey_tol[sidx[j]] = atol_u if smodel[j] == hysteresis.MODEL_BILINEAR else atol_u / sprm[j, 0]
+    # Yielding storeys' located events (bilinear yield onset and unloading) and the collapse limit.
     sev_s = np.empty(nh)
     sev_kind = np.zeros(nh, dtype=np.int64)
     spending = np.zeros(nh, dtype=np.int64)
-    shear = np.zeros(n)
     collapse_floor = zero - 1
     collapse_s = -1.0
     collapse_pending = False
@@ -1074,12 +1104,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     t = 0.0
     seg = zero
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+         cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey)
     # First output sample at t = 0.
     out_time[0] = 0.0
-    for j in range(n):
-        out_shear[0, j] = shear[j]
-    _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, 0)
+    _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, 0)
     for i in range(S):
         out_state[0, i] = y[i]
     for j in range(n):
@@ -1112,9 +1140,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         n_retake = zero
         for c in range(nc):
             pending[c] = EVENT_NONE
-        for hi in range(nh):
-            spending[hi] = STOREY_NONE
-        collapse_pending = False
+        if storey is not None:
+            for hi in range(nh):
+                spending[hi] = STOREY_NONE
+            collapse_pending = False
         while True:
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
@@ -1123,28 +1152,28 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -1166,8 +1195,11 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         finite = False
                     elif r > err:
                         err = r
-            for hi in range(nh):
-                if finite:
+            if storey is not None:
+                storey_tol = storey[8]
+                for hi in range(nh):
+                    if not finite:
+                        break
                     i = ih + hi
                     e = h_try * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
                     r = abs(e) / (storey_tol[hi] + rtol * max(abs(y[i]), abs(ynew[i])))
@@ -1183,9 +1215,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 n_retake = zero
                 for c in range(nc):
                     pending[c] = EVENT_NONE
-                for hi in range(nh):
-                    spending[hi] = STOREY_NONE
-                collapse_pending = False
+                if storey is not None:
+                    for hi in range(nh):
+                        spending[hi] = STOREY_NONE
+                    collapse_pending = False
                 continue
             for c in range(nc):
                 forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
@@ -1196,13 +1229,13 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 event_kind[c] = EVENT_NONE
                 # δ, δ̇ at both ends of the step, their rates (k1, k7), and the round-off scale of δ,
                 # summed over the contact's floor terms in one loop (no helper taking the arrays).
-                d0 = -cgap[c]
+                d0 = 0.0
                 r0 = 0.0
-                d1 = -cgap[c]
+                d1 = 0.0
                 r1 = 0.0
                 q0 = 0.0
                 q1 = 0.0
-                size = abs(cgap[c])
+                size = 0.0
                 for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
                     w = cw[k]
                     f = cf[k]
@@ -1213,7 +1246,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     q0 += w * k1[n + f]
                     q1 += w * k7[n + f]
                     size += abs(w * y[f])
-                floor = DELTA_ROUNDOFF * size
+                d0 -= cgap[c]
+                d1 -= cgap[c]
+                floor = DELTA_ROUNDOFF * (size + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
                 if not closed[c]:
@@ -1231,7 +1266,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2,
-                                 fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                                 fbuf, forces, storey)
                             if forces[c] < 0.0:
                                 hi = mid
                             else:
@@ -1255,21 +1290,25 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     event_kind[c] = kind
                     if s < s_first:
                         s_first = s
-            for hi in range(nh):
-                j = sfloor[hi]
-                s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j], smode[hi],
-                                        h_try)
-                sev_s[hi] = s
-                sev_kind[hi] = kind
-                if kind != STOREY_NONE and s < s_first:
-                    s_first = s
             collapse_s = -1.0
-            if stop_ratio > 0.0:
-                collapse_s, collapse_at = _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio, h_try)
-                if collapse_s >= 0.0:
-                    collapse_floor = collapse_at
-                    if collapse_s < s_first:
-                        s_first = collapse_s
+            if storey is not None:
+                smodel, sprm, heights, stop_ratio, smode, sfloor = (storey[0], storey[1], storey[4], storey[5],
+                                                                    storey[6], storey[7])
+                for hi in range(nh):
+                    j = sfloor[hi]
+                    s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j],
+                                            smode[hi], h_try)
+                    sev_s[hi] = s
+                    sev_kind[hi] = kind
+                    if kind != STOREY_NONE and s < s_first:
+                        s_first = s
+                if stop_ratio > 0.0:
+                    collapse_s, collapse_at = _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio,
+                                                                 h_try)
+                    if collapse_s >= 0.0:
+                        collapse_floor = collapse_at
+                        if collapse_s < s_first:
+                            s_first = collapse_s
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 for c in range(nc):
@@ -1278,14 +1317,16 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
                     status = STATUS_COLLAPSED
                     break
-                for hi in range(nh):
-                    if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
-                        sev_kind[hi] = STOREY_NONE
-                n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
+                n_storey = zero
+                if storey is not None:
+                    for hi in range(nh):
+                        if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
+                            sev_kind[hi] = STOREY_NONE
+                    n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
-                    impacts, n_imp, open_imp, smodel, sprm, sidx, kpd, smode, shear)
+                    impacts, n_imp, open_imp, storey)
                 n_applied += n_storey
                 if t - window_start > dt_rec:
                     window_start = t
@@ -1296,24 +1337,27 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if status != 0:
                     break
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                     dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
                 for c in range(nc):
                     pending[c] = EVENT_NONE
-                for hi in range(nh):
-                    spending[hi] = STOREY_NONE
-                collapse_pending = False
+                if storey is not None:
+                    for hi in range(nh):
+                        spending[hi] = STOREY_NONE
+                    collapse_pending = False
                 n_retake = zero
                 continue
             if s_first < 1.0 - EVENT_END_TOLERANCE and n_retake < MAX_RETAKES:
                 # Retake the step to end at the first event; the retaken step is searched again.
                 for c in range(nc):
                     pending[c] = event_kind[c] if event_kind[c] != EVENT_NONE and event_s[c] <= s_first else EVENT_NONE
-                for hi in range(nh):
-                    spending[hi] = sev_kind[hi] if sev_kind[hi] != STOREY_NONE and sev_s[hi] <= s_first else STOREY_NONE
-                collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
+                if storey is not None:
+                    for hi in range(nh):
+                        spending[hi] = (sev_kind[hi] if sev_kind[hi] != STOREY_NONE and sev_s[hi] <= s_first
+                                        else STOREY_NONE)
+                    collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
                 h_try = s_first * h_try
                 n_retake += 1
                 continue
@@ -1407,7 +1451,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1417,9 +1461,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 out_force[i_out, c] = forces[c]
             out_ag[i_out] = ag_o
             out_pot[i_out] = _contact_energy(ystage, n, cf, cw, cgap, claw, cprm)
-            for j in range(n):
-                out_shear[i_out, j] = shear[j]
-            _storey_energy(ystage, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i_out)
+            _storey_outputs(ystage, n, nc, below, kst, storey, out_shear, out_storey_energy, i_out)
             i_out += 1
         # ---- accept ---------------------------------------------------------
         t = t_new
@@ -1431,17 +1473,19 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         for c in range(nc):
             if event_kind[c] == EVENT_NONE:
                 event_kind[c] = pending[c]
-        if collapse_s >= 0.0 or collapse_pending:
-            status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
-            break
-        for hi in range(nh):
-            if sev_kind[hi] == STOREY_NONE:
-                sev_kind[hi] = spending[hi]
-        n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
+        n_storey = zero
+        if storey is not None:
+            if collapse_s >= 0.0 or collapse_pending:
+                status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
+                break
+            for hi in range(nh):
+                if sev_kind[hi] == STOREY_NONE:
+                    sev_kind[hi] = spending[hi]
+            n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
-            smodel, sprm, sidx, kpd, smode, shear)
+            storey)
         n_applied += n_storey
         if n_applied > 0:
             if t - window_start > dt_rec:
@@ -1451,7 +1495,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1477,12 +1521,10 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, smodel, sprm, sidx, kpd, smode, shear)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
-            for j in range(n):
-                out_shear[i2, j] = shear[j]
-            _storey_energy(y, n, nc, below, kst, kpd, smodel, sprm, sidx, out_storey_energy, i2)
+            _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, i2)
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
             out_pot[i2] = _contact_energy(y, n, cf, cw, cgap, claw, cprm)
         i_out = n_out
@@ -1500,6 +1542,31 @@ jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Di
                               [__file__, kernels.__file__, contact_laws.__file__, storeys.__file__,
                                hysteresis.__file__])
 jit.load_from_cache_without_refresh(_integrate)
+
+
+def _storey_arguments(system: System, atol: float) -> tuple | None:
+    """The compiled integrator's *storey* argument: None for linear elastic storeys without
+    P-Delta or collapse limit (the integrator then compiles without any storey code), else
+    ``(model, parameters, state index, P-Delta stiffness, height, stop ratio, mode, floor of
+    each state, tolerance of each state)``.
+
+    A state's tolerance is atol for a bilinear storey's plastic drift (m) and atol/u_y for
+    Bouc–Wen's dimensionless z; its mode (a fresh array: the integrator changes it) starts elastic.
+    """
+    if system.n_hysteretic == 0 and not np.any(system.p_delta_stiffness) and system.stop_drift_ratio <= 0.0:
+        return None
+    floors = np.flatnonzero(system.storey_state >= 0)
+    state_floor = np.empty(floors.size, dtype=np.int64)
+    state_floor[system.storey_state[floors]] = floors
+    bilinear = system.storey_model[state_floor] == hysteresis.MODEL_BILINEAR
+    tolerance = np.where(bilinear, atol, atol / np.where(bilinear, 1.0, system.storey_parameters[state_floor, 0]))
+    return (np.ascontiguousarray(system.storey_model, dtype=np.int64),
+            np.ascontiguousarray(system.storey_parameters, dtype=np.float64),
+            np.ascontiguousarray(system.storey_state, dtype=np.int64),
+            np.ascontiguousarray(system.p_delta_stiffness, dtype=np.float64),
+            np.ascontiguousarray(system.storey_height, dtype=np.float64),
+            float(system.stop_drift_ratio), np.zeros(floors.size, dtype=np.int64), state_floor,
+            np.ascontiguousarray(tolerance, dtype=np.float64))
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,
@@ -1543,10 +1610,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     raw = _integrate(system.mass, system.storey_stiffness, system.below, system.rayleigh_mass,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
                      system.dense_offset, system.dense_values, kernel_floors,
-                     np.ascontiguousarray(system.contact_weights, dtype=float).reshape(-1), system.contact_gap, system.contact_law,
-                     system.contact_parameters, system.storey_model, system.storey_parameters,
-                     system.storey_state, system.p_delta_stiffness, system.storey_height,
-                     float(system.stop_drift_ratio), ag, float(time_step), float(duration), float(rtol),
+                     np.ascontiguousarray(system.contact_weights, dtype=float).reshape(-1), system.contact_gap,
+                     system.contact_law, system.contact_parameters, _storey_arguments(system, float(atol)), ag,
+                     float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
     (time, state, acc, force, ag_out, potential, peak_u, peak_drift, peak_force, impacts, trace, shear,

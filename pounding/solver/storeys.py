@@ -44,7 +44,8 @@ def state_rate(model, prm, mode, drift_rate, r):
     if model == MODEL_BILINEAR:
         return drift_rate if mode != ELASTIC else 0.0
     if model == MODEL_BOUC_WEN:
-        power = abs(r) if prm[2] == 1.0 else abs(r) ** prm[2]
+        n = prm[2]
+        power = abs(r) if n == 1.0 else (r * r if n == 2.0 else abs(r) ** n)  # |z|^n; exact for n = 1, 2
         same = 1.0 if drift_rate * r > 0.0 else (-1.0 if drift_rate * r < 0.0 else 0.0)
         return drift_rate / prm[0] * (prm[5] - power * (prm[3] * same + prm[4]))
     return 0.0

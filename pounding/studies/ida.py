@@ -454,7 +454,7 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     are stored as None (JSON has no NaN).
     """
     from pounding.model.model import model_from_data
-    from pounding.simulation import simulate
+    from pounding.simulation import simulate_peaks
     from pounding.studies.sweep.scenario import one_line
     from pounding.studies.sweep.spec import PARTS_FORMAT
 
@@ -464,29 +464,26 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model = model_from_data(task["data"], name=task.get("name", "model"), source=task["document"],
                                 base_dir=task.get("base_dir"))
-        ds = simulate(model)
-        residual = ds["residual_drift_ratio"].values if "residual_drift_ratio" in ds else \
-            np.full(ds.storey.size, np.nan)
-        collapse_time = float(ds.attrs.get("collapse_time", float("nan")))
+        peaks = simulate_peaks(model)   # the peaks of simulate(model), without histories or dataset
         result.update({
             "status": "ok",
-            "outcome": "collapsed" if ds.attrs.get("status") == "collapsed" else "completed",
-            "run_status": str(ds.attrs.get("status", "")),
-            "collapse_time": _plain(collapse_time),
-            "collapse_storey": str(ds.attrs.get("collapse_storey", "") or ""),
+            "outcome": peaks["status"],
+            "run_status": peaks["status"],
+            "collapse_time": _plain(peaks["collapse_time"]),
+            "collapse_storey": peaks["collapse_storey"],
             "storeys": {
-                "storey": [str(x) for x in ds.storey.values],
-                "building": [str(x) for x in ds.storey_building.values],
-                "peak_drift_ratio": [float(x) for x in ds.peak_drift_ratio.values],
-                "residual_drift_ratio": [_plain(float(x)) for x in residual],
+                "storey": list(peaks["storey"]),
+                "building": list(peaks["storey_building"]),
+                "peak_drift_ratio": [float(x) for x in peaks["peak_drift_ratio"]],
+                "residual_drift_ratio": [_plain(float(x)) for x in peaks["residual_drift_ratio"]],
             },
             "contacts": {
-                "contact": [str(x) for x in ds.contact.values],
-                "impact_count": [int(x) for x in ds.impact_count.values],
-                "peak_contact_force": [float(x) for x in ds.peak_contact_force.values],
+                "contact": list(peaks["contact"]),
+                "impact_count": [int(x) for x in peaks["impact_count"]],
+                "peak_contact_force": [float(x) for x in peaks["peak_contact_force"]],
             },
-            "scale_factor": float(ds.attrs.get("record_scale", float("nan"))),
-            "solver_wall_time": float(ds.attrs["wall_time"]),
+            "scale_factor": peaks["record_scale"],
+            "solver_wall_time": peaks["wall_time"],
         })
     except Exception as exc:  # noqa: BLE001 - a failing run is a result, not a crash
         result["error"] = f"{task.get('where', 'scenario')}: {one_line(exc)}"
