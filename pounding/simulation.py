@@ -117,6 +117,17 @@ def assemble(model: Model) -> System:
         gaps.append(gap.gap)
         laws.append(gap.law.law_id)
         params.append(gap.law.kernel_parameters(_side_mass(terms_left, mass_all), _side_mass(terms_right, mass_all)))
+    # Links follow the contacts in the same arrays: elements engaged from the start, gap 0, never open.
+    for link in model.links:
+        lf = model.floor_offset(link.left) + link.level_left - 1
+        rf = model.floor_offset(link.right) + link.level_right - 1
+        left.append(lf)
+        right.append(rf)
+        floors.append([lf, -1, rf, -1])
+        weights.append([1.0, 0.0, -1.0, 0.0])
+        gaps.append(0.0)
+        laws.append(link.law.law_id)
+        params.append(link.law.kernel_parameters())
 
     return System(
         mass=np.ascontiguousarray(mass_all, dtype=float),

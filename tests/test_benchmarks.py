@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ROOT / "benchmarks"
 SCRIPTS = sorted(p for p in BENCHMARKS.glob("*.py") if not p.name.startswith("_"))
 #: The documentation files each benchmark may rewrite, with --update-docs only.
-OWNS = {"scaling.py": ["docs/scaling.png"], "vs_opensees.py": [], "sweep_scaling.py": [], "configurations.py": []}
+OWNS = {"scaling.py": ["docs/scaling.png"], "vs_opensees.py": [], "sweep_scaling.py": [], "configurations.py": [],
+        "ida_throughput.py": []}
 
 
 def _output_module():

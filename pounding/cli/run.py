@@ -125,6 +125,13 @@ def summary(ds) -> str:
         if total:
             v0 = ds.impact_velocity.values
             lines.append(f"  {total} impacts in all; approach velocity {np.nanmin(v0):.3g}-{np.nanmax(v0):.3g} m/s")
+    if ds.sizes.get("link", 0):
+        lines.append("links (floors: peak |force|, peak |deformation|, energy dissipated, element):")
+        for i in range(ds.sizes["link"]):
+            peak_deformation = float(np.abs(ds.link_deformation.values[:, i]).max())
+            lines.append(f"  {ds.link.values[i]}: peak {_fmt_force(float(ds.peak_link_force.values[i]))}, "
+                         f"{1000 * peak_deformation:.3g} mm, {float(ds.link_dissipated_energy.values[i]) / 1e3:.4g} kJ, "
+                         f"{ds.link_law.values[i]}")
     lines.append(f"energy closure error {ds.attrs['energy_closure_error']:.2e}; "
                  f"{ds.attrs['solver_steps']} steps ({ds.attrs['solver_rejected_steps']} rejected); "
                  f"solver wall time {ds.attrs['wall_time']:.3f} s")

@@ -33,6 +33,13 @@ OpenSeesPy and runs it under the same record:
   with ``uniaxialMaterial Hertzdamp Kh xiNorm −gap`` (``xiNorm = p(e)`` of the
   chosen ξ formula) and ``-doRayleigh 0`` (``hertz`` exports as ``xiNorm = 0``,
   ``linear`` as ``ElasticPPGap``);
+* each link (``links:``, a permanent damper between two floors) a
+  ``zeroLength`` from the left floor to the right floor with ``-doRayleigh 0``
+  and the material of its law: ``Viscous(c, 1)`` (linear viscous),
+  ``Parallel`` of ``Elastic(k)`` and ``Viscous(c, 1)`` (Kelvin), and
+  ``ViscousDamper(k, c, 1)`` (Maxwell: a spring in series with a linear
+  dashpot, integrated inside the material by an adaptive Dormand-Prince
+  scheme); the peak |force| of each link is recorded as ``peak_link_force``;
 * the record as ``timeSeries Path`` + ``pattern UniformExcitation`` (linear
   between samples and zero after the end, as in :func:`pounding.simulate`);
 * ``Newmark`` average acceleration (γ = 1/2, β = 1/4), ``Newton`` with an
@@ -146,6 +153,27 @@ def _contact_material(law, gap: float) -> tuple[list, list[str]]:
         return ["ElasticPPGap", float(law.k), -1.0e30, -float(gap)], []
     raise PoundingError(f"contact law '{law.name}' has no OpenSees counterpart in this exporter "
                         "(supported: hertz-damp, hertz, linear)")
+
+
+#: Material tags of the parts of a Parallel link material: this offset plus 2·element (+1).
+_PART_TAG_OFFSET = 1_000_000
+
+
+def _link_materials(law, element: int) -> list[list]:
+    """OpenSees materials of one link: ``[tag, type, args...]`` rows, the last one the element's (tag *element*)."""
+    from pounding.contact.links import KelvinLink, MaxwellLink, ViscousLink
+
+    if isinstance(law, ViscousLink):
+        return [[element, "Viscous", float(law.damping), 1.0]]
+    if isinstance(law, KelvinLink):
+        spring, dashpot = _PART_TAG_OFFSET + 2 * element, _PART_TAG_OFFSET + 2 * element + 1
+        return [[spring, "Elastic", float(law.stiffness)], [dashpot, "Viscous", float(law.damping), 1.0],
+                [element, "Parallel", spring, dashpot]]
+    if isinstance(law, MaxwellLink):
+        # ViscousDamper K Cd alpha: the Maxwell model of a fluid damper (Akcelyan, Lignos & Hikino 2018).
+        return [[element, "ViscousDamper", float(law.stiffness), float(law.damping), 1.0]]
+    raise PoundingError(f"link law '{law.name}' has no OpenSees counterpart in this exporter "
+                        "(supported: viscous, kelvin, maxwell)")
 
 
 def _storey_material(law, stiffness: float, height: float) -> list:
@@ -291,6 +319,13 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         right = grounds[g.left] if g.right == WALL else floor_node[(g.right, g.level_right)]
         contacts.append((element, left, right, material, g.label(names)))
 
+    links = []         # (element, node left, node right, [[tag, material, args...], ...], link label)
+    for link in model.links:
+        element += 1
+        links.append((element, floor_node[(link.left, link.level_left)], floor_node[(link.right, link.level_right)],
+                      _link_materials(link.law, element),
+                      f"{names[link.left]}:{link.level_left}-{names[link.right]}:{link.level_right}"))
+
     n_samples = min(motion.acceleration.size, int(math.ceil(end_time / motion.time_step - 1e-9)) + 1)
     samples = motion.acceleration[:n_samples]
     lines = []
@@ -312,7 +347,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         notes=note_text, record_name=_inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
         duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
         floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
-        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta),
+        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta), links=rows(links),
     ), notes
 
 
@@ -399,6 +434,11 @@ DASHPOTS = [
 CONTACTS = [
 {contacts}
 ]
+# links (permanent dampers, no gap): (element, left floor node, right floor node,
+# materials [[tag, type, args...], ...] the last of which is the element's, link label)
+LINKS = [
+{links}
+]
 
 
 def build(log_file=None):
@@ -424,6 +464,10 @@ def build(log_file=None):
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
     for ele, i, j, material, _label in CONTACTS:
         ops.uniaxialMaterial(material[0], ele, *material[1:])
+        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
+    for ele, i, j, materials, _label in LINKS:
+        for tag, kind, *args in materials:
+            ops.uniaxialMaterial(kind, tag, *args)
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
     for region, (_name, a0, a1, elements, nodes) in enumerate(RAYLEIGH, start=1):
         # Each building its own a0 (on its nodes' masses) and a1 (on its storeys' initial stiffness:
@@ -465,6 +509,10 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
                      "deformation")
         if contact_elements:
             ops.recorder("Element", "-binary", force, "-ele", *contact_elements, "basicForce")
+        link_elements = [row[0] for row in LINKS]
+        link_force = os.path.join(workdir, "link_force.bin")
+        if link_elements:
+            ops.recorder("Element", "-binary", link_force, "-ele", *link_elements, "basicForce")
         ops.constraints("Plain")
         ops.numberer("RCM")
         ops.system("BandGeneral")
@@ -511,6 +559,11 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
                     closed[c] = f != 0.0
                     if f > peak_force[c]:
                         peak_force[c] = f
+        peak_link = [0.0] * len(link_elements)
+        if link_elements:
+            for row in _read_rows(link_force, len(link_elements)):
+                for c in range(len(link_elements)):
+                    peak_link[c] = max(peak_link[c], abs(row[c]))
         return {{
             "model": MODEL_NAME,
             "record": RECORD_NAME,
@@ -528,6 +581,8 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             "contact": [row[4] for row in CONTACTS],
             "peak_contact_force": peak_force,
             "impact_count": impacts,
+            "link": [row[4] for row in LINKS],
+            "peak_link_force": peak_link,
         }}
     finally:
         if own:
@@ -567,7 +622,7 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
     -------
     dict
         ``floor``/``peak_displacement`` (m), ``storey``/``peak_drift_ratio``,
-        ``contact``/``peak_contact_force`` (N)/``impact_count``, labelled as
+        ``contact``/``peak_contact_force`` (N)/``impact_count``, ``link``/``peak_link_force`` (N), labelled as
         in the results dataset, plus ``wall_time`` (s, the ``analyze`` calls
         only), ``converged`` and ``dt``.
 

@@ -34,6 +34,7 @@ from pounding.model import schema
 from pounding.model.document import DataSource
 from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
+from pounding.contact.links import LinkLaw
 from pounding.errors import ModelError, PoundingError, did_you_mean
 from pounding.records.catalogue import is_catalogued
 from pounding.units import STANDARD_GRAVITY
@@ -42,6 +43,7 @@ __all__ = [
     "Damping",
     "Building",
     "GapElement",
+    "Link",
     "GroundMotionSpec",
     "SolverSettings",
     "Model",
@@ -64,7 +66,7 @@ def column_weights(at: float) -> tuple[float, float]:
     column point's displacement ``N1·u_below + N2·u_above`` under end
     displacements of rigid floors, and the shares of a point force there taken
     by the floor below and the floor above (the fixed-fixed beam's end shears
-    ``P(1−ξ)²(1+2ξ)`` and ``Pξ²(3−2ξ)``; docs/physics.md §10).
+    ``P(1−ξ)²(1+2ξ)`` and ``Pξ²(3−2ξ)``; docs/physics.md §11).
     """
     xi = float(at)
     n2 = xi * xi * (3.0 - 2.0 * xi)
@@ -394,6 +396,31 @@ class GapElement:
 
 
 @dataclass(frozen=True)
+class Link:
+    """A permanent link (damper) between floor ``level_left`` of building ``left``
+    and floor ``level_right`` of building ``right = left + 1``: always engaged,
+    no gap, pulls as well as pushes (docs/physics.md §9).
+
+    Attributes
+    ----------
+    entry : int
+        Index of the YAML ``links`` entry it came from.
+    left, right : int
+        Building indices (left to right).
+    level_left, level_right : int
+        1-based floor numbers.
+    law : LinkLaw
+    """
+
+    entry: int
+    left: int
+    right: int
+    level_left: int
+    level_right: int
+    law: LinkLaw
+
+
+@dataclass(frozen=True)
 class GroundMotionSpec:
     """Which record to apply and how.
 
@@ -517,6 +544,8 @@ class Model:
         Left to right.
     gaps : tuple of GapElement
         One per joined floor pair, in ``contacts`` order.
+    links : tuple of Link
+        One per linked floor pair, in ``links`` order (default: none).
     ground_motion : GroundMotionSpec
     solver : SolverSettings
     source : str
@@ -536,12 +565,14 @@ class Model:
     solver: SolverSettings
     source: str
     path: str | None = None
+    links: tuple[Link, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "buildings", tuple(self.buildings))
         object.__setattr__(self, "gaps", tuple(self.gaps))
+        object.__setattr__(self, "links", tuple(self.links))
         last = len(self.buildings) - 1
-        for gap in self.gaps:
+        for gap in self.gaps + self.links:
             if gap.left == WALL and gap.right == 0 or gap.right == WALL and gap.left == last:
                 continue
             if not (0 <= gap.left < len(self.buildings) - 1 and gap.right == gap.left + 1):
@@ -637,6 +668,11 @@ class Model:
             pairs = ", ".join(f"{schema.side_text(self.buildings, g.left, g.level_left, g.at_left)}-"
                               f"{schema.side_text(self.buildings, g.right, g.level_right, g.at_right)}" for g in gaps)
             lines.append(f"contact {contact}: {pairs}; gap {gaps[0].gap:g} m, {gaps[0].law.describe()}")
+        for index in sorted({link.entry for link in self.links}):
+            mine = [link for link in self.links if link.entry == index]
+            left, right = self.buildings[mine[0].left].name, self.buildings[mine[0].right].name
+            pairs = ", ".join(f"{left}{k.level_left}-{right}{k.level_right}" for k in mine)
+            lines.append(f"link {index}: {pairs}; {mine[0].law.describe()}")
         gm = self.ground_motion
         lines.append(f"ground motion: {gm.record} {gm.describe_scale()}"
                      + (f", processing {gm.processing.to_document()}" if gm.processing is not None else "")
@@ -668,13 +704,24 @@ class Model:
             entry: dict[str, Any] = {"between": between, "levels": levels, "gap": float(first.gap)}
             entry.update(first.law.model_dump(mode="json"))
             contacts.append(entry)
-        return {
+        links = []
+        for index in sorted({link.entry for link in self.links}):
+            mine = [link for link in self.links if link.entry == index]
+            first = mine[0]
+            entry = {"between": [self.buildings[first.left].name, self.buildings[first.right].name],
+                     "levels": [[link.level_left, link.level_right] for link in mine]}
+            entry.update(first.law.model_dump(mode="json"))
+            links.append(entry)
+        document = {
             "name": self.name,
             "buildings": [_building_document(b) for b in self.buildings],
             "contacts": contacts,
             "ground_motion": self.ground_motion.to_document(),
             "solver": {k: v for k, v in dataclasses.asdict(self.solver).items() if v is not None},
         }
+        if links:
+            document["links"] = links
+        return document
 
     def to_yaml(self) -> str:
         """A YAML document that :func:`model_from_text` turns back into this model.
@@ -735,12 +782,14 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
                                   p_delta=b.p_delta, **arrays))
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters, at_a, at_r)
                  for index, c in enumerate(entry.contacts) for (a, r), (at_a, at_r) in zip(c.pairs, c.points))
+    links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)
+                  for index, e in enumerate(entry.links) for a, r in e.pairs)
     gm = entry.ground_motion
     ground_motion = _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
                              units=gm.units, base_dir=base_dir, processing=gm.processing)
     solver = _trusted(SolverSettings, **entry.solver.model_dump())
     return _trusted(Model, name=entry.name or name, buildings=tuple(buildings), gaps=gaps,
-                    ground_motion=ground_motion, solver=solver, source=text, path=path)
+                    ground_motion=ground_motion, solver=solver, source=text, path=path, links=links)
 
 
 def model_from_text(text: str, *, name: str = "model", path: str | None = None,

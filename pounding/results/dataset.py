@@ -42,6 +42,7 @@ import xarray as xr
 
 from pounding import __version__
 from pounding.contact import laws as contact_laws
+from pounding.contact import links as contact_links
 from pounding.records.record import Record
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
@@ -111,6 +112,29 @@ def _storey_drift(u: np.ndarray, below: np.ndarray) -> np.ndarray:
     return drift
 
 
+def _link_results(system: System, raw: RawSolution, ng: int) -> dict[str, np.ndarray]:
+    """Per link (the elements after the *ng* contacts): deformation, work and stored energy histories.
+
+    Stored energy (docs/physics.md §9): ½kδ² in a Kelvin spring, q²/(2k) in a Maxwell spring, none
+    in a dashpot (the solver's ``kernels.potential`` of the same elements, vectorised here).
+    """
+    n = system.n_floors
+    nc = system.n_contacts
+    u = raw.state[:, :n]
+    left, right = system.contact_left[ng:], system.contact_right[ng:]
+    deformation = np.take(u, left, axis=1) - np.take(u, right, axis=1)
+    work = raw.state[:, 2 * n + nc + ng:2 * n + 2 * nc]
+    internal = raw.state[:, 2 * n + 2 * nc + ng:2 * n + 3 * nc]
+    law = system.contact_law[ng:]
+    stiffness = system.contact_parameters[ng:, 0]
+    stored = np.zeros_like(deformation)
+    kelvin = law == contact_links.LINK_KELVIN
+    maxwell = law == contact_links.LINK_MAXWELL
+    stored[:, kelvin] = 0.5 * stiffness[kelvin] * deformation[:, kelvin] ** 2
+    stored[:, maxwell] = 0.5 * internal[:, maxwell] ** 2 / stiffness[maxwell]
+    return {"deformation": deformation, "work": work, "stored": stored}
+
+
 def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray) -> dict[str, np.ndarray]:
     """Per storey: residual drift ratio, yield drift, peak ductility and dissipated energy at the end."""
     n = system.n_floors
@@ -174,7 +198,7 @@ def column_shear_demand(shear: np.ndarray, force: np.ndarray, at: float, side: s
     +x (``−F`` on a left side, ``+F`` on a right side, F ≥ 0 the contact force)
     the segment below the point carries ``V + N1·Q``, the one above
     ``V − N2·Q`` (``N1``, ``N2``: :func:`pounding.model.model.column_weights`);
-    the demand is the larger magnitude (docs/physics.md §10).
+    the demand is the larger magnitude (docs/physics.md §11).
     """
     n1, n2 = column_weights(at)
     q = -force if side == "left" else force
@@ -221,6 +245,9 @@ def energy_closure(ds: xr.Dataset) -> float:
     """``max |E_in − Σ parts| / max |E_in|`` of a results dataset (dimensionless)."""
     parts = (ds.energy_kinetic + ds.energy_strain + ds.energy_damping
              + ds.energy_contact_dissipated + ds.energy_contact_strain)
+    for name in ("energy_link_dissipated", "energy_link_strain"):
+        if name in ds:
+            parts = parts + ds[name]
     if "energy_hysteretic" in ds:
         parts = parts + ds.energy_hysteretic
     scale = float(np.abs(ds.energy_input).max())
@@ -241,7 +268,7 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     """
     labels = _labels(model)
     heights = labels["height"]
-    nc = system.n_contacts
+    ng = len(model.gaps)   # the gap elements; the links follow them in the solver's arrays
     floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
     building_names = [b.name for b in model.buildings]
     collapsed = raw.collapse_storey >= 0
@@ -251,9 +278,9 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
         "contact": [g.label(building_names) for g in model.gaps],
         "peak_drift_ratio": raw.peak_drift / heights,
         "residual_drift_ratio": _inelastic_summary(system, raw, heights)["residual"],
-        "impact_count": (np.bincount(raw.impact_contact, minlength=nc).astype(np.int32) if nc
+        "impact_count": (np.bincount(raw.impact_contact, minlength=ng).astype(np.int32) if ng
                          else np.zeros(0, np.int32)),
-        "peak_contact_force": raw.peak_contact_force,
+        "peak_contact_force": raw.peak_contact_force[:ng],
         "status": "collapsed" if collapsed else "completed",
         "collapse_time": float(raw.final_time) if collapsed else float("nan"),
         "collapse_storey": floor_names[raw.collapse_storey] if collapsed else "",
@@ -274,8 +301,11 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
 
     drift = _storey_drift(u, system.below)
     heights = labels["height"]
+    # Contacts first, then links (pounding.simulation.assemble puts the links after the gap elements).
+    ng = len(model.gaps)
     # np.take gathers columns of the strided state far faster than fancy indexing.
-    penetration = _penetration(u, system)
+    penetration = _penetration(u, system)[:, :ng]
+    links = _link_results(system, raw, ng)
 
     kinetic = 0.5 * np.einsum("ij,ij,j->i", v, v, system.mass)
     # Recoverable storey energy (with the P-Delta potential), summed by the solver at each output time;
@@ -287,8 +317,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
     inelastic = _inelastic_summary(system, raw, heights)
     peaks = run_peaks(model, system, raw)
-    contact_strain = raw.contact_potential  # summed over contacts by the solver at each output time
-    contact_work = work.sum(axis=1)
+    # Summed over contacts and links by the solver at each output time; the links' share is taken out.
+    contact_strain = raw.contact_potential - links["stored"].sum(axis=1)
+    contact_work = work[:, :ng].sum(axis=1)
 
     floor_names = peaks["storey"]
     building_names = [b.name for b in model.buildings]
@@ -299,7 +330,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     with np.errstate(invalid="ignore", divide="ignore"):
         restitution = raw.impact_separation_velocity / raw.impact_velocity
     is_hertz_damp = np.array([g.law.law_id == contact_laws.LAW_HERTZ_DAMP for g in gaps], dtype=bool)
-    impact_xi = np.where(is_hertz_damp[raw.impact_contact] if nc else np.zeros(0, bool),
+    impact_xi = np.where(is_hertz_damp[raw.impact_contact] if ng else np.zeros(0, bool),
                          raw.impact_constant, np.nan)
 
     coords = {
@@ -329,6 +360,11 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                        {"long_name": "formula for the Hertz-damp damping constant"}),
         "law_parameters": ("contact", np.array([g.law.describe() for g in gaps], dtype=object),
                            {"long_name": "contact law and its parameters"}),
+        "link": ("link", np.array([f"{building_names[k.left]}:{k.level_left}-{building_names[k.right]}:"
+                                   f"{k.level_right}" for k in model.links], dtype=object),
+                 {"long_name": "link label left:level-right:level"}),
+        "link_law": ("link", np.array([k.law.describe() for k in model.links], dtype=object),
+                     {"long_name": "link element and its parameters"}),
     }
     variables = {
         "displacement": _var(("time", "floor"), u, "m", "floor displacement relative to the ground"),
@@ -337,7 +373,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                                       "m s-2", "absolute floor acceleration"),
         "storey_drift": _var(("time", "storey"), drift, "m", "storey drift u_i - u_(i-1)"),
         "drift_ratio": _var(("time", "storey"), drift / heights, "1", "storey drift ratio (drift / height)"),
-        "contact_force": _var(("time", "contact"), raw.contact_force, "N", "contact force (>= 0 pushes apart)"),
+        "contact_force": _var(("time", "contact"), raw.contact_force[:, :ng], "N", "contact force (>= 0 pushes apart)"),
         "penetration": _var(("time", "contact"), penetration, "m",
                             "penetration u_left - u_right - gap (positive = overlap, negative = open gap)"),
         "ground_acceleration": _var(("time",), raw.ground_acceleration, "m s-2", "ground acceleration"),
@@ -378,6 +414,17 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                                           "energy dissipated by the contacts"),
         "energy_contact_strain": _var(("time",), contact_strain, "J", "elastic energy stored in the contacts"),
         "energy_hysteretic": _var(("time",), hysteretic, "J", "energy dissipated by yielding storeys"),
+        "energy_link_dissipated": _var(("time",), links["work"].sum(axis=1) - links["stored"].sum(axis=1), "J",
+                                       "energy dissipated by the links"),
+        "energy_link_strain": _var(("time",), links["stored"].sum(axis=1), "J", "elastic energy stored in the links"),
+        "link_force": _var(("time", "link"), raw.contact_force[:, ng:], "N",
+                           "link force (> 0 pushes the floors apart, < 0 pulls them together)"),
+        "link_deformation": _var(("time", "link"), links["deformation"], "m",
+                                 "relative displacement u_left - u_right across the link"),
+        "peak_link_force": _var(("link",), raw.peak_contact_force[ng:], "N",
+                                "peak absolute link force, tracked on every step"),
+        "link_dissipated_energy": _var(("link",), links["work"][-1] - links["stored"][-1], "J",
+                                       "energy dissipated by the link over the run"),
         "storey_shear": _var(("time", "storey"), raw.storey_shear, "N",
                              "storey restoring (column) shear, without P-Delta and damping"),
         "residual_drift_ratio": _var(("storey",), peaks["residual_drift_ratio"], "1",
@@ -394,14 +441,21 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     if any(g.has_column_point for g in gaps):
         coords.update(_column_point_coords(gaps))
         variables.update(_column_shear_variables(system, raw, gaps))
+    if not model.links:
+        # A model without links has no link dimension and no link variables (archives as before links).
+        for name in ("link", "link_law"):
+            del coords[name]
+        for name in ("energy_link_dissipated", "energy_link_strain", "link_force", "link_deformation",
+                     "peak_link_force", "link_dissipated_energy"):
+            del variables[name]
     ds = xr.Dataset(variables, coords=coords)
     # The ragged dims get their times and contact labels as coordinates, so that
     # ds.trace_force.plot(x="trace_time") and groupby("trace_contact_label") work.
     labels = np.asarray(ds.contact.values, dtype=object)
     ds = ds.set_coords(["impact_time", "trace_time"]).assign_coords(
-        impact_contact_label=("impact", labels[raw.impact_contact] if nc else np.zeros(0, dtype=object),
+        impact_contact_label=("impact", labels[raw.impact_contact] if ng else np.zeros(0, dtype=object),
                               {"long_name": "gap element of the impact (label of impact_contact)"}),
-        trace_contact_label=("trace", labels[raw.trace_contact] if nc else np.zeros(0, dtype=object),
+        trace_contact_label=("trace", labels[raw.trace_contact] if ng else np.zeros(0, dtype=object),
                              {"long_name": "gap element of the sample (label of trace_contact)"}))
     closure = energy_closure(ds)
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")

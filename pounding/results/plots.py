@@ -52,7 +52,7 @@ def _side_displacement(ds: xr.Dataset, i: int, side: str) -> tuple[str, np.ndarr
     """Label and displacement history (m) of one side of contact *i*: a floor, a wall (0) or a column point.
 
     A column point at fraction ξ of storey s moves as ``N1·u_(s−1) + N2·u_s``
-    (Hermite shape functions of the fixed-fixed column, docs/physics.md §10).
+    (Hermite shape functions of the fixed-fixed column, docs/physics.md §11).
     """
     building = str(ds[f"building_{side}"].values[i])
     level = int(ds[f"level_{side}"].values[i])

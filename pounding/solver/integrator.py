@@ -61,6 +61,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws as contact_laws
+from pounding.contact import links as contact_links
 from pounding import hysteresis
 from pounding.solver import kernels
 from pounding.solver import jit
@@ -433,7 +434,10 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 continue
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
-            out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
+            if kernels.is_permanent(claw[c]):
+                out[2 * n + 2 * nc + c] = kernels.link_internal_rate(claw[c], cprm[c], rate, q)
+            else:
+                out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
         forces[c] = f
         if f != 0.0:
             for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
@@ -644,6 +648,38 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
             f = kernels.mode_force(claw, prm, const, mode, delta, rate, _hermite(q0, qr0, q1, qr1, h, s))
             if f > best:
                 best = f
+    return best
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _peak_magnitude(values) -> float:
+    """Largest |value| of equally spaced samples, refined by a parabola through the largest and its neighbours.
+
+    For a link's force over a step (it pulls as well as pushes): the samples
+    of :func:`_closed_contact_samples`.  A largest sample at either end of
+    the step uses the parabola through the three samples at that end, and its
+    vertex is accepted up to half a sample spacing beyond the step (a peak
+    that falls between two steps' end samples is found by one of them).
+    """
+    best = 0.0
+    best_i = 0
+    m = values.size
+    for i in range(m):
+        if abs(values[i]) > best:
+            best = abs(values[i])
+            best_i = i
+    if m < 3:
+        return best
+    centre = min(max(best_i, 1), m - 2)
+    fm, f0, fp = abs(values[centre - 1]), abs(values[centre]), abs(values[centre + 1])
+    denom = fm - 2.0 * f0 + fp
+    if denom < 0.0:
+        offset = 0.5 * (fm - fp) / denom
+        where = centre + offset
+        if -0.5 <= where <= m - 0.5:
+            top = f0 - 0.25 * (fm - fp) * offset
+            if top > best:
+                best = top
     return best
 
 
@@ -1100,6 +1136,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     open_imp = np.empty(nc, dtype=np.int64)
     for c in range(nc):
         open_imp[c] = -1
+        closed[c] = kernels.is_permanent(claw[c])  # links are engaged from the start and never open
 
     t = 0.0
     seg = zero
@@ -1251,6 +1288,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 floor = DELTA_ROUNDOFF * (size + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
+                if kernels.is_permanent(claw[c]):
+                    continue  # a link has no events
                 if not closed[c]:
                     s = _first_crossing(d0, r0, d1, r1, h_try, True, floor)
                     kind = EVENT_CLOSE
@@ -1394,7 +1433,31 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if v > peak_drift[j]:
                     peak_drift[j] = v
         for c in range(nc):
-            if closed[c] and cmode[c] == kernels.MODE_STUCK:
+            if kernels.is_permanent(claw[c]):
+                # A link: peak |F| on the step's interpolant (no trace: it is engaged at every step).
+                e_d0 = 0.0
+                e_r0 = 0.0
+                e_d1 = 0.0
+                e_r1 = 0.0
+                e_a0 = 0.0
+                e_a1 = 0.0
+                for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+                    w = cw[k]
+                    f = cf[k]
+                    e_d0 += w * y[f]
+                    e_r0 += w * y[n + f]
+                    e_d1 += w * ynew[f]
+                    e_r1 += w * ynew[n + f]
+                    e_a0 += w * k1[n + f]
+                    e_a1 += w * k7[n + f]
+                _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
+                                        e_d0, e_r0, e_d1, e_r1, e_a0, e_a1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                                        y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_used, fractions, deltas,
+                                        values)
+                fpk = _peak_magnitude(values)
+                if fpk > peak_force[c]:
+                    peak_force[c] = fpk
+            elif closed[c] and cmode[c] == kernels.MODE_STUCK:
                 fpk = forces_end[c]
                 if fpk > peak_force[c]:
                     peak_force[c] = fpk
@@ -1540,7 +1603,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 # its cached code is stale when any of the three files changes.
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
                               [__file__, kernels.__file__, contact_laws.__file__, storeys.__file__,
-                               hysteresis.__file__])
+                               hysteresis.__file__, contact_links.__file__])
 jit.load_from_cache_without_refresh(_integrate)
 
 

@@ -15,6 +15,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws
+from pounding.contact import links
 from pounding.numba_cache import use_writable_cache
 from pounding.solver import jit
 from pounding.contact.laws import (LAW_BILINEAR, LAW_BUMPER, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_JANKOWSKI, LAW_KELVIN,
@@ -27,6 +28,27 @@ from pounding.contact.laws import (LAW_BILINEAR, LAW_BUMPER, LAW_HERTZ, LAW_HERT
 
 
 use_writable_cache(__file__)  # a read-only install caches its kernels in the user's cache folder
+
+LINK_VISCOUS, LINK_KELVIN, LINK_MAXWELL, FIRST_LINK_ID = (links.LINK_VISCOUS, links.LINK_KELVIN, links.LINK_MAXWELL,
+                                                          links.FIRST_LINK_ID)
+
+
+@njit(cache=True)
+def is_permanent(law_id: int) -> bool:
+    """True for link elements (pounding.contact.links): always engaged, no gap, no events, tension allowed."""
+    return law_id >= FIRST_LINK_ID
+
+
+@njit(cache=True)
+def link_force(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
+    """Force of a link (N, may be negative: a pull) at relative displacement *delta* and its rate."""
+    if law_id == LINK_VISCOUS:
+        return prm[1] * delta_rate
+    if law_id == LINK_KELVIN:
+        return prm[0] * delta + prm[1] * delta_rate
+    if law_id == LINK_MAXWELL:
+        return q
+    return 0.0
 
 
 @njit(cache=True)
@@ -86,6 +108,8 @@ def _bumper_force(prm: np.ndarray, xi_bumper: float, delta: float, delta_rate: f
 def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
           delta_rate: float, q: float) -> float:
     """Contact force (N) for penetration *delta* (m), its rate (m/s) and internal state *q*."""
+    if law_id >= FIRST_LINK_ID:
+        return link_force(law_id, prm, delta, delta_rate, q)
     if delta <= 0.0:
         return 0.0
     if law_id == LAW_HERTZ_DAMP:
@@ -133,7 +157,16 @@ def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float,
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)  # called from compiled code only
 def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
-    """Elastic energy stored in the contact (J): what unloading would give back."""
+    """Elastic energy stored in the contact (J): what unloading would give back.
+
+    Links: ½kδ² in a Kelvin spring, q²/(2k) in a Maxwell spring, none in a dashpot.
+    """
+    if law_id == LINK_KELVIN:
+        return 0.5 * prm[0] * delta * delta
+    if law_id == LINK_MAXWELL:
+        return 0.5 * q * q / prm[0]
+    if law_id == LINK_VISCOUS:
+        return 0.0
     if delta <= 0.0:
         return 0.0
     if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI:
@@ -228,6 +261,8 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
     the difference is that the formula does not switch before the located
     event (just past an event the clamp still holds the force at ≥ 0).
     """
+    if law_id >= FIRST_LINK_ID:
+        return link_force(law_id, prm, delta, delta_rate, q)
     if delta <= 0.0:
         return 0.0
     if law_id == LAW_HERTZ_DAMP:
@@ -264,6 +299,14 @@ def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, de
         if mode == MODE_ELASTIC:
             return prm[0] * delta_rate
         return prm[1] * delta_rate
+    return 0.0
+
+
+@njit(cache=True)
+def link_internal_rate(law_id: int, prm: np.ndarray, delta_rate: float, q: float) -> float:
+    """Rate of a link's internal state (N/s): a Maxwell element's force, ``k·(δ̇ − q/c)``."""
+    if law_id == LINK_MAXWELL:
+        return prm[0] * (delta_rate - q / prm[1])
     return 0.0
 
 
@@ -351,7 +394,7 @@ def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delt
 @njit(cache=True)
 def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -> float:
     """Absolute error tolerance of the internal state (N): K1·atol for the bilinear force, 0 if unused."""
-    if law_id == LAW_BILINEAR:
+    if law_id == LAW_BILINEAR or law_id == LINK_MAXWELL:
         return prm[0] * atol_displacement
     return 0.0
 
@@ -389,4 +432,4 @@ def rest_velocity(law_id: int, prm: np.ndarray) -> float:
 
 # The kernels inline the law ids and sizes of contact/laws.py: their cached code is stale when it changes.
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
-                              [__file__, laws.__file__])
+                              [__file__, laws.__file__, links.__file__])
