@@ -539,7 +539,6 @@ class _JoinEntry(_Schema):
     between: Any = Field(description="two adjacent building names, left first, e.g. [A, B]")
     levels: Any = Field("matching", description="'matching' or [[level_left, level_right], ...]; "
                         "for a wall, [floor, ...]")
-    gap: NonNegativeNumber = Field(description="separation at rest, m")
     tolerance: OptionalPositiveNumber = Field(None, description="elevation tolerance of levels: matching, m")
     law: Any = Field(description="the element's law")
 
