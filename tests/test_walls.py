@@ -180,3 +180,18 @@ def test_walls_on_both_sides_of_one_building_round_trip():
     assert [(g.left, g.right, g.level_left, g.level_right, g.gap) for g in again.gaps] == \
         [(0, -1, 1, 0, 0.01), (0, -1, 3, 0, 0.01), (-1, 0, 0, 2, 0.02)]
     assert "A1-wall, A3-wall" in "\n".join(model.summary_lines())
+
+
+@pytest.mark.parametrize("link, message", [
+    ("{between: [B, wall], levels: [1], law: viscous, damping: 1.0e6}",
+     "moat.yaml:18: links[0].between: links join the floors of two buildings; a wall takes contacts only"),
+    ("{between: [A, B], levels: [[1, {storey: 1, at: 0.5}]], law: viscous, damping: 1.0e6}",
+     "moat.yaml:18: links[0].levels[0]: links join floors; a column point {storey, at} is for contacts only"),
+])
+def test_links_refuse_walls_and_column_points(link, message):
+    text = MOAT.replace("BETWEEN", "[A, B]").replace("LEVELS", "[[1, 1]]")
+    text = text.replace("ground_motion:", f"links:\n  - {link}\nground_motion:")
+    with pytest.raises(ModelError) as failed:
+        model_from_text(text, path="moat.yaml")
+    assert "\n" not in str(failed.value)
+    assert message in str(failed.value), str(failed.value)
