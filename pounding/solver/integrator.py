@@ -917,6 +917,8 @@ def _switch_contact(c, upward, t, y, n, cf, cw, claw, cprm, closed, cconst, impa
         if kernels.is_instantaneous(claw[c]):
             return _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass)
         closed[c] = True
+        if rate < 0.0:
+            rate = 0.0  # a grazing touch (the caller removed δ̇ < 0): what is left is round-off of that correction
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = kernels.onset_constant(claw[c], cprm[c], rate)
         impacts[n_imp, IMP_CONTACT] = c
