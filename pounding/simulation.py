@@ -29,13 +29,13 @@ from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
-from pounding.model.model import Model, model_from_text
+from pounding.model.model import WALL, Model, column_weights, model_from_text
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import run_peaks, to_dataset
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "simulate", "simulate_peaks", "record_for", "support_motions", "SupportMotions", "rerun",
-           "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
+__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "support_motions",
+           "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
 
 #: Energy closure error above which a run is flagged (attribute ``status``, summary
@@ -112,22 +112,30 @@ def assemble(model: Model, building_ground: Any = None) -> System:
     yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
     storey_state = np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64)
 
-    left, right, gaps, laws, params, ground_left, ground_right = [], [], [], [], [], [], []
+    left, right, gaps, laws, params, floors, weights, ground_left, ground_right = [], [], [], [], [], [], [], [], []
     mass_all = np.concatenate(masses)
     for gap in model.gaps:
-        lf = model.floor_offset(gap.left) + gap.level_left - 1
-        rf = model.floor_offset(gap.right) + gap.level_right - 1
-        left.append(lf)
-        right.append(rf)
-        ground_left.append(rows[gap.left])
-        ground_right.append(rows[gap.right])
+        terms_left = contact_side_terms(model, gap.left, gap.level_left, gap.at_left)
+        terms_right = contact_side_terms(model, gap.right, gap.level_right, gap.at_right)
+        left.append(terms_left[-1][0] if terms_left[-1][1] != 0.0 else terms_left[0][0])
+        right.append(terms_right[-1][0] if terms_right[-1][1] != 0.0 else terms_right[0][0])
+        floors.append([f for f, _ in terms_left] + [f for f, _ in terms_right])
+        weights.append([w for _, w in terms_left] + [-w for _, w in terms_right])
+        # Each side moves with its building's ground (a column point too); a wall moves with the ground of the
+        # building it faces (docs/physics.md §11), so a wall contact sees no differential ground motion.
+        ground_left.append(rows[gap.right if gap.left == WALL else gap.left])
+        ground_right.append(rows[gap.left if gap.right == WALL else gap.right])
         gaps.append(gap.gap)
         laws.append(gap.law.law_id)
-        params.append(gap.law.kernel_parameters(mass_all[lf], mass_all[rf]))
+        params.append(gap.law.kernel_parameters(_side_mass(terms_left, mass_all), _side_mass(terms_right, mass_all)))
     # Links follow the contacts in the same arrays: elements engaged from the start, gap 0, never open.
     for link in model.links:
-        left.append(model.floor_offset(link.left) + link.level_left - 1)
-        right.append(model.floor_offset(link.right) + link.level_right - 1)
+        lf = model.floor_offset(link.left) + link.level_left - 1
+        rf = model.floor_offset(link.right) + link.level_right - 1
+        left.append(lf)
+        right.append(rf)
+        floors.append([lf, -1, rf, -1])
+        weights.append([1.0, 0.0, -1.0, 0.0])
         ground_left.append(rows[link.left])     # a link's ends move with their own buildings' grounds
         ground_right.append(rows[link.right])
         gaps.append(0.0)
@@ -159,7 +167,34 @@ def assemble(model: Model, building_ground: Any = None) -> System:
         floor_ground=np.repeat(np.asarray(rows, dtype=np.int64), [b.n_floors for b in model.buildings]),
         contact_ground_left=np.asarray(ground_left, dtype=np.int64),
         contact_ground_right=np.asarray(ground_right, dtype=np.int64),
+        contact_floors=np.ascontiguousarray(np.array(floors, dtype=np.int64).reshape(len(floors), 4)),
+        contact_weights=np.ascontiguousarray(np.array(weights, dtype=float).reshape(len(weights), 4)),
     )
+
+
+def contact_side_terms(model: Model, building: int, level: int, at: float | None) -> list[tuple[int, float]]:
+    """The two ``(floor index, weight)`` terms of one contact side (floor index −1: ground or wall, weight 0).
+
+    A floor is ``[(floor, 1), (−1, 0)]``; a wall ``[(−1, 0), (−1, 0)]``; a point
+    at fraction *at* of storey *level*'s column ``[(floor below, N1), (floor
+    above, N2)]`` with the Hermite shape functions of
+    :func:`pounding.model.model.column_weights` (the floor below of storey 1
+    is the ground: its term has floor −1).
+    """
+    if building == WALL:
+        return [(-1, 0.0), (-1, 0.0)]
+    offset = model.floor_offset(building)
+    if at is None:
+        return [(offset + level - 1, 1.0), (-1, 0.0)]
+    n1, n2 = column_weights(at)
+    below = offset + level - 2 if level > 1 else -1
+    return [(below, n1 if below >= 0 else 0.0), (offset + level - 1, n2)]
+
+
+def _side_mass(terms: list[tuple[int, float]], mass: np.ndarray) -> float:
+    """Generalised mass of a contact side, kg: ``1/Σ w²/m`` (a floor: its mass; a wall: inf)."""
+    compliance = sum(w * w / mass[f] for f, w in terms if f >= 0 and w != 0.0)
+    return 1.0 / compliance if compliance > 0.0 else float("inf")
 
 
 def record_for(model: Model, *, factor: float | None = None, where: str = "yaml",

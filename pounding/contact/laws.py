@@ -228,7 +228,9 @@ class HertzDamp(ContactLaw):
 
 
 def _effective_mass(mass_left: float, mass_right: float) -> float:
-    """m1·m2/(m1+m2), kg: the two floor masses stand for the colliding bodies."""
+    """m1·m2/(m1+m2), kg: the two floor masses stand for the colliding bodies (a fixed wall: inf, m_eff = m)."""
+    if math.isinf(mass_left) or math.isinf(mass_right):
+        return min(mass_left, mass_right)
     return mass_left * mass_right / (mass_left + mass_right)
 
 

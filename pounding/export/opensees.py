@@ -80,6 +80,7 @@ import numpy as np
 
 from pounding import __version__
 from pounding.errors import PoundingError
+from pounding.model.schema import WALL
 
 __all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "DEFAULT_DT"]
 
@@ -309,13 +310,19 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
     names = [b.name for b in model.buildings]
     contacts = []      # (element, node left, node right, material args, label)
     for g in model.gaps:
+        if g.has_column_point:
+            raise PoundingError(f"contact {g.label(names)} strikes a column between floors; the OpenSees export "
+                                "joins floor nodes only (a column point needs a column element): export a model "
+                                "with floor-to-floor and wall contacts only")
         element += 1
         material, warnings = _contact_material(g.law, g.gap)
         for w in warnings:
             if w not in notes:
                 notes.append(w)
-        contacts.append((element, floor_node[(g.left, g.level_left)], floor_node[(g.right, g.level_right)],
-                         material, f"{names[g.left]}:{g.level_left}-{names[g.right]}:{g.level_right}"))
+        # A fixed wall is the building's fixed ground node: it moves with the ground, as the wall does.
+        left = grounds[g.right] if g.left == WALL else floor_node[(g.left, g.level_left)]
+        right = grounds[g.left] if g.right == WALL else floor_node[(g.right, g.level_right)]
+        contacts.append((element, left, right, material, g.label(names)))
 
     links = []         # (element, node left, node right, [[tag, material, args...], ...], link label)
     for link in model.links:

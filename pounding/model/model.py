@@ -51,7 +51,26 @@ __all__ = [
     "model_from_text",
     "model_from_data",
     "read_yaml_text",
+    "WALL",
+    "column_weights",
 ]
+
+#: Building index of a fixed wall in a gap element's sides (:data:`pounding.model.schema.WALL`).
+WALL = schema.WALL
+
+
+def column_weights(at: float) -> tuple[float, float]:
+    """Hermite shape functions ``(N1, N2)`` of a fixed-fixed column at fraction *at* of its height.
+
+    ``N1 = 1 − 3ξ² + 2ξ³`` (floor below), ``N2 = 3ξ² − 2ξ³`` (floor above): the
+    column point's displacement ``N1·u_below + N2·u_above`` under end
+    displacements of rigid floors, and the shares of a point force there taken
+    by the floor below and the floor above (the fixed-fixed beam's end shears
+    ``P(1−ξ)²(1+2ξ)`` and ``Pξ²(3−2ξ)``; docs/physics.md §12).
+    """
+    xi = float(at)
+    n2 = xi * xi * (3.0 - 2.0 * xi)
+    return 1.0 - n2, n2
 
 
 def _checked(cls: type, data: Any, root: tuple = (), prefix: str = "", context: dict | None = None) -> Any:
@@ -314,9 +333,14 @@ class Building:
 @dataclass(frozen=True)
 class GapElement:
     """One contact element between floor ``level_left`` of building ``left``
-    and floor ``level_right`` of building ``right = left + 1``.
+    and floor ``level_right`` of building ``right = left + 1``, or between the
+    end building of the row and a fixed wall (``left`` or ``right`` is
+    :data:`WALL`, its level 0).
 
-    Penetration ``δ = u_left − u_right − gap`` (m, positive = overlap).
+    Penetration ``δ = u_left − u_right − gap`` (m, positive = overlap); a
+    wall's displacement relative to the ground is 0.  A side with ``at_*``
+    set is a point of a column: ``level_*`` is then its storey and ``at_*``
+    the fraction of the storey height above the floor below (0 < at < 1).
 
     Attributes
     ----------
@@ -325,10 +349,12 @@ class GapElement:
     left, right : int
         Building indices (left to right).
     level_left, level_right : int
-        1-based floor numbers.
+        1-based floor numbers (storey numbers for a column point; 0 for a wall).
     gap : float
         Separation at rest, m.
     law : ContactLaw
+    at_left, at_right : float or None
+        Column point: fraction of the storey height; None for a floor or a wall.
     """
 
     contact: int
@@ -338,6 +364,35 @@ class GapElement:
     level_right: int
     gap: float
     law: ContactLaw
+    at_left: float | None = None
+    at_right: float | None = None
+
+    @property
+    def has_wall(self) -> bool:
+        """True if one side is a fixed wall."""
+        return WALL in (self.left, self.right)
+
+    @property
+    def has_column_point(self) -> bool:
+        """True if one side is a point of a column between floors."""
+        return self.at_left is not None or self.at_right is not None
+
+    def side_label(self, names: list[str], side: str) -> str:
+        """``A:3`` (floor), ``A:s4@0.5`` (storey 4's column at half its height) or ``wall``."""
+        building, level, at = ((self.left, self.level_left, self.at_left) if side == "left"
+                               else (self.right, self.level_right, self.at_right))
+        if building == WALL:
+            return schema.WALL_NAME
+        return f"{names[building]}:{level}" if at is None else f"{names[building]}:s{level}@{at:g}"
+
+    def label(self, names: list[str]) -> str:
+        """Gap element label, e.g. ``A:3-B:3``, ``A:1-wall``, ``A:3-B:s4@0.5``."""
+        return f"{self.side_label(names, 'left')}-{self.side_label(names, 'right')}"
+
+    def level_document(self, side: str) -> Any:
+        """The YAML of one side: a floor number, or ``{storey: s, at: x}``."""
+        level, at = (self.level_left, self.at_left) if side == "left" else (self.level_right, self.at_right)
+        return int(level) if at is None else {"storey": int(level), "at": float(at)}
 
 
 @dataclass(frozen=True)
@@ -537,7 +592,10 @@ class Model:
         object.__setattr__(self, "buildings", tuple(self.buildings))
         object.__setattr__(self, "gaps", tuple(self.gaps))
         object.__setattr__(self, "links", tuple(self.links))
+        last = len(self.buildings) - 1
         for gap in self.gaps + self.links:
+            if gap.left == WALL and gap.right == 0 or gap.right == WALL and gap.left == last:
+                continue
             if not (0 <= gap.left < len(self.buildings) - 1 and gap.right == gap.left + 1):
                 raise ModelError(f"gap element joins buildings {gap.left} and {gap.right}, which are not "
                                  "adjacent in the row")
@@ -664,8 +722,8 @@ class Model:
                              + ("; P-Delta on" if b.p_delta else ""))
         for contact in sorted({g.contact for g in self.gaps}):
             gaps = [g for g in self.gaps if g.contact == contact]
-            left, right = self.buildings[gaps[0].left].name, self.buildings[gaps[0].right].name
-            pairs = ", ".join(f"{left}{g.level_left}-{right}{g.level_right}" for g in gaps)
+            pairs = ", ".join(f"{schema.side_text(self.buildings, g.left, g.level_left, g.at_left)}-"
+                              f"{schema.side_text(self.buildings, g.right, g.level_right, g.at_right)}" for g in gaps)
             lines.append(f"contact {contact}: {pairs}; gap {gaps[0].gap:g} m, {gaps[0].law.describe()}")
         for index in sorted({link.entry for link in self.links}):
             mine = [link for link in self.links if link.entry == index]
@@ -703,11 +761,15 @@ class Model:
         for contact in sorted({g.contact for g in self.gaps}):
             gaps = [g for g in self.gaps if g.contact == contact]
             first = gaps[0]
-            entry: dict[str, Any] = {
-                "between": [self.buildings[first.left].name, self.buildings[first.right].name],
-                "levels": [[g.level_left, g.level_right] for g in gaps],
-                "gap": float(first.gap),
-            }
+            names = [b.name for b in self.buildings]
+            between = [schema.WALL_NAME if b == WALL else names[b] for b in (first.left, first.right)]
+            if first.left == WALL:
+                levels: list = [g.level_document("right") for g in gaps]
+            elif first.right == WALL:
+                levels = [g.level_document("left") for g in gaps]
+            else:
+                levels = [[g.level_document("left"), g.level_document("right")] for g in gaps]
+            entry: dict[str, Any] = {"between": between, "levels": levels, "gap": float(first.gap)}
             entry.update(first.law.model_dump(mode="json"))
             contacts.append(entry)
         links = []
@@ -787,8 +849,8 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
             arrays[key] = array
         buildings.append(_trusted(Building, name=b.name, damping=damping, hysteresis=b.column("hysteresis"),
                                   p_delta=b.p_delta, **arrays))
-    gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters)
-                 for index, c in enumerate(entry.contacts) for a, r in c.pairs)
+    gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters, at_a, at_r)
+                 for index, c in enumerate(entry.contacts) for (a, r), (at_a, at_r) in zip(c.pairs, c.points))
     links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)
                   for index, e in enumerate(entry.links) for a, r in e.pairs)
 

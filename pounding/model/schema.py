@@ -60,7 +60,7 @@ __all__ = [
     "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
-    "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS",
+    "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME",
 ]
 
 #: Default elevation tolerance of ``levels: matching`` (m).
@@ -69,6 +69,10 @@ DEFAULT_TOLERANCE = 0.01
 MIN_RTOL = 1e-12
 #: Most storeys a building may have (a list or ``count``); more is a typo, not a building.
 MAX_STOREYS = 10_000
+#: ``between`` name of a fixed wall (a moat wall moving with the ground), reserved: no building may take it.
+WALL_NAME = "wall"
+#: Building index that stands for the wall in a contact's sides.
+WALL = -1
 
 
 # --------------------------------------------------------------------------- #
@@ -539,13 +543,15 @@ class _JoinEntry(_Schema):
     KEYS: ClassVar[tuple[str, ...]] = ContactGeometry.KEYS
 
     between: Any = Field(description="two adjacent building names, left first, e.g. [A, B]")
-    levels: Any = Field("matching", description="'matching' or [[level_left, level_right], ...]")
+    levels: Any = Field("matching", description="'matching' or [[level_left, level_right], ...]; "
+                        "for a wall, [floor, ...]")
     tolerance: OptionalPositiveNumber = Field(None, description="elevation tolerance of levels: matching, m")
     law: Any = Field(description="the element's law")
 
     _left: int = PrivateAttr(-1)
     _right: int = PrivateAttr(-1)
     _pairs: tuple[tuple[int, int], ...] = PrivateAttr(())
+    _points: tuple[tuple[float | None, float | None], ...] = PrivateAttr(())
 
     @model_validator(mode="before")
     @classmethod
@@ -568,12 +574,21 @@ class _JoinEntry(_Schema):
 
     @property
     def pairs(self) -> tuple[tuple[int, int], ...]:
-        """1-based ``(level_left, level_right)`` pairs (after the model's check)."""
+        """1-based ``(level_left, level_right)`` pairs (after the model's check).
+
+        A wall side has level 0; a point of a column has the number of its storey.
+        """
         return self._pairs
 
     @property
+    def points(self) -> tuple[tuple[float | None, float | None], ...]:
+        """Per pair ``(at_left, at_right)``: the fraction of the storey's height of a column point, None for a
+        floor or a wall (after the model's check)."""
+        return self._points
+
+    @property
     def sides(self) -> tuple[int, int]:
-        """Indices of the left and right building (after the model's check)."""
+        """Indices of the left and right building, :data:`WALL` (−1) for a wall (after the model's check)."""
         return self._left, self._right
 
     def resolve(self, index: int, buildings: list[BuildingEntry]) -> None:
@@ -586,7 +601,18 @@ class _JoinEntry(_Schema):
         """
         left, right = _between(index, self.between, buildings, self.SECTION)
         self._left, self._right = left, right
-        self._pairs = tuple(_levels(index, self, buildings[left], buildings[right]))
+        sides = _levels(index, self, None if left == WALL else buildings[left],
+                        None if right == WALL else buildings[right])
+        self._pairs = tuple((a[0], b[0]) for a, b in sides)
+        self._points = tuple((a[1], b[1]) for a, b in sides)
+
+
+def side_text(buildings: list, building: int, level: int, at: float | None) -> str:
+    """``A3`` (floor), ``A storey 4 at 0.5`` (a point of a column) or ``wall``, for messages."""
+    if building == WALL:
+        return WALL_NAME
+    name = buildings[building].name
+    return f"{name}{level}" if at is None else f"{name} storey {level} at {at:g}"
 
 
 class ContactEntry(_JoinEntry):
@@ -625,11 +651,16 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str =
             name = as_name(item)
         except Problem as failed:
             raise problem(failed.predicate, at=at + (position,)) from None
+        if name == WALL_NAME:
+            indices.append(WALL)
+            continue
         if name not in names:
-            raise problem(f"unknown building '{name}'{did_you_mean(name, names)}; buildings are: {', '.join(names)}",
-                          kind="error", at=at + (position,))
+            raise problem(f"unknown building '{name}'{did_you_mean(name, names + [WALL_NAME])}; buildings are: "
+                          f"{', '.join(names)}", kind="error", at=at + (position,))
         indices.append(names.index(name))
     left, right = indices
+    if WALL in indices:
+        return _wall_sides(at, left, right, names)
     a, b = names[left], names[right]
     neighbours = ", ".join(f"{names[i]}-{names[i + 1]}" for i in range(len(names) - 1)) or "none"
     if left == right:
@@ -644,7 +675,99 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str =
     return left, right
 
 
-def _levels(index: int, entry: ContactEntry, left: BuildingEntry, right: BuildingEntry) -> list[tuple[int, int]]:
+def _wall_sides(at: Location, left: int, right: int, names: list[str]) -> tuple[int, int]:
+    """Check a contact with a wall: one wall, at an end of the row, beside the end building."""
+    if left == right == WALL:
+        raise problem(f"joins the wall to itself; a wall contact joins the wall to the first building "
+                      f"([{WALL_NAME}, {names[0]}]) or the last ([{names[-1]}, {WALL_NAME}])", kind="error", at=at)
+    if left == WALL:
+        if right != 0:
+            raise problem(f"a wall on the left stands only beside the first building of the row: "
+                          f"[{WALL_NAME}, {names[0]}] ({names[right]} has {names[right - 1]} on its left)",
+                          kind="error", at=at)
+        return left, right
+    if left != len(names) - 1:
+        raise problem(f"a wall on the right stands only beside the last building of the row: "
+                      f"[{names[-1]}, {WALL_NAME}] ({names[left]} has {names[left + 1]} on its right)",
+                      kind="error", at=at)
+    return left, right
+
+
+def _side_item(value: Any, building: BuildingEntry, at: Location) -> tuple[int, float | None]:
+    """One side of a level pair: a floor number, or ``{storey: s, at: x}`` (a point of storey s's column).
+
+    Returns ``(floor or storey number, fraction of the storey height or None)``.
+    """
+    n = building.n_floors
+    if isinstance(value, dict):
+        unknown = [k for k in value if k not in ("storey", "at")]
+        if unknown:
+            raise problem(f"unknown key '{unknown[0]}'{did_you_mean(str(unknown[0]), ['storey', 'at'])} in a column "
+                          "point; write {storey: 4, at: 0.5}", kind="error", at=at)
+        for key in ("storey", "at"):
+            if key not in value:
+                raise problem(f"a column point needs '{key}': write {{storey: 4, at: 0.5}} (storey number, "
+                              "fraction of its height above the floor below)", kind="error", at=at)
+        try:
+            storey = as_positive_integer(value["storey"])
+        except Problem:
+            raise problem("must be a storey number (a positive integer)", at=at + ("storey",)) from None
+        if storey > n:
+            raise problem(f"storey {storey} does not exist: building {building.name} has {plural(n, 'storey')}",
+                          kind="error", at=at + ("storey",))
+        try:
+            fraction = as_number(value["at"])
+        except Problem as failed:
+            raise problem(failed.predicate, at=at + ("at",)) from None
+        if not 0.0 < fraction < 1.0:
+            hint = (f"at 0 or 1 the point is a floor: write the floor number ({storey - 1 if fraction <= 0 else storey})"
+                    if fraction in (0.0, 1.0) and (fraction == 1.0 or storey > 1) else "")
+            raise problem("must be in (0, 1), the fraction of the storey height above the floor below", hint=hint,
+                          at=at + ("at",))
+        return storey, fraction
+    if isinstance(value, int) and not isinstance(value, bool) and value == 0:
+        raise problem(f"level 0 is the ground; floors are numbered 1 to {n} from the ground up "
+                      f"in building {building.name}", kind="error", at=at)
+    try:
+        level = as_positive_integer(value)
+    except Problem:
+        raise problem("must be a floor number (a positive integer) or a column point {storey: 4, at: 0.5}",
+                      at=at) from None
+    if level > n:
+        raise problem(f"level {level} does not exist: building {building.name} has {plural(n, 'floor')}",
+                      kind="error", at=at)
+    return level, None
+
+
+def _wall_levels(index: int, entry: ContactEntry, building: BuildingEntry) -> list[tuple[tuple, tuple]]:
+    """``levels`` of a wall contact: a list of the building's floors (or column points) that can hit the wall."""
+    here: Location = (index, "levels")
+    levels = entry.levels
+    if entry.tolerance is not None:
+        raise problem("applies only to 'levels: matching' between two buildings; remove it", kind="error",
+                      at=(index, "tolerance"), line="key", colon=False)
+    if levels == "matching" or not isinstance(levels, (list, tuple)):
+        raise problem(f"a wall contact needs levels: the list of {building.name}'s floors that can hit the wall, "
+                      "e.g. levels: [1] (or a column point {storey: 1, at: 0.5})", kind="error", at=here,
+                      fallback=True)
+    if not levels:
+        raise problem(f"list at least one floor of {building.name}, e.g. [1]", kind="error", at=here)
+    sides = []
+    for position, item in enumerate(levels):
+        if isinstance(item, (list, tuple)):
+            raise problem(f"must be a floor number of {building.name} (a wall has no floors: levels: [1, 2] "
+                          "lists the building's floors)", at=here + (position,))
+        sides.append(_side_item(item, building, here + (position,)))
+    return sides
+
+
+def _levels(index: int, entry: ContactEntry, left: BuildingEntry | None,
+            right: BuildingEntry | None) -> list[tuple[tuple, tuple]]:
+    """Checked level pairs as ``((level_left, at_left), (level_right, at_right))``; a wall side is ``(0, None)``."""
+    if left is None:
+        return [((0, None), side) for side in _wall_levels(index, entry, right)]
+    if right is None:
+        return [(side, (0, None)) for side in _wall_levels(index, entry, left)]
     levels = entry.levels
     here: Location = (index, "levels")
     if levels == "matching":
@@ -658,7 +781,7 @@ def _levels(index: int, entry: ContactEntry, left: BuildingEntry, right: Buildin
                           f"floor of {right.name} (elevations {left.name}: {show(left)} m; {right.name}: "
                           f"{show(right)} m); give explicit pairs [[level_left, level_right], ...] or a larger "
                           "tolerance", kind="error", at=here)
-        return pairs
+        return [((a, None), (b, None)) for a, b in pairs]
     if entry.tolerance is not None:
         raise problem("applies only to 'levels: matching'; remove it or use 'levels: matching'", kind="error",
                       at=(index, "tolerance"), line="key", colon=False)
@@ -675,21 +798,11 @@ def _levels(index: int, entry: ContactEntry, left: BuildingEntry, right: Buildin
             pair = list(pair)
         if not isinstance(pair, list) or len(pair) != 2:
             raise problem("must be a pair [level_left, level_right] of 1-based floor numbers", at=where)
-        checked = []
-        for side, (level, building) in enumerate(zip(pair, (left, right))):
-            at = where + (side,)
-            n = building.n_floors
-            if isinstance(level, int) and not isinstance(level, bool) and level == 0:
-                raise problem(f"level 0 is the ground; floors are numbered 1 to {n} from the ground up "
-                              f"in building {building.name}", kind="error", at=at)
-            try:
-                level = as_positive_integer(level)
-            except Problem:
-                raise problem("must be a floor number (a positive integer)", at=at) from None
-            if level > n:
-                raise problem(f"level {level} does not exist: building {building.name} has {plural(n, 'floor')}",
-                              kind="error", at=at)
-            checked.append(level)
+        checked = [_side_item(level, building, where + (side,))
+                   for side, (level, building) in enumerate(zip(pair, (left, right)))]
+        if checked[0][1] is not None and checked[1][1] is not None:
+            raise problem("joins two column points; a slab strikes a column: one side must be a floor",
+                          kind="error", at=where)
         pairs.append((checked[0], checked[1]))
     return pairs
 
@@ -883,6 +996,9 @@ class ModelEntry(_Schema):
     def _unique_names(cls, buildings: list[BuildingEntry]) -> list[BuildingEntry]:
         seen: dict[str, int] = {}
         for index, building in enumerate(buildings):
+            if building.name == WALL_NAME:
+                raise problem(f"'{WALL_NAME}' is reserved for a fixed wall in contacts (between: [A, {WALL_NAME}]); "
+                              "rename the building", kind="error", at=(index, "name"))
             if building.name in seen:
                 first = seen[building.name]
                 raise problem("must be unique", at=(index, "name"), hint=f"buildings[{first}]{{on_line}} has the "
@@ -897,16 +1013,25 @@ class ModelEntry(_Schema):
         if buildings is None:
             return contacts
         section = info.field_name
-        joined: dict[tuple[int, int, int], int] = {}   # (left building, level_left, level_right) -> entry
+        joined: dict[tuple, int] = {}   # (left, right, side_left, side_right) -> entry
         for index, contact in enumerate(contacts):
             contact.resolve(index, buildings)
             left, right = contact.sides
-            for position, (a, b) in enumerate(contact.pairs):
-                key = (left, a, b)
+            if section == "links" and WALL in (left, right):
+                raise problem(f"links join the floors of two buildings; a wall takes contacts only "
+                              f"(contacts: - between: [{', '.join(str(x) for x in contact.between)}])",
+                              kind="error", at=(index, "between"))
+            for position, ((a, b), (at_a, at_b)) in enumerate(zip(contact.pairs, contact.points)):
+                if section == "links" and (at_a is not None or at_b is not None):
+                    raise problem("links join floors; a column point {storey, at} is for contacts only",
+                                  kind="error", at=(index, "levels", position))
+                key = (left, right, a, at_a, b, at_b)
                 if key in joined:
                     other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
-                    raise problem(f"floors {buildings[left].name}{a} and {buildings[right].name}{b} are already "
-                                  f"joined by {other}", kind="error", at=(index, "levels", position), fallback=True)
+                    names = (side_text(buildings, left, a, at_a), side_text(buildings, right, b, at_b))
+                    what = "floors" if at_a is None and at_b is None and WALL not in (left, right) else "sides"
+                    raise problem(f"{what} {names[0]} and {names[1]} are already joined by {other}", kind="error",
+                                  at=(index, "levels", position), fallback=True)
                 joined[key] = index
         return contacts
 

@@ -48,7 +48,8 @@ from pounding import __version__
 from pounding.contact import laws as contact_laws
 from pounding.contact import links as contact_links
 from pounding.records.record import Record
-from pounding.model.model import Model
+from pounding.model.model import Model, column_weights
+from pounding.model.schema import WALL_NAME
 from pounding.solver.integrator import RawSolution, System, ground_state_at
 from pounding.solver.storeys import recoverable_energy
 
@@ -174,6 +175,88 @@ def _recoverable(model: int, parameters: np.ndarray, stiffness: float, drift: fl
     return float(recoverable_energy(model, parameters, stiffness, drift, state))
 
 
+def _penetration(u: np.ndarray, system: System, ground_displacement: np.ndarray) -> np.ndarray:
+    """(nt, nc) penetration ``Σ_k w_k·u[floor_k] + u_g,L − u_g,R − gap`` of every contact.
+
+    Walls and the ground contribute no floor term; *ground_displacement* (nt, G)
+    holds each ground row's displacement (a wall's row is the one of the
+    building it faces, so a wall contact's ground difference is 0).
+    """
+    floors = system.contact_floors
+    weights = system.contact_weights
+    out = np.empty((u.shape[0], floors.shape[0]))
+    differential = (np.take(ground_displacement, system.contact_ground_left, axis=1)
+                    - np.take(ground_displacement, system.contact_ground_right, axis=1))
+    for c in range(floors.shape[0]):
+        total = np.zeros(u.shape[0])
+        for f, w in zip(floors[c], weights[c]):
+            if f >= 0 and w != 0.0:
+                total = total + w * u[:, f] if w != 1.0 else total + u[:, f]
+        out[:, c] = total + differential[:, c] - system.contact_gap[c]
+    return out
+
+
+def _column_point_coords(gaps) -> dict:
+    """``at_left`` / ``at_right``: the column point's fraction of the storey height (NaN for a floor or a wall)."""
+    def column(side: str) -> np.ndarray:
+        return np.array([np.nan if getattr(g, f"at_{side}") is None else getattr(g, f"at_{side}") for g in gaps])
+    return {f"at_{side}": ("contact", column(side),
+                           {"units": "1", "long_name": f"column point on the {side}: fraction of the height of "
+                                                       f"storey level_{side} (NaN: a floor or a wall)"})
+            for side in ("left", "right")}
+
+
+def column_shear_demand(shear: np.ndarray, force: np.ndarray, at: float, side: str) -> np.ndarray:
+    """Largest column shear (N) of a storey struck at fraction *at* of its height.
+
+    The fixed-fixed column carries the storey's restoring shear ``V`` (end
+    displacements) plus the point force: with ``Q`` the force on the column in
+    +x (``−F`` on a left side, ``+F`` on a right side, F ≥ 0 the contact force)
+    the segment below the point carries ``V + N1·Q``, the one above
+    ``V − N2·Q`` (``N1``, ``N2``: :func:`pounding.model.model.column_weights`);
+    the demand is the larger magnitude (docs/physics.md §12).
+    """
+    n1, n2 = column_weights(at)
+    q = -force if side == "left" else force
+    return np.maximum(np.abs(shear + n1 * q), np.abs(shear - n2 * q))
+
+
+def _column_shear_variables(system: System, raw: RawSolution, gaps) -> dict:
+    """``column_shear`` (time, contact) and ``peak_column_shear`` (contact); NaN for a contact without a column point.
+
+    The peak is the larger of the maximum over the output samples and over the
+    contact's full-resolution trace samples, where the trace's force is exact
+    and the storey shear is interpolated linearly between output samples.
+    """
+    nt = raw.time.size
+    nc = len(gaps)
+    demand = np.full((nt, nc), np.nan)
+    peak = np.full(nc, np.nan)
+    for c, g in enumerate(gaps):
+        side = "left" if g.at_left is not None else ("right" if g.at_right is not None else None)
+        if side is None:
+            continue
+        at = g.at_left if side == "left" else g.at_right
+        # the storey of the column point is the storey under the side's upper floor term
+        storey = int(system.contact_floors[c, 1 if side == "left" else 3])
+        shear = raw.storey_shear[:, storey]
+        demand[:, c] = column_shear_demand(shear, raw.contact_force[:, c], at, side)
+        best = float(np.max(demand[:, c])) if nt else 0.0
+        rows = raw.trace_contact == c
+        if rows.any() and nt > 1:
+            at_trace = np.interp(raw.trace_time[rows], raw.time, shear)
+            best = max(best, float(np.max(column_shear_demand(at_trace, raw.trace_force[rows], at, side))))
+        peak[c] = best
+    return {
+        "column_shear": _var(("time", "contact"), demand, "N",
+                             "largest column shear of the struck storey (storey shear plus the impact force's "
+                             "share), NaN for a contact without a column point"),
+        "peak_column_shear": _var(("contact",), peak, "N",
+                                  "peak column shear demand at the impact point's storey (output and full-resolution "
+                                  "trace samples), NaN for a contact without a column point"),
+    }
+
+
 def energy_closure(ds: xr.Dataset) -> float:
     """``max |E_in + W_g − Σ parts| / max |E_in + W_g|`` of a results dataset (dimensionless).
 
@@ -214,8 +297,7 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     return {
         "storey": floor_names,
         "storey_building": [str(b) for b in labels["building"]],
-        "contact": [f"{building_names[g.left]}:{g.level_left}-{building_names[g.right]}:{g.level_right}"
-                    for g in model.gaps],
+        "contact": [g.label(building_names) for g in model.gaps],
         "peak_drift_ratio": raw.peak_drift / heights,
         "residual_drift_ratio": _inelastic_summary(system, raw, heights)["residual"],
         "impact_count": (np.bincount(raw.impact_contact, minlength=ng).astype(np.int32) if ng
@@ -249,12 +331,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     ground = _grounds(model, record, system, raw, supports)
     # Contacts first, then links (pounding.simulation.assemble puts the links after the gap elements).
     ng = len(model.gaps)
-    # np.take gathers columns of the strided state far faster than fancy indexing.  Total displacements:
-    # the differential ground displacement of each gap element's two sides joins (0 on one common ground).
-    penetration = (np.take(u, system.contact_left[:ng], axis=1) - np.take(u, system.contact_right[:ng], axis=1)
-                   + (np.take(ground["displacement"], system.contact_ground_left[:ng], axis=1)
-                      - np.take(ground["displacement"], system.contact_ground_right[:ng], axis=1))
-                   - system.contact_gap[:ng])
+    # Total displacements: the differential ground displacement of each gap element's two sides joins
+    # (0 on one common ground, and for a wall, which moves with the ground of the building it faces).
+    penetration = _penetration(u, system, ground["displacement"])[:, :ng]
     links = _link_results(system, raw, ng, ground["displacement"])
 
     kinetic = 0.5 * np.einsum("ij,ij,j->i", v, v, system.mass)
@@ -276,6 +355,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     gaps = model.gaps
     contact_names = peaks["contact"]
     impact_count = peaks["impact_count"]
+    side_names = building_names + [WALL_NAME]  # index WALL (−1) is the wall
     with np.errstate(invalid="ignore", divide="ignore"):
         restitution = raw.impact_separation_velocity / raw.impact_velocity
     is_hertz_damp = np.array([g.law.law_id == contact_laws.LAW_HERTZ_DAMP for g in gaps], dtype=bool)
@@ -296,9 +376,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "storey_level": ("storey", labels["level"], {"units": "1", "long_name": "storey number above ground"}),
         "height": ("storey", heights, {"units": "m", "long_name": "storey height"}),
         "contact": ("contact", np.array(contact_names, dtype=object), {"long_name": "gap element label"}),
-        "building_left": ("contact", np.array([building_names[g.left] for g in gaps], dtype=object),
+        "building_left": ("contact", np.array([side_names[g.left] for g in gaps], dtype=object),
                           {"long_name": "left building of the gap element"}),
-        "building_right": ("contact", np.array([building_names[g.right] for g in gaps], dtype=object),
+        "building_right": ("contact", np.array([side_names[g.right] for g in gaps], dtype=object),
                            {"long_name": "right building of the gap element"}),
         "level_left": ("contact", np.array([g.level_left for g in gaps], dtype=np.int32),
                        {"units": "1", "long_name": "floor number in the left building"}),
@@ -409,6 +489,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "storey_hysteretic_energy": _var(("storey",), inelastic["dissipated"], "J",
                                          "energy dissipated by the storey's hysteresis over the run"),
     }
+    if any(g.has_column_point for g in gaps):
+        coords.update(_column_point_coords(gaps))
+        variables.update(_column_shear_variables(system, raw, gaps))
     if not model.links:
         # A model without links has no link dimension and no link variables (archives as before links).
         for name in ("link", "link_law"):

@@ -48,19 +48,39 @@ def _grid(plt, count: int, *, width: float = 9.0, height: float = 2.2, sharex: b
     return fig, axes[:, 0]
 
 
+def _side_displacement(ds: xr.Dataset, i: int, side: str) -> tuple[str, np.ndarray]:
+    """Label and displacement history (m) of one side of contact *i*: a floor, a wall (0) or a column point.
+
+    A column point at fraction ξ of storey s moves as ``N1·u_(s−1) + N2·u_s``
+    (Hermite shape functions of the fixed-fixed column, docs/physics.md §12).
+    """
+    building = str(ds[f"building_{side}"].values[i])
+    level = int(ds[f"level_{side}"].values[i])
+    if building == "wall":
+        return "wall", np.zeros(ds.sizes["time"])
+    at_name = f"at_{side}"
+    at = float(ds[at_name].values[i]) if at_name in ds.coords else float("nan")
+    if np.isnan(at):
+        return f"{building}:{level}", ds.displacement.sel(floor=f"{building}:{level}").values
+    n2 = at * at * (3.0 - 2.0 * at)
+    above = ds.displacement.sel(floor=f"{building}:{level}").values
+    below = ds.displacement.sel(floor=f"{building}:{level - 1}").values if level > 1 else 0.0 * above
+    return f"{building} storey {level} at {at:g}", (1.0 - n2) * below + n2 * above
+
+
 def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
     n = ds.sizes["contact"]
     fig, axes = _grid(plt, n)
     t = ds.time.values
     for i, ax in enumerate(axes[:n]):
-        left = ds.displacement.sel(floor=f"{ds.building_left.values[i]}:{int(ds.level_left.values[i])}")
-        right = ds.displacement.sel(floor=f"{ds.building_right.values[i]}:{int(ds.level_right.values[i])}")
+        left_name, left = _side_displacement(ds, i, "left")
+        right_name, right = _side_displacement(ds, i, "right")
         gap = float(ds.gap.values[i])
-        ax.plot(t, 1e3 * left.values, lw=0.8, label=f"{left.floor.item()} (left)")
-        ax.plot(t, 1e3 * (right.values + gap), lw=0.8, label=f"{right.floor.item()} (right) + gap")
+        ax.plot(t, 1e3 * left, lw=0.8, label=f"{left_name} (left)")
+        ax.plot(t, 1e3 * (right + gap), lw=0.8, label=f"{right_name} (right) + gap")
         hits = ds.impact_time.values[ds.impact_contact.values == i]
         if hits.size:
-            ax.plot(hits, 1e3 * np.interp(hits, t, left.values), "k|", ms=10, label="impact")
+            ax.plot(hits, 1e3 * np.interp(hits, t, left), "k|", ms=10, label="impact")
         ax.set_ylabel("displacement (mm)")
         ax.set_title(f"{ds.contact.values[i]}, gap {1e3 * gap:.1f} mm", fontsize=9)
         ax.legend(fontsize=7, loc="upper right")

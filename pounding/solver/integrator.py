@@ -157,7 +157,8 @@ class System:
     rayleigh_mass, rayleigh_stiffness : (N,) Rayleigh a0 (1/s) and a1 (s) of the floor's building
     dense_start, dense_size, dense_offset : (B,) int, modal damping blocks (size 0 for Rayleigh)
     dense_values : flat float array of the dense damping blocks, N·s/m
-    contact_left, contact_right : (nc,) int, floor indices of each gap element
+    contact_left, contact_right : (nc,) int, floor index of each gap element's left and right side
+        (−1: a fixed wall; for a point of a column, the floor above it)
     contact_gap : (nc,) m
     contact_law : (nc,) int, kernel branch (pounding.contact)
     contact_parameters : (nc, N_PARAMETERS) float
@@ -167,11 +168,17 @@ class System:
     p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
     storey_height : (N,) m
     stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
+    contact_floors : (nc, SIDE_TERMS) int, optional
+        Floor terms of each contact ``[left, left, right, right]`` (−1: none, the ground or a wall);
+        default from ``contact_left`` / ``contact_right``: ``[left, −1, right, −1]``.
+    contact_weights : (nc, SIDE_TERMS) float, optional
+        Their weights: δ = Σ_k w_k·u[floor_k] − gap, the force enters floor_k as w_k·F (left
+        weights ≥ 0, right ≤ 0); default ``[1, 0, −1, 0]`` (−1 sides get weight 0).
     floor_ground : (N,) int, row of the ground-acceleration array that moves each floor's building
         (all 0 with one common ground motion)
     contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
         side of each gap element: their differential displacement enters the penetration
-        (``pounding.simulation.assemble``)
+        (``pounding.simulation.assemble``; a wall takes the row of the building it faces)
     """
 
     mass: np.ndarray
@@ -194,11 +201,22 @@ class System:
     p_delta_stiffness: np.ndarray | None = None
     storey_height: np.ndarray | None = None
     stop_drift_ratio: float = 0.0
+    contact_floors: np.ndarray | None = None
+    contact_weights: np.ndarray | None = None
     floor_ground: np.ndarray | None = None
     contact_ground_left: np.ndarray | None = None
     contact_ground_right: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        nc = int(self.contact_gap.size)
+        if self.contact_floors is None:
+            left = np.asarray(self.contact_left, dtype=np.int64).reshape(nc)
+            right = np.asarray(self.contact_right, dtype=np.int64).reshape(nc)
+            none = np.full(nc, -1, dtype=np.int64)
+            object.__setattr__(self, "contact_floors", np.ascontiguousarray(np.stack([left, none, right, none], 1)))
+            weights = np.stack([(left >= 0) * 1.0, np.zeros(nc), (right >= 0) * -1.0, np.zeros(nc)], 1)
+            object.__setattr__(self, "contact_weights", np.ascontiguousarray(weights.reshape(nc, SIDE_TERMS)))
+
         # Storey fields left out: linear elastic storeys of unit height, no P-Delta, no collapse check.
         n = int(self.mass.size)
         defaults = {"storey_model": np.zeros(n, dtype=np.int64),
@@ -269,6 +287,78 @@ class RawSolution:
 
 
 # --------------------------------------------------------------------------- #
+# Contact sides: weighted floors (a floor, a point of a column, a fixed wall)
+# --------------------------------------------------------------------------- #
+# Contact c measures δ = Σ_k cw[c, k]·u[cf[c, k]] − gap over SIDE_TERMS terms
+# (the left side's weights positive, the right side's negative); a term with
+# cf < 0 is the ground or a fixed wall (zero displacement relative to the
+# ground) and contributes nothing.  The contact force F enters the floors with
+# the same weights (fbuf[cf] += cw·F), so its power is F·δ̇ exactly (virtual
+# work): a floor is the term (floor, ±1); a point at fraction ξ of a storey's
+# height the two terms (floor below, ±N1(ξ)) and (floor above, ±N2(ξ)).
+
+#: Terms per contact: two per side.
+SIDE_TERMS = 4
+
+
+# The kernels get the terms flat (term k of contact c at SIDE_TERMS·c + k) and absent terms (floor −1)
+# as floor 0 with weight 0, so every sum below is
+# branch-free over the SIDE_TERMS terms (:func:`integrate` maps them); 0·y[0] adds an exact 0.
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _combo(y, offset, cf, cw, c) -> float:
+    """Σ_k w_k·y[offset + f_k] over the contact's floor terms (δ + gap for offset 0, δ̇ for offset n)."""
+    return (cw[4 * c + 0] * y[offset + cf[4 * c + 0]] + cw[4 * c + 1] * y[offset + cf[4 * c + 1]]
+            + cw[4 * c + 2] * y[offset + cf[4 * c + 2]] + cw[4 * c + 3] * y[offset + cf[4 * c + 3]])
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _push(fbuf, cf, cw, c, force) -> None:
+    """Add contact force *force* (N, ≥ 0 pushes apart) to the floors' internal forces with the side weights."""
+    for k in range(SIDE_TERMS):
+        fbuf[cf[4 * c + k]] += cw[4 * c + k] * force
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _compliance(mass, cf, cw, c) -> float:
+    """Σ_k cw²/m (1/kg): δ̈ per unit contact force; 1/m_eff of the contact (a wall adds nothing)."""
+    total = 0.0
+    for k in range(SIDE_TERMS):
+        total += cw[4 * c + k] * cw[4 * c + k] / mass[cf[4 * c + k]]
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _effective_mass(mass, cf, cw, c) -> float:
+    """m_eff of contact *c* (kg): ``1/Σ cw²/m``; a plain floor pair as ``m_L·m_R/(m_L + m_R)``.
+
+    The floor pair's form is the one the solver used before contact sides
+    became weighted sums: it keeps a floor-to-floor run bit for bit the same
+    (the two forms differ in the last bit for some masses).
+    """
+    k = SIDE_TERMS * c
+    if cw[k] == 1.0 and cw[k + 1] == 0.0 and cw[k + 2] == -1.0 and cw[k + 3] == 0.0:
+        ml = mass[cf[k]]
+        mr = mass[cf[k + 2]]
+        return ml * mr / (ml + mr)
+    return 1.0 / _compliance(mass, cf, cw, c)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _ground_weight(cf, cw, c) -> float:
+    """Σ_k cw over the floor terms: 0 between two buildings, ±1 against a wall (a_g's share in δ̈)."""
+    return cw[4 * c + 0] + cw[4 * c + 1] + cw[4 * c + 2] + cw[4 * c + 3]
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _kick(y, n, mass, cf, cw, c, impulse) -> None:
+    """Apply an impulse *impulse* (N·s, ≥ 0 pushes apart) of contact *c* to the floor velocities."""
+    for k in range(SIDE_TERMS):
+        y[n + cf[4 * c + k]] -= cw[4 * c + k] * impulse / mass[cf[4 * c + k]]
+
+
+# --------------------------------------------------------------------------- #
 # Right-hand side
 # --------------------------------------------------------------------------- #
 
@@ -318,15 +408,52 @@ def _ground_offset(ground, gstate, c, row):
 
     *row* 2: displacement (m), 1: velocity (m/s), 0: acceleration (m/s²) of the ground state
     *gstate*.  This is the one place where the supports' motion enters the contact kinematics:
-    ``δ = u_L − u_R + (u_g,L − u_g,R) − gap`` with ``u`` relative to each floor's own ground
-    (a wall or a link joining two grounds needs only its two rows in ``ground[4]``, ``ground[5]``).
+    ``δ = Σ_k w_k·u[f_k] + (u_g,L − u_g,R) − gap`` with ``u`` relative to each floor's own ground
+    (the rows ``ground[4]``, ``ground[5]``: a side's building's ground; a wall's, the ground of the
+    building it faces, so a wall contact's offset is 0).
     """
     return gstate[row, ground[4][c]] - gstate[row, ground[5][c]]
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _stuck_constraints(ag_t, mass, cf, cw, closed, cmode, fbuf, forces, ground):
+    """Constraint forces of stuck contacts (added to *forces* and *fbuf*): make every δ̈ = 0.
+
+    Gauss–Seidel sweeps, exact in one when no two stuck contacts share a floor.
+    a_g is common to both floors of a pair and cancels; against a wall it
+    stays (the wall moves with the ground).  With several grounds (*ground* not
+    None) a side's total acceleration is ``Σ w·(−fbuf/m − a_g,side) + a_g,side``
+    (its weights sum to 1 with the ground's share of a storey-1 column point),
+    so δ̈ = Σ_k w_k·(−fbuf_k/m_k) + a_g,L·(1 − W_L) − a_g,R·(1 + W_R) with W_L, W_R
+    the sums of the left and right floor weights.  Kept out of :func:`_rhs` (rarely needed).
+    """
+    nc = forces.size
+    for _ in range(100):
+        largest = 0.0
+        scale = 0.0
+        for c in range(nc):
+            if closed[c] and cmode[c] == kernels.MODE_STUCK:
+                # δ̈ = Σ_k cw·(−fbuf/m − a_g) over the floor terms
+                if ground is None:
+                    relative = -ag_t * _ground_weight(cf, cw, c)
+                else:
+                    gnow = ground[6]
+                    relative = (gnow[0, ground[4][c]] * (1.0 - cw[SIDE_TERMS * c] - cw[SIDE_TERMS * c + 1])
+                                - gnow[0, ground[5][c]] * (1.0 + cw[SIDE_TERMS * c + 2] + cw[SIDE_TERMS * c + 3]))
+                for k in range(SIDE_TERMS):
+                    relative -= cw[SIDE_TERMS * c + k] * (fbuf[cf[SIDE_TERMS * c + k]] / mass[cf[SIDE_TERMS * c + k]])
+                change = relative / _compliance(mass, cf, cw, c)
+                forces[c] += change
+                _push(fbuf, cf, cw, c, change)
+                largest = max(largest, abs(change))
+                scale = max(scale, abs(forces[c]))
+        if largest <= 1e-13 * scale:
+            break
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey, ground):
+         cf, cw, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey, ground):
     """Time derivative of the state; contact forces are written to *forces*.
 
     With several grounds (*ground* not None) each floor takes its own ground's
@@ -383,17 +510,24 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     for c in range(nc):
         f = 0.0
         out[2 * n + 2 * nc + c] = 0.0
+        out[2 * n + nc + c] = 0.0  # δ̇ of a closed contact for now; its power F·δ̇ below
         if closed[c]:
+            # Loops over the terms, no helper taking the arrays (each call would reference-count
+            # them); the gap last, so a floor pair's δ is u_L − u_R − gap to the bit, as before.
+            delta = 0.0
+            rate = 0.0
+            for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+                delta += cw[k] * y[cf[k]]
+                rate += cw[k] * y[n + cf[k]]
+            if ground is not None:
+                delta += _ground_offset(ground, ground[6], c, 2)
+                rate += _ground_offset(ground, ground[6], c, 1)
+            delta -= cgap[c]
+            out[2 * n + nc + c] = rate
             if cmode[c] == kernels.MODE_STUCK:
                 n_stuck += 1
                 forces[c] = 0.0
                 continue
-            if ground is None:
-                delta = y[cl[c]] - y[cr[c]] - cgap[c]
-                rate = y[n + cl[c]] - y[n + cr[c]]
-            else:
-                delta = y[cl[c]] - y[cr[c]] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
-                rate = y[n + cl[c]] - y[n + cr[c]] + _ground_offset(ground, ground[6], c, 1)
             q = y[2 * n + 2 * nc + c]
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             if kernels.is_permanent(claw[c]):
@@ -401,50 +535,31 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             else:
                 out[2 * n + 2 * nc + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
         forces[c] = f
-        fbuf[cl[c]] += f
-        fbuf[cr[c]] -= f
+        if f != 0.0:
+            for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+                fbuf[cf[k]] += cw[k] * f
     if n_stuck > 0:
-        # Constraint forces of stuck contacts: make δ̈ = 0 (a floor's total acceleration is −fbuf/m:
-        # its own ground's acceleration cancels).
-        for _ in range(100):
-            largest = 0.0
-            scale = 0.0
-            for c in range(nc):
-                if closed[c] and cmode[c] == kernels.MODE_STUCK:
-                    lf = cl[c]
-                    rf = cr[c]
-                    relative = fbuf[rf] / mass[rf] - fbuf[lf] / mass[lf]
-                    change = relative / (1.0 / mass[lf] + 1.0 / mass[rf])
-                    forces[c] += change
-                    fbuf[lf] += change
-                    fbuf[rf] -= change
-                    largest = max(largest, abs(change))
-                    scale = max(scale, abs(forces[c]))
-            if largest <= 1e-13 * scale:
-                break
+        _stuck_constraints(ag_t, mass, cf, cw, closed, cmode, fbuf, forces, ground)
     e_in_rate = 0.0
     if ground is None:
         for c in range(nc):
             f = forces[c]
             out[2 * n + c] = f
-            out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]]) if closed[c] else 0.0
+            out[2 * n + nc + c] *= f
         for j in range(n):
             out[j] = y[n + j]
             out[n + j] = -fbuf[j] / mass[j] - ag_t
             e_in_rate -= ag_t * mass[j] * y[n + j]
     else:
-        # Several grounds: δ̇ includes the differential ground velocity; its work on the contact
-        # forces is the input W_g (the last state); each building from its own ground.
+        # Several grounds: δ̇ (above) includes the differential ground velocity; its work on the
+        # contact forces is the input W_g (the last state); each building from its own ground.
         ground_power = 0.0
         for c in range(nc):
             f = forces[c]
             out[2 * n + c] = f
+            out[2 * n + nc + c] *= f
             if closed[c]:
-                dvg = _ground_offset(ground, ground[6], c, 1)
-                out[2 * n + nc + c] = f * (y[n + cl[c]] - y[n + cr[c]] + dvg)
-                ground_power += f * dvg
-            else:
-                out[2 * n + nc + c] = 0.0
+                ground_power += f * _ground_offset(ground, ground[6], c, 1)
         gnow = ground[6]
         fground = ground[3]
         for j in range(n):
@@ -688,14 +803,14 @@ def _peak_magnitude(values) -> float:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground) -> float:
+def _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
     total = 0.0
     for c in range(nc):
-        delta = y[cl[c]] - y[cr[c]] - cgap[c]
+        delta = _combo(y, 0, cf, cw, c) - cgap[c]
         if ground is not None:
-            delta = y[cl[c]] - y[cr[c]] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
+            delta = _combo(y, 0, cf, cw, c) + _ground_offset(ground, ground[6], c, 2) - cgap[c]
         total += kernels.potential(claw[c], cprm[c], delta, y[2 * n + 2 * nc + c])
     return total
 
@@ -880,7 +995,7 @@ def _grown(table, rows, needed, limit):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg):
+def _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass, dvg):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
     The impulse ``J = (1+e)·m_eff·v0`` acts on the two floors (−J on the
@@ -891,14 +1006,11 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg):
     differential ground velocity: ``v0 = δ̇`` includes it, and the work
     ``J·dvg`` it does goes to the ground-work state (the last one).
     """
-    nc = cl.size
-    lf = cl[c]
-    rf = cr[c]
-    v0 = y[n + lf] - y[n + rf] + dvg
+    nc = cf.size // SIDE_TERMS
+    v0 = _combo(y, n, cf, cw, c) + dvg
     impulse = kernels.jump_impulse(claw[c], cprm[c], v0)
-    y[n + lf] -= impulse / mass[lf]
-    y[n + rf] += impulse / mass[rf]
-    v_after = y[n + lf] - y[n + rf] + dvg
+    _kick(y, n, mass, cf, cw, c, impulse)
+    v_after = _combo(y, n, cf, cw, c) + dvg
     y[2 * n + c] += impulse
     y[2 * n + nc + c] += impulse * 0.5 * (v0 + v_after)
     y[y.size - 1] += impulse * dvg
@@ -915,7 +1027,7 @@ def _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass, dvg):
+def _switch_contact(c, upward, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass, dvg):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
     Closure fixes the per-impact constant from the approach velocity
@@ -923,12 +1035,14 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
     row with the separation velocity and the impulse.  The caller makes room
     for one more row first (:func:`_grown`); returns the new row count.
     """
-    rate = y[n + cl[c]] - y[n + cr[c]] + dvg
+    rate = _combo(y, n, cf, cw, c) + dvg
     nc = closed.size
     if upward:
         if kernels.is_instantaneous(claw[c]):
-            return _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg)
+            return _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass, dvg)
         closed[c] = True
+        if rate < 0.0:
+            rate = 0.0  # a grazing touch (the caller removed δ̇ < 0): what is left is round-off of that correction
         y[2 * n + 2 * nc + c] = 0.0  # internal state starts afresh at every impact
         cconst[c] = kernels.onset_constant(claw[c], cprm[c], rate)
         impacts[n_imp, IMP_CONTACT] = c
@@ -953,29 +1067,26 @@ def _switch_contact(c, upward, t, y, n, cl, cr, claw, cprm, closed, cconst, impa
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _plastic_jump(c, y, n, cl, cr, mass, dvg):
+def _plastic_jump(c, y, n, cf, cw, mass, dvg):
     """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
 
     The impulse and its work (the energy lost, ½·m_eff·v0²) are added to the
     contact's energy-audit states, ``J·dvg`` to the ground work (*dvg*: the
     contact's differential ground velocity, m/s, part of ``v0 = δ̇``).
     """
-    nc = cl.size
-    lf = cl[c]
-    rf = cr[c]
-    v0 = y[n + lf] - y[n + rf] + dvg
-    impulse = mass[lf] * mass[rf] / (mass[lf] + mass[rf]) * v0
-    y[n + lf] -= impulse / mass[lf]
-    y[n + rf] += impulse / mass[rf]
+    nc = cf.size // SIDE_TERMS
+    v0 = _combo(y, n, cf, cw, c) + dvg
+    impulse = _effective_mass(mass, cf, cw, c) * v0
+    _kick(y, n, mass, cf, cw, c, impulse)
     y[2 * n + c] += impulse
-    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (y[n + lf] - y[n + rf] + dvg))
+    y[2 * n + nc + c] += impulse * 0.5 * (v0 + (_combo(y, n, cf, cw, c) + dvg))
     y[y.size - 1] += impulse * dvg
     return impulse
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                  cl, cr, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
+                  cf, cw, cgap, claw, cprm, closed, cconst, cmode, scratch, deriv, fbuf, forces,
                   impacts, n_imp, open_imp, storey, ground):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state *y*, in place.
 
@@ -1008,12 +1119,10 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
         if kind == EVENT_NONE:
             continue
         n_applied += 1
-        lf = cl[c]
-        rf = cr[c]
         dvg = 0.0
         if ground is not None:
             dvg = _ground_offset(ground, ground[6], c, 1)
-        rate = y[n + lf] - y[n + rf] + dvg
+        rate = _combo(y, n, cf, cw, c) + dvg
         if kind == EVENT_CLOSE:
             if n_imp + 1 > IMPACT_ROW_LIMIT:
                 status = STATUS_TABLE_LIMIT
@@ -1027,16 +1136,16 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
                         scratch[i] = y[i]
-                    _plastic_jump(c, scratch, n, cl, cr, mass, dvg)
+                    _plastic_jump(c, scratch, n, cf, cw, mass, dvg)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     _rhs(scratch, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                         cl, cr, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, storey, ground)
+                         cf, cw, cgap, claw, cprm, closed, cconst, cmode, deriv, fbuf, forces, storey, ground)
                     stick = forces[c] > 0.0
                     closed[c] = False
                     cmode[c] = 0
                 if not stick:
-                    n_imp = _velocity_jump(c, t, y, n, cl, cr, claw, cprm, impacts, n_imp, mass, dvg)
+                    n_imp = _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass, dvg)
                     continue
                 impacts[n_imp, IMP_CONTACT] = c
                 impacts[n_imp, IMP_TIME] = t
@@ -1045,7 +1154,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 impacts[n_imp, IMP_PEAK_FORCE] = 0.0
                 impacts[n_imp, IMP_IMPULSE] = y[2 * n + c]
                 impacts[n_imp, IMP_WORK] = y[2 * n + nc + c]
-                _plastic_jump(c, y, n, cl, cr, mass, dvg)
+                _plastic_jump(c, y, n, cf, cw, mass, dvg)
                 closed[c] = True
                 cmode[c] = kernels.MODE_STUCK
                 cconst[c] = 0.0
@@ -1054,26 +1163,33 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
                 continue
             if rate < 0.0:
                 # A tangency located to round-off (δ̇ ~ −1e-17 m/s): a grazing touch, v0 = 0.
-                y[n + lf] -= rate * mass[rf] / (mass[lf] + mass[rf])
-                y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
+                k = SIDE_TERMS * c
+                if cw[k] == 1.0 and cw[k + 1] == 0.0 and cw[k + 2] == -1.0 and cw[k + 3] == 0.0:
+                    # a plain floor pair: the pre-weighted form, bit for bit (see _effective_mass)
+                    lf = cf[k]
+                    rf = cf[k + 2]
+                    y[n + lf] -= rate * mass[rf] / (mass[lf] + mass[rf])
+                    y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
+                else:
+                    _kick(y, n, mass, cf, cw, c, rate / _compliance(mass, cf, cw, c))
                 rate = 0.0
-            n_imp = _switch_contact(c, True, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
+            n_imp = _switch_contact(c, True, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp,
                                     open_imp, mass, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
-            m_eff = mass[lf] * mass[rf] / (mass[lf] + mass[rf])
+            m_eff = _effective_mass(mass, cf, cw, c)
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
                 cap = min(cap, duration / STEPS_PER_CONTACT)
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
-            n_imp = _switch_contact(c, False, t, y, n, cl, cr, claw, cprm, closed, cconst, impacts, n_imp,
+            n_imp = _switch_contact(c, False, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp,
                                     open_imp, mass, dvg)
             cmode[c] = 0
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)
-            delta = y[lf] - y[rf] - cgap[c]
+            delta = _combo(y, 0, cf, cw, c) - cgap[c]
             if ground is not None:
-                delta = y[lf] - y[rf] + _ground_offset(ground, ground[6], c, 2) - cgap[c]
+                delta = _combo(y, 0, cf, cw, c) + _ground_offset(ground, ground[6], c, 2) - cgap[c]
             y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
     return impacts, n_imp, n_applied, cap, status
@@ -1086,7 +1202,7 @@ def _apply_events(kinds, t, y, ag_t, mass, kst, below, a0, a1, dstart, dsize, do
 
 @njit(cache=True)
 def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-               cl, cr, cgap, claw, cprm, storey, ground,
+               cf, cw, cgap, claw, cprm, storey, ground,
                ag, dt_rec, t_end, rtol, atol_u, atol_v, output_dt, first_step, y_initial):
     n = mass.size
     nc = cgap.size
@@ -1173,7 +1289,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     if ground is not None:
         _fill_grounds(ground, dt_rec, seg, 0.0, ground[6])
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-         cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
+         cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
     # First output sample at t = 0.
     out_time[0] = 0.0
     _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, 0)
@@ -1187,7 +1303,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     if ground is not None:
         for g in range(n_ground):
             out_support[0, g] = ground[6][0, g]
-    out_pot[0] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground)
+    out_pot[0] = _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground)
     i_out = 1
 
     h = first_step
@@ -1226,38 +1342,38 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t + C2 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t + C3 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey, ground)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t + C4 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey, ground)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t + C5 * h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey, ground)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey, ground)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey, ground)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey, ground)
+                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey, ground)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
@@ -1307,9 +1423,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 forces_end[c] = forces[c]  # forces at the step's end (the last stage evaluation)
             # ---- contact events inside the step ------------------------------
-            # With several grounds δ is the Hermite cubic of the total displacements: each floor's
-            # displacement over its own ground plus the contact's differential ground motion (itself
-            # a cubic within a record step, so the interpolant reproduces it exactly).
+            # With several grounds δ is the Hermite cubic of the total displacements: each side's
+            # weighted floors over its own ground plus the contact's differential ground motion
+            # (itself a cubic within a record step, so the interpolant reproduces it exactly).
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t, ground[7])
                 _fill_grounds(ground, dt_rec, seg, t + h_try, ground[8])
@@ -1317,26 +1433,35 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 event_s[c] = -1.0
                 event_kind[c] = EVENT_NONE
-                lf = cl[c]
-                rf = cr[c]
-                od0 = ov0 = oa0 = od1 = ov1 = oa1 = 0.0
+                # δ, δ̇ at both ends of the step, their rates (k1, k7), and the round-off scale of δ,
+                # summed over the contact's floor terms in one loop (no helper taking the arrays).
+                d0 = 0.0
+                r0 = 0.0
+                d1 = 0.0
+                r1 = 0.0
+                q0 = 0.0
+                q1 = 0.0
+                size = 0.0
+                for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+                    w = cw[k]
+                    f = cf[k]
+                    d0 += w * y[f]
+                    r0 += w * y[n + f]
+                    d1 += w * ynew[f]
+                    r1 += w * ynew[n + f]
+                    q0 += w * k1[n + f]
+                    q1 += w * k7[n + f]
+                    size += abs(w * y[f])
                 if ground is not None:
-                    od0 = _ground_offset(ground, ground[7], c, 2)
-                    ov0 = _ground_offset(ground, ground[7], c, 1)
-                    oa0 = _ground_offset(ground, ground[7], c, 0)
-                    od1 = _ground_offset(ground, ground[8], c, 2)
-                    ov1 = _ground_offset(ground, ground[8], c, 1)
-                    oa1 = _ground_offset(ground, ground[8], c, 0)
-                    d0 = y[lf] - y[rf] + od0 - cgap[c]
-                    r0 = y[n + lf] - y[n + rf] + ov0
-                    d1 = ynew[lf] - ynew[rf] + od1 - cgap[c]
-                    r1 = ynew[n + lf] - ynew[n + rf] + ov1
-                else:
-                    d0 = y[lf] - y[rf] - cgap[c]
-                    r0 = y[n + lf] - y[n + rf]
-                    d1 = ynew[lf] - ynew[rf] - cgap[c]
-                    r1 = ynew[n + lf] - ynew[n + rf]
-                floor = DELTA_ROUNDOFF * (abs(y[lf]) + abs(y[rf]) + abs(cgap[c]))
+                    d0 += _ground_offset(ground, ground[7], c, 2)
+                    r0 += _ground_offset(ground, ground[7], c, 1)
+                    q0 += _ground_offset(ground, ground[7], c, 0)
+                    d1 += _ground_offset(ground, ground[8], c, 2)
+                    r1 += _ground_offset(ground, ground[8], c, 1)
+                    q1 += _ground_offset(ground, ground[8], c, 0)
+                d0 -= cgap[c]
+                d1 -= cgap[c]
+                floor = DELTA_ROUNDOFF * (size + abs(cgap[c]))
                 s = -1.0
                 kind = EVENT_NONE
                 if kernels.is_permanent(claw[c]):
@@ -1357,7 +1482,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             if ground is not None:
                                 _fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground[6])
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
-                                 dstart, dsize, doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2,
+                                 dstart, dsize, doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2,
                                  fbuf, forces, storey, ground)
                             if forces[c] < 0.0:
                                 hi = mid
@@ -1370,10 +1495,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     s = _first_crossing(d0, r0, d1, r1, h_try, False, floor)
                     kind = EVENT_SEPARATE
                     for which in range(kernels.switch_count(claw[c], cprm[c])):
+                        # The interpolants are linear in the data: δ's from the combined side data.
                         sw = _switch_crossing(claw[c], cprm[c], cconst[c], cmode[c], which, cgap[c],
-                                              y[lf] + od0, y[n + lf] + ov0, ynew[lf] + od1, ynew[n + lf] + ov1,
-                                              k1[n + lf] + oa0, k7[n + lf] + oa1,
-                                              y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
+                                              d0 + cgap[c], r0, d1 + cgap[c], r1, q0, q1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                                               y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_try)
                         if sw >= 0.0 and (s < 0.0 or sw < s):
                             s = sw
@@ -1420,7 +1544,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     _fill_grounds(ground, dt_rec, seg, t, ground[6])
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
-                    doff, dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
+                    doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
                     impacts, n_imp, open_imp, storey, ground)
                 n_applied += n_storey
                 if t - window_start > dt_rec:
@@ -1434,7 +1558,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if ground is not None:
                     _fill_grounds(ground, dt_rec, seg, t, ground[6])
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
-                     dvals, cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
+                     dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -1493,11 +1617,30 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         for c in range(nc):
             if kernels.is_permanent(claw[c]):
                 # A link: peak |F| on the step's interpolant (no trace: it is engaged at every step).
-                lf = cl[c]
-                rf = cr[c]
+                e_d0 = 0.0
+                e_r0 = 0.0
+                e_d1 = 0.0
+                e_r1 = 0.0
+                e_a0 = 0.0
+                e_a1 = 0.0
+                for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+                    w = cw[k]
+                    f = cf[k]
+                    e_d0 += w * y[f]
+                    e_r0 += w * y[n + f]
+                    e_d1 += w * ynew[f]
+                    e_r1 += w * ynew[n + f]
+                    e_a0 += w * k1[n + f]
+                    e_a1 += w * k7[n + f]
+                if ground is not None:
+                    e_d0 += _ground_offset(ground, ground[7], c, 2)
+                    e_r0 += _ground_offset(ground, ground[7], c, 1)
+                    e_a0 += _ground_offset(ground, ground[7], c, 0)
+                    e_d1 += _ground_offset(ground, ground[8], c, 2)
+                    e_r1 += _ground_offset(ground, ground[8], c, 1)
+                    e_a1 += _ground_offset(ground, ground[8], c, 0)
                 _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
-                                        y[lf], y[n + lf], ynew[lf], ynew[n + lf], k1[n + lf], k7[n + lf],
-                                        y[rf], y[n + rf], ynew[rf], ynew[n + rf], k1[n + rf], k7[n + rf],
+                                        e_d0, e_r0, e_d1, e_r1, e_a0, e_a1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                                         y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c], h_used, fractions, deltas,
                                         values)
                 fpk = _peak_magnitude(values)
@@ -1511,20 +1654,32 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if row >= 0 and fpk > impacts[row, IMP_PEAK_FORCE]:
                     impacts[row, IMP_PEAK_FORCE] = fpk
             elif closed[c]:
-                lf = cl[c]
-                rf = cr[c]
-                od0 = ov0 = oa0 = od1 = ov1 = oa1 = 0.0
+                # The interpolants are linear in the data: δ's from the combined side data.
+                e_d0 = 0.0
+                e_r0 = 0.0
+                e_d1 = 0.0
+                e_r1 = 0.0
+                e_a0 = 0.0
+                e_a1 = 0.0
+                for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+                    w = cw[k]
+                    f = cf[k]
+                    e_d0 += w * y[f]
+                    e_r0 += w * y[n + f]
+                    e_d1 += w * ynew[f]
+                    e_r1 += w * ynew[n + f]
+                    e_a0 += w * k1[n + f]
+                    e_a1 += w * k7[n + f]
                 if ground is not None:
-                    od0 = _ground_offset(ground, ground[7], c, 2)
-                    ov0 = _ground_offset(ground, ground[7], c, 1)
-                    oa0 = _ground_offset(ground, ground[7], c, 0)
-                    od1 = _ground_offset(ground, ground[8], c, 2)
-                    ov1 = _ground_offset(ground, ground[8], c, 1)
-                    oa1 = _ground_offset(ground, ground[8], c, 0)
+                    e_d0 += _ground_offset(ground, ground[7], c, 2)
+                    e_r0 += _ground_offset(ground, ground[7], c, 1)
+                    e_a0 += _ground_offset(ground, ground[7], c, 0)
+                    e_d1 += _ground_offset(ground, ground[8], c, 2)
+                    e_r1 += _ground_offset(ground, ground[8], c, 1)
+                    e_a1 += _ground_offset(ground, ground[8], c, 0)
                 fpk = _closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
-                                              y[lf] + od0, y[n + lf] + ov0, ynew[lf] + od1, ynew[n + lf] + ov1,
-                                              k1[n + lf] + oa0, k7[n + lf] + oa1, y[rf], y[n + rf], ynew[rf], ynew[n + rf],
-                                              k1[n + rf], k7[n + rf], y[iq + c], k1[iq + c], ynew[iq + c],
+                                              e_d0, e_r0, e_d1, e_r1, e_a0, e_a1,
+                                              0.0, 0.0, 0.0, 0.0, 0.0, 0.0, y[iq + c], k1[iq + c], ynew[iq + c],
                                               k7[iq + c], h_used, fractions, deltas, values)
                 if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
                     status = STATUS_TABLE_LIMIT
@@ -1559,7 +1714,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 for g in range(n_ground):
                     out_support[i_out, g] = ground[6][0, g]
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             out_time[i_out] = t_o
             for i in range(S):
                 out_state[i_out, i] = ystage[i]
@@ -1568,7 +1723,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for c in range(nc):
                 out_force[i_out, c] = forces[c]
             out_ag[i_out] = ag_o
-            out_pot[i_out] = _contact_energy(ystage, n, cl, cr, cgap, claw, cprm, ground)
+            out_pot[i_out] = _contact_energy(ystage, n, cf, cw, cgap, claw, cprm, ground)
             _storey_outputs(ystage, n, nc, below, kst, storey, out_shear, out_storey_energy, i_out)
             i_out += 1
         # ---- accept ---------------------------------------------------------
@@ -1594,7 +1749,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             _fill_grounds(ground, dt_rec, seg, t, ground[6])
         impacts, n_imp, n_applied, cap, status = _apply_events(
             event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-            cl, cr, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
+            cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
             storey, ground)
         n_applied += n_storey
         if n_applied > 0:
@@ -1607,7 +1762,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t, ground[6])
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -1635,7 +1790,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if ground is not None:
                 _fill_grounds(ground, dt_rec, seg, t, ground[6])
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-                 cl, cr, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
+                 cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for c in range(nc):
                 out_force[i2, c] = forces[c]
             _storey_outputs(y, n, nc, below, kst, storey, out_shear, out_storey_energy, i2)
@@ -1643,7 +1798,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if ground is not None:
                 for g in range(n_ground):
                     out_support[i2, g] = ground[6][0, g]
-            out_pot[i2] = _contact_energy(y, n, cl, cr, cgap, claw, cprm, ground)
+            out_pot[i2] = _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground)
         i_out = n_out
     if status != STATUS_COLLAPSED:
         collapse_floor = zero - 1
@@ -1725,11 +1880,15 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         y_initial[: system.n_floors] = initial_displacement
     if initial_velocity is not None:
         y_initial[system.n_floors:] = initial_velocity
+    # Absent terms (the ground, a wall: floor −1) go to the kernels as floor 0 with weight 0.
+    kernel_floors = np.ascontiguousarray(np.where(system.contact_weights == 0.0, 0, system.contact_floors),
+                                         dtype=np.int64).reshape(-1)  # flat: term k of contact c at 4c + k
     raw = _integrate(system.mass, system.storey_stiffness, system.below, system.rayleigh_mass,
                      system.rayleigh_stiffness, system.dense_start, system.dense_size,
-                     system.dense_offset, system.dense_values, system.contact_left,
-                     system.contact_right, system.contact_gap, system.contact_law,
-                     system.contact_parameters, _storey_arguments(system, float(atol)), ground, ag, float(time_step), float(duration), float(rtol),
+                     system.dense_offset, system.dense_values, kernel_floors,
+                     np.ascontiguousarray(system.contact_weights, dtype=float).reshape(-1), system.contact_gap,
+                     system.contact_law, system.contact_parameters, _storey_arguments(system, float(atol)), ground, ag,
+                     float(time_step), float(duration), float(rtol),
                      float(atol), float(atol_velocity), float(output_dt), float(first_step),
                      y_initial)
     (time, state, acc, force, ag_out, potential, support, peak_u, peak_drift, peak_force, impacts, trace, shear,

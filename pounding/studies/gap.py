@@ -296,6 +296,13 @@ def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = 
 
     base = load_model(model)  # the model's own errors, with its file name
     base.refuse_building_records("the gap study (it runs the model under one record at a time)")
+    names = [b.name for b in base.buildings]
+    for g in base.gaps:
+        if g.has_wall or g.has_column_point:
+            what = "a fixed wall" if g.has_wall else "a point of a column between floors"
+            raise PoundingError(f"{os.fspath(model)}: contacts[{g.contact}] ({g.label(names)}) joins {what}; the gap "
+                                "study's separation rules compare the floors of two buildings: keep only "
+                                "floor-to-floor level pairs between buildings in the model you study")
     if not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: the model has no contacts; list the level pairs to check in "
                             "'contacts' (gap: 0 is fine: only the levels and buildings are used)")
