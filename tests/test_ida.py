@@ -411,3 +411,33 @@ def test_an_ida_run_keeps_exactly_the_peaks_and_collapse_of_the_full_simulation(
     np.testing.assert_array_equal(part["contacts"]["impact_count"], full.impact_count.values)
     np.testing.assert_array_equal(part["contacts"]["peak_contact_force"], full.peak_contact_force.values)
     assert part["scale_factor"] == full.attrs["record_scale"]
+
+
+def test_every_scenario_text_is_the_yaml_of_its_own_data():
+    """The plan writes each run's document from one dump per variant and record with the factor
+    filled in; the text (which the resumable part's key hashes) must be exactly the pure-Python
+    PyYAML dump of the run's data, whatever the factor's digits, and the runs must not share
+    the mapping that differs between them."""
+    import yaml
+
+    from pounding.studies.gap import OPEN_GAP
+    from pounding.studies.sweep.spec import scenario_key
+
+    plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.1,0.30000000000000004,1e-05,123456.789",
+                              without_contacts=True, duration=3.0)
+    scenarios = plan.stripe_scenarios()
+    assert len(scenarios) == 2 * 3 * 4
+    factors = set()
+    for scenario in scenarios:
+        expected = yaml.dump(scenario.data, Dumper=yaml.SafeDumper, sort_keys=False, default_flow_style=None,
+                             width=100)
+        assert scenario.document == expected
+        assert scenario.identity == scenario_key(expected, plan.sweep.base_dir)
+        variant = scenario.coords["variant"]
+        gaps = {c["gap"] for c in scenario.data["contacts"]}
+        assert (gaps == {OPEN_GAP}) == (variant == "without_contacts")
+        factors.add(scenario.data["ground_motion"]["scale"])
+    assert len(factors) == 3 * 4  # both variants of a record and level share the factor, nothing else does
+    first, second = scenarios[0], scenarios[1]
+    first.data["ground_motion"]["scale"] = -1.0
+    assert second.data["ground_motion"]["scale"] > 0.0

@@ -344,3 +344,23 @@ axes:
     assert len(files) == 2 and files[0].name.startswith("gap=0.01_record=fema-p695_farfield_1a_")
     run = open_run(files[1])
     np.testing.assert_array_equal(run.peak_drift_ratio.values, ds.peak_drift_ratio.sel(gap=0.02).values[0])
+
+
+def test_parts_are_saved_in_batches_and_killed_writers_temporaries_are_cleared(tmp_path):
+    """A task's parts are written together (one folder flush); the temporaries a killed writer left
+    are removed once, when a sweep (re)opens its parts folder, and never read as parts."""
+    from pounding.studies.sweep.store import load_parts, prepare_store, save_parts
+
+    store = tmp_path / "out.nc.parts"
+    store.mkdir()
+    dead = 2 ** 22 + 12345   # above the default pid_max: no process has it
+    stale = store / f".abc.json.pounding-{dead}-x1.tmp"
+    stale.write_text("{half a part")
+    prepare_store(store)
+    assert not stale.exists()
+    results = [{"key": f"{i:064x}", "status": "error", "error": "boom", "format": sw.spec.PARTS_FORMAT,
+                "wall_time": 0.0} for i in range(3)]
+    paths = save_parts(store, results)
+    assert [p.name for p in paths] == [f"{i:064x}.json" for i in range(3)]
+    assert sorted(load_parts(store)) == [r["key"] for r in results]
+    assert not [p for p in store.iterdir() if p.name.endswith(".tmp")]

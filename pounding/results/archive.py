@@ -174,17 +174,20 @@ def clean_stale_temporaries(folder: str | os.PathLike) -> int:
 
 
 @contextmanager
-def atomic_path(target: Path) -> Iterator[str]:
+def atomic_path(target: Path, *, clean_stale: bool = True) -> Iterator[str]:
     """Yield a temporary file name beside *target* to write to.
 
     On success the file is flushed to disk and renamed over *target* (an
     atomic replacement on POSIX); on any failure, including KeyboardInterrupt,
     it is removed and *target* is left as it was.  The temporary name carries
     the writer's pid (``.NAME.pounding-PID-XXXX.tmp``) so that temporaries of
-    writers that were killed are removed by the next writer in that folder.
+    writers that were killed are removed by the next writer in that folder
+    (*clean_stale*; a writer of many files in one folder, such as a sweep's
+    parts, cleans the folder once instead of listing it before every file).
     """
     folder = target.parent if str(target.parent) else Path(".")
-    clean_stale_temporaries(folder)
+    if clean_stale:
+        clean_stale_temporaries(folder)
     try:
         descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.pounding-{os.getpid()}-", suffix=".tmp",
                                                  dir=folder)

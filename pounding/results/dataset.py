@@ -162,17 +162,18 @@ def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray) ->
         index = system.storey_state[yielding]
         state = final[first + index]
         work = final[first + nh + index]
-        recoverable = np.array([_recoverable(int(m), p, k, d, r) for m, p, k, d, r in zip(
-            system.storey_model[yielding], system.storey_parameters[yielding], system.storey_stiffness[yielding],
-            drift[yielding], state)])
+        table = np.ascontiguousarray(system.storey_parameters, dtype=np.float64)
+        recoverable = np.array([_recoverable(int(system.storey_model[j]), table, int(j),
+                                             float(system.storey_stiffness[j]), float(drift[j]), float(r))
+                                for j, r in zip(np.flatnonzero(yielding), state)])
         dissipated[yielding] = work - recoverable
     return {"residual": drift / heights, "yield_drift": yield_drift, "ductility": ductility,
             "dissipated": dissipated}
 
 
-def _recoverable(model: int, parameters: np.ndarray, stiffness: float, drift: float, state: float) -> float:
-    """Recoverable energy of one storey (J), by the solver's own kernel."""
-    return float(recoverable_energy(model, parameters, stiffness, drift, state))
+def _recoverable(model: int, table: np.ndarray, row: int, stiffness: float, drift: float, state: float) -> float:
+    """Recoverable energy of storey *row* (J), by the solver's own kernel (*table*: every storey's kernel vector)."""
+    return float(recoverable_energy(model, table, row, stiffness, drift, state))
 
 
 def _penetration(u: np.ndarray, system: System, ground_displacement: np.ndarray) -> np.ndarray:

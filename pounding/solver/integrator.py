@@ -871,8 +871,8 @@ def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
             smodel, sprm, sidx, kpd = storey[0], storey[1], storey[2], storey[3]
             hi = sidx[j]
             r = y[2 * n + 3 * nc + 2 + hi] if hi >= 0 else 0.0
-            shear[row, j] = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
-            recoverable = storeys.recoverable_energy(smodel[j], sprm[j], kst[j], du, r)
+            shear[row, j] = storeys.restoring_force(smodel[j], sprm, j, kst[j], du, r)
+            recoverable = storeys.recoverable_energy(smodel[j], sprm, j, kst[j], du, r)
             total += recoverable + 0.5 * kpd[j] * du * du
             if hi >= 0:
                 yielding += recoverable
@@ -886,6 +886,8 @@ def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
 
     Writes the rates of the hysteretic states and of the storeys' work
     ∫F dΔ into *out*.  The caller has already applied ``kΔ`` to every storey.
+    The storey kernels take the parameter table and a row (no row views:
+    each would be reference-counted, in the solver's innermost loop).
     """
     smodel, sprm, kpd, smode, sfloor = storey[0], storey[1], storey[3], storey[6], storey[7]
     nh = sfloor.size
@@ -903,8 +905,9 @@ def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
         du = y[j] - y[b] if b >= 0 else y[j]
         dv = y[n + j] - y[n + b] if b >= 0 else y[n + j]
         r = y[ih + hi]
-        restoring = storeys.restoring_force(smodel[j], sprm[j], kst[j], du, r)
-        out[ih + hi] = storeys.state_rate(smodel[j], sprm[j], smode[hi], dv, r)
+        model = smodel[j]
+        restoring = storeys.restoring_force(model, sprm, j, kst[j], du, r)
+        out[ih + hi] = storeys.state_rate(model, sprm, j, smode[hi], dv, r)
         out[ih + nh + hi] = restoring * dv
         departure = restoring - kst[j] * du
         fbuf[j] += departure
@@ -922,19 +925,19 @@ def _drift_interpolant(y, ynew, k1, k7, n, j, b):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, prm, mode, h):
+def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, uy, mode, h):
     """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
 
     Elastic mode: ``Δ − Δ_p`` reaching ``+u_y`` or ``−u_y`` (Δ_p is constant, so
     this is a crossing of the drift's Hermite cubic, found exactly by
     :func:`_first_crossing`).  Yielding: the drift rate crossing 0 against
-    the yield direction (the cubic of Δ̇ from Δ̇ and Δ̈ at the ends).
+    the yield direction (the cubic of Δ̇ from Δ̇ and Δ̈ at the ends).  *uy*: its
+    yield drift, m.
     """
     if model != hysteresis.MODEL_BILINEAR:
         return -1.0, STOREY_NONE
     d0, r0, d1, r1, a0, a1 = _drift_interpolant(y, ynew, k1, k7, n, j, b)
     ih = 2 * n + 3 * nc + 2
-    uy = prm[0]
     if mode == storeys.ELASTIC:
         plastic = y[ih + hi]
         e0 = d0 - plastic
@@ -1549,7 +1552,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                                                                     storey[6], storey[7])
                 for hi in range(nh):
                     j = sfloor[hi]
-                    s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j],
+                    s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j, 0],
                                             smode[hi], h_try)
                     sev_s[hi] = s
                     sev_kind[hi] = kind

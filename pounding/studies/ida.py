@@ -57,6 +57,7 @@ Fragility (:mod:`pounding.studies.fragility`)
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 import sys
@@ -66,8 +67,10 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+import yaml
 
 from pounding.errors import PoundingError
+from pounding.model.document import dump_document
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["IDA_PART", "VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "IntensityMeasure", "Hunt",
@@ -226,6 +229,15 @@ def limit_label(value: float) -> str:
 # The plan: records, their IM and factors, the scenarios
 # --------------------------------------------------------------------------- #
 
+#: A scale no model uses, written into a document's one dump per variant and record and then
+#: replaced by each run's factor (IdaPlan._scaled_document).
+_SCALE_PLACEHOLDER = 1.2345678901234567e+299
+
+
+def _yaml_scalar(value: float) -> str:
+    """*value* as :func:`~pounding.model.document.dump_document` writes it inside a document (``0.5``, ``1.0e-05``, ``.inf``)."""
+    return yaml.representer.SafeRepresenter().represent_float(value).value
+
 
 @dataclass
 class IdaPlan:
@@ -266,32 +278,56 @@ class IdaPlan:
 
     def scenario(self, variant: str, record: int, level_g: float):
         """The :class:`~pounding.studies.sweep.spec.Scenario` of one run (cached)."""
-        import copy
-
-        import yaml
-
-        from pounding.studies.gap import OPEN_GAP
         from pounding.studies.sweep.spec import Scenario, code_fingerprint, content_key, record_fingerprint, \
             scenario_key
 
         cache_key = (variant, record, float(level_g))
         if cache_key in self._cache:
             return self._cache[cache_key]
-        document = copy.deepcopy(self.documents[record])
         coords = {"variant": variant, "record": self.records[record], "level": f"{level_g:g}g"}
         error = self.errors[record]
         if error is None:
-            document["ground_motion"]["scale"] = self.factor(record, level_g)
-            if variant == "without_contacts":
-                for contact in document.get("contacts") or []:
-                    contact["gap"] = OPEN_GAP
-        text = yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100)
+            document, text = self._scaled_document(variant, record, self.factor(record, level_g))
+        else:
+            document = copy.deepcopy(self.documents[record])
+            text = dump_document(document)
         base_dir = self.sweep.base_dir
         identity = scenario_key(text if error is None else f"{text}\n# invalid: {error}", base_dir)
-        key = content_key(identity, record_fingerprint(self.records[record], base_dir), code_fingerprint())
+        fingerprint = self._cache.get(("record", record))
+        if fingerprint is None:  # hashes the record file, or asks the package version: once per record
+            fingerprint = self._cache[("record", record)] = record_fingerprint(self.records[record], base_dir)
+        key = content_key(identity, fingerprint, code_fingerprint())
         scenario = Scenario((VARIANTS.index(variant), record), coords, text, base_dir, key, error, document, identity)
         self._cache[cache_key] = scenario
         return scenario
+
+    def _scaled_document(self, variant: str, record: int, factor: float) -> tuple[dict, str]:
+        """Record *record*'s model document in *variant* with the record scaled by *factor*: (data, YAML text).
+
+        The text is exactly :func:`~pounding.model.document.dump_document` of the data (the
+        scenario key hashes it), but built from one dump per variant and record with the factor
+        written in: a dump takes milliseconds, which over the thousands of runs of an IDA was
+        seconds of serial work on the client before the first run.  The documents share everything but their
+        ``ground_motion`` mapping; nothing changes a scenario's data after it is made.
+        """
+        from pounding.studies.gap import OPEN_GAP
+
+        template = self._cache.get(("template", variant, record))
+        if template is None:
+            base = copy.deepcopy(self.documents[record])
+            if variant == "without_contacts":
+                for contact in base.get("contacts") or []:
+                    contact["gap"] = OPEN_GAP
+            base["ground_motion"]["scale"] = _SCALE_PLACEHOLDER
+            pieces = dump_document(base).split(_yaml_scalar(_SCALE_PLACEHOLDER))
+            template = (base, pieces)
+            self._cache[("template", variant, record)] = template
+        base, pieces = template
+        document = dict(base)
+        document["ground_motion"] = dict(base["ground_motion"], scale=factor)
+        if len(pieces) != 2:  # the placeholder is not one scalar of the text: dump the whole document
+            return document, dump_document(document)
+        return document, _yaml_scalar(factor).join(pieces)
 
     def stripe_scenarios(self) -> list:
         """Every (variant, record, level) of the fixed stripes, variant slowest."""

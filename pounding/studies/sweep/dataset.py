@@ -6,9 +6,9 @@ import json
 from datetime import datetime, timezone
 from typing import Any, Iterable
 
-import yaml
 
 from pounding import __version__
+from pounding.model.document import dump_document
 from pounding.studies.sweep.spec import Axis, Sweep
 
 __all__ = ["build_dataset"]
@@ -144,7 +144,7 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "sweep_name": sweep.name,
         "sweep_file": sweep.label,
         "sweep_text": sweep.text,
-        "base_model": yaml.safe_dump(sweep.base_document, sort_keys=False, default_flow_style=None, width=100),
+        "base_model": dump_document(sweep.base_document),
         "base_model_file": sweep.model_path or "",
         "axes": json.dumps({a.name: a.key for a in sweep.axes}),
         "n_scenarios": int(sweep.size),

@@ -15,7 +15,7 @@ from pounding.errors import PoundingError
 from pounding.studies.sweep.dataset import build_dataset
 from pounding.studies.sweep.scenario import one_line, run_scenario
 from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario, Sweep
-from pounding.studies.sweep.store import (history_name, load_parts, parts_dir, prepare_store, save_part,
+from pounding.studies.sweep.store import (history_name, load_parts, parts_dir, prepare_store, save_parts,
                                           sweep_lock)
 
 __all__ = ["default_workers", "start_client", "run_sweep", "run_chunk", "failures", "failure_report",
@@ -367,14 +367,19 @@ def _run_on(client, sweep: Sweep, todo: list[Scenario], results: dict[str, dict[
             finally:
                 future.release()
             batcher.observe(outcomes)
+            # The task's parts first, in one batch (a part whose history is missing runs again on resume).
+            finished, datasets = [], []
             for scenario, result in zip(chunk, outcomes):
-                dataset = result.pop("dataset", None)
-                if dataset is not None and histories is not None:
-                    save_run(dataset, histories / history_name(scenario), overwrite=True)
+                datasets.append(result.pop("dataset", None))
                 if store is not None and scenario.key not in transient:
                     result["identity"] = scenario.identity
-                    save_part(store, result)
+                    finished.append(result)
                 results[scenario.key] = result
+            if finished:
+                save_parts(store, finished)
+            for scenario, dataset in zip(chunk, datasets):
+                if dataset is not None and histories is not None:
+                    save_run(dataset, histories / history_name(scenario), overwrite=True)
             bar.update(len(chunk))
             submit_more()
     except BaseException:

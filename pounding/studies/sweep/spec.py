@@ -79,7 +79,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from pounding import __version__
 from pounding.model import schema
-from pounding.model.document import Document
+from pounding.model.document import Document, dump_document
 from pounding.records.catalogue import is_catalogue_reference, is_catalogued
 from pounding.errors import ModelError, PoundingError, did_you_mean
 
@@ -604,7 +604,7 @@ class Sweep:
                 except (ModelError, PathError) as exc:
                     error = error or (f"{self.label}:{axis.lines[positions[i]]}: axes.{axis.key}"
                                       f"[{positions[i]}]: {exc}")
-            text = yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=100)
+            text = dump_document(document)
             # a scenario with an invalid value must not share the key of the valid one it resembles
             identity = scenario_key(text if error is None else f"{text}\n# invalid: {error}", self.base_dir)
             record = (document.get("ground_motion") or {}).get("record") if isinstance(document, dict) else None
@@ -629,7 +629,7 @@ class Sweep:
         """
         from pounding.simulation import check_memory
 
-        text = yaml.safe_dump(self.base_document, sort_keys=False, default_flow_style=None, width=100)
+        text = dump_document(self.base_document)
         floors = text.count("mass")
         contacts = len(self.base_document.get("contacts") or []) if isinstance(self.base_document, dict) else 0
         per_scenario = 3 * len(text) + 400 * (floors + contacts) + 2000

@@ -15,8 +15,8 @@ from typing import Any, Iterator
 from pounding.errors import PoundingError
 from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario
 
-__all__ = ["PARTS_SUFFIX", "parts_dir", "save_part", "load_parts", "history_name", "check_part", "prepare_store",
-           "sweep_lock", "BAD_SUFFIX"]
+__all__ = ["PARTS_SUFFIX", "parts_dir", "save_part", "save_parts", "load_parts", "history_name", "check_part",
+           "prepare_store", "sweep_lock", "BAD_SUFFIX"]
 
 #: Suffix given to a part file that failed validation (kept for inspection, never loaded).
 BAD_SUFFIX = ".bad"
@@ -37,7 +37,8 @@ def parts_dir(output: str | os.PathLike) -> Path:
 def _write_atomic(path: Path, data: bytes) -> None:
     from pounding.results.archive import atomic_path
 
-    with atomic_path(path) as temporary:
+    # The parts folder is cleaned of killed writers' temporaries once, by prepare_store.
+    with atomic_path(path, clean_stale=False) as temporary:
         Path(temporary).write_bytes(data)
 
 
@@ -56,11 +57,26 @@ def _fsync_dir(path: Path) -> None:
 
 def save_part(directory: Path, result: dict[str, Any]) -> Path:
     """Persist one finished scenario (atomic: a crash leaves the old state or the new file)."""
-    record = {k: v for k, v in result.items() if k != "dataset"}
-    path = directory / f"{result['key']}.json"
-    _write_atomic(path, json.dumps(record).encode())
-    _fsync_dir(directory)
-    return path
+    return save_parts(directory, [result])[0]
+
+
+def save_parts(directory: Path, results: list[dict[str, Any]]) -> list[Path]:
+    """Persist finished scenarios, each file atomically, then the folder's entries once.
+
+    Every part is written to a temporary file, flushed to disk and renamed
+    into place, so a kill at any moment leaves each part absent or whole;
+    the folder is flushed once for the batch (a task's results arrive
+    together), not once per part.
+    """
+    paths = []
+    for result in results:
+        record = {k: v for k, v in result.items() if k != "dataset"}
+        path = directory / f"{result['key']}.json"
+        _write_atomic(path, json.dumps(record).encode())
+        paths.append(path)
+    if paths:
+        _fsync_dir(directory)
+    return paths
 
 
 def prepare_store(directory: Path) -> Path:
@@ -72,6 +88,9 @@ def prepare_store(directory: Path) -> Path:
         directory.mkdir(exist_ok=True)
     except OSError as exc:
         raise PoundingError(f"cannot create {directory}: {exc.strerror or exc}") from None
+    from pounding.results.archive import clean_stale_temporaries
+
+    clean_stale_temporaries(directory)  # of a run that was killed mid-write (parts are written without it)
     return directory
 
 
