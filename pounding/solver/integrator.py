@@ -506,9 +506,11 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     nc = cgap.size
     # fbuf[:n] accumulates internal + damping forces (N); power is the
     # damping power v·C v (W), summed in the same loops.  Storeys are linear
-    # elastic here; *storey* (None for a purely elastic row, which compiles
-    # without any of it) corrects the yielding ones and adds P-Delta.
+    # elastic here, with P-Delta; *storey* (None for a purely elastic row,
+    # which compiles without any of it) then corrects the yielding ones.
     power = 0.0
+    if storey is not None:
+        kpd = storey[3]
     for j in range(n):
         v = y[n + j]
         fbuf[j] = a0[j] * mass[j] * v
@@ -523,6 +525,8 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             dv = y[n + j]
         damping = kst[j] * a1[j] * dv
         s = kst[j] * du + damping
+        if storey is not None:
+            s += kpd[j] * du  # P-Delta: −(P/h)·Δ (kpd ≤ 0)
         power += damping * dv
         fbuf[j] += s
         if b >= 0:
@@ -882,23 +886,17 @@ def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
-    """Add P-Delta and the yielding storeys' departure from ``kΔ`` to the floor forces *fbuf*, N.
+    """Add the yielding storeys' departure from ``kΔ`` to the floor forces *fbuf*, N.
 
     Writes the rates of the hysteretic states and of the storeys' work
-    ∫F dΔ into *out*.  The caller has already applied ``kΔ`` to every storey.
+    ∫F dΔ into *out*.  The caller has already applied ``kΔ`` and P-Delta to
+    every storey.
     The storey kernels take the parameter table and a row (no row views:
     each would be reference-counted, in the solver's innermost loop).
     """
-    smodel, sprm, kpd, smode, sfloor = storey[0], storey[1], storey[3], storey[6], storey[7]
+    smodel, sprm, smode, sfloor = storey[0], storey[1], storey[6], storey[7]
     nh = sfloor.size
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
-    for j in range(n):
-        if kpd[j] != 0.0:
-            b = below[j]
-            du = y[j] - y[b] if b >= 0 else y[j]
-            fbuf[j] += kpd[j] * du
-            if b >= 0:
-                fbuf[b] -= kpd[j] * du
     for hi in range(nh):
         j = sfloor[hi]
         b = below[j]
