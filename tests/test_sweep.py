@@ -364,3 +364,20 @@ def test_parts_are_saved_in_batches_and_killed_writers_temporaries_are_cleared(t
     assert [p.name for p in paths] == [f"{i:064x}.json" for i in range(3)]
     assert sorted(load_parts(store)) == [r["key"] for r in results]
     assert not [p for p in store.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_a_chunk_of_scenarios_is_shipped_whole_and_runs_like_the_list():
+    """Dask walks lists and mappings in a task's arguments looking for futures; a Chunk must reach
+    the worker as one object (no walk over every model document) and run exactly as the list."""
+    from pounding.studies.sweep.execution import Chunk, run_chunk
+
+    tasks = [{"key": "a", "data": {"buildings": [{"storeys": [1.0, 2.0]}]}}, {"key": "b", "data": {}}]
+    chunk = Chunk(tasks)
+    try:  # where Dask walks a task's arguments (a private module of recent releases)
+        from dask._task_spec import parse_input
+    except ImportError:
+        parse_input = None
+    if parse_input is not None:
+        assert parse_input(chunk) is chunk
+    runner = lambda task: {"key": task["key"], "size": len(task["data"])}  # noqa: E731
+    assert run_chunk(runner, chunk) == run_chunk(runner, tasks) == [{"key": "a", "size": 1}, {"key": "b", "size": 0}]
