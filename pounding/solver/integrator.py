@@ -884,7 +884,7 @@ def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
     energy[row, 1] = yielding
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
 def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
     """Add the yielding storeys' departure from ``kΔ`` to the floor forces *fbuf*, N.
 
@@ -922,7 +922,7 @@ def _drift_interpolant(y, ynew, k1, k7, n, j, b):
     return y[j], y[n + j], ynew[j], ynew[n + j], k1[n + j], k7[n + j]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
 def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, uy, mode, h):
     """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
 
@@ -989,7 +989,7 @@ def _apply_storey_events(kinds, y, n, nc, below, sfloor, sprm, smode):
     return applied
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
 def _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio, h):
     """First instant in a step where a storey's |drift| exceeds ``stop_ratio·height``: (fraction, floor)."""
     best = -1.0
