@@ -1728,24 +1728,36 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             k1[i] = k7[i]
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
+        # (The appliers are called only when there is something to apply: a call passes each of
+        # their arrays as a flattened struct, and most steps end without an event.)
+        contact_events = False
         for c in range(nc):
             if event_kind[c] == EVENT_NONE:
                 event_kind[c] = pending[c]
+            if event_kind[c] != EVENT_NONE:
+                contact_events = True
         n_storey = zero
         if storey is not None:
             if collapse_s >= 0.0 or collapse_pending:
                 status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
                 break
+            storey_events = False
             for hi in range(nh):
                 if sev_kind[hi] == STOREY_NONE:
                     sev_kind[hi] = spending[hi]
-            n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+                if sev_kind[hi] != STOREY_NONE:
+                    storey_events = True
+            if storey_events:
+                n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
         if ground is not None:
             _fill_grounds(ground, dt_rec, seg, t, ground[6])
-        impacts, n_imp, n_applied, cap, status = _apply_events(
-            event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
-            cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp, open_imp,
-            storey, ground)
+        n_applied = zero
+        cap = np.inf
+        if contact_events:
+            impacts, n_imp, n_applied, cap, status = _apply_events(
+                event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
+                dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces, impacts, n_imp,
+                open_imp, storey, ground)
         n_applied += n_storey
         if n_applied > 0:
             if t - window_start > dt_rec:
