@@ -638,7 +638,7 @@ def run_hunt(plan: IdaPlan, output: str | os.PathLike | None = None, *, workers:
 def _hunt_locked(plan: IdaPlan, target, store, done, say, *, workers, scheduler, client, progress, retries):
     import uuid
 
-    from pounding.studies.sweep.execution import start_client
+    from pounding.studies.sweep.execution import Chunk, run_chunk, start_client
     from pounding.studies.sweep.scenario import one_line
     from pounding.studies.sweep.spec import PARTS_FORMAT
     from pounding.studies.sweep.store import save_part
@@ -701,7 +701,8 @@ def _hunt_locked(plan: IdaPlan, target, store, done, say, *, workers, scheduler,
         def submit(chain, scenario):
             task = scenario.task(sweep_label=plan.sweep.label, name=plan.model_name)
             key = f"pounding-ida-{scenario.key[:16]}-{uuid.uuid4().hex[:8]}"
-            future = client.submit(run_ida_scenario, task, key=key, retries=retries, pure=False)
+            # one run as a Chunk, as the stripes send theirs: Dask does not walk its model document
+            future = client.submit(run_chunk, run_ida_scenario, Chunk([task]), key=key, retries=retries, pure=False)
             flying[future.key] = (chain, scenario)
             completed.add(future)
 
@@ -714,7 +715,7 @@ def _hunt_locked(plan: IdaPlan, target, store, done, say, *, workers, scheduler,
             for future in completed:
                 chain, scenario = flying.pop(future.key)
                 try:
-                    result = future.result()
+                    result = future.result()[0]
                 except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after the retries
                     result = {"key": scenario.key, "status": "error", "format": PARTS_FORMAT, "study": IDA_PART,
                               "wall_time": float("nan"),
