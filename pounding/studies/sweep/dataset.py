@@ -6,7 +6,6 @@ import json
 from datetime import datetime, timezone
 from typing import Any, Iterable
 
-
 from pounding import __version__
 from pounding.model.document import dump_document
 from pounding.studies.sweep.spec import Axis, Sweep
