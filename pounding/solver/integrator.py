@@ -306,21 +306,21 @@ SIDE_TERMS = 4
 # branch-free over the SIDE_TERMS terms (:func:`integrate` maps them); 0·y[0] adds an exact 0.
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _combo(y, offset, cf, cw, c) -> float:
     """Σ_k w_k·y[offset + f_k] over the contact's floor terms (δ + gap for offset 0, δ̇ for offset n)."""
     return (cw[4 * c + 0] * y[offset + cf[4 * c + 0]] + cw[4 * c + 1] * y[offset + cf[4 * c + 1]]
             + cw[4 * c + 2] * y[offset + cf[4 * c + 2]] + cw[4 * c + 3] * y[offset + cf[4 * c + 3]])
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _push(fbuf, cf, cw, c, force) -> None:
     """Add contact force *force* (N, ≥ 0 pushes apart) to the floors' internal forces with the side weights."""
     for k in range(SIDE_TERMS):
         fbuf[cf[4 * c + k]] += cw[4 * c + k] * force
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _compliance(mass, cf, cw, c) -> float:
     """Σ_k cw²/m (1/kg): δ̈ per unit contact force; 1/m_eff of the contact (a wall adds nothing)."""
     total = 0.0
@@ -329,7 +329,7 @@ def _compliance(mass, cf, cw, c) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _effective_mass(mass, cf, cw, c) -> float:
     """m_eff of contact *c* (kg): ``1/Σ cw²/m``; a plain floor pair as ``m_L·m_R/(m_L + m_R)``.
 
@@ -345,13 +345,13 @@ def _effective_mass(mass, cf, cw, c) -> float:
     return 1.0 / _compliance(mass, cf, cw, c)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _ground_weight(cf, cw, c) -> float:
     """Σ_k cw over the floor terms: 0 between two buildings, ±1 against a wall (a_g's share in δ̈)."""
     return cw[4 * c + 0] + cw[4 * c + 1] + cw[4 * c + 2] + cw[4 * c + 3]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _kick(y, n, mass, cf, cw, c, impulse) -> None:
     """Apply an impulse *impulse* (N·s, ≥ 0 pushes apart) of contact *c* to the floor velocities."""
     for k in range(SIDE_TERMS):
@@ -363,7 +363,7 @@ def _kick(y, n, mass, cf, cw, c, impulse) -> None:
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     """Piecewise-linear ground acceleration inside segment *seg* at time *t*."""
     t0 = seg * dt_rec
@@ -380,7 +380,7 @@ def _ground(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
 # now, at the start of the step and at its end).
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _fill_grounds(ground, dt_rec, seg, t, gstate):
     """Acceleration, velocity and displacement of every ground at time *t* into *gstate* (3, G).
 
@@ -402,7 +402,7 @@ def _fill_grounds(ground, dt_rec, seg, t, gstate):
         gstate[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _ground_offset(ground, gstate, c, row):
     """Differential ground motion of contact *c*: ground of its left side minus ground of its right side.
 
@@ -415,7 +415,7 @@ def _ground_offset(ground, gstate, c, row):
     return gstate[row, ground[4][c]] - gstate[row, ground[5][c]]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground):
     """Contact *c*'s ``Σ w·u`` (gap not subtracted) over an accepted or trial step: its value, rate
     and acceleration at both ends ``(d0, r0, d1, r1, a0, a1)`` and the round-off scale ``Σ |w·u|``
@@ -450,7 +450,7 @@ def _step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground):
     return d0, r0, d1, r1, a0, a1, size
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _stuck_constraints(ag_t, mass, cf, cw, closed, cmode, fbuf, forces, ground):
     """Constraint forces of stuck contacts (added to *forces* and *fbuf*): make every δ̈ = 0.
 
@@ -486,7 +486,7 @@ def _stuck_constraints(ag_t, mass, cf, cw, closed, cmode, fbuf, forces, ground):
             break
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cf, cw, cgap, claw, cprm, closed, cconst, cmode, out, fbuf, forces, storey, ground):
     """Time derivative of the state; contact forces are written to *forces*.
@@ -616,7 +616,7 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> float:
     """Cubic Hermite value at fraction *s* of a step of length *h*."""
     s2 = s * s
@@ -625,7 +625,7 @@ def _hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> 
             + (-2.0 * s3 + 3.0 * s2) * y1 + (s3 - s2) * h * r1)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
     """Largest |y| of the Hermite cubic at its interior stationary points (0 if none)."""
     qa = 6.0 * y0 + 3.0 * h * r0 - 6.0 * y1 + 3.0 * h * r1
@@ -653,7 +653,7 @@ def _extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> f
     return best
 
 
-@njit(cache=True)  # with a Python wrapper: tested directly
+@njit(cache=True, **jit.NO_REFCOUNT)  # with a Python wrapper: tested directly
 def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward: bool,
                     threshold: float) -> float:
     """Fraction of the step where the Hermite cubic of δ first crosses into the far side.
@@ -728,7 +728,7 @@ def _first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward
     return -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _switch_crossing(claw, prm, const, mode, which, gap, yl0, vl0, yl1, vl1, al0, al1,
                      yr0, vr0, yr1, vr1, ar0, ar1, q0, qr0, q1, qr1, h) -> float:
     """Fraction of the step where switch function *which* of a closed contact's mode turns negative.
@@ -772,7 +772,7 @@ def _switch_crossing(claw, prm, const, mode, which, gap, yl0, vl0, yl1, vl1, al0
     return -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0, al1,
                             yr0, vr0, yr1, vr1, ar0, ar1, q0, qr0, q1, qr1, h, fractions, deltas,
                             values) -> float:
@@ -809,7 +809,7 @@ def _closed_contact_samples(claw, prm, const, mode, gap, yl0, vl0, yl1, vl1, al0
     return best
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _peak_magnitude(values) -> float:
     """Largest |value| of equally spaced samples, refined by a parabola through the largest and its neighbours.
 
@@ -841,7 +841,7 @@ def _peak_magnitude(values) -> float:
     return best
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     nc = cgap.size
@@ -854,7 +854,7 @@ def _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
     """Storey shears and energies of state *y* into ``shear[row]`` and ``energy[row]``.
 
@@ -884,7 +884,7 @@ def _storey_outputs(y, n, nc, below, kst, storey, shear, energy, row):
     energy[row, 1] = yielding
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
 def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
     """Add the yielding storeys' departure from ``kΔ`` to the floor forces *fbuf*, N.
 
@@ -913,7 +913,7 @@ def _storey_forces(y, n, nc, below, kst, storey, out, fbuf):
             fbuf[b] -= departure
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _drift_interpolant(y, ynew, k1, k7, n, j, b):
     """Drift and drift rate of the storey under floor *j* at both ends of a step, and their rates."""
     if b >= 0:
@@ -922,7 +922,7 @@ def _drift_interpolant(y, ynew, k1, k7, n, j, b):
     return y[j], y[n + j], ynew[j], ynew[n + j], k1[n + j], k7[n + j]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, uy, mode, h):
     """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
 
@@ -957,7 +957,7 @@ def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, uy, mode, h):
     return s, STOREY_UNLOAD if s >= 0.0 else STOREY_NONE
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _apply_storey_events(kinds, y, n, nc, below, sfloor, sprm, smode):
     """Apply located storey events ``kinds[h]`` (STOREY_*) to the state, in place; returns how many.
 
@@ -989,7 +989,7 @@ def _apply_storey_events(kinds, y, n, nc, below, sfloor, sprm, smode):
     return applied
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always")
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio, h):
     """First instant in a step where a storey's |drift| exceeds ``stop_ratio·height``: (fraction, floor)."""
     best = -1.0
@@ -1030,7 +1030,7 @@ def _grown(table, rows, needed, limit):
     return bigger
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass, dvg):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
@@ -1062,7 +1062,7 @@ def _velocity_jump(c, t, y, n, cf, cw, claw, cprm, impacts, n_imp, mass, dvg):
     return n_imp + 1
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _switch_contact(c, upward, t, y, n, cf, cw, claw, cprm, closed, cconst, impacts, n_imp, open_imp, mass, dvg):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
@@ -1102,7 +1102,7 @@ def _switch_contact(c, upward, t, y, n, cf, cw, claw, cprm, closed, cconst, impa
     return n_imp
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _plastic_jump(c, y, n, cf, cw, mass, dvg):
     """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
 
@@ -1246,14 +1246,18 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     # ``if storey is not None`` block below is then pruned at compile time, and the elastic
     # row runs the plain elastic integrator.  Otherwise it is the tuple built by
     # :func:`_storey_arguments`.
+    # The tuples' arrays are taken out once, here: each ``storey[k]`` in the loop would count a reference.
     nh = nc - nc
     if storey is not None:
-        nh = storey[7].size
+        smodel, sprm, heights, stop_ratio, smode, sfloor, storey_tol = (storey[0], storey[1], storey[4], storey[5],
+                                                                        storey[6], storey[7], storey[8])
+        nh = sfloor.size
     S = 2 * n + 3 * nc + 2 + 2 * nh + 1  # the last state: work of the differential ground motion on the contacts
     # *ground* is None with one common ground (row 0 is *ag*); else the tuple of _ground_arguments.
     n_ground = nc - nc + 1
     if ground is not None:
         n_ground = ground[0].shape[0]
+        gnow, gstart, gend = ground[6], ground[7], ground[8]  # the ground state now, at a step's start and end
     ih = 2 * n + 3 * nc + 2  # first hysteretic state
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     iq = 2 * n + 2 * nc  # first internal-state component
@@ -1323,7 +1327,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     t = 0.0
     seg = zero
     if ground is not None:
-        _fill_grounds(ground, dt_rec, seg, 0.0, ground[6])
+        _fill_grounds(ground, dt_rec, seg, 0.0, gnow)
     _rhs(y, _ground(ag, dt_rec, seg, 0.0), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
          cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
     # First output sample at t = 0.
@@ -1338,7 +1342,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
     out_ag[0] = _ground(ag, dt_rec, seg, 0.0)
     if ground is not None:
         for g in range(n_ground):
-            out_support[0, g] = ground[6][0, g]
+            out_support[0, g] = gnow[0, g]
     out_pot[0] = _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground)
     i_out = 1
 
@@ -1376,38 +1380,38 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for i in range(S):
                 ystage[i] = y[i] + h_try * A21 * k1[i]
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C2 * h_try, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t + C2 * h_try, gnow)
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C3 * h_try, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t + C3 * h_try, gnow)
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C4 * h_try, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t + C4 * h_try, gnow)
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C5 * h_try, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t + C5 * h_try, gnow)
             _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey, ground)
             for i in range(S):
                 ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                             + A65 * k5[i])
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t + h_try, gnow)
             _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey, ground)
             for i in range(S):
                 ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t + h_try, gnow)
             _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
                  doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey, ground)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
@@ -1432,7 +1436,6 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     elif r > err:
                         err = r
             if storey is not None:
-                storey_tol = storey[8]
                 for hi in range(nh):
                     if not finite:
                         break
@@ -1463,8 +1466,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             # weighted floors over its own ground plus the contact's differential ground motion
             # (itself a cubic within a record step, so the interpolant reproduces it exactly).
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t, ground[7])
-                _fill_grounds(ground, dt_rec, seg, t + h_try, ground[8])
+                _fill_grounds(ground, dt_rec, seg, t, gstart)
+                _fill_grounds(ground, dt_rec, seg, t + h_try, gend)
             s_first = 2.0
             for c in range(nc):
                 event_s[c] = -1.0
@@ -1490,12 +1493,12 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     q1 += w * k7[n + f]
                     size += abs(w * y[f])
                 if ground is not None:
-                    d0 += _ground_offset(ground, ground[7], c, 2)
-                    r0 += _ground_offset(ground, ground[7], c, 1)
-                    q0 += _ground_offset(ground, ground[7], c, 0)
-                    d1 += _ground_offset(ground, ground[8], c, 2)
-                    r1 += _ground_offset(ground, ground[8], c, 1)
-                    q1 += _ground_offset(ground, ground[8], c, 0)
+                    d0 += _ground_offset(ground, gstart, c, 2)
+                    r0 += _ground_offset(ground, gstart, c, 1)
+                    q0 += _ground_offset(ground, gstart, c, 0)
+                    d1 += _ground_offset(ground, gend, c, 2)
+                    r1 += _ground_offset(ground, gend, c, 1)
+                    q1 += _ground_offset(ground, gend, c, 0)
                 d0 -= cgap[c]
                 d1 -= cgap[c]
                 floor = DELTA_ROUNDOFF * (size + abs(cgap[c]))
@@ -1517,7 +1520,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                             for i in range(S):
                                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
                             if ground is not None:
-                                _fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground[6])
+                                _fill_grounds(ground, dt_rec, seg, t + mid * h_try, gnow)
                             _rhs(ystage, _ground(ag, dt_rec, seg, t + mid * h_try), mass, kst, below, a0, a1,
                                  dstart, dsize, doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2,
                                  fbuf, forces, storey, ground)
@@ -1546,8 +1549,6 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         s_first = s
             collapse_s = -1.0
             if storey is not None:
-                smodel, sprm, heights, stop_ratio, smode, sfloor = (storey[0], storey[1], storey[4], storey[5],
-                                                                    storey[6], storey[7])
                 for hi in range(nh):
                     j = sfloor[hi]
                     s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j, 0],
@@ -1576,9 +1577,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                     for hi in range(nh):
                         if sev_kind[hi] != STOREY_NONE and sev_s[hi] * h_try > tiny:
                             sev_kind[hi] = STOREY_NONE
-                    n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+                    n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
                 if ground is not None:
-                    _fill_grounds(ground, dt_rec, seg, t, ground[6])
+                    _fill_grounds(ground, dt_rec, seg, t, gnow)
                 impacts, n_imp, n_applied, cap, status = _apply_events(
                     event_kind, t, y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize,
                     doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, ystage, k2, fbuf, forces,
@@ -1593,7 +1594,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if status != 0:
                     break
                 if ground is not None:
-                    _fill_grounds(ground, dt_rec, seg, t, ground[6])
+                    _fill_grounds(ground, dt_rec, seg, t, gnow)
                 _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff,
                      dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
                 if cap < h_try:
@@ -1705,9 +1706,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 ystage[i] = _hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _ground(ag, dt_rec, seg, t_o)
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t_o, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t_o, gnow)
                 for g in range(n_ground):
-                    out_support[i_out, g] = ground[6][0, g]
+                    out_support[i_out, g] = gnow[0, g]
             _rhs(ystage, ag_o, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             out_time[i_out] = t_o
@@ -1748,9 +1749,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 if sev_kind[hi] != STOREY_NONE:
                     storey_events = True
             if storey_events:
-                n_storey = _apply_storey_events(sev_kind, y, n, nc, below, storey[7], storey[1], storey[6])
+                n_storey = _apply_storey_events(sev_kind, y, n, nc, below, sfloor, sprm, smode)
         if ground is not None:
-            _fill_grounds(ground, dt_rec, seg, t, ground[6])
+            _fill_grounds(ground, dt_rec, seg, t, gnow)
         n_applied = zero
         cap = np.inf
         if contact_events:
@@ -1767,7 +1768,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t, gnow)
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cf, cw, cgap, claw, cprm, closed, cconst, cmode, k1, fbuf, forces, storey, ground)
             # The step the controller accepted before the event cut it short; a newly closed
@@ -1795,7 +1796,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             for j in range(n):
                 out_acc[i2, j] = k1[n + j]
             if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t, ground[6])
+                _fill_grounds(ground, dt_rec, seg, t, gnow)
             _rhs(y, _ground(ag, dt_rec, seg, t), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                  cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
             for c in range(nc):
@@ -1804,7 +1805,7 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             out_ag[i2] = _ground(ag, dt_rec, seg, t)
             if ground is not None:
                 for g in range(n_ground):
-                    out_support[i2, g] = ground[6][0, g]
+                    out_support[i2, g] = gnow[0, g]
             out_pot[i2] = _contact_energy(y, n, cf, cw, cgap, claw, cprm, ground)
         i_out = n_out
     if status != STATUS_COLLAPSED:

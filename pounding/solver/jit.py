@@ -31,7 +31,7 @@ import os
 import sys
 from typing import Iterable
 
-__all__ = ["TESTED_NUMBA", "shortcuts_supported", "load_registries_without_scipy", "load_from_cache_without_refresh",
+__all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "shortcuts_supported", "load_registries_without_scipy", "load_from_cache_without_refresh",
            "stamp_caches_with_sources", "source_stamp"]
 
 #: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with
@@ -49,6 +49,16 @@ def shortcuts_supported() -> bool:
     except (IndexError, ValueError):
         return False
     return release in TESTED_NUMBA
+
+
+#: numba options of a kernel that neither allocates an array nor returns one: compiled without
+#: numba's reference counting (its ``_nrt`` option).  Such a kernel only reads and writes arrays
+#: its caller owns for the whole call, so counting them buys nothing; with counting, every call
+#: increments and decrements each array argument's count with an atomic instruction, which was
+#: a third of the solver's time (the right-hand side alone takes ~30 arrays, six times a step).
+#: numba refuses to compile an allocation in such a kernel, so the option cannot free an array in
+#: use.  Applied on the numba releases of :data:`TESTED_NUMBA` only, like the start-up shortcuts.
+NO_REFCOUNT: dict = {"_nrt": False} if shortcuts_supported() else {}
 
 
 def load_registries_without_scipy() -> None:
