@@ -34,7 +34,7 @@ from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import run_peaks, to_dataset
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "support_motions",
+__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "processed_record_for", "support_motions",
            "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
 
@@ -224,16 +224,29 @@ def record_for(model: Model, *, factor: float | None = None, where: str = "yaml"
         Load this building's own record (``buildings[i].ground_motion``);
         default: the model-level one.
     """
-    from pounding.records.processing import process, scale_record
+    from pounding.records.processing import scale_record
 
     spec = model.ground_motion if building is None else model.ground_motion_of(building)
-    record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where)
-    record = process(record, spec.processing)
+    record = processed_record_for(model, where=where, building=building)
     period = None
     building = getattr(spec.scale, "building", None)
     if building is not None:
         period = float(model.buildings[model.building_index(building)].periods[0])
     return scale_record(record, spec.scale, period=period, factor=factor)
+
+
+def processed_record_for(model: Model, *, where: str = "yaml", building: int | str | None = None) -> Record:
+    """The ground motion a model names, read and processed but not yet scaled: :func:`record_for`'s first two steps.
+
+    ``scale_record(processed_record_for(model), factor)`` is ``record_for(model)`` of the
+    same model with ``ground_motion.scale: factor``, sample for sample (what an IDA worker
+    reuses for the runs of one record that differ only in their factor).
+    """
+    from pounding.records.processing import process
+
+    spec = model.ground_motion if building is None else model.ground_motion_of(building)
+    record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where)
+    return process(record, spec.processing)
 
 
 @dataclass(frozen=True)
@@ -442,8 +455,8 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     return ds
 
 
-def simulate_peaks(model: Model) -> dict[str, Any]:
-    """Run *model* under its own ground motion and keep only its peaks (no histories, no dataset).
+def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]:
+    """Run *model* under its own ground motion (or *record*, loaded and scaled) and keep only its peaks.
 
     What an IDA or a sweep of many runs keeps of each: the values
     :func:`pounding.results.dataset.run_peaks` documents, plus
@@ -453,9 +466,11 @@ def simulate_peaks(model: Model) -> dict[str, Any]:
     sampling), so every peak equals that of ``simulate(model)`` exactly; only
     the two end samples of the histories are stored, which skips the
     per-sample work and the dataset.  Errors as :func:`simulate`; a wave
-    passage is applied as there.
+    passage is applied as there.  *record* (optional) is used as
+    :func:`support_motions` uses it: instead of loading the model's.  No
+    histories and no dataset are made.
     """
-    supports = support_motions(model, where="yaml")
+    supports = support_motions(model, record, where="yaml")
     motion = supports.records[0]
     end_time = supports.end_time
     if end_time <= 0.0:

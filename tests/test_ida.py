@@ -441,3 +441,48 @@ def test_every_scenario_text_is_the_yaml_of_its_own_data():
     first, second = scenarios[0], scenarios[1]
     first.data["ground_motion"]["scale"] = -1.0
     assert second.data["ground_motion"]["scale"] > 0.0
+
+
+def test_runs_of_one_template_reuse_its_model_and_record_and_give_the_fresh_runs_peaks(monkeypatch):
+    """A worker validates the model and reads the record once per variant and record (the runs
+    differ only in their scale factor) while that template is among the last few it used; each
+    run must still give exactly the peaks of its own document validated and loaded from scratch,
+    and a run whose record cannot be read must fail every time (nothing of it kept)."""
+    import pounding.model.model as model_module
+    from pounding.simulation import simulate_peaks
+
+    fresh_model = model_module.model_from_data
+    validated = []
+
+    def counting_model_from_data(*args, **kwargs):
+        validated.append(1)
+        return fresh_model(*args, **kwargs)
+
+    monkeypatch.setattr(model_module, "model_from_data", counting_model_from_data)
+    monkeypatch.setattr(ida, "_TEMPLATES", type(ida._TEMPLATES)())
+    monkeypatch.setattr(ida, "_TEMPLATES_KEPT", 2)
+    plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.2,0.9", without_contacts=True, duration=4.0)
+    with_0, without_0, with_1 = ("with_contacts", 0), ("without_contacts", 0), ("with_contacts", 1)
+    # (template, level, validated afresh?) with two templates kept, least recently used dropped first
+    runs = [(with_0, 0.9, True), (with_0, 0.2, False), (without_0, 0.9, True), (with_0, 0.9, False),
+            (with_1, 0.2, True), (without_0, 0.2, True), (with_0, 0.2, True)]
+    for (variant, record), level, afresh in runs:
+        before = len(validated)
+        task = plan.scenario(variant, record, level).task(sweep_label="test", name="pair")
+        part = ida.run_ida_scenario(task)
+        assert part["status"] == "ok", part["error"]
+        assert len(validated) - before == (1 if afresh else 0)
+        fresh = simulate_peaks(fresh_model(task["data"], name="pair", source=task["document"],
+                                           base_dir=task.get("base_dir")))
+        np.testing.assert_array_equal(part["storeys"]["peak_drift_ratio"], fresh["peak_drift_ratio"])
+        np.testing.assert_array_equal(part["storeys"]["residual_drift_ratio"], fresh["residual_drift_ratio"])
+        np.testing.assert_array_equal(part["contacts"]["impact_count"], fresh["impact_count"])
+        np.testing.assert_array_equal(part["contacts"]["peak_contact_force"], fresh["peak_contact_force"])
+        assert part["scale_factor"] == fresh["record_scale"] == task["data"]["ground_motion"]["scale"]
+    # A record that cannot be read: the run fails with the loader's message, every time.
+    task = plan.scenario(plan.variants[0], 0, 0.2).task(sweep_label="test", name="pair")
+    broken = dict(task, data=dict(task["data"], ground_motion=dict(task["data"]["ground_motion"],
+                                                                  record="no/such/record.at2")))
+    for _ in range(2):
+        part = ida.run_ida_scenario(broken)
+        assert part["status"] == "error" and "record.at2" in part["error"]
