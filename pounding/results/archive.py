@@ -39,6 +39,12 @@ INTERRUPT_GRACE = 0.8
 
 _COMPRESSION = {"zlib": True, "complevel": 4}
 
+#: Serialises this module's NetCDF reads and writes across threads.  HDF5 (under netCDF4) is
+#: not thread-safe, and xarray does not route every call into it through its own lock: a file
+#: its cache evicted is closed in whichever thread releases it last, which can overlap another
+#: thread's read (seen as a segmentation fault with archives opened from two threads at once).
+_NETCDF_LOCK = threading.RLock()
+
 
 def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
                    inputs: tuple | list = ()) -> Path:
@@ -300,7 +306,7 @@ def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False
     target = check_writable(path, overwrite=overwrite)
     with atomic_path(target) as temporary:
         try:
-            with _interrupt_deferred(temporary):
+            with _interrupt_deferred(temporary), _NETCDF_LOCK:
                 ds.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))
         except (OSError, RuntimeError) as exc:   # disk full, file too large, HDF error
             detail = getattr(exc, "strerror", None) or " ".join(str(exc).split())[:160]
@@ -323,7 +329,7 @@ def open_run(path: str | os.PathLike) -> xr.Dataset:
     """
     source = check_regular_file(path)
     try:
-        with xr.open_dataset(source, engine="netcdf4") as handle:
+        with _NETCDF_LOCK, xr.open_dataset(source, engine="netcdf4") as handle:
             ds = handle.load()
     except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
         raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
