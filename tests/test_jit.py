@@ -153,3 +153,62 @@ def test_cached_kernel_is_recompiled_when_a_file_it_inlines_changes(tmp_path):
     # numba alone would load the cached force() with the old stiffness inlined (6.0).
     assert _last_json_line(run, env=env) == {"force": 10.0, "cache_hits": 0}
     assert _last_json_line(run, env=env) == {"force": 10.0, "cache_hits": 1}
+
+
+def test_the_solver_frees_every_array_it_allocates_and_nothing_more():
+    """Most solver kernels are compiled without reference counting (jit.NO_REFCOUNT): they may
+    neither keep an array alive nor release one.  A kernel that returned an array, or handed a
+    view it made to a counting caller, would leak it or free it while in use.  Over runs that take
+    every path of the compiled solver (yielding storeys with P-Delta, impacts with grown tables,
+    bumpers, links, a wall, several grounds, and stuck contacts that release), numba's allocator
+    must count exactly as many frees as allocations once the results are dropped."""
+    import gc
+
+    from numba.core.runtime import _nrt_python as nrt
+    from test_solver import pairs   # independent one-storey pairs, built directly
+
+    from pounding.contact import laws as contact
+    from pounding.model.model import load_model
+    from pounding.simulation import _solve, support_motions
+    from pounding.solver.integrator import integrate
+
+    runs = [(model, support_motions(model)) for model in
+            (load_model(ROOT / "models" / f"{name}.yaml") for name in
+             ("pair_inelastic", "pair_links", "pair_wave_passage", "pair_bumper", "pair_column", "isolated_moat"))]
+    # A floor resting against its neighbour, pushed onto it and then pulled away (as in
+    # test_solver_adversarial): a stuck stereo-mechanical contact that releases.
+    m1, m2, gap, dt = 1e5, 2e5, 0.01, 0.01
+    sticky = pairs(m1, m2, 0.0, m2 * (2 * np.pi / 0.5) ** 2, [gap], contact.StereoMechanical(restitution=0.5))
+    push_pull = np.where(np.arange(61) * dt < 0.305, -2.0, 3.0)
+
+    def run_sticky():
+        return integrate(sticky, push_pull, dt, 0.6, rtol=1e-6, atol=1e-8, atol_velocity=1e-7, output_dt=0.01,
+                         initial_displacement=np.array([gap, 0.0]))
+
+    for model, supports in runs:
+        _solve(model, supports, 1.0, 0.01)   # compiled (or loaded) before counting
+    run_sticky()
+    counters = (nrt.memsys_get_stats_alloc, nrt.memsys_get_stats_free, nrt.memsys_get_stats_mi_alloc,
+                nrt.memsys_get_stats_mi_free)
+    was_enabled = nrt.memsys_stats_enabled()
+    nrt.memsys_enable_stats()
+    try:
+        gc.collect()
+        before = [count() for count in counters]
+        impacts = 0
+        for model, supports in runs:
+            system, raw, _, rows = _solve(model, supports, supports.end_time, 0.01)
+            impacts = max(impacts, raw.impact_time.size)
+            del system, raw, rows
+        raw = run_sticky()
+        released_at = float(raw.impact_end_time[0])
+        del raw
+        gc.collect()
+        allocated, freed, made, released = (count() - start for count, start in zip(counters, before))
+    finally:
+        if not was_enabled:
+            nrt.memsys_disable_stats()
+    assert impacts > 64               # a run's impacts outgrew the first table (64 rows): tables were grown
+    assert 0.31 < released_at < 0.6   # the stuck contact released (its constraint path ran)
+    assert allocated > 0 and made > 0
+    assert (freed, released) == (allocated, made)
