@@ -199,6 +199,26 @@ axes:
 # --------------------------------------------------------------------------- #
 
 
+def test_the_local_cluster_runs_without_the_profiler_and_fast_ticks_and_leaves_the_client_config(client):
+    """The LocalCluster start_client makes passes LOCAL_CLUSTER_CONFIG to its worker processes (the
+    profiler sampled every stack every 10 ms: ~8 % of a core per idle worker); the settings are scoped
+    to starting it, not left in this process's Dask configuration."""
+    import dask
+
+    from pounding.studies.sweep.execution import LOCAL_CLUSTER_CONFIG
+
+    def settings():
+        import dask
+
+        return {key: dask.config.get(key) for key in LOCAL_CLUSTER_CONFIG}
+
+    on_workers = client.run(settings)
+    assert len(on_workers) == 2
+    for values in on_workers.values():
+        assert values == LOCAL_CLUSTER_CONFIG
+    assert dask.config.get("distributed.worker.profile.enabled") is True   # Dask's default, here
+
+
 def test_a_two_worker_sweep_gives_the_results_layout_and_matches_simulate(tmp_path, client):
     from pounding.model.model import load_model
     from pounding.simulation import simulate
