@@ -922,7 +922,7 @@ def _drift_interpolant(y, ynew, k1, k7, n, j, b):
     return y[j], y[n + j], ynew[j], ynew[n + j], k1[n + j], k7[n + j]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
 def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, uy, mode, h):
     """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
 
@@ -955,6 +955,25 @@ def _storey_event(y, ynew, k1, k7, n, nc, j, b, hi, model, uy, mode, h):
     floor = DELTA_ROUNDOFF * (abs(y[n + j]) + (abs(y[n + b]) if b >= 0 else 0.0))
     s = _first_crossing(r0, a0, r1, a1, h, mode < 0, floor)
     return s, STOREY_UNLOAD if s >= 0.0 else STOREY_NONE
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def _storey_events(y, ynew, k1, k7, n, nc, below, smodel, sprm, smode, sfloor, h, sev_s, sev_kind) -> float:
+    """Each yielding storey's first switch inside a step (:func:`_storey_event`, inlined here) into
+    ``sev_s`` and ``sev_kind``; returns the earliest fraction (2.0 if none).
+
+    One call per attempted step for all the storeys: a call per storey passed
+    its four state arrays each time, which measured ~6 % of an inelastic run.
+    """
+    first = 2.0
+    for hi in range(sfloor.size):
+        j = sfloor[hi]
+        s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j, 0], smode[hi], h)
+        sev_s[hi] = s
+        sev_kind[hi] = kind
+        if kind != STOREY_NONE and s < first:
+            first = s
+    return first
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
@@ -1549,14 +1568,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                         s_first = s
             collapse_s = -1.0
             if storey is not None:
-                for hi in range(nh):
-                    j = sfloor[hi]
-                    s, kind = _storey_event(y, ynew, k1, k7, n, nc, j, below[j], hi, smodel[j], sprm[j, 0],
-                                            smode[hi], h_try)
-                    sev_s[hi] = s
-                    sev_kind[hi] = kind
-                    if kind != STOREY_NONE and s < s_first:
-                        s_first = s
+                s = _storey_events(y, ynew, k1, k7, n, nc, below, smodel, sprm, smode, sfloor, h_try, sev_s, sev_kind)
+                if s < s_first:
+                    s_first = s
                 if stop_ratio > 0.0:
                     collapse_s, collapse_at = _collapse_crossing(y, ynew, k1, k7, n, below, heights, stop_ratio,
                                                                  h_try)
