@@ -88,6 +88,9 @@ A51, A52, A53, A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
 A61, A62, A63, A64, A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
 B1, B3, B4, B5, B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 E1, E3, E4, E5, E6, E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+#: Time of each stage within a step, as a fraction of it (stage s + 1 at t + _C[s]·h; the last two
+#: at the step's end).
+_C = np.array([0.0, C2, C3, C4, C5, 1.0, 1.0])
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -609,6 +612,51 @@ def _rhs(y, ag_t, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         out[out.size - 1] = ground_power
     out[2 * n + 3 * nc] = e_in_rate
     out[2 * n + 3 * nc + 1] = power
+
+
+_rhs_inline = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always",
+                   **jit.NO_REFCOUNT)(_rhs.py_func)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def _dp_stages(y, K, ystage, ynew, h, t, ag, dt_rec, seg, mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+               cf, cw, cgap, claw, cprm, closed, cconst, cmode, fbuf, forces, storey, ground):
+    """Stages 2–7 of a Dormand–Prince step of size *h* from *y* at *t* (stage 1, ``K[0]``, given).
+
+    Fills ``K[1..6]`` and the 5th-order solution *ynew* (stage 7 is its rate: first same as last).
+    One call per attempted step, with the right-hand side inlined once, in its loop: six calls of
+    :func:`_rhs`, each passing its ~30 arrays, cost more than their arithmetic (this kernel counts
+    no references, so the inlined arguments cost nothing).  The weighted sums are written out per
+    stage (they vectorise; a loop over the tableau did not).
+    """
+    S = y.size
+    k1, k2, k3, k4, k5, k6 = K[0], K[1], K[2], K[3], K[4], K[5]
+    for stage in range(1, 7):
+        target = ystage
+        if stage == 1:
+            for i in range(S):
+                ystage[i] = y[i] + h * A21 * k1[i]
+        elif stage == 2:
+            for i in range(S):
+                ystage[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
+        elif stage == 3:
+            for i in range(S):
+                ystage[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+        elif stage == 4:
+            for i in range(S):
+                ystage[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+        elif stage == 5:
+            for i in range(S):
+                ystage[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+        else:
+            target = ynew
+            for i in range(S):
+                ynew[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+        at = t + _C[stage] * h
+        if ground is not None:
+            _fill_grounds(ground, dt_rec, seg, at, ground[6])
+        _rhs_inline(target, _ground(ag, dt_rec, seg, at), mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
+                    cf, cw, cgap, claw, cprm, closed, cconst, cmode, K[stage], fbuf, forces, storey, ground)
 
 
 # --------------------------------------------------------------------------- #
@@ -1289,13 +1337,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
         y[i] = y_initial[i]
     ynew = np.zeros(S)
     ystage = np.zeros(S)
-    k1 = np.zeros(S)
-    k2 = np.zeros(S)
-    k3 = np.zeros(S)
-    k4 = np.zeros(S)
-    k5 = np.zeros(S)
-    k6 = np.zeros(S)
-    k7 = np.zeros(S)
+    K = np.zeros((7, S))  # the stage rates, rows k1..k7
+    k1, k2, k3, k4, k5, k6, k7 = K[0], K[1], K[2], K[3], K[4], K[5], K[6]
     fbuf = np.zeros(n)
     forces = np.zeros(nc)
     closed = np.zeros(nc, dtype=np.bool_)
@@ -1395,44 +1438,9 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
-            # ---- Dormand–Prince stages -----------------------------------
-            for i in range(S):
-                ystage[i] = y[i] + h_try * A21 * k1[i]
-            if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C2 * h_try, gnow)
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C2 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k2, fbuf, forces, storey, ground)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A31 * k1[i] + A32 * k2[i])
-            if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C3 * h_try, gnow)
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C3 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k3, fbuf, forces, storey, ground)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-            if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C4 * h_try, gnow)
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C4 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k4, fbuf, forces, storey, ground)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-            if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + C5 * h_try, gnow)
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + C5 * h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k5, fbuf, forces, storey, ground)
-            for i in range(S):
-                ystage[i] = y[i] + h_try * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
-                                            + A65 * k5[i])
-            if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + h_try, gnow)
-            _rhs(ystage, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k6, fbuf, forces, storey, ground)
-            for i in range(S):
-                ynew[i] = y[i] + h_try * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-            if ground is not None:
-                _fill_grounds(ground, dt_rec, seg, t + h_try, gnow)
-            _rhs(ynew, _ground(ag, dt_rec, seg, t + h_try), mass, kst, below, a0, a1, dstart, dsize,
-                 doff, dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, k7, fbuf, forces, storey, ground)
+            # ---- Dormand–Prince stages 2–7 ---------------------------------
+            _dp_stages(y, K, ystage, ynew, h_try, t, ag, dt_rec, seg, mass, kst, below, a0, a1, dstart, dsize, doff,
+                       dvals, cf, cw, cgap, claw, cprm, closed, cconst, cmode, fbuf, forces, storey, ground)
             # ---- error norm (max norm over displacements, velocities and the laws' internal states)
             err = 0.0
             finite = True
