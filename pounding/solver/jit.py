@@ -16,6 +16,9 @@ safe:
   law, a changed force) would otherwise leave the solver running the old
   contact kernels it inlined.
 
+It also holds :data:`NO_REFCOUNT`, the options that compile the solver's
+kernels without numba's reference counting (a third of the solver's time).
+
 The first two change how numba loads code, through numba internals; they
 are applied only on the numba versions they were tested on
 (:data:`TESTED_NUMBA`, the same range as the ``numba`` pin in
@@ -31,7 +34,8 @@ import os
 import sys
 from typing import Iterable
 
-__all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "shortcuts_supported", "load_registries_without_scipy", "load_from_cache_without_refresh",
+__all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "shortcuts_supported", "load_registries_without_scipy",
+           "load_from_cache_without_refresh",
            "stamp_caches_with_sources", "source_stamp"]
 
 #: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with

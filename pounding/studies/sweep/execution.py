@@ -101,7 +101,7 @@ def default_workers() -> int:
 #: Dask settings of the LocalCluster :func:`start_client` starts (a cluster reached with a scheduler
 #: address keeps its own).  Dask's defaults sample every worker's stack every 10 ms (its statistical
 #: profiler) and tick every event loop every 20 ms: on a 2-core machine each idle worker process
-#: and the scheduler each took ~8 % of a core, time the runs wait for; with these, under 1 %.
+#: and the scheduler each took ~8 % of a core, time the runs wait for; with these, 1.5-3 %.
 #: The profiler only feeds the dashboard's profile page; the tick only warns of a blocked loop.
 LOCAL_CLUSTER_CONFIG = {"distributed.worker.profile.enabled": False,
                         "distributed.admin.tick.interval": "1s",
