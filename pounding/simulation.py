@@ -34,8 +34,8 @@ from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import run_peaks, to_dataset
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
 
-__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "processed_record_for", "support_motions",
-           "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
+__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "processed_record_for",
+           "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
 
 #: Energy closure error above which a run is flagged (attribute ``status``, summary

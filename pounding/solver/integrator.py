@@ -1501,7 +1501,8 @@ def _integrate(mass, kst, below, a0, a1, dstart, dsize, doff, dvals,
                 event_kind[c] = EVENT_NONE
                 # δ, δ̇ at both ends of the step, their rates (k1, k7), and the round-off scale of δ:
                 # _step_kinematics written out, as this search runs for every contact at every step
-                # (as a call it measured ~5 % slower on pair.yaml, on a noisy machine).
+                # (as a call it measured ~5 % slower on pair.yaml, and again once the kernels counted
+                # no references: min of 6 alternated runs, 9.2 against 8.7 ms).
                 d0 = 0.0
                 r0 = 0.0
                 d1 = 0.0
