@@ -14,7 +14,8 @@ yield drift u_y = F_y / k (m), post-yield stiffness ratio α.
 Contract of a model
 -------------------
 ``model_id``
-    Integer that selects the branch of the compiled kernels.
+    Integer that selects the branch of the compiled kernels, given by
+    :func:`register` (1 + the place in :data:`HYSTERESES`; 0 is elastic).
 ``yield_force_for(stiffness, height)``
     F_y (N) from ``yield_force`` or ``yield_drift_ratio`` (exactly one is given).
 ``kernel_parameters(stiffness, height)``
@@ -32,7 +33,7 @@ from typing import Annotated, ClassVar, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from pounding.registry import add_unique
+from pounding.registry import add_numbered
 
 __all__ = ["StoreyHysteresis", "BilinearStorey", "BoucWenStorey", "HYSTERESES", "register",
            "N_HYSTERESIS_PARAMETERS", "MODEL_ELASTIC", "MODEL_BILINEAR", "MODEL_BOUC_WEN"]
@@ -40,10 +41,9 @@ __all__ = ["StoreyHysteresis", "BilinearStorey", "BoucWenStorey", "HYSTERESES", 
 #: Length of every model's kernel parameter vector.
 N_HYSTERESIS_PARAMETERS = 6
 
-# Kernel branch identifiers (MODEL_ELASTIC: a storey without ``hysteresis``).
+#: Kernel branch id of a storey without ``hysteresis``; a model's id is 1 + its place in
+#: :data:`HYSTERESES` (:func:`register`).
 MODEL_ELASTIC = 0
-MODEL_BILINEAR = 1
-MODEL_BOUC_WEN = 2
 
 PostYieldRatio = Annotated[float, Field(ge=0.0, lt=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
@@ -99,8 +99,7 @@ HYSTERESES: dict[str, type[StoreyHysteresis]] = {}
 
 def register(cls: type[StoreyHysteresis]) -> type[StoreyHysteresis]:
     """Class decorator: add a model to :data:`HYSTERESES` under ``cls.name`` (a name is taken once)."""
-    add_unique(HYSTERESES, cls.name, cls, "storey hysteresis")
-    return cls
+    return add_numbered(HYSTERESES, cls, "storey hysteresis", "model_id", first=MODEL_ELASTIC + 1)
 
 
 @register
@@ -120,7 +119,6 @@ class BilinearStorey(StoreyHysteresis):
     """
 
     name: ClassVar[str] = "bilinear"
-    model_id: ClassVar[int] = MODEL_BILINEAR
     reference: ClassVar[str] = "Chopra (2017) Dynamics of Structures §5.7; OpenSees Steel01 (no isotropic hardening)"
 
     model: Literal["bilinear"] = "bilinear"
@@ -140,7 +138,6 @@ class BoucWenStorey(StoreyHysteresis):
     """
 
     name: ClassVar[str] = "bouc-wen"
-    model_id: ClassVar[int] = MODEL_BOUC_WEN
     reference: ClassVar[str] = "Wen (1976) J. Eng. Mech. Div. ASCE 102(2), 249-263"
 
     model: Literal["bouc-wen"] = "bouc-wen"
@@ -160,3 +157,8 @@ class BoucWenStorey(StoreyHysteresis):
         out = super().kernel_parameters(stiffness, height)
         out[2:6] = (self.n, self.beta, self.gamma, self.A)
         return out
+
+
+#: Kernel branch ids of the models, read from the registry (compile-time constants of the kernels).
+MODEL_BILINEAR = BilinearStorey.model_id
+MODEL_BOUC_WEN = BoucWenStorey.model_id

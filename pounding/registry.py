@@ -1,14 +1,17 @@
-"""Registries keyed by name (contact laws, ξ formulas, storey hysteresis, separation rules).
+"""Registries keyed by name (contact laws, link laws, ξ formulas, storey hysteresis, separation rules).
 
 Each registry is a plain ``dict``; :func:`add_unique` is how every one of them
-takes a new entry, so a name is taken once everywhere.
+takes a new entry, so a name is taken once everywhere.  Registries whose
+entries select a branch of the compiled solver number them with
+:func:`add_numbered`: the id is the entry's place in the registry, so no id is
+written by hand and none is taken twice.
 """
 
 from __future__ import annotations
 
 from typing import Any, MutableMapping
 
-__all__ = ["add_unique"]
+__all__ = ["add_unique", "add_numbered"]
 
 
 def add_unique(registry: MutableMapping[str, Any], key: str, value: Any, kind: str) -> None:
@@ -22,3 +25,21 @@ def add_unique(registry: MutableMapping[str, Any], key: str, value: Any, kind: s
     if key in registry:
         raise ValueError(f"{kind} '{key}' is registered twice")
     registry[key] = value
+
+
+def add_numbered(registry: MutableMapping[str, Any], cls: type, kind: str, id_attribute: str, first: int = 0) -> type:
+    """Register class *cls* under ``cls.name`` and give it the id ``first + (its place in the registry)``.
+
+    The id is set as the class attribute *id_attribute* (``law_id``,
+    ``model_id``): the branch of the compiled kernels the class selects.
+    Registration order is the id order, so ids are dense and never shared.
+
+    Raises
+    ------
+    ValueError
+        If ``cls.name`` is registered already (:func:`add_unique`).
+    """
+    number = first + len(registry)
+    add_unique(registry, cls.name, cls, kind)
+    setattr(cls, id_attribute, number)
+    return cls

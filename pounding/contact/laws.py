@@ -42,7 +42,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from pounding.contact import xi as xi_formulas
 from pounding.errors import PoundingError, did_you_mean
-from pounding.registry import add_unique
+from pounding.registry import add_numbered
 
 __all__ = [
     "ContactLaw",
@@ -72,16 +72,6 @@ N_PARAMETERS = 8
 #: ``p·kh·δ^1.5·δ̇/1e-3``, stays bounded by the elastic force scale.
 MIN_IMPACT_VELOCITY = 1.0e-3
 
-# Kernel branch identifiers.
-LAW_LINEAR = 0
-LAW_HERTZ = 1
-LAW_HERTZ_DAMP = 2
-LAW_KELVIN = 3
-LAW_JANKOWSKI = 4
-LAW_BILINEAR = 5
-LAW_STEREO = 6
-LAW_BUMPER = 7
-
 Restitution = Annotated[float, Field(gt=0.0, le=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
 
@@ -100,6 +90,9 @@ class ContactLaw(BaseModel):
     reference: ClassVar[str]
     dissipative: ClassVar[bool] = False
     instantaneous: ClassVar[bool] = False
+    #: True if the per-impact constant fixed at the located closure (``onset_constant``) is a
+    #: damping constant ξ (N·s/m^2.5), reported per impact as ``impact_xi`` in the run archive.
+    onset_xi: ClassVar[bool] = False
 
     law: str
 
@@ -124,9 +117,11 @@ LAWS: dict[str, type[ContactLaw]] = {}
 
 
 def register(cls: type[ContactLaw]) -> type[ContactLaw]:
-    """Class decorator: add a law to :data:`LAWS` under ``cls.name`` (a name is taken once)."""
-    add_unique(LAWS, cls.name, cls, "contact law")
-    return cls
+    """Class decorator: add a law to :data:`LAWS` under ``cls.name`` (a name is taken once).
+
+    Its ``law_id`` is its place in :data:`LAWS` (:func:`pounding.registry.add_numbered`).
+    """
+    return add_numbered(LAWS, cls, "contact law", "law_id")
 
 
 def _pack(*values: float) -> np.ndarray:
@@ -144,7 +139,6 @@ class Linear(ContactLaw):
     """
 
     name: ClassVar[str] = "linear"
-    law_id: ClassVar[int] = LAW_LINEAR
     reference: ClassVar[str] = "Maison & Kasai (1992), EESD 21, 771-786"
 
     law: Literal["linear"] = "linear"
@@ -163,7 +157,6 @@ class Hertz(ContactLaw):
     """
 
     name: ClassVar[str] = "hertz"
-    law_id: ClassVar[int] = LAW_HERTZ
     reference: ClassVar[str] = "Davis (1992), EESD 21, 253-274"
 
     law: Literal["hertz"] = "hertz"
@@ -194,9 +187,9 @@ class HertzDamp(ContactLaw):
     """
 
     name: ClassVar[str] = "hertz-damp"
-    law_id: ClassVar[int] = LAW_HERTZ_DAMP
     reference: ClassVar[str] = "Muthukumar & DesRoches (2006), EESD 35, 811-828; Ye, Li & Zhu (2009), EESD 38, 1135-1142"
     dissipative: ClassVar[bool] = True
+    onset_xi: ClassVar[bool] = True
 
     law: Literal["hertz-damp"] = "hertz-damp"
     kh: Positive = Field(description="Hertz stiffness, N/m^1.5")
@@ -249,7 +242,6 @@ class Kelvin(ContactLaw):
     """
 
     name: ClassVar[str] = "kelvin"
-    law_id: ClassVar[int] = LAW_KELVIN
     reference: ClassVar[str] = "Anagnostopoulos (1988), EESD 16, 443-456"
     dissipative: ClassVar[bool] = True
 
@@ -288,7 +280,6 @@ class Jankowski(ContactLaw):
     """
 
     name: ClassVar[str] = "jankowski"
-    law_id: ClassVar[int] = LAW_JANKOWSKI
     reference: ClassVar[str] = "Jankowski (2005), EESD 34, 595-611; Jankowski (2006), EESD 35, 517-524"
     dissipative: ClassVar[bool] = True
 
@@ -325,7 +316,6 @@ class Bilinear(ContactLaw):
     """
 
     name: ClassVar[str] = "bilinear"
-    law_id: ClassVar[int] = LAW_BILINEAR
     reference: ClassVar[str] = "Muthukumar (2003), PhD thesis, Georgia Tech; OpenSees ImpactMaterial"
     dissipative: ClassVar[bool] = True
 
@@ -366,7 +356,6 @@ class StereoMechanical(ContactLaw):
     """
 
     name: ClassVar[str] = "stereo-mechanical"
-    law_id: ClassVar[int] = LAW_STEREO
     reference: ClassVar[str] = "Goldsmith (1960), Impact, Edward Arnold"
     dissipative: ClassVar[bool] = True
     instantaneous: ClassVar[bool] = True
@@ -422,10 +411,10 @@ class Bumper(ContactLaw):
     """
 
     name: ClassVar[str] = "bumper"
-    law_id: ClassVar[int] = LAW_BUMPER
     reference: ClassVar[str] = ("Polycarpou, Komodromos & Polycarpou (2013), EESD 42, 81-100 (layered structure); "
                                 "Hunt & Crossley (1975), J. Appl. Mech. 42, 440-445")
     dissipative: ClassVar[bool] = True
+    onset_xi: ClassVar[bool] = True
 
     law: Literal["bumper"] = "bumper"
     thickness: Positive = Field(description="thickness t of the rubber layer, m")

@@ -12,8 +12,9 @@ force, internal rate and stored energy are branches of
 Contract of a link law
 ----------------------
 ``law_id``
-    Integer that selects the kernel branch (20 and up: the contact laws' ids
-    stay below).
+    Integer that selects the kernel branch, given by :func:`register`:
+    FIRST_LINK_ID (20) + the place in :data:`LINK_LAWS` (the contact laws'
+    ids stay below).
 ``kernel_parameters()``
     ``[stiffness, damping]`` padded to :data:`pounding.contact.laws.N_PARAMETERS`.
 """
@@ -26,15 +27,14 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from pounding.contact.laws import N_PARAMETERS
+from pounding.registry import add_numbered
 
-__all__ = ["LinkLaw", "ViscousLink", "KelvinLink", "MaxwellLink", "LINK_LAWS", "register",
-           "LINK_VISCOUS", "LINK_KELVIN", "LINK_MAXWELL", "FIRST_LINK_ID"]
+__all__ = ["LinkLaw", "ViscousLink", "KelvinLink", "MaxwellLink", "LINK_LAWS", "register", "FIRST_LINK_ID",
+           "LINK_VISCOUS", "LINK_KELVIN", "LINK_MAXWELL"]
 
-#: Kernel branch identifiers of the link laws (contact laws use ids below FIRST_LINK_ID).
+#: First kernel branch id of the link laws (contact laws use ids below it); a link's id is
+#: FIRST_LINK_ID + its place in :data:`LINK_LAWS`.
 FIRST_LINK_ID = 20
-LINK_VISCOUS = 20
-LINK_KELVIN = 21
-LINK_MAXWELL = 22
 
 Positive = Annotated[float, Field(gt=0.0)]
 
@@ -67,11 +67,9 @@ LINK_LAWS: dict[str, type[LinkLaw]] = {}
 
 
 def register(cls: type[LinkLaw]) -> type[LinkLaw]:
-    """Class decorator: add a link law to :data:`LINK_LAWS` under ``cls.name`` (a name is taken once)."""
-    if cls.name in LINK_LAWS:
-        raise ValueError(f"link law '{cls.name}' is already registered")
-    LINK_LAWS[cls.name] = cls
-    return cls
+    """Class decorator: add a link law to :data:`LINK_LAWS` under ``cls.name`` (a name is taken once); its ``law_id`` is
+    FIRST_LINK_ID + its place."""
+    return add_numbered(LINK_LAWS, cls, "link law", "law_id", first=FIRST_LINK_ID)
 
 
 @register
@@ -83,7 +81,6 @@ class ViscousLink(LinkLaw):
     """
 
     name: ClassVar[str] = "viscous"
-    law_id: ClassVar[int] = LINK_VISCOUS
     reference: ClassVar[str] = "Soong & Dargush (1997) Passive Energy Dissipation Systems, ch. 6"
 
     law: Literal["viscous"] = "viscous"
@@ -100,7 +97,6 @@ class KelvinLink(LinkLaw):
     """
 
     name: ClassVar[str] = "kelvin"
-    law_id: ClassVar[int] = LINK_KELVIN
     reference: ClassVar[str] = "Westermo (1989) EESD 18, 687-699"
 
     law: Literal["kelvin"] = "kelvin"
@@ -122,9 +118,14 @@ class MaxwellLink(LinkLaw):
     """
 
     name: ClassVar[str] = "maxwell"
-    law_id: ClassVar[int] = LINK_MAXWELL
     reference: ClassVar[str] = "Constantinou & Symans (1993) Struct. Design Tall Build. 2, 93-132"
 
     law: Literal["maxwell"] = "maxwell"
     stiffness: Positive = Field(description="spring (brace) stiffness k, N/m")
     damping: Positive = Field(description="dashpot coefficient c, N s/m")
+
+
+#: Kernel branch ids of the link laws, read from the registry (compile-time constants of the kernels).
+LINK_VISCOUS = ViscousLink.law_id
+LINK_KELVIN = KelvinLink.law_id
+LINK_MAXWELL = MaxwellLink.law_id

@@ -359,7 +359,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     side_names = building_names + [WALL_NAME]  # index WALL (−1) is the wall
     with np.errstate(invalid="ignore", divide="ignore"):
         restitution = raw.impact_separation_velocity / raw.impact_velocity
-    is_hertz_damp = np.array([g.law.law_id == contact_laws.LAW_HERTZ_DAMP for g in gaps], dtype=bool)
+    is_hertz_damp = np.array([type(g.law) is contact_laws.HertzDamp for g in gaps], dtype=bool)
     impact_xi = np.where(is_hertz_damp[raw.impact_contact] if ng else np.zeros(0, bool),
                          raw.impact_constant, np.nan)
 

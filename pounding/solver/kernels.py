@@ -18,8 +18,7 @@ from pounding.contact import laws
 from pounding.contact import links
 from pounding.numba_cache import use_writable_cache
 from pounding.solver import jit
-from pounding.contact.laws import (LAW_BILINEAR, LAW_BUMPER, LAW_HERTZ, LAW_HERTZ_DAMP, LAW_JANKOWSKI, LAW_KELVIN,
-                                   LAW_LINEAR, LAW_STEREO, MIN_IMPACT_VELOCITY)
+from pounding.contact.laws import MIN_IMPACT_VELOCITY
 
 
 # --------------------------------------------------------------------------- #
@@ -29,8 +28,19 @@ from pounding.contact.laws import (LAW_BILINEAR, LAW_BUMPER, LAW_HERTZ, LAW_HERT
 
 use_writable_cache(__file__)  # a read-only install caches its kernels in the user's cache folder
 
-LINK_VISCOUS, LINK_KELVIN, LINK_MAXWELL, FIRST_LINK_ID = (links.LINK_VISCOUS, links.LINK_KELVIN, links.LINK_MAXWELL,
-                                                          links.FIRST_LINK_ID)
+# Branch ids, read from the registries (pounding.registry.add_numbered): compile-time constants here.
+LAW_LINEAR = laws.Linear.law_id
+LAW_HERTZ = laws.Hertz.law_id
+LAW_HERTZ_DAMP = laws.HertzDamp.law_id
+LAW_KELVIN = laws.Kelvin.law_id
+LAW_JANKOWSKI = laws.Jankowski.law_id
+LAW_BILINEAR = laws.Bilinear.law_id
+LAW_STEREO = laws.StereoMechanical.law_id
+LAW_BUMPER = laws.Bumper.law_id
+LINK_VISCOUS = links.LINK_VISCOUS
+LINK_KELVIN = links.LINK_KELVIN
+LINK_MAXWELL = links.LINK_MAXWELL
+FIRST_LINK_ID = links.FIRST_LINK_ID
 
 
 @njit(cache=True, **jit.NO_REFCOUNT)
@@ -104,57 +114,6 @@ def _bumper_force(prm: np.ndarray, xi_bumper: float, delta: float, delta_rate: f
     return f
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
-def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
-          delta_rate: float, q: float) -> float:
-    """Contact force (N) for penetration *delta* (m), its rate (m/s) and internal state *q*."""
-    if law_id >= FIRST_LINK_ID:
-        return link_force(law_id, prm, delta, delta_rate, q)
-    if delta <= 0.0:
-        return 0.0
-    if law_id == LAW_HERTZ_DAMP:
-        d15 = delta * math.sqrt(delta)
-        f = d15 * (prm[0] + impact_constant * delta_rate)
-        if prm[3] == 0.0 and f < 0.0:
-            return 0.0
-        return f
-    if law_id == LAW_HERTZ:
-        return prm[0] * delta * math.sqrt(delta)
-    if law_id == LAW_LINEAR:
-        return prm[0] * delta
-    if law_id == LAW_KELVIN:
-        f = prm[0] * delta + prm[1] * delta_rate
-        if prm[2] == 0.0 and f < 0.0:
-            return 0.0
-        return f
-    if law_id == LAW_JANKOWSKI:
-        f = prm[0] * delta * math.sqrt(delta)
-        if delta_rate > 0.0:
-            f += 2.0 * prm[1] * math.sqrt(prm[0] * math.sqrt(delta) * prm[2]) * delta_rate
-        return f
-    if law_id == LAW_BILINEAR:
-        lower, upper = _bilinear_bounds(prm, delta)
-        return min(max(q, lower), upper)
-    if law_id == LAW_BUMPER:
-        return _bumper_force(prm, impact_constant, delta, delta_rate, q, True, delta > prm[6], True)
-    return 0.0
-
-
-@njit(cache=True, **jit.NO_REFCOUNT)
-def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
-    """Rate of the internal state (N/s): the bilinear force follows K1, or K2 on an envelope."""
-    if law_id == LAW_BILINEAR:
-        if delta <= 0.0:
-            return 0.0
-        lower, upper = _bilinear_bounds(prm, delta)
-        if delta_rate > 0.0 and q >= upper:
-            return prm[1] * delta_rate if delta > prm[2] else prm[0] * delta_rate
-        if delta_rate < 0.0 and q <= lower:
-            return prm[1] * delta_rate
-        return prm[0] * delta_rate
-    return 0.0
-
-
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)  # called from compiled code only
 def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
     """Elastic energy stored in the contact (J): what unloading would give back.
@@ -175,7 +134,8 @@ def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
         return 0.5 * prm[0] * delta * delta
     if law_id == LAW_BILINEAR:
         k1, k2 = prm[0], prm[1]
-        f = force(law_id, prm, 0.0, delta, 0.0, q)
+        lower, upper = _bilinear_bounds(prm, delta)
+        f = min(max(q, lower), upper)  # the loop's force at this state (q off the loop by round-off: its edge)
         # Unloading: slope K1 from (δ, f) down to the line K2·δ at δ*, then that line to 0.
         d_star = (k1 * delta - f) / (k1 - k2)
         d_star = min(max(d_star, 0.0), delta)
@@ -257,9 +217,10 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
                delta_rate: float, q: float) -> float:
     """Contact force (N) of a closed contact in *mode* (no branch on the state inside a mode).
 
-    Equal to :func:`force` wherever the mode is the one the state implies;
-    the difference is that the formula does not switch before the located
-    event (just past an event the clamp still holds the force at ≥ 0).
+    The one force routine of every law: :func:`force` is this routine in the
+    mode the state implies (:func:`implied_mode`).  Inside a mode the formula
+    does not switch before the located event (just past an event the clamp
+    still holds the force at ≥ 0).
     """
     if law_id >= FIRST_LINK_ID:
         return link_force(law_id, prm, delta, delta_rate, q)
@@ -289,7 +250,11 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
     if law_id == LAW_BUMPER:
         return _bumper_force(prm, impact_constant, delta, delta_rate, q, (mode & BUMPER_CLAMPED) == 0,
                              (mode & BUMPER_HARD) != 0, (mode & BUMPER_HARD_CLAMPED) == 0)
-    return force(law_id, prm, impact_constant, delta, delta_rate, q)
+    if law_id == LAW_HERTZ:
+        return prm[0] * delta * math.sqrt(delta)
+    if law_id == LAW_LINEAR:
+        return prm[0] * delta
+    return 0.0  # stereo-mechanical: no force history (a velocity jump; a stuck contact's force is the solver's)
 
 
 @njit(cache=True, **jit.NO_REFCOUNT)
@@ -389,6 +354,65 @@ def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delt
         if mode == MODE_YIELD_BOTTOM:
             return prm[1] * delta
     return q
+
+
+@njit(cache=True, **jit.NO_REFCOUNT)
+def implied_mode(law_id: int, prm: np.ndarray, impact_constant: float, delta: float, delta_rate: float,
+                 q: float) -> int:
+    """Mode a closed contact's state implies, without the history the solver's located events carry.
+
+    Hertz-damp and Kelvin: clamped where the clamp is on and the formula
+    would pull.  Jankowski: approaching while δ̇ > 0.  Bilinear: yielding at
+    the top where ``q`` is on or above the upper envelope while loading past
+    δy, at the bottom where it is on or below the line ``K2·δ`` while
+    unloading, elastic otherwise.  Bumper: the hard face engaged where
+    ``δ > δlim``, each clamp where its part would pull.  Other laws: 0.
+    """
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_KELVIN or law_id == LAW_BUMPER:
+        mode = 0
+        first = 0
+        if law_id == LAW_BUMPER:
+            first = 1  # switch 0 of a bumper is the hard face, set here from δ; 1 and 2 are its clamps
+            if delta > prm[6]:
+                mode = BUMPER_HARD
+        for which in range(first, switch_count(law_id, prm)):
+            # a clamp's switch function is negative where its part would pull: its next mode is clamped
+            if switch_value(law_id, prm, impact_constant, mode, which, delta, delta_rate, q) < 0.0:
+                mode = next_mode(law_id, mode, which)
+        return mode
+    if law_id == LAW_JANKOWSKI:
+        return MODE_APPROACH if delta_rate > 0.0 else MODE_RECEDE
+    if law_id == LAW_BILINEAR:
+        lower, upper = _bilinear_bounds(prm, delta)
+        if delta_rate > 0.0 and q >= upper and delta > prm[2]:
+            return MODE_YIELD_TOP
+        if delta_rate < 0.0 and q <= lower:
+            return MODE_YIELD_BOTTOM
+        return MODE_ELASTIC
+    return 0
+
+
+@njit(cache=True, **jit.NO_REFCOUNT)
+def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
+          delta_rate: float, q: float) -> float:
+    """Contact force (N) at penetration *delta* (m), its rate (m/s) and internal state *q*, no mode given.
+
+    :func:`mode_force` in the mode the state implies (:func:`implied_mode`):
+    one formula per law.  The bilinear force is its internal state ``q`` in
+    every mode (the loop's branches are located by the solver's events).
+    """
+    mode = implied_mode(law_id, prm, impact_constant, delta, delta_rate, q)
+    return mode_force(law_id, prm, impact_constant, mode, delta, delta_rate, q)
+
+
+@njit(cache=True, **jit.NO_REFCOUNT)
+def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
+    """Rate of the internal state (N/s) in the mode the state implies (:func:`mode_internal_rate`); links too."""
+    if law_id >= FIRST_LINK_ID:
+        return link_internal_rate(law_id, prm, delta_rate, q)
+    if delta <= 0.0:
+        return 0.0
+    return mode_internal_rate(law_id, prm, implied_mode(law_id, prm, 0.0, delta, delta_rate, q), delta, delta_rate)
 
 
 @njit(cache=True, **jit.NO_REFCOUNT)

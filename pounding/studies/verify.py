@@ -26,10 +26,16 @@ Procedure (one call of :func:`ball_drop`)
    precision.  The per-impact constant (ξ for Hertz-damp) is fixed once from
    ``v0`` by :func:`pounding.solver.kernels.onset_constant`, exactly as the building
    solver does at a located closure.
-3. The contact phase is integrated with the compiled kernel
-   :func:`pounding.solver.kernels.force`; the bilinear law's internal state ``q``
-   (its hysteretic force, 0 at closure) is an extra ODE state advanced by
-   :func:`pounding.solver.kernels.internal_rate`.  The maximum penetration
+3. The contact phase (:func:`contact_phase`) is integrated with the very
+   routines the building solver calls for a closed contact: the mode at the
+   closure (:func:`pounding.solver.kernels.onset_mode`), the force and the
+   internal rate in that mode (:func:`pounding.solver.kernels.mode_force`,
+   :func:`pounding.solver.kernels.mode_internal_rate`; the bilinear law's
+   internal state ``q``, its hysteretic force, 0 at closure, is an extra ODE
+   state), and each switch of mode (a clamp, Jankowski's damping turned off,
+   a branch of the bilinear loop) located as an event on
+   :func:`pounding.solver.kernels.switch_value` and applied with
+   ``next_mode`` / ``snapped_internal``.  The maximum penetration
    (``δ̇ = 0``) and the separation (``δ`` back to 0 while rebounding) are
    located as events.  Tolerances: rtol 1e-12, atol 1e-12 times the scale of
    each state (Hertz ``δmax``, ``v0``, ``kh·δmax^1.5``) — i.e. ~4e-16 m on
@@ -94,6 +100,7 @@ __all__ = [
     "make_law",
     "hertz_max_penetration",
     "ball_drop",
+    "contact_phase",
     "ball_drop_production",
     "production_system",
     "impact_velocity",
@@ -268,7 +275,6 @@ def ball_drop(model_key: str, e_pre: float, *, mass: float = 0.5, height: float 
         ``max_penetration`` (m) and ``contact_duration`` (s; 0 for the
         stereo-mechanical jump).
     """
-    from scipy.integrate import solve_ivp
 
     _check_settings(mass, height, kh, gravity)
     v0 = impact_velocity(height, gravity)
@@ -282,12 +288,52 @@ def ball_drop(model_key: str, e_pre: float, *, mass: float = 0.5, height: float 
         return _result(e_pre, rebound / v0, v0, 0.0, 0.0)
 
     constant = kernels.onset_constant(law_id, prm, v0)
-    g = float(gravity)
+    dmax = hertz_max_penetration(mass, v0, kh)
+    t_contact = 2.94 * dmax / v0
+    atol = [ATOL_SCALE * dmax, ATOL_SCALE * v0, ATOL_SCALE * kh * dmax**1.5]
+    where = f"ball drop: {model_key} at e_pre={e_pre}"
+    rebound, penetration, duration = contact_phase(law_id, prm, constant, v0, mass=mass, gravity=float(gravity),
+                                                   t_contact=t_contact, atol=atol, where=where)
+    return _result(e_pre, rebound / v0, v0, penetration, duration)
+
+
+#: Most mode switches one contact phase of :func:`contact_phase` may take (a bilinear loop takes 2,
+#: a clamp 1): more is chattering between two modes at one instant, refused as an error.
+MAX_SWITCHES = 50
+
+
+def contact_phase(law_id: int, prm: np.ndarray, constant: float, v0: float, *, mass: float, gravity: float,
+                  t_contact: float, atol: Sequence[float], where: str) -> tuple[float, float, float]:
+    """Integrate one contact of the ball with the solver's own law routines; (rebound m/s, δmax m, duration s).
+
+    The state is ``(δ, δ̇, q)``: penetration (m), its rate (m/s) and the law's
+    internal state.  Exactly the calls the building solver makes for a closed
+    contact (:mod:`pounding.solver.kernels`): the mode at the closure is
+    :func:`~pounding.solver.kernels.onset_mode`; inside a mode the force is
+    :func:`~pounding.solver.kernels.mode_force` and the internal rate
+    :func:`~pounding.solver.kernels.mode_internal_rate`; the mode ends where
+    one of its :func:`~pounding.solver.kernels.switch_value` functions
+    crosses zero (located as a terminal event), and the next mode and the
+    snapped internal state are :func:`~pounding.solver.kernels.next_mode` and
+    :func:`~pounding.solver.kernels.snapped_internal`.  The maximum
+    penetration (``δ̇ = 0``) and the separation (``δ`` back to 0) are located
+    as events too.  DOP853 at :data:`RTOL` with *atol* per state.
+
+    Raises
+    ------
+    PoundingError
+        If the ball does not separate within 100 contact durations, or a mode
+        switches more than :data:`MAX_SWITCHES` times.
+    """
+    from scipy.integrate import solve_ivp
+
+    mode = kernels.onset_mode(law_id, prm, v0)
+    n_switch = kernels.switch_count(law_id, prm)
 
     def rhs(t, state):
         delta, rate, q = state
-        f = kernels.force(law_id, prm, constant, delta, rate, q)
-        return [rate, g - f / mass, kernels.internal_rate(law_id, prm, delta, rate, q)]
+        f = kernels.mode_force(law_id, prm, constant, mode, delta, rate, q)
+        return [rate, gravity - f / mass, kernels.mode_internal_rate(law_id, prm, mode, delta, rate)]
 
     def separation(t, state):
         return state[0]
@@ -300,17 +346,34 @@ def ball_drop(model_key: str, e_pre: float, *, mass: float = 0.5, height: float 
 
     turning.direction = -1.0
 
-    dmax = hertz_max_penetration(mass, v0, kh)
-    t_contact = 2.94 * dmax / v0
-    atol = [ATOL_SCALE * dmax, ATOL_SCALE * v0, ATOL_SCALE * kh * dmax**1.5]
-    sol = solve_ivp(rhs, (0.0, 100.0 * t_contact), [0.0, v0, 0.0], method="DOP853", rtol=RTOL, atol=atol,
-                    events=(separation, turning), max_step=t_contact / 50.0, first_step=t_contact * 1e-4)
-    if not sol.t_events[0].size:
-        raise PoundingError(f"ball drop: {model_key} at e_pre={e_pre}: the ball did not separate within "
-                            f"{100.0 * t_contact:.3g} s")
-    rebound = -float(sol.y_events[0][0][1])
-    penetration = float(sol.y_events[1][0][0]) if sol.t_events[1].size else float(np.max(sol.y[0]))
-    return _result(e_pre, rebound / v0, v0, penetration, float(sol.t_events[0][0]))
+    def switch(which: int):
+        def value(t, state):
+            return kernels.switch_value(law_id, prm, constant, mode, which, state[0], state[1], state[2])
+
+        value.terminal = True
+        value.direction = -1.0  # positive while the mode holds
+        return value
+
+    t, state, penetration = 0.0, [0.0, v0, 0.0], float("nan")
+    end = 100.0 * t_contact
+    for _ in range(MAX_SWITCHES + 1):
+        switches = [switch(which) for which in range(n_switch)]
+        sol = solve_ivp(rhs, (t, end), state, method="DOP853", rtol=RTOL, atol=atol,
+                        events=[separation, turning, *switches], max_step=t_contact / 50.0,
+                        first_step=t_contact * 1e-4)
+        if sol.t_events[1].size and not math.isfinite(penetration):
+            penetration = float(sol.y_events[1][0][0])
+        if sol.t_events[0].size:
+            return -float(sol.y_events[0][0][1]), penetration, float(sol.t_events[0][0])
+        crossed = [which for which in range(n_switch) if sol.t_events[2 + which].size]
+        if not crossed:
+            raise PoundingError(f"{where}: the ball did not separate within {end:.3g} s")
+        which = crossed[0]
+        t = float(sol.t_events[2 + which][0])
+        delta, rate, q = (float(x) for x in sol.y_events[2 + which][0])
+        mode = kernels.next_mode(law_id, mode, which)
+        state = [delta, rate, kernels.snapped_internal(law_id, prm, mode, delta, rate, q)]
+    raise PoundingError(f"{where}: more than {MAX_SWITCHES} mode switches in one contact")
 
 
 # --------------------------------------------------------------------------- #
