@@ -256,3 +256,18 @@ def test_base_is_valid():
     model = model_from_text(BASE)
     assert isinstance(model.gaps[0].law, contact.Bumper)
     assert model.gaps[0].law.limit == pytest.approx(0.03)
+
+
+def test_archive_reports_the_rubbers_xi_per_impact():
+    # impact_xi is filled for every law whose class has an onset ξ (ContactLaw.onset_xi), bumpers
+    # included (NaN before issue #24): it is ξb = p(eb)·kb / max(v0, v_min) of each impact's own
+    # approach velocity, the constant the solver fixed, so it matches to round-off (1e-12 relative).
+    from pounding.simulation import simulate
+
+    model = load_model(MODELS / "pair_bumper.yaml")
+    ds = simulate(model, duration=8.0)
+    assert ds.impact_xi.size > 0 and not np.any(np.isnan(ds.impact_xi.values))
+    for i, contact_index in enumerate(ds.impact_contact.values):
+        law = model.gaps[int(contact_index)].law
+        expected = law.damping_constant(float(ds.impact_velocity.values[i]))
+        assert float(ds.impact_xi.values[i]) == pytest.approx(expected, rel=1e-12)

@@ -45,7 +45,6 @@ import numpy as np
 import xarray as xr
 
 from pounding import __version__
-from pounding.contact import laws as contact_laws
 from pounding.contact import links as contact_links
 from pounding.records.record import Record
 from pounding.model.model import Model, column_weights
@@ -359,9 +358,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     side_names = building_names + [WALL_NAME]  # index WALL (−1) is the wall
     with np.errstate(invalid="ignore", divide="ignore"):
         restitution = raw.impact_separation_velocity / raw.impact_velocity
-    is_hertz_damp = np.array([type(g.law) is contact_laws.HertzDamp for g in gaps], dtype=bool)
-    impact_xi = np.where(is_hertz_damp[raw.impact_contact] if ng else np.zeros(0, bool),
-                         raw.impact_constant, np.nan)
+    has_xi = np.array([type(g.law).onset_xi for g in gaps], dtype=bool)  # the law's class says (ContactLaw)
+    impact_xi = np.where(has_xi[raw.impact_contact] if ng else np.zeros(0, bool), raw.impact_constant, np.nan)
 
     coords = {
         "time": ("time", raw.time, {"units": "s", "long_name": "time", "standard_name": "time"}),
