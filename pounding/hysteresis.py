@@ -61,6 +61,8 @@ class StoreyHysteresis(BaseModel):
     name: ClassVar[str]
     model_id: ClassVar[int]
     reference: ClassVar[str]
+    #: Checks of tests/test_registry_contract.py that apply to the model (its kind).
+    checks: ClassVar[tuple[str, ...]] = ("dissipation_nonnegative",)
 
     model: str
     yield_force: Positive | None = Field(None, description="yield force F_y, N")
@@ -119,6 +121,7 @@ class BilinearStorey(StoreyHysteresis):
     """
 
     name: ClassVar[str] = "bilinear"
+    checks: ClassVar[tuple[str, ...]] = ("elastic_potential", "dissipation_nonnegative")
     reference: ClassVar[str] = "Chopra (2017) Dynamics of Structures §5.7; OpenSees Steel01 (no isotropic hardening)"
 
     model: Literal["bilinear"] = "bilinear"
@@ -138,6 +141,7 @@ class BoucWenStorey(StoreyHysteresis):
     """
 
     name: ClassVar[str] = "bouc-wen"
+    checks: ClassVar[tuple[str, ...]] = ("bounded_state", "dissipation_nonnegative")
     reference: ClassVar[str] = "Wen (1976) J. Eng. Mech. Div. ASCE 102(2), 249-263"
 
     model: Literal["bouc-wen"] = "bouc-wen"

@@ -34,8 +34,9 @@ branch in each compiled kernel of :mod:`pounding.solver.kernels`.
 
 from __future__ import annotations
 
+import importlib
 import math
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Callable, ClassVar, Literal, NamedTuple
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator
@@ -46,6 +47,7 @@ from pounding.registry import add_numbered
 
 __all__ = [
     "ContactLaw",
+    "effective_mass",
     "HertzDamp",
     "Hertz",
     "Linear",
@@ -57,6 +59,8 @@ __all__ = [
     "LAWS",
     "register",
     "law_from_mapping",
+    "LawKernels",
+    "LAW_MODULES",
     "N_PARAMETERS",
     "MIN_IMPACT_VELOCITY",
 ]
@@ -71,6 +75,103 @@ N_PARAMETERS = 8
 #: grazing contacts, where the damping force it produces,
 #: ``p·kh·δ^1.5·δ̇/1e-3``, stays bounded by the elastic force scale.
 MIN_IMPACT_VELOCITY = 1.0e-3
+
+# --------------------------------------------------------------------------- #
+# The kernels of a law written in a module of its own (docs/adding-a-law.md).
+# Plain Python on floats and the parameter vector ``prm``: the solver compiles
+# them (pounding.solver.kernels) and dispatches to them by ``law_id``.
+# --------------------------------------------------------------------------- #
+
+
+def no_onset_constant(prm, v0):
+    """Default ``onset_constant``: no per-impact constant (0.0)."""
+    return 0.0
+
+
+def first_mode(prm, v0):
+    """Default ``onset_mode`` (and, with other arguments, ``implied_mode``): mode 0."""
+    return 0
+
+
+def no_switches(prm):
+    """Default ``switch_count``: the force is one formula while closed."""
+    return 0
+
+
+def no_internal_rate(prm, mode, delta, delta_rate):
+    """Default ``mode_internal_rate``: no internal state (0.0 N/s)."""
+    return 0.0
+
+
+def no_switch_value(prm, impact_constant, mode, which, delta, delta_rate, q):
+    """Default ``switch_value``: 1.0 (positive: a switch the mode does not have never fires)."""
+    return 1.0
+
+
+def other_mode(mode, which):
+    """Default ``next_mode``: toggles between modes 0 and 1."""
+    return 1 - mode
+
+
+def same_internal(prm, mode, delta, delta_rate, q):
+    """Default ``snapped_internal``: the internal state as it is."""
+    return q
+
+
+def mode_zero(prm, impact_constant, delta, delta_rate, q):
+    """Default ``implied_mode``: mode 0."""
+    return 0
+
+
+def no_internal_tolerance(prm, atol_displacement):
+    """Default ``internal_tolerance``: 0.0 (no internal state to control)."""
+    return 0.0
+
+
+def linear_duration(prm, v0, effective_mass):
+    """Default ``contact_duration`` (s): the half period ``π·sqrt(m/k)`` with ``k = prm[0]`` (N/m)."""
+    return math.pi * math.sqrt(effective_mass / prm[0])
+
+
+class LawKernels(NamedTuple):
+    """The compiled behaviour of a law written in a module of its own: plain Python functions.
+
+    Each is compiled by :mod:`pounding.solver.kernels` (numba ``njit``), so it
+    may use only ``math``, arithmetic, comparisons and indexing of ``prm``
+    (the law's float vector of length :data:`N_PARAMETERS`).  Arguments:
+    ``impact_constant`` the constant fixed at the located closure, ``mode``
+    the contact's integer mode, ``which`` a switch index, ``delta`` the
+    penetration (m), ``delta_rate`` its rate (m/s), ``q`` the internal state.
+    ``mode_force`` and ``potential`` have no default; the others describe a
+    law without modes, internal state or per-impact constant.
+
+    mode_force(prm, impact_constant, mode, delta, delta_rate, q) -> N (only called with delta > 0)
+    potential(prm, delta, q) -> J, elastic energy stored (only called with delta > 0)
+    onset_constant(prm, v0) -> the per-impact constant from the approach velocity v0 (m/s)
+    onset_mode(prm, v0) -> mode at the located closure
+    switch_count(prm) -> number of switch functions of a mode (at most pounding.solver.kernels.N_SWITCHES)
+    switch_value(prm, impact_constant, mode, which, delta, delta_rate, q) -> > 0 while the mode holds
+    next_mode(mode, which) -> mode entered where switch *which* crosses 0
+    snapped_internal(prm, mode, delta, delta_rate, q) -> internal state put on the new mode's branch
+    mode_internal_rate(prm, mode, delta, delta_rate) -> rate of the internal state
+    implied_mode(prm, impact_constant, delta, delta_rate, q) -> the mode the state implies (no history)
+    internal_tolerance(prm, atol_displacement) -> absolute tolerance of the internal state
+    contact_duration(prm, v0, effective_mass) -> s, free-impact duration estimate (first step inside)
+    """
+
+    mode_force: Callable
+    potential: Callable
+    onset_constant: Callable = no_onset_constant
+    onset_mode: Callable = first_mode
+    switch_count: Callable = no_switches
+    switch_value: Callable = no_switch_value
+    next_mode: Callable = other_mode
+    snapped_internal: Callable = same_internal
+    mode_internal_rate: Callable = no_internal_rate
+    implied_mode: Callable = mode_zero
+    internal_tolerance: Callable = no_internal_tolerance
+    contact_duration: Callable = linear_duration
+
 
 Restitution = Annotated[float, Field(gt=0.0, le=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
@@ -90,6 +191,11 @@ class ContactLaw(BaseModel):
     reference: ClassVar[str]
     dissipative: ClassVar[bool] = False
     instantaneous: ClassVar[bool] = False
+    #: The law's compiled behaviour when it is written in a module of its own (docs/adding-a-law.md);
+    #: None for the laws of this module, whose branches are in pounding.solver.kernels.
+    kernels: ClassVar[LawKernels | None] = None
+    #: Checks of tests/test_registry_contract.py that apply to the law (its kind): see that file.
+    checks: ClassVar[tuple[str, ...]] = ()
     #: True if the per-impact constant fixed at the located closure (``onset_constant``) is a
     #: damping constant ξ (N·s/m^2.5), reported per impact as ``impact_xi`` in the run archive.
     onset_xi: ClassVar[bool] = False
@@ -111,6 +217,17 @@ class ContactLaw(BaseModel):
         """One-line description for summaries and archive attributes."""
         fields = ", ".join(f"{k}={v}" for k, v in self.model_dump().items() if k != "law")
         return f"{self.name}({fields})"
+
+    @classmethod
+    def for_ball_drop(cls, restitution: float, *, mass: float, kh: float, v0: float) -> ContactLaw | None:
+        """The law's row in the ball-drop verification (``pounding verify``), or None for no row.
+
+        A law written in a module of its own returns itself for a ball of
+        *mass* (kg) hitting a rigid surface at *v0* (m/s) with restitution
+        *restitution*, ``kh`` (N/m^1.5) the test's Hertz stiffness; the laws
+        of this module have their rows written in :mod:`pounding.studies.verify`.
+        """
+        return None
 
 
 LAWS: dict[str, type[ContactLaw]] = {}
@@ -139,6 +256,7 @@ class Linear(ContactLaw):
     """
 
     name: ClassVar[str] = "linear"
+    checks: ClassVar[tuple[str, ...]] = ('elastic_potential', 'never_pulls', 'dissipation_nonnegative')
     reference: ClassVar[str] = "Maison & Kasai (1992), EESD 21, 771-786"
 
     law: Literal["linear"] = "linear"
@@ -157,6 +275,7 @@ class Hertz(ContactLaw):
     """
 
     name: ClassVar[str] = "hertz"
+    checks: ClassVar[tuple[str, ...]] = ('elastic_potential', 'never_pulls', 'dissipation_nonnegative')
     reference: ClassVar[str] = "Davis (1992), EESD 21, 253-274"
 
     law: Literal["hertz"] = "hertz"
@@ -187,6 +306,7 @@ class HertzDamp(ContactLaw):
     """
 
     name: ClassVar[str] = "hertz-damp"
+    checks: ClassVar[tuple[str, ...]] = ('implied_mode_force', 'elastic_potential', 'never_pulls', 'dissipation_nonnegative')
     reference: ClassVar[str] = "Muthukumar & DesRoches (2006), EESD 35, 811-828; Ye, Li & Zhu (2009), EESD 38, 1135-1142"
     dissipative: ClassVar[bool] = True
     onset_xi: ClassVar[bool] = True
@@ -220,7 +340,7 @@ class HertzDamp(ContactLaw):
         return self.p * self.kh / max(v0, self.min_impact_velocity)
 
 
-def _effective_mass(mass_left: float, mass_right: float) -> float:
+def effective_mass(mass_left: float, mass_right: float) -> float:
     """m1·m2/(m1+m2), kg: the two floor masses stand for the colliding bodies (a fixed wall: inf, m_eff = m)."""
     if math.isinf(mass_left) or math.isinf(mass_right):
         return min(mass_left, mass_right)
@@ -242,6 +362,7 @@ class Kelvin(ContactLaw):
     """
 
     name: ClassVar[str] = "kelvin"
+    checks: ClassVar[tuple[str, ...]] = ('implied_mode_force', 'elastic_potential', 'never_pulls', 'dissipation_nonnegative')
     reference: ClassVar[str] = "Anagnostopoulos (1988), EESD 16, 443-456"
     dissipative: ClassVar[bool] = True
 
@@ -257,7 +378,7 @@ class Kelvin(ContactLaw):
         return -log_e / math.sqrt(math.pi**2 + log_e**2)
 
     def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
-        c = 2.0 * self.damping_ratio * math.sqrt(self.k * _effective_mass(mass_left, mass_right))
+        c = 2.0 * self.damping_ratio * math.sqrt(self.k * effective_mass(mass_left, mass_right))
         return _pack(self.k, c, 1.0 if self.tension == "allow" else 0.0)
 
 
@@ -280,6 +401,7 @@ class Jankowski(ContactLaw):
     """
 
     name: ClassVar[str] = "jankowski"
+    checks: ClassVar[tuple[str, ...]] = ('implied_mode_force', 'elastic_potential', 'never_pulls', 'dissipation_nonnegative')
     reference: ClassVar[str] = "Jankowski (2005), EESD 34, 595-611; Jankowski (2006), EESD 35, 517-524"
     dissipative: ClassVar[bool] = True
 
@@ -294,7 +416,7 @@ class Jankowski(ContactLaw):
         return 9.0 * math.sqrt(5.0) / 2.0 * (1.0 - e * e) / (e * (e * (9.0 * math.pi - 16.0) + 16.0))
 
     def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
-        return _pack(self.beta, self.damping_ratio, _effective_mass(mass_left, mass_right))
+        return _pack(self.beta, self.damping_ratio, effective_mass(mass_left, mass_right))
 
 
 @register
@@ -316,6 +438,7 @@ class Bilinear(ContactLaw):
     """
 
     name: ClassVar[str] = "bilinear"
+    checks: ClassVar[tuple[str, ...]] = ('implied_mode_force', 'never_pulls')
     reference: ClassVar[str] = "Muthukumar (2003), PhD thesis, Georgia Tech; OpenSees ImpactMaterial"
     dissipative: ClassVar[bool] = True
 
@@ -356,6 +479,7 @@ class StereoMechanical(ContactLaw):
     """
 
     name: ClassVar[str] = "stereo-mechanical"
+    checks: ClassVar[tuple[str, ...]] = ('free_restitution',)
     reference: ClassVar[str] = "Goldsmith (1960), Impact, Edward Arnold"
     dissipative: ClassVar[bool] = True
     instantaneous: ClassVar[bool] = True
@@ -364,7 +488,7 @@ class StereoMechanical(ContactLaw):
     restitution: Restitution = Field(description="coefficient of restitution e, 0 < e <= 1")
 
     def kernel_parameters(self, mass_left: float, mass_right: float) -> np.ndarray:
-        return _pack(self.restitution, _effective_mass(mass_left, mass_right))
+        return _pack(self.restitution, effective_mass(mass_left, mass_right))
 
 
 @register
@@ -411,6 +535,7 @@ class Bumper(ContactLaw):
     """
 
     name: ClassVar[str] = "bumper"
+    checks: ClassVar[tuple[str, ...]] = ('implied_mode_force', 'elastic_potential', 'never_pulls', 'dissipation_nonnegative')
     reference: ClassVar[str] = ("Polycarpou, Komodromos & Polycarpou (2013), EESD 42, 81-100 (layered structure); "
                                 "Hunt & Crossley (1975), J. Appl. Mech. 42, 440-445")
     dissipative: ClassVar[bool] = True
@@ -474,3 +599,11 @@ def law_from_mapping(fields: dict) -> ContactLaw:
         first = exc.errors()[0]
         where = ".".join(str(x) for x in first["loc"])
         raise PoundingError(f"contact law {name}: {where}: {first['msg']}") from None
+
+
+#: Contact laws written in modules of their own, one line each: importing a module registers its law
+#: (after the laws above, so their ids stay put).  docs/adding-a-law.md.
+LAW_MODULES: tuple[str, ...] = (
+)
+for _module in LAW_MODULES:
+    importlib.import_module(_module)

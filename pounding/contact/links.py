@@ -47,6 +47,8 @@ class LinkLaw(BaseModel):
     name: ClassVar[str]
     law_id: ClassVar[int]
     reference: ClassVar[str]
+    #: Checks of tests/test_registry_contract.py that apply to the link (its kind).
+    checks: ClassVar[tuple[str, ...]] = ("dissipation_nonnegative",)
 
     law: str
 
@@ -81,6 +83,7 @@ class ViscousLink(LinkLaw):
     """
 
     name: ClassVar[str] = "viscous"
+    checks: ClassVar[tuple[str, ...]] = ("elastic_potential", "dissipation_nonnegative")
     reference: ClassVar[str] = "Soong & Dargush (1997) Passive Energy Dissipation Systems, ch. 6"
 
     law: Literal["viscous"] = "viscous"
@@ -97,6 +100,7 @@ class KelvinLink(LinkLaw):
     """
 
     name: ClassVar[str] = "kelvin"
+    checks: ClassVar[tuple[str, ...]] = ("elastic_potential", "dissipation_nonnegative")
     reference: ClassVar[str] = "Westermo (1989) EESD 18, 687-699"
 
     law: Literal["kelvin"] = "kelvin"

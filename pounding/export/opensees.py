@@ -82,7 +82,8 @@ from pounding import __version__
 from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
-__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "DEFAULT_DT"]
+__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "contact_material",
+           "link_materials", "storey_material", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
 DEFAULT_DT = 1.0e-4
@@ -141,7 +142,7 @@ def _prepare(model, record=None, xi=None, duration=None):
     return model, motion, float(end_time)
 
 
-def _contact_material(law, gap: float) -> tuple[list, list[str]]:
+def contact_material(law, gap: float) -> tuple[list, list[str]]:
     """OpenSees material arguments (after the tag) for one gap element, and warnings."""
     from pounding.contact.laws import Hertz, HertzDamp, Linear
 
@@ -164,7 +165,7 @@ def _contact_material(law, gap: float) -> tuple[list, list[str]]:
 _PART_TAG_OFFSET = 1_000_000
 
 
-def _link_materials(law, element: int) -> list[list]:
+def link_materials(law, element: int) -> list[list]:
     """OpenSees materials of one link: ``[tag, type, args...]`` rows, the last one the element's (tag *element*)."""
     from pounding.contact.links import KelvinLink, MaxwellLink, ViscousLink
 
@@ -181,7 +182,7 @@ def _link_materials(law, element: int) -> list[list]:
                         "(supported: viscous, kelvin, maxwell)")
 
 
-def _storey_material(law, stiffness: float, height: float) -> list:
+def storey_material(law, stiffness: float, height: float) -> list:
     """OpenSees material arguments (after the tag) of a storey: Elastic, Steel01 or BoucWen."""
     from pounding.hysteresis import BilinearStorey, BoucWenStorey
 
@@ -278,7 +279,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
             below = ground if level == 1 else floor_node[(b_index, level - 1)]
             k, h, law = float(b.stiffness[level - 1]), float(b.height[level - 1]), b.hysteresis[level - 1]
             storeys.append((element, below, floor_node[(b_index, level)], k, f"{b.name}:{level}", h,
-                            _storey_material(law, k, h)))
+                            storey_material(law, k, h)))
             elements.append(element)
         if b.p_delta:
             for level, kg in enumerate(b.p_delta_stiffness, start=1):
@@ -315,7 +316,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
                                 "joins floor nodes only (a column point needs a column element): export a model "
                                 "with floor-to-floor and wall contacts only")
         element += 1
-        material, warnings = _contact_material(g.law, g.gap)
+        material, warnings = contact_material(g.law, g.gap)
         for w in warnings:
             if w not in notes:
                 notes.append(w)
@@ -328,7 +329,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
     for link in model.links:
         element += 1
         links.append((element, floor_node[(link.left, link.level_left)], floor_node[(link.right, link.level_right)],
-                      _link_materials(link.law, element),
+                      link_materials(link.law, element),
                       f"{names[link.left]}:{link.level_left}-{names[link.right]}:{link.level_right}"))
 
     n_samples = min(motion.acceleration.size, int(math.ceil(end_time / motion.time_step - 1e-9)) + 1)

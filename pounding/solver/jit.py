@@ -36,7 +36,7 @@ from typing import Iterable
 
 __all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "shortcuts_supported", "load_registries_without_scipy",
            "load_from_cache_without_refresh",
-           "stamp_caches_with_sources", "source_stamp"]
+           "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES"]
 
 #: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with
 #: the ``numba`` pin in pyproject.toml, and widen both only after tests/test_jit.py passes.
@@ -123,9 +123,15 @@ def load_from_cache_without_refresh(dispatcher) -> None:
     cache.load_overload = load_overload
 
 
+#: Source files compiled into every solver kernel besides the ones each stamp names: the modules of
+#: contact laws written in files of their own (pounding.solver.kernels adds them), so that editing
+#: one discards the cached solver as editing contact/laws.py does.
+EXTRA_SOURCES: list[str] = []
+
+
 def source_stamp(files: Iterable[str | os.PathLike]) -> tuple[float, int]:
-    """(newest modification time, total size) of *files*: numba's source stamp over several files."""
-    stats = [os.stat(f) for f in files]
+    """(newest modification time, total size) of *files* and :data:`EXTRA_SOURCES`: numba's source stamp."""
+    stats = [os.stat(f) for f in dict.fromkeys([*map(str, files), *EXTRA_SOURCES])]
     return max(s.st_mtime for s in stats), sum(s.st_size for s in stats)
 
 

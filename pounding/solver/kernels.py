@@ -9,6 +9,7 @@ Python objects inside.
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 from numba import njit
@@ -43,6 +44,59 @@ LINK_MAXWELL = links.LINK_MAXWELL
 FIRST_LINK_ID = links.FIRST_LINK_ID
 
 
+# --------------------------------------------------------------------------- #
+# Laws written in modules of their own (laws.LAW_MODULES; docs/adding-a-law.md).
+# Their kernels are plain Python functions (laws.LawKernels), compiled here; a
+# law's routine is reached through a chain of small compiled functions, one per
+# such law, selected by law_id.  The laws with branches of their own below are
+# registered first, so these ids start at FIRST_PLUGIN_ID.
+# --------------------------------------------------------------------------- #
+
+PLUGIN_LAWS = [cls for cls in laws.LAWS.values() if cls.kernels is not None]
+FIRST_PLUGIN_ID = min((cls.law_id for cls in PLUGIN_LAWS), default=FIRST_LINK_ID)
+if any(cls.law_id >= FIRST_PLUGIN_ID for cls in laws.LAWS.values() if cls.kernels is None) or \
+        max((cls.law_id for cls in laws.LAWS.values()), default=0) >= FIRST_LINK_ID:
+    raise RuntimeError(f"contact laws with kernels of their own are registered after the others and "
+                       f"below id {FIRST_LINK_ID}: {[(c.name, c.law_id) for c in laws.LAWS.values()]}")
+
+
+def _chain_end(law_id, *args):
+    return 0  # never reached: the callers test FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID
+
+
+def _chain_link(head, number, tail):
+    """Compiled ``f(law_id, *args)``: *head(*args)* for law *number*, else *tail*."""
+    def routine(law_id, *args):
+        if law_id == number:
+            return head(*args)
+        return tail(law_id, *args)
+    return njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)(routine)
+
+
+def _chain(routine: str):
+    """The compiled dispatch of one :class:`pounding.contact.laws.LawKernels` routine over the plugin laws."""
+    tail = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)(_chain_end)
+    for cls in reversed(PLUGIN_LAWS):
+        head = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True,
+                    **jit.NO_REFCOUNT)(getattr(cls.kernels, routine))
+        tail = _chain_link(head, cls.law_id, tail)
+    return tail
+
+
+_plugin_mode_force = _chain("mode_force")
+_plugin_potential = _chain("potential")
+_plugin_onset_constant = _chain("onset_constant")
+_plugin_onset_mode = _chain("onset_mode")
+_plugin_switch_count = _chain("switch_count")
+_plugin_switch_value = _chain("switch_value")
+_plugin_next_mode = _chain("next_mode")
+_plugin_snapped_internal = _chain("snapped_internal")
+_plugin_mode_internal_rate = _chain("mode_internal_rate")
+_plugin_implied_mode = _chain("implied_mode")
+_plugin_internal_tolerance = _chain("internal_tolerance")
+_plugin_contact_duration = _chain("contact_duration")
+
+
 @njit(cache=True, **jit.NO_REFCOUNT)
 def is_permanent(law_id: int) -> bool:
     """True for link elements (pounding.contact.links): always engaged, no gap, no events, tension allowed."""
@@ -64,6 +118,8 @@ def link_force(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q:
 @njit(cache=True, **jit.NO_REFCOUNT)
 def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
     """Per-impact constant fixed at the located gap closure (ξ for Hertz-damp, the rubber's ξb for a bumper)."""
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_onset_constant(law_id, prm, v0)
     if law_id == LAW_HERTZ_DAMP or law_id == LAW_BUMPER:
         return prm[1] * prm[0] / max(v0, prm[2])
     return 0.0
@@ -128,6 +184,8 @@ def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
         return 0.0
     if delta <= 0.0:
         return 0.0
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_potential(law_id, prm, delta, q)
     if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI:
         return prm[0] * delta * delta * math.sqrt(delta) / 2.5
     if law_id == LAW_LINEAR or law_id == LAW_KELVIN:
@@ -189,6 +247,8 @@ N_SWITCHES = 3
 @njit(cache=True, **jit.NO_REFCOUNT)
 def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
     """Mode of a contact at its located gap closure with approach velocity *v0* (m/s)."""
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_onset_mode(law_id, prm, v0)
     if law_id == LAW_JANKOWSKI:
         return MODE_APPROACH if v0 > 0.0 else MODE_RECEDE
     if law_id == LAW_STEREO:
@@ -199,6 +259,8 @@ def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
 @njit(cache=True, **jit.NO_REFCOUNT)
 def switch_count(law_id: int, prm: np.ndarray) -> int:
     """How many switch functions the law has (0: the force is one formula while closed)."""
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_switch_count(law_id, prm)
     if law_id == LAW_HERTZ_DAMP:
         return 1 if prm[3] == 0.0 else 0
     if law_id == LAW_KELVIN:
@@ -226,6 +288,8 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
         return link_force(law_id, prm, delta, delta_rate, q)
     if delta <= 0.0:
         return 0.0
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_mode_force(law_id, prm, impact_constant, mode, delta, delta_rate, q)
     if law_id == LAW_HERTZ_DAMP:
         if mode == MODE_CLAMPED:
             return 0.0
@@ -260,6 +324,8 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
 @njit(cache=True, **jit.NO_REFCOUNT)
 def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float) -> float:
     """Rate of the internal state in *mode* (N/s): the bilinear force follows K1 (elastic) or K2 (yielding)."""
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_mode_internal_rate(law_id, prm, mode, delta, delta_rate)
     if law_id == LAW_BILINEAR:
         if mode == MODE_ELASTIC:
             return prm[0] * delta_rate
@@ -289,6 +355,8 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
     hard face's clamp, ``±(kh + ξh·δ̇)`` (engaged modes only).  Units vary (only
     the sign is used); 1.0 for a switch the mode does not have.
     """
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_switch_value(law_id, prm, impact_constant, mode, which, delta, delta_rate, q)
     if law_id == LAW_HERTZ_DAMP and which == 0:
         g = prm[0] + impact_constant * delta_rate
         return g if mode == MODE_PUSH else -g
@@ -321,6 +389,8 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
 @njit(cache=True, **jit.NO_REFCOUNT)
 def next_mode(law_id: int, mode: int, which: int) -> int:
     """Mode entered when switch function *which* of *mode* crosses zero."""
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_next_mode(law_id, mode, which)
     if law_id == LAW_BILINEAR:
         if mode == MODE_ELASTIC:
             return MODE_YIELD_TOP if which == 0 else MODE_YIELD_BOTTOM
@@ -342,6 +412,8 @@ def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delt
     its approach velocity ``δ̇`` (``p(e)·kh/max(δ̇, v_min)``), kept while engaged
     (clamp switches) and reset to 0 where it disengages.
     """
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_snapped_internal(law_id, prm, mode, delta, delta_rate, q)
     if law_id == LAW_BUMPER:
         if (mode & BUMPER_HARD) == 0:
             return 0.0
@@ -368,6 +440,8 @@ def implied_mode(law_id: int, prm: np.ndarray, impact_constant: float, delta: fl
     unloading, elastic otherwise.  Bumper: the hard face engaged where
     ``δ > δlim``, each clamp where its part would pull.  Other laws: 0.
     """
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_implied_mode(law_id, prm, impact_constant, delta, delta_rate, q)
     if law_id == LAW_HERTZ_DAMP or law_id == LAW_KELVIN or law_id == LAW_BUMPER:
         mode = 0
         first = 0
@@ -418,6 +492,8 @@ def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float,
 @njit(cache=True, **jit.NO_REFCOUNT)
 def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -> float:
     """Absolute error tolerance of the internal state (N): K1·atol for the bilinear force, 0 if unused."""
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_internal_tolerance(law_id, prm, atol_displacement)
     if law_id == LAW_BILINEAR or law_id == LINK_MAXWELL:
         return prm[0] * atol_displacement
     return 0.0
@@ -431,6 +507,8 @@ def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: fl
     (physics.md §2; the rubber's kb for a bumper); linear-type laws: the half period ``π·sqrt(m/k)`` (K1 for
     the bilinear law).  Used only to choose the first step inside a contact.
     """
+    if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
+        return _plugin_contact_duration(law_id, prm, v0, effective_mass)
     v = max(v0, 1e-12)
     m = effective_mass
     if law_id == LAW_HERTZ_DAMP or law_id == LAW_HERTZ or law_id == LAW_JANKOWSKI or law_id == LAW_BUMPER:
@@ -455,5 +533,6 @@ def rest_velocity(law_id: int, prm: np.ndarray) -> float:
 
 
 # The kernels inline the law ids and sizes of contact/laws.py: their cached code is stale when it changes.
+jit.EXTRA_SOURCES.extend(sys.modules[cls.__module__].__file__ for cls in PLUGIN_LAWS)  # compiled into every solver
 jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
                               [__file__, laws.__file__, links.__file__])

@@ -59,7 +59,10 @@ Models (keys)
 * ``jankowski``: ``β = kh``;
 * ``bilinear``: Muthukumar's element with ``kh``, ``δm`` = the Hertz
   ``δmax`` above, yield ratio 0.1;
-* ``stereo-mechanical``: instantaneous jump.
+* ``stereo-mechanical``: instantaneous jump;
+* every law written in a module of its own (:data:`OWN_ROW_LAWS`, e.g.
+  ``mahmoud-jankowski``), with the law its class returns for the ball drop
+  (``ContactLaw.for_ball_drop``).
 
 ``gravity = 0``: the ball cannot fall, so it is given the impact velocity of
 the drop under standard gravity, ``sqrt(2·9.81·h)``, and the contact is then a
@@ -93,6 +96,7 @@ __all__ = [
     "TABLE_I_E_PRE",
     "DEFAULT_E_PRE",
     "OTHER_MODELS",
+    "OWN_ROW_LAWS",
     "RIGID_MASS",
     "STANDARD_GRAVITY",
     "model_keys",
@@ -132,9 +136,15 @@ TABLE_I_MISPRINTS: dict[tuple[str, float], float] = {("lankarani-nikravesh", 1.0
 
 DEFAULT_E_PRE: tuple[float, ...] = TABLE_I_E_PRE
 
-#: Models other than the Hertz-damp ξ formulas.
+#: Laws that give their own ball-drop row (``ContactLaw.for_ball_drop``): the laws written in modules of
+#: their own (docs/adding-a-law.md), each under its name.
+OWN_ROW_LAWS: dict[str, type[contact.ContactLaw]] = {
+    name: cls for name, cls in contact.LAWS.items()
+    if cls.for_ball_drop(0.5, mass=0.5, kh=2.0e9, v0=3.0) is not None}
+
+#: Models other than the Hertz-damp ξ formulas: the rows written here, then :data:`OWN_ROW_LAWS`.
 OTHER_MODELS: tuple[str, ...] = ("hertz", "linear", "kelvin", "kelvin-allow", "jankowski", "bilinear",
-                                 "stereo-mechanical")
+                                 "stereo-mechanical", *OWN_ROW_LAWS)
 
 #: Mass standing for the rigid surface (kg): m·1e30/(m + 1e30) = m in double precision.
 RIGID_MASS = 1.0e30
@@ -218,6 +228,8 @@ def make_law(model_key: str, e_pre: float, *, mass: float, kh: float, v0: float)
                                 yield_ratio=BILINEAR_YIELD_RATIO)
     if key == "stereo-mechanical":
         return contact.StereoMechanical(restitution=e_pre)
+    if key in OWN_ROW_LAWS:
+        return OWN_ROW_LAWS[key].for_ball_drop(e_pre, mass=mass, kh=kh, v0=v0)
     raise AssertionError(key)  # pragma: no cover - resolve_model guards this
 
 
@@ -527,6 +539,8 @@ def _published(e_grid: np.ndarray) -> np.ndarray:
 def _law_description(key: str) -> str:
     if key in xi_formulas.FORMULAS:
         return f"hertz-damp, xi = {key}: p(e) = {xi_formulas.FORMULAS[key].expression}"
+    if key in OWN_ROW_LAWS:
+        return f"{key}: {(OWN_ROW_LAWS[key].for_ball_drop.__doc__ or '').strip().splitlines()[0]}"
     return {
         "hertz": "hertz, F = kh delta^1.5",
         "linear": "linear, k = kh sqrt(delta_max) (Hertz secant at the ball's peak penetration)",
