@@ -604,6 +604,7 @@ def law_from_mapping(fields: dict) -> ContactLaw:
 #: Contact laws written in modules of their own, one line each: importing a module registers its law
 #: (after the laws above, so their ids stay put).  docs/adding-a-law.md.
 LAW_MODULES: tuple[str, ...] = (
+    "pounding.contact.mahmoud_jankowski",
 )
 for _module in LAW_MODULES:
     importlib.import_module(_module)
