@@ -32,7 +32,8 @@ OpenSeesPy and runs it under the same record:
 * each gap element a ``zeroLength`` from the left floor to the right floor
   with ``uniaxialMaterial Hertzdamp Kh xiNorm −gap`` (``xiNorm = p(e)`` of the
   chosen ξ formula) and ``-doRayleigh 0`` (``hertz`` exports as ``xiNorm = 0``,
-  ``linear`` as ``ElasticPPGap``);
+  ``linear`` as ``ElasticPPGap``, ``bilinear`` as ``ImpactMaterial K1 K2 −δy −gap``,
+  the same parallelogram loop; other laws are refused by name in one line);
 * each link (``links:``, a permanent damper between two floors) a
   ``zeroLength`` from the left floor to the right floor with ``-doRayleigh 0``
   and the material of its law: ``Viscous(c, 1)`` (linear viscous),
@@ -60,6 +61,12 @@ peer converges slowly once impacts start):
 * it has no ``min_impact_velocity`` floor on v0;
 * it never clamps tension: a model with ``tension: clamp`` exports with a
   warning; compare against ``tension: allow`` (:func:`allow_tension`);
+* ``ImpactMaterial`` (``bilinear``) updates its force from the last
+  committed strain: in the step in which the gap closes the force starts
+  from K1 times the whole strain increment, the open part of the step
+  included (then capped by the loop's upper line), where our solver starts
+  it at the located closure — an overshoot of at most K1 times the open part
+  of one step, which vanishes with dt;
 * peaks are read at the committed steps and an impact shorter than one step
   can be missed;
 * the script always runs to the end: it does not stop at
@@ -83,7 +90,7 @@ from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
 __all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "contact_material",
-           "link_materials", "storey_material", "DEFAULT_DT"]
+           "link_materials", "storey_material", "BILINEAR_NOTE", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
 DEFAULT_DT = 1.0e-4
@@ -144,7 +151,7 @@ def _prepare(model, record=None, xi=None, duration=None):
 
 def contact_material(law, gap: float) -> tuple[list, list[str]]:
     """OpenSees material arguments (after the tag) for one gap element, and warnings."""
-    from pounding.contact.laws import Hertz, HertzDamp, Linear
+    from pounding.contact.laws import Bilinear, Hertz, HertzDamp, Linear
 
     if isinstance(law, HertzDamp):
         notes = []
@@ -157,8 +164,19 @@ def contact_material(law, gap: float) -> tuple[list, list[str]]:
     if isinstance(law, Linear):
         # Compression-only elastic gap: ElasticPPGap E Fy gap with a yield force it never reaches.
         return ["ElasticPPGap", float(law.k), -1.0e30, -float(gap)], []
+    if isinstance(law, Bilinear):
+        # Muthukumar's element is OpenSees' ImpactMaterial K1 K2 δy gap, compression negative: our K2 > 0
+        # check (kernel_parameters) first, so a loop that cannot be built is refused as in a run.
+        k1, k2, dy = (float(x) for x in law.kernel_parameters(1.0, 1.0)[:3])
+        return ["ImpactMaterial", k1, k2, -dy, -float(gap)], [BILINEAR_NOTE]
     raise PoundingError(f"contact law '{law.name}' has no OpenSees counterpart in this exporter "
-                        "(supported: hertz-damp, hertz, linear)")
+                        "(supported: hertz-damp, hertz, linear, bilinear)")
+
+
+#: What an exported ``law: bilinear`` contact does differently (OpenSees' ImpactMaterial::setTrialStrain).
+BILINEAR_NOTE = ("bilinear (ImpactMaterial): in the step in which a gap closes, OpenSees starts the force from "
+                 "K1 times the whole strain increment of that step, the part still open included (capped by the "
+                 "loop's upper line); our solver starts it at the located closure")
 
 
 #: Material tags of the parts of a Parallel link material: this offset plus 2·element (+1).
