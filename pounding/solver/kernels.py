@@ -60,6 +60,10 @@ if any(cls.law_id >= FIRST_PLUGIN_ID for cls in laws.LAWS.values() if cls.kernel
                        f"below id {FIRST_LINK_ID}: {[(c.name, c.law_id) for c in laws.LAWS.values()]}")
 
 
+#: numba options of a dispatch-chain function: cached, called from compiled code only, no reference counting.
+_CHAIN_OPTIONS = dict(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+
+
 def _chain_end(law_id, *args):
     return 0  # never reached: the callers test FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID
 
@@ -70,19 +74,18 @@ def _chain_link(head, number, tail):
         if law_id == number:
             return head(*args)
         return tail(law_id, *args)
-    return njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)(routine)
+    return njit(**_CHAIN_OPTIONS)(routine)
 
 
 def _chain(routine: str):
     """The compiled dispatch of one :class:`pounding.contact.laws.LawKernels` routine over the plugin laws."""
-    tail = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)(_chain_end)
+    tail = njit(**_CHAIN_OPTIONS)(_chain_end)
     for cls in reversed(PLUGIN_LAWS):
-        head = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True,
-                    **jit.NO_REFCOUNT)(getattr(cls.kernels, routine))
-        tail = _chain_link(head, cls.law_id, tail)
+        tail = _chain_link(njit(**_CHAIN_OPTIONS)(getattr(cls.kernels, routine)), cls.law_id, tail)
     return tail
 
 
+# One chain per LawKernels routine (named globals: the kernels below call them by name).
 _plugin_mode_force = _chain("mode_force")
 _plugin_potential = _chain("potential")
 _plugin_onset_constant = _chain("onset_constant")
