@@ -63,6 +63,11 @@ class StoreyHysteresis(BaseModel):
     reference: ClassVar[str]
     #: Checks of tests/test_registry_contract.py that apply to the model (its kind).
     checks: ClassVar[tuple[str, ...]] = ("dissipation_nonnegative",)
+    #: True if the model has modes whose switches the solver locates as storey events (yield onset,
+    #: unloading). The integrator's storey-event search handles modes for the bilinear model only
+    #: (pounding.solver.integrator tests ``model == MODEL_BILINEAR``); tests/test_registry_contract.py
+    #: holds this attribute to that rule until the search reads it from here.
+    has_modes: ClassVar[bool] = False
 
     model: str
     yield_force: Positive | None = Field(None, description="yield force F_y, N")
@@ -121,6 +126,7 @@ class BilinearStorey(StoreyHysteresis):
     """
 
     name: ClassVar[str] = "bilinear"
+    has_modes: ClassVar[bool] = True
     checks: ClassVar[tuple[str, ...]] = ("elastic_potential", "dissipation_nonnegative")
     reference: ClassVar[str] = "Chopra (2017) Dynamics of Structures §5.7; OpenSees Steel01 (no isotropic hardening)"
 
