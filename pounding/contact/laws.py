@@ -10,12 +10,15 @@ overlap) and its rate ``δ̇`` (m/s).
 Contract of a law
 -----------------
 ``law_id``
-    Integer that selects the branch of the compiled kernels below.
+    Integer that selects the branch of the compiled kernels: given by
+    :func:`register` (the law's place in :data:`LAWS`), never by hand.
 ``kernel_parameters(mass_left, mass_right)``
     A float64 vector of length :data:`N_PARAMETERS` handed to the kernels.
-``force(law_id, prm, impact_constant, δ, δ̇, q)``
+``mode_force(law_id, prm, impact_constant, mode, δ, δ̇, q)``
     Contact force (N, ≥ 0 unless the law allows tension) while the contact is
-    closed.  ``impact_constant`` is fixed once per impact by
+    closed, in the contact's mode (:mod:`pounding.solver.kernels`);
+    ``force(law_id, prm, impact_constant, δ, δ̇, q)`` is the same routine in
+    the mode the state implies.  ``impact_constant`` is fixed once per impact by
     ``onset_constant`` at the located instant of gap closure; ``q`` is the
     law's internal state (the hysteretic force of the bilinear law), reset to
     0 at every gap closure and advanced by ``internal_rate``.
@@ -28,8 +31,17 @@ Contract of a law
 ``potential(law_id, prm, δ, q)``
     Elastic energy stored in the contact (J), for the energy audit.
 
-Adding a law is one subclass with its citation, one ``register`` line and one
-branch in each compiled kernel of :mod:`pounding.solver.kernels`.
+``onset_xi``, ``checks``, ``kernels``, ``for_ball_drop``
+    Whether the per-impact constant is a ξ the archive reports; the checks of
+    tests/test_registry_contract.py that apply; the law's own compiled
+    behaviour (:class:`LawKernels`) and its ball-drop row, for a law written
+    in a module of its own.
+
+The laws of this module have their compiled branches in
+:mod:`pounding.solver.kernels`.  A new law is one module of its own with its
+class and its :class:`LawKernels`, one line in :data:`LAW_MODULES` and one
+row of tests/data/registry_examples.yaml (docs/adding-a-law.md;
+:mod:`pounding.contact.mahmoud_jankowski` is the example).
 """
 
 from __future__ import annotations

@@ -3,7 +3,12 @@
 The law classes (parameters, citations, packing into ``prm``) are in
 :mod:`pounding.contact.laws`; these are their numba kernels, one branch per
 law, inlined by the integrator (:mod:`pounding.solver.integrator`).  No
-Python objects inside.
+Python objects inside.  Each law's force is written once, in
+:func:`mode_force`; :func:`force` is that routine in the mode the state
+implies (:func:`implied_mode`).  Laws written in modules of their own
+(``laws.LAW_MODULES``) bring their kernels as plain functions
+(``laws.LawKernels``), compiled and dispatched here by ``law_id``
+(docs/adding-a-law.md).
 """
 
 from __future__ import annotations
