@@ -378,7 +378,7 @@ def test_a_run_reported_collapsed_counts_as_collapse_and_keeps_its_residual_drif
     assert ds.status.values.item() == "collapsed"
     assert (ds.collapsed.values == 1).all()                         # every building
     assert (ds.max_drift_ratio.values < 0.5).all()                  # though far below the limit...
-    hit = ida._exceeds(ds, 0.5)
+    hit = ida.exceeds(ds, 0.5)
     assert (hit == 1).all()                                         # ...it counts as exceeding it
     np.testing.assert_allclose(ds.residual_drift_ratio.values[0, 0, 0], np.linspace(-0.01, 0.02, 13))
 
@@ -459,8 +459,10 @@ def test_runs_of_one_template_reuse_its_model_and_record_and_give_the_fresh_runs
         return fresh_model(*args, **kwargs)
 
     monkeypatch.setattr(model_module, "model_from_data", counting_model_from_data)
-    monkeypatch.setattr(ida, "_TEMPLATES", type(ida._TEMPLATES)())
-    monkeypatch.setattr(ida, "_TEMPLATES_KEPT", 2)
+    from pounding.studies.ida import runs
+
+    monkeypatch.setattr(runs, "_TEMPLATES", type(runs._TEMPLATES)())
+    monkeypatch.setattr(runs, "_TEMPLATES_KEPT", 2)
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.2,0.9", without_contacts=True, duration=4.0)
     with_0, without_0, with_1 = ("with_contacts", 0), ("without_contacts", 0), ("with_contacts", 1)
     # (template, level, validated afresh?) with two templates kept, least recently used dropped first
