@@ -10,9 +10,9 @@ import pytest
 @pytest.fixture(scope="module")
 def client():
     """One 2-worker LocalCluster (one process per worker) for the tests of a module."""
-    from pounding.studies import sweep
+    from pounding.studies.engine import execution
 
-    c, cluster = sweep.start_client(workers=2)
+    c, cluster = execution.start_client(workers=2)
     yield c
     c.close()
     cluster.close()

@@ -49,7 +49,7 @@ def client():
 @pytest.fixture
 def in_process(client, monkeypatch):
     """The CLI's studies run on the in-process cluster (no worker start-up; monkeypatches reach the runs)."""
-    from pounding.studies.sweep import execution
+    from pounding.studies.engine import execution
 
     monkeypatch.setattr(execution, "start_client", lambda **_: (client, None))
     # the study closes the client it started: keep this one open
@@ -66,7 +66,7 @@ def _run(argv, capsys):
 @pytest.fixture(scope="module")
 def stripes(tmp_path_factory, client):
     """A fixed-stripe IDA with and without contacts, written by the CLI."""
-    from pounding.studies.sweep import execution
+    from pounding.studies.engine import execution
 
     out = tmp_path_factory.mktemp("ida") / "ida.nc"
     original = execution.start_client
@@ -421,7 +421,7 @@ def test_every_scenario_text_is_the_yaml_of_its_own_data():
     import yaml
 
     from pounding.studies.gap import OPEN_GAP
-    from pounding.studies.sweep.spec import scenario_key
+    from pounding.studies.engine.keys import scenario_key
 
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.1,0.30000000000000004,1e-05,123456.789",
                               without_contacts=True, duration=3.0)

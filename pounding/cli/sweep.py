@@ -7,9 +7,10 @@ import sys
 from pathlib import Path
 
 from pounding.errors import PoundingError
-from pounding.studies.sweep.execution import default_workers, failure_report, run_sweep
+from pounding.studies.engine.execution import default_workers
+from pounding.studies.sweep.execution import failure_report, run_sweep
 from pounding.studies.sweep.spec import load_sweep
-from pounding.studies.sweep.store import parts_dir
+from pounding.studies.engine.store import parts_dir
 
 __all__ = ["register_cli", "add_cluster_options", "check_study_options", "summary_lines", "raise_if_all_failed"]
 

@@ -29,7 +29,7 @@ import xarray as xr
 
 from pounding.errors import PoundingError
 
-__all__ = ["plot_run", "plot_sweep", "pyplot", "storey_spans", "draw_drift_profile", "finish_drift_axes"]
+__all__ = ["plot_run", "plot_sweep", "plot_directory", "pyplot", "storey_spans", "draw_drift_profile", "finish_drift_axes"]
 
 
 def pyplot():
@@ -295,7 +295,7 @@ def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float
     list of pathlib.Path
         The PNG files written.
     """
-    out = _directory(directory)
+    out = plot_directory(directory)
     plt = pyplot()
     written = []
     for name, draw in (("contact_displacements.png", _contact_displacements),
@@ -313,10 +313,11 @@ def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float
     return written
 
 
-def _directory(directory: str | os.PathLike) -> Path:
+def plot_directory(directory: str | os.PathLike) -> Path:
+    """The ``--plot`` folder, created if missing; refused in one line if it is a file."""
     out = Path(directory)
     if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; give a directory for the plots")
+        raise PoundingError(f"{out} is a file; --plot needs a directory")
     out.mkdir(parents=True, exist_ok=True)
     return out
 
@@ -328,7 +329,7 @@ def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
     a line per building at the mean over the other dimensions, with a band
     from their minimum to their maximum.  Failed scenarios are left out.
     """
-    out = _directory(directory)
+    out = plot_directory(directory)
     plt = pyplot()
     names = list(dict.fromkeys(str(b) for b in ds.storey_building.values))
     dims = [d for d in ds.status.dims if ds.sizes[d] > 1] or list(ds.status.dims[:1])

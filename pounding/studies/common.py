@@ -1,20 +1,19 @@
-"""What every study shares: the ``--records`` option, a study's record sweep, option checks, plot folders.
+"""What every study shares: the ``--records`` option, a study's record sweep, option checks.
 
 ``compare``, ``gap`` and ``ida`` each run a model over a list of records on
-the sweep engine; they read their options and build their sweep here, the
-same way.
+the study engine (:mod:`pounding.studies.engine`); they read their options
+and build their record sweep here, the same way.
 """
 
 from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 from typing import Any
 
 from pounding.errors import PoundingError
 
-__all__ = ["record_list", "record_values", "study_sweep", "check_duration", "plot_directory", "finite_or_none"]
+__all__ = ["record_list", "record_values", "study_sweep", "check_duration", "finite_or_none"]
 
 
 def record_list(text: str | list[str] | None) -> list[str] | None:
@@ -78,15 +77,6 @@ def check_duration(duration: float | None) -> float | None:
     if not duration > 0:
         raise PoundingError(f"--duration must be > 0 (got {duration:g})")
     return float(duration)
-
-
-def plot_directory(directory: str | os.PathLike) -> Path:
-    """The ``--plot`` folder, created if missing; refused in one line if it is a file."""
-    out = Path(directory)
-    if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; --plot needs a directory")
-    out.mkdir(parents=True, exist_ok=True)
-    return out
 
 
 def finite_or_none(value: Any) -> float | None:

@@ -174,8 +174,7 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     fewer than 3 records the distribution is a strip plot (every record a
     dot), not boxes.
     """
-    from pounding.results.plots import draw_drift_profile, finish_drift_axes, pyplot, storey_spans
-    from pounding.studies.common import plot_directory
+    from pounding.results.plots import draw_drift_profile, finish_drift_axes, plot_directory, pyplot, storey_spans
 
     out = plot_directory(directory)
     plt = pyplot()

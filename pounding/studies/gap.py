@@ -230,8 +230,8 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     """
     from pounding.model.model import model_from_text
     from pounding.simulation import simulate
-    from pounding.studies.sweep.scenario import one_line
-    from pounding.studies.sweep.spec import PARTS_FORMAT
+    from pounding.studies.engine.keys import PARTS_FORMAT
+    from pounding.studies.engine.tasks import one_line
 
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": GAP_PART,
@@ -521,8 +521,7 @@ def gap_table(ds) -> str:
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
-    from pounding.results.plots import pyplot
-    from pounding.studies.common import plot_directory
+    from pounding.results.plots import plot_directory, pyplot
 
     plt = pyplot()
     out = plot_directory(directory)

@@ -65,10 +65,9 @@ Modules
 from __future__ import annotations
 
 import os
-from dataclasses import replace
 
 from pounding.studies.ida.dataset import MAX_BETA, assemble_ida_dataset, exceeds, ida_fragility
-from pounding.studies.ida.hunt import next_hunt_level, run_hunt
+from pounding.studies.ida.hunt import HuntTasks, next_hunt_level, run_hunt
 from pounding.studies.ida.plan import (DEFAULT_LIMITS, IM_NAMES, MAX_LEVELS, SA_DAMPING, SCALINGS, VARIANTS, Hunt,
                                        IdaPlan, IntensityMeasure, build_ida_plan, limit_label, parse_intensity,
                                        parse_levels, parse_limits)
@@ -77,27 +76,28 @@ from pounding.studies.ida.runs import IDA_PART, building_drifts, collapsed_in, r
 
 __all__ = ["IDA_PART", "VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "MAX_BETA", "SA_DAMPING",
            "IntensityMeasure", "Hunt", "IdaPlan", "parse_levels", "parse_limits", "build_ida_plan",
-           "run_ida_scenario", "next_hunt_level", "run_hunt", "ida_study", "assemble_ida_dataset", "ida_fragility",
+           "run_ida_scenario", "next_hunt_level", "HuntTasks", "run_hunt", "ida_study", "assemble_ida_dataset", "ida_fragility",
            "ida_summary", "ida_table", "plot_ida", "run_outcome", "parse_intensity", "limit_label", "exceeds",
            "building_drifts", "collapsed_in"]
 
 
 def ida_study(plan: IdaPlan, output: str | os.PathLike | None = None, **run_options):
-    """Run the IDA of *plan* (stripes on the sweep engine, hunt on futures); returns its dataset.
+    """Run the IDA of *plan* on the study engine (stripes: a static list; hunt: :class:`HuntTasks`).
 
-    *run_options* go to :func:`pounding.studies.sweep.execution.run_sweep`
-    or :func:`run_hunt` (workers, scheduler, client, progress, overwrite...).
+    *run_options* go to :func:`pounding.studies.engine.execution.run_study`
+    (workers, scheduler, client, progress, overwrite...).
     """
-    from pounding.studies.sweep.execution import run_sweep
+    from pounding.studies.engine.execution import run_study
+    from pounding.studies.sweep.execution import sweep_tasks
 
     if plan.hunt is not None:
         return run_hunt(plan, output, **run_options)
     scenarios = plan.stripe_scenarios()
-    sweep = replace(plan.sweep, _scenarios=scenarios)
     entries = [(v, r, float(level), plan.scenario(v, r, float(level)).key) for v in plan.variants
                for r in range(len(plan.records)) for level in plan.levels]
 
     def assemble(_sweep, results, *, elapsed=float("nan"), ran=0):
         return assemble_ida_dataset(plan, results, entries, elapsed=elapsed, ran=ran)
 
-    return run_sweep(sweep, output, runner=run_ida_scenario, assemble=assemble, **run_options)
+    tasks = sweep_tasks(plan.sweep, runner=run_ida_scenario, assemble=assemble, scenarios=scenarios)
+    return run_study(tasks, output, **run_options)

@@ -220,9 +220,9 @@ class IdaPlan:
         return float(self.factor(record, level_g) * self.im_stored[record])
 
     def scenario(self, variant: str, record: int, level_g: float):
-        """The :class:`~pounding.studies.sweep.spec.Scenario` of one run (cached)."""
-        from pounding.studies.sweep.spec import Scenario, code_fingerprint, content_key, record_fingerprint, \
-            scenario_key
+        """The :class:`~pounding.studies.engine.tasks.Scenario` of one run (cached)."""
+        from pounding.studies.engine.keys import code_fingerprint, content_key, record_fingerprint, scenario_key
+        from pounding.studies.engine.tasks import Scenario
 
         cache_key = (variant, record, float(level_g))
         if cache_key in self._cache:

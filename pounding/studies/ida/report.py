@@ -133,8 +133,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     ``fragility.png`` (fitted curves with the stripe fractions as points), per building."""
     from scipy.special import ndtr
 
-    from pounding.results.plots import pyplot
-    from pounding.studies.common import plot_directory
+    from pounding.results.plots import plot_directory, pyplot
 
     plt = pyplot()
     out = plot_directory(directory)

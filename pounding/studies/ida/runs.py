@@ -76,8 +76,8 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     are stored as None (JSON has no NaN).
     """
     from pounding.simulation import simulate_peaks
-    from pounding.studies.sweep.scenario import one_line
-    from pounding.studies.sweep.spec import PARTS_FORMAT
+    from pounding.studies.engine.keys import PARTS_FORMAT
+    from pounding.studies.engine.tasks import one_line
 
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": IDA_PART,
