@@ -1,6 +1,6 @@
 """Compare ξ formulas on storey drifts: ``pounding compare MODEL.yaml --xi ye,lankarani-nikravesh,exact``.
 
-A sweep (:mod:`pounding.sweep`) over the ξ formula of every hertz-damp
+A sweep (:mod:`pounding.studies.sweep`) over the ξ formula of every hertz-damp
 contact × a list of records.  For each building it prints the peak storey
 drift ratio profile of each formula (mean over the records) and its
 difference from the reference formula (``exact`` by default): for each
@@ -90,7 +90,7 @@ def compare(model: str | os.PathLike, formulas: str | list[str] = ("ye", "lankar
     duration : float, optional
         Simulated time, s.
     run_options
-        Passed to :func:`pounding.sweep.run_sweep` (workers, scheduler, client, progress, overwrite...).
+        Passed to :func:`pounding.studies.sweep.execution.run_sweep` (workers, scheduler, client, progress, overwrite...).
     """
     from pounding.studies.sweep.execution import run_sweep
 

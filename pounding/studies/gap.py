@@ -443,7 +443,7 @@ def gap_study(model: str | os.PathLike, records: str | list[str] | None = None, 
               duration: float | None = None, output: str | os.PathLike | None = None, **run_options):
     """Run the gap study of *model* over *records*; returns its dataset (see :func:`assemble_gap_dataset`).
 
-    *run_options* go to :func:`pounding.studies.sweep.execution.run_sweep`
+    *run_options* go to :func:`pounding.studies.sweep.execution.run_sweep` and the study engine
     (workers, scheduler, client, progress, overwrite...).
     """
     from pounding.studies.sweep.execution import run_sweep
