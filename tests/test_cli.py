@@ -99,7 +99,7 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
             "            ('matplotlib', 'distributed', 'tqdm')], 'matplotlib, distributed or tqdm imported'; "
             "other = [m for m in ('studies.sweep', 'studies.compare', 'studies.verify', 'studies.engine', "
             "                    'studies.ida', 'export.opensees', 'cli.sweep', 'cli.compare', 'cli.records', "
-            "                    'cli.export', 'cli.verify') "
+            "                    'cli.export', 'cli.verify', 'results.plots') "
             "         if 'pounding.' + m in sys.modules]; "
             "assert not other, f'other subcommands imported: {other}'; "
             "sys.exit(status)")
