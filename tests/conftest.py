@@ -18,6 +18,18 @@ def client():
     cluster.close()
 
 
+@pytest.fixture(scope="module")
+def in_process_client():
+    """A LocalCluster of threads in this process (no worker start-up; monkeypatches reach the runs)."""
+    from dask.distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0")
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """Under CI (``CI=true``), a skipped test fails the run: CI installs every peer, so a skip is a missing install."""
     if os.environ.get("CI", "").strip().lower() not in ("1", "true", "yes"):

@@ -10,7 +10,6 @@ import hashlib
 from typing import Any
 
 import numpy as np
-import pytest
 import xarray as xr
 
 from pounding.studies.engine.execution import run_study
@@ -19,18 +18,6 @@ from pounding.studies.engine.store import parts_dir
 from pounding.studies.engine.tasks import Scenario, StaticTasks, TaskSource
 
 STUDY = "toy-1"
-
-
-@pytest.fixture(scope="module")
-def threads():
-    """An in-process cluster: the toy runner needs no worker processes."""
-    from dask.distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0")
-    client = Client(cluster)
-    yield client
-    client.close()
-    cluster.close()
 
 
 def square(task: dict[str, Any]) -> dict[str, Any]:
@@ -83,7 +70,7 @@ class Doubling(TaskSource):
         return dataset(self.ran, results)
 
 
-def test_a_static_list_runs_once_and_resumes_from_its_parts(threads, tmp_path):
+def test_a_static_list_runs_once_and_resumes_from_its_parts(in_process_client, tmp_path):
     out = tmp_path / "static.nc"
     scenarios = [toy(x) for x in range(5)]
 
@@ -91,29 +78,29 @@ def test_a_static_list_runs_once_and_resumes_from_its_parts(threads, tmp_path):
         return StaticTasks(lambda: listed, lambda results, **_: dataset(listed, results), name="static",
                            label="<static>", model_name="toy", runner=square, inputs=[])
 
-    first = run_study(source(scenarios), out, client=threads, progress=False, keep_parts=True)
+    first = run_study(source(scenarios), out, client=in_process_client, progress=False, keep_parts=True)
     assert first.value.values.tolist() == [0, 1, 4, 9, 16] and first.attrs["n_stale"] == 0
     assert len(list(parts_dir(out).glob("*.json"))) == 5
     notes: list[str] = []
-    again = run_study(source(scenarios), out, client=threads, progress=False, overwrite=True, log=notes.append)
+    again = run_study(source(scenarios), out, client=in_process_client, progress=False, overwrite=True, log=notes.append)
     assert again.value.values.tolist() == [0, 1, 4, 9, 16]
     assert notes == [f"5 of 5 scenarios already done (in {parts_dir(out)}); running the other 0"]
     assert not parts_dir(out).exists()          # removed once the file is written
 
 
-def test_an_adaptive_source_gets_its_next_scenarios_from_each_result_and_replays_on_resume(threads, tmp_path):
+def test_an_adaptive_source_gets_its_next_scenarios_from_each_result_and_replays_on_resume(in_process_client, tmp_path):
     out = tmp_path / "adaptive.nc"
-    first = run_study(Doubling(16), out, client=threads, progress=False, keep_parts=True)
+    first = run_study(Doubling(16), out, client=in_process_client, progress=False, keep_parts=True)
     assert first.value.values.tolist() == [1, 4, 16, 64, 256]
     assert first.attrs["n_stale"] == 0 and first.attrs["n_invalid_parts"] == 0
     notes: list[str] = []
-    longer = run_study(Doubling(64), out, client=threads, progress=False, overwrite=True, keep_parts=True,
+    longer = run_study(Doubling(64), out, client=in_process_client, progress=False, overwrite=True, keep_parts=True,
                        log=notes.append)
     assert longer.value.values.tolist() == [1, 4, 16, 64, 256, 1024, 4096]
     assert notes == [f"5 runs already done (in {parts_dir(out)}); the study goes on from there"]
     # Parts of other code: one line, and every scenario runs again.
     notes.clear()
-    other = run_study(Doubling(64, code="v2"), out, client=threads, progress=False, overwrite=True,
+    other = run_study(Doubling(64, code="v2"), out, client=in_process_client, progress=False, overwrite=True,
                       log=notes.append)
     assert other.value.values.tolist() == longer.value.values.tolist()
     assert other.attrs["n_stale"] == 1          # the first run of the chain, found before anything ran

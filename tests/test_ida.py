@@ -36,14 +36,9 @@ LEVELS = "0.05:0.45:0.1"
 
 
 @pytest.fixture(scope="module")
-def client():
-    from dask.distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0")
-    c = Client(cluster)
-    yield c
-    c.close()
-    cluster.close()
+def client(in_process_client):
+    """This module's studies run on threads of the test process."""
+    return in_process_client
 
 
 @pytest.fixture
