@@ -174,7 +174,8 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     fewer than 3 records the distribution is a strip plot (every record a
     dot), not boxes.
     """
-    from pounding.results.plots import draw_drift_profile, finish_drift_axes, plot_directory, pyplot, storey_spans
+    from pounding.results.plots import (draw_drift_profile, finish_drift_axes, plot_directory, pyplot, save_figure,
+                                        storey_spans)
 
     out = plot_directory(directory)
     plt = pyplot()
@@ -226,10 +227,8 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     what = (f"mean over {n_records} records; lower panels: bars span the records" if n_records > 1
             else str(ds.record.values[0]))
     fig.suptitle(f"peak storey drift ratio per xi formula ({what})", fontsize=9)
-    fig.tight_layout()
     profiles = out / "xi_drift_profiles.png"
-    fig.savefig(profiles, dpi=110)
-    plt.close(fig)
+    save_figure(fig, profiles)
 
     # ---- distribution over records of each building's largest storey drift
     fig, axes = plt.subplots(2, len(buildings), figsize=(3.4 * len(buildings) + 0.6, 6.4), squeeze=False)
@@ -264,8 +263,6 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
                 ax.set_title(f"building {building}", fontsize=9)
     fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}"
                  + (" (boxes: quartiles and median, whiskers: 1.5 IQR; dots: records)" if n_records >= 3 else " (one dot per record)"), fontsize=9)
-    fig.tight_layout()
     distribution = out / "xi_drift_distribution.png"
-    fig.savefig(distribution, dpi=110)
-    plt.close(fig)
+    save_figure(fig, distribution)
     return [profiles, distribution]

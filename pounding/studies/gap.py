@@ -521,7 +521,7 @@ def gap_table(ds) -> str:
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
-    from pounding.results.plots import plot_directory, pyplot
+    from pounding.results.plots import plot_directory, pyplot, save_figure
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -551,8 +551,6 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower right")
     fig.suptitle(f"separation needed to avoid pounding, {int(ok.sum())} record(s)", fontsize=10)
-    fig.tight_layout()
     path = out / "gap_profile.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     return [path]

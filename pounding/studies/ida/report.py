@@ -133,7 +133,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     ``fragility.png`` (fitted curves with the stripe fractions as points), per building."""
     from scipy.special import ndtr
 
-    from pounding.results.plots import plot_directory, pyplot
+    from pounding.results.plots import plot_directory, pyplot, save_figure
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -185,10 +185,8 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="lower right")
     fig.suptitle(f"IDA curves, {ds.record.size} records; IM = {ds.attrs['im_description']}", fontsize=10)
-    fig.tight_layout()
     path = out / "ida_curves.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     paths.append(path)
 
     # Fragility curves: one panel per building, a colour per limit, solid with contacts, dashed without
@@ -233,9 +231,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
             ax.legend(handles, names, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
                       frameon=False)
     fig.suptitle(f"fragility, {ds.record.size} records ({ds.attrs['method']})", fontsize=10)
-    fig.tight_layout()
     path = out / "fragility.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     paths.append(path)
     return paths
