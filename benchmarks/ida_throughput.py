@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from pounding.studies.ida import build_ida_plan, ida_study, run_ida_scenario  # noqa: E402
-from pounding.studies.sweep.execution import start_client  # noqa: E402
+from pounding.studies.engine.execution import start_client  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402

@@ -10,9 +10,21 @@ import pytest
 @pytest.fixture(scope="module")
 def client():
     """One 2-worker LocalCluster (one process per worker) for the tests of a module."""
-    from pounding.studies import sweep
+    from pounding.studies.engine import execution
 
-    c, cluster = sweep.start_client(workers=2)
+    c, cluster = execution.start_client(workers=2)
+    yield c
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def in_process_client():
+    """A LocalCluster of threads in this process (no worker start-up; monkeypatches reach the runs)."""
+    from dask.distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0")
+    c = Client(cluster)
     yield c
     c.close()
     cluster.close()

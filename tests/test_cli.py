@@ -95,14 +95,33 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
             f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
             "status = console_main(); "
             "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
-            "other = [m for m in ('studies.sweep', 'studies.compare', 'studies.verify', 'export.opensees', "
-            "                    'cli.sweep', 'cli.compare', 'cli.records', 'cli.export') "
+            "assert not [m for m, v in sys.modules.items() if v is not None and m.split('.')[0] in "
+            "            ('matplotlib', 'distributed', 'tqdm')], 'matplotlib, distributed or tqdm imported'; "
+            "other = [m for m in ('studies.sweep', 'studies.compare', 'studies.verify', 'studies.engine', "
+            "                    'studies.ida', 'export.opensees', 'cli.sweep', 'cli.compare', 'cli.records', "
+            "                    'cli.export', 'cli.verify', 'results.plots') "
             "         if 'pounding.' + m in sys.modules]; "
             "assert not other, f'other subcommands imported: {other}'; "
             "sys.exit(status)")
+    _python_succeeds(code)
+    assert open_run(out).sizes["time"] == 301
+
+
+def test_the_command_line_imports_no_heavy_library_before_a_command_needs_it():
+    # `import pounding.cli` and the whole parser (`pounding --help` registers every subcommand)
+    # import none of dask, matplotlib, tqdm, xarray or numba: each handler imports what it needs.
+    code = ("import sys; import pounding, pounding.cli; from pounding.cli import build_parser; "
+            "build_parser(None).parse_args(['verify', '--models', 'ye']); "
+            "heavy = sorted({m.split('.')[0] for m in sys.modules} & "
+            "{'dask', 'distributed', 'matplotlib', 'tqdm', 'xarray', 'numba', 'pandas', 'scipy'}); "
+            "assert not heavy, f'imported: {heavy}'")
+    _python_succeeds(code)
+
+
+def _python_succeeds(code: str) -> None:
+    """Run *code* in a fresh interpreter (its imports are its own) and require exit status 0."""
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
-    assert open_run(out).sizes["time"] == 301
 
 
 def test_help_lists_every_subcommand_and_each_parses_its_own_options(capsys):

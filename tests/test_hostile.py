@@ -94,12 +94,13 @@ def test_sweep_keys_follow_record_content(tmp_path):
 
 
 def test_sweep_keys_follow_the_code(tmp_path, monkeypatch):
-    from pounding.studies.sweep import load_sweep, spec
+    from pounding.studies.engine import keys
+    from pounding.studies.sweep import load_sweep
 
     _write_case(tmp_path, base_model())
     (tmp_path / "s.yaml").write_text("model: model.yaml\naxes:\n  contacts[*].gap: [0.01]\n")
     key = load_sweep(tmp_path / "s.yaml").scenarios()[0].key
-    monkeypatch.setattr(spec, "_CODE_FINGERPRINT", ["another version of the code"])
+    monkeypatch.setattr(keys, "_CODE_FINGERPRINT", ["another version of the code"])
     assert load_sweep(tmp_path / "s.yaml").scenarios()[0].key != key
 
 
@@ -438,11 +439,11 @@ def test_internal_problem_type_does_not_leak(tmp_path):
 
 
 def test_two_sweeps_on_one_output(tmp_path):
-    from pounding.studies.sweep.store import sweep_lock
+    from pounding.studies.engine.store import sweep_lock
 
     target = tmp_path / "out.nc"
     with sweep_lock(target):
-        code = ("import sys; from pathlib import Path; from pounding.studies.sweep.store import sweep_lock\n"
+        code = ("import sys; from pathlib import Path; from pounding.studies.engine.store import sweep_lock\n"
                 f"with sweep_lock(Path({str(target)!r})): pass")
         done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
                               env=dict(os.environ, PYTHONPATH=str(ROOT)))

@@ -36,20 +36,15 @@ LEVELS = "0.05:0.45:0.1"
 
 
 @pytest.fixture(scope="module")
-def client():
-    from dask.distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0")
-    c = Client(cluster)
-    yield c
-    c.close()
-    cluster.close()
+def client(in_process_client):
+    """This module's studies run on threads of the test process."""
+    return in_process_client
 
 
 @pytest.fixture
 def in_process(client, monkeypatch):
     """The CLI's studies run on the in-process cluster (no worker start-up; monkeypatches reach the runs)."""
-    from pounding.studies.sweep import execution
+    from pounding.studies.engine import execution
 
     monkeypatch.setattr(execution, "start_client", lambda **_: (client, None))
     # the study closes the client it started: keep this one open
@@ -66,7 +61,7 @@ def _run(argv, capsys):
 @pytest.fixture(scope="module")
 def stripes(tmp_path_factory, client):
     """A fixed-stripe IDA with and without contacts, written by the CLI."""
-    from pounding.studies.sweep import execution
+    from pounding.studies.engine import execution
 
     out = tmp_path_factory.mktemp("ida") / "ida.nc"
     original = execution.start_client
@@ -378,7 +373,7 @@ def test_a_run_reported_collapsed_counts_as_collapse_and_keeps_its_residual_drif
     assert ds.status.values.item() == "collapsed"
     assert (ds.collapsed.values == 1).all()                         # every building
     assert (ds.max_drift_ratio.values < 0.5).all()                  # though far below the limit...
-    hit = ida._exceeds(ds, 0.5)
+    hit = ida.exceeds(ds, 0.5)
     assert (hit == 1).all()                                         # ...it counts as exceeding it
     np.testing.assert_allclose(ds.residual_drift_ratio.values[0, 0, 0], np.linspace(-0.01, 0.02, 13))
 
@@ -421,7 +416,7 @@ def test_every_scenario_text_is_the_yaml_of_its_own_data():
     import yaml
 
     from pounding.studies.gap import OPEN_GAP
-    from pounding.studies.sweep.spec import scenario_key
+    from pounding.studies.engine.keys import scenario_key
 
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.1,0.30000000000000004,1e-05,123456.789",
                               without_contacts=True, duration=3.0)
@@ -459,8 +454,10 @@ def test_runs_of_one_template_reuse_its_model_and_record_and_give_the_fresh_runs
         return fresh_model(*args, **kwargs)
 
     monkeypatch.setattr(model_module, "model_from_data", counting_model_from_data)
-    monkeypatch.setattr(ida, "_TEMPLATES", type(ida._TEMPLATES)())
-    monkeypatch.setattr(ida, "_TEMPLATES_KEPT", 2)
+    from pounding.studies.ida import runs
+
+    monkeypatch.setattr(runs, "_TEMPLATES", type(runs._TEMPLATES)())
+    monkeypatch.setattr(runs, "_TEMPLATES_KEPT", 2)
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.2,0.9", without_contacts=True, duration=4.0)
     with_0, without_0, with_1 = ("with_contacts", 0), ("without_contacts", 0), ("with_contacts", 1)
     # (template, level, validated afresh?) with two templates kept, least recently used dropped first

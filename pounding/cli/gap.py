@@ -15,7 +15,7 @@ __all__ = ["register_cli"]
 
 def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
-    from pounding.studies.sweep.store import parts_dir
+    from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
     scale = None if args.scale is None else parse_scale_option(args.scale)

@@ -15,7 +15,7 @@ __all__ = ["register_cli"]
 def _cmd_ida(args: argparse.Namespace) -> int:
     from pounding.studies.ida import Hunt, build_ida_plan, ida_study, ida_summary, ida_table, parse_intensity, \
         plot_ida
-    from pounding.studies.sweep.store import parts_dir
+    from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
     hunt = None

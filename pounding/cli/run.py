@@ -187,7 +187,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from pounding.errors import PoundingError
     from pounding.results.archive import check_writable, save_run
     from pounding.model.model import load_model
-    from pounding.results.plots import plot_run
     from pounding.simulation import model_inputs, simulate
 
     started = time.perf_counter()
@@ -213,6 +212,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(summary(ds))
     print(f"wrote {path}")
     if args.plot:
+        from pounding.results.plots import plot_run
+
         try:
             written = plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation)
         except OSError as exc:

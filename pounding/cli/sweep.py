@@ -7,9 +7,7 @@ import sys
 from pathlib import Path
 
 from pounding.errors import PoundingError
-from pounding.studies.sweep.execution import default_workers, failure_report, run_sweep
-from pounding.studies.sweep.spec import load_sweep
-from pounding.studies.sweep.store import parts_dir
+from pounding.studies.engine.execution import default_workers
 
 __all__ = ["register_cli", "add_cluster_options", "check_study_options", "summary_lines", "raise_if_all_failed"]
 
@@ -43,6 +41,8 @@ def check_study_options(args: argparse.Namespace) -> None:
 
 def summary_lines(ds) -> list[str]:
     """Counts and each distinct error of a sweep results dataset, with the scenarios it hit."""
+    from pounding.studies.sweep.execution import failure_report
+
     status = ds.status.values.ravel()
     lines = [f"{status.size} scenarios: {int((status == 'ok').sum())} ok, {int((status != 'ok').sum())} failed"]
     return lines + failure_report(ds)
@@ -50,6 +50,8 @@ def summary_lines(ds) -> list[str]:
 
 def raise_if_all_failed(ds, output) -> None:
     """Print each distinct error on stderr and stop (status 2) when no scenario ran."""
+    from pounding.studies.sweep.execution import failure_report
+
     if ds.status.size and not bool((ds.status == "ok").any()):
         for line in failure_report(ds):
             print(f"pounding: {line.strip()}", file=sys.stderr)
@@ -58,6 +60,10 @@ def raise_if_all_failed(ds, output) -> None:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    from pounding.studies.engine.store import parts_dir
+    from pounding.studies.sweep.execution import run_sweep
+    from pounding.studies.sweep.spec import load_sweep
+
     if args.workers is not None and args.workers < 1:
         raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
     sweep = load_sweep(args.sweep)

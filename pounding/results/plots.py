@@ -29,7 +29,7 @@ import xarray as xr
 
 from pounding.errors import PoundingError
 
-__all__ = ["plot_run", "plot_sweep", "pyplot", "storey_spans", "draw_drift_profile", "finish_drift_axes"]
+__all__ = ["plot_run", "plot_sweep", "plot_directory", "save_figure", "pyplot", "storey_spans", "draw_drift_profile", "finish_drift_axes"]
 
 
 def pyplot():
@@ -40,6 +40,14 @@ def pyplot():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def save_figure(fig, path: str | os.PathLike) -> Path:
+    """Lay out *fig*, write it to *path* (PNG, 110 dpi) and close it; returns the path."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+    return Path(path)
 
 
 def _grid(plt, count: int, *, width: float = 9.0, height: float = 2.2, sharex: bool = True):
@@ -88,9 +96,7 @@ def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
         axes[0].text(0.5, 0.5, "no contacts in this model", ha="center", transform=axes[0].transAxes)
     axes[-1].set_xlabel("time (s)")
     fig.suptitle(ds.attrs.get("title", ""), fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def _contact_forces(plt, ds: xr.Dataset, path: Path) -> None:
@@ -130,9 +136,7 @@ def _contact_forces(plt, ds: xr.Dataset, path: Path) -> None:
     axes[-1].set_xlabel("time (s)")
     fig.suptitle(f"contact forces — {ds.attrs.get('model_name', '')} under {ds.attrs.get('record_name', '')} "
                  "(every solver step: trace_force)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def storey_spans(ds: xr.Dataset, building: str, *, elevation: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -196,9 +200,7 @@ def _drift_profiles(plt, ds: xr.Dataset, path: Path, *, drift_limit: float | Non
         axes[0][-1].legend(fontsize=7, loc="lower right")
     fig.suptitle(f"peak storey drift ratio — {ds.attrs.get('model_name', '')} under "
                  f"{ds.attrs.get('record_name', '')}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
@@ -233,9 +235,7 @@ def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
                      fontsize=9)
         ax.grid(alpha=0.3)
     fig.suptitle("force-penetration loops (full solver resolution)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 #: Storeys shown in ``storey_hysteresis.png`` (the most yielded first).
@@ -272,9 +272,7 @@ def _storey_hysteresis(plt, ds: xr.Dataset, path: Path) -> None:
     if ds.attrs.get("status") == "collapsed":
         title += f" - COLLAPSED at {ds.attrs['collapse_time']:.2f} s (storey {ds.attrs['collapse_storey']})"
     fig.suptitle(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float | None = None,
@@ -295,7 +293,7 @@ def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float
     list of pathlib.Path
         The PNG files written.
     """
-    out = _directory(directory)
+    out = plot_directory(directory)
     plt = pyplot()
     written = []
     for name, draw in (("contact_displacements.png", _contact_displacements),
@@ -313,10 +311,11 @@ def plot_run(ds: xr.Dataset, directory: str | os.PathLike, *, drift_limit: float
     return written
 
 
-def _directory(directory: str | os.PathLike) -> Path:
+def plot_directory(directory: str | os.PathLike) -> Path:
+    """The ``--plot`` folder, created if missing; refused in one line if it is a file."""
     out = Path(directory)
     if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; give a directory for the plots")
+        raise PoundingError(f"{out} is a file; --plot needs a directory")
     out.mkdir(parents=True, exist_ok=True)
     return out
 
@@ -328,7 +327,7 @@ def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
     a line per building at the mean over the other dimensions, with a band
     from their minimum to their maximum.  Failed scenarios are left out.
     """
-    out = _directory(directory)
+    out = plot_directory(directory)
     plt = pyplot()
     names = list(dict.fromkeys(str(b) for b in ds.storey_building.values))
     dims = [d for d in ds.status.dims if ds.sizes[d] > 1] or list(ds.status.dims[:1])
@@ -357,8 +356,6 @@ def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
     failed = int((ds.status != "ok").sum())
     fig.suptitle(f"sweep '{ds.attrs.get('sweep_name', '')}': mean over the other dimensions, band = min-max"
                  + (f"; {failed} failed scenario(s) left out" if failed else ""), fontsize=9)
-    fig.tight_layout()
     path = out / "sweep_peak_drift.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     return [path]

@@ -1,6 +1,11 @@
-"""Studies built on many runs: parameter sweeps, ξ-formula comparison and the ball-drop verification.
+"""Studies built on many runs, all on one engine: parameter sweeps, ξ formulas compared, gap, IDA; the ball drop.
 
-``sweep``    sweep files, scenarios, the parts store, Dask execution, the results dataset
-``compare``  ξ formulas compared on storey drifts (a sweep over ``xi``)
-``verify``   the ball-drop test of Ye, Li & Zhu (2009, Table I)
+``engine``     the study engine: scenarios, task sources (static, adaptive), part keys, parts store, Dask
+``common``     what the record studies share: the ``--records`` option, the record sweep, option checks
+``sweep``      sweep files, scenarios, the results dataset (a static task source)
+``compare``    ξ formulas compared on storey drifts (a sweep over ``xi``)
+``gap``        the separation that avoids pounding, by simulation and by the code rules
+``ida``        incremental dynamic analysis: plan, runs, hunt-and-fill (an adaptive source), dataset, report
+``fragility``  lognormal fragility fits and the collapse margin ratio
+``verify``     the ball-drop test of Ye, Li & Zhu (2009, Table I)
 """

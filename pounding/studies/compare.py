@@ -1,6 +1,6 @@
 """Compare ξ formulas on storey drifts: ``pounding compare MODEL.yaml --xi ye,lankarani-nikravesh,exact``.
 
-A sweep (:mod:`pounding.sweep`) over the ξ formula of every hertz-damp
+A sweep (:mod:`pounding.studies.sweep`) over the ξ formula of every hertz-damp
 contact × a list of records.  For each building it prints the peak storey
 drift ratio profile of each formula (mean over the records) and its
 difference from the reference formula (``exact`` by default): for each
@@ -20,7 +20,7 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "comparison_table", "differences", "plot_comparison", "record_list"]
+__all__ = ["compare", "comparison_table", "differences", "plot_comparison"]
 
 REFERENCE = "exact"
 
@@ -47,35 +47,14 @@ def _formulas(text: str | list[str], reference: str) -> list[str]:
     return keys
 
 
-def record_list(text: str | list[str] | None) -> list[str] | None:
-    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given."""
-    from pounding.studies.sweep.spec import expand_records
-
-    if text is None:
-        return None
-    items = [r.strip() for r in (text.split(",") if isinstance(text, str) else text) if r.strip()]
-    records: list[str] = []
-    for item in items:
-        try:
-            expanded = expand_records(item)
-        except PoundingError as exc:
-            raise PoundingError(f"--records: {exc}") from None
-        records += [r for r in expanded if r not in records]
-    if not records:
-        raise PoundingError("--records needs a set (fema-p695:farfield) or a comma-separated list of records")
-    return records
-
-
 def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: str | list[str] | None = None, *,
                 duration: float | None = None, reference: str = REFERENCE):
     """The sweep behind ``pounding compare`` (formulas × records)."""
-    import yaml
-
+    from pounding.contact.laws import HertzDamp
     from pounding.model.model import load_model
-    from pounding.studies.sweep.spec import sweep_from_text
+    from pounding.studies.common import check_duration, record_values, study_sweep
 
     path = os.path.abspath(os.fspath(model))
-    from pounding.contact.laws import HertzDamp
 
     base = load_model(model)                # the model's own errors, with its file name
     base.refuse_building_records("pounding compare (it runs the model under one record at a time)")
@@ -84,20 +63,13 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: st
                             "law hertz-damp")
     keys = _formulas(formulas, reference)
     axes: dict[str, Any] = {"xi": keys}
-    listed = record_list(records)
+    listed = record_values(records)
     if listed is not None:
-        axes["records"] = [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
+        axes["records"] = listed
     document: dict[str, Any] = {"name": f"compare-{Path(path).stem}", "model": path, "axes": axes}
-    if duration is not None:
-        if not duration > 0:
-            raise PoundingError(f"--duration must be > 0 (got {duration:g})")
+    if check_duration(duration) is not None:
         document["set"] = {"ground_motion.duration": float(duration)}
-    text = yaml.safe_dump(document, sort_keys=False)
-    sweep = sweep_from_text(text, label=f"<compare {os.fspath(model)}>", base_dir=os.getcwd())
-    invalid = sweep.invalid_values()
-    if invalid:
-        raise PoundingError(invalid[0].split(": ", 1)[-1])
-    return sweep
+    return study_sweep(document, f"<compare {os.fspath(model)}>")
 
 
 def compare(model: str | os.PathLike, formulas: str | list[str] = ("ye", "lankarani-nikravesh", "exact"),
@@ -118,7 +90,7 @@ def compare(model: str | os.PathLike, formulas: str | list[str] = ("ye", "lankar
     duration : float, optional
         Simulated time, s.
     run_options
-        Passed to :func:`pounding.sweep.run_sweep` (workers, scheduler, client, progress, overwrite...).
+        Passed to :func:`pounding.studies.sweep.execution.run_sweep` (workers, scheduler, client, progress, overwrite...).
     """
     from pounding.studies.sweep.execution import run_sweep
 
@@ -202,12 +174,10 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     fewer than 3 records the distribution is a strip plot (every record a
     dot), not boxes.
     """
-    from pounding.results.plots import draw_drift_profile, finish_drift_axes, pyplot, storey_spans
+    from pounding.results.plots import (draw_drift_profile, finish_drift_axes, plot_directory, pyplot, save_figure,
+                                        storey_spans)
 
-    out = Path(directory)
-    if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; --plot needs a directory")
-    out.mkdir(parents=True, exist_ok=True)
+    out = plot_directory(directory)
     plt = pyplot()
     formulas = [str(x) for x in ds.xi.values]
     buildings = _buildings(ds)
@@ -257,10 +227,8 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     what = (f"mean over {n_records} records; lower panels: bars span the records" if n_records > 1
             else str(ds.record.values[0]))
     fig.suptitle(f"peak storey drift ratio per xi formula ({what})", fontsize=9)
-    fig.tight_layout()
     profiles = out / "xi_drift_profiles.png"
-    fig.savefig(profiles, dpi=110)
-    plt.close(fig)
+    save_figure(fig, profiles)
 
     # ---- distribution over records of each building's largest storey drift
     fig, axes = plt.subplots(2, len(buildings), figsize=(3.4 * len(buildings) + 0.6, 6.4), squeeze=False)
@@ -295,8 +263,6 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
                 ax.set_title(f"building {building}", fontsize=9)
     fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}"
                  + (" (boxes: quartiles and median, whiskers: 1.5 IQR; dots: records)" if n_records >= 3 else " (one dot per record)"), fontsize=9)
-    fig.tight_layout()
     distribution = out / "xi_drift_distribution.png"
-    fig.savefig(distribution, dpi=110)
-    plt.close(fig)
+    save_figure(fig, distribution)
     return [profiles, distribution]

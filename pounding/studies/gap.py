@@ -230,8 +230,8 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     """
     from pounding.model.model import model_from_text
     from pounding.simulation import simulate
-    from pounding.studies.sweep.scenario import one_line
-    from pounding.studies.sweep.spec import PARTS_FORMAT
+    from pounding.studies.engine.keys import PARTS_FORMAT
+    from pounding.studies.engine.tasks import one_line
 
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": GAP_PART,
@@ -288,11 +288,8 @@ def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = 
     duration : float, optional
         Simulated time, s.
     """
-    import yaml
-
     from pounding.model.model import load_model
-    from pounding.studies.compare import record_list
-    from pounding.studies.sweep.spec import sweep_from_text
+    from pounding.studies.common import check_duration, record_values, study_sweep
 
     base = load_model(model)  # the model's own errors, with its file name
     base.refuse_building_records("the gap study (it runs the model under one record at a time)")
@@ -310,23 +307,11 @@ def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = 
     settings: dict[str, Any] = {"name": f"{base.name} (gap study)"}
     if scale is not None:
         settings["scale"] = scale
-    if duration is not None:
-        if not duration > 0:
-            raise PoundingError(f"--duration must be > 0 (got {duration:g})")
+    if check_duration(duration) is not None:
         settings["ground_motion.duration"] = float(duration)
-    document: dict[str, Any] = {"name": f"gap-{Path(path).stem}", "model": path, "set": settings}
-    listed = record_list(records)
-    if listed is not None:
-        document["axes"] = {"records": [os.path.abspath(r) if os.path.exists(r) else r for r in listed]}
-    else:
-        document["axes"] = {"records": [base.ground_motion.record if base.ground_motion.is_catalogue
-                                        else str(base.ground_motion.record_path)]}
-    sweep = sweep_from_text(yaml.safe_dump(document, sort_keys=False), label=f"<gap {os.fspath(model)}>",
-                            base_dir=os.getcwd())
-    invalid = sweep.invalid_values()
-    if invalid:
-        raise PoundingError(invalid[0].split(": ", 1)[-1])
-    return sweep
+    document: dict[str, Any] = {"name": f"gap-{Path(path).stem}", "model": path, "set": settings,
+                                "axes": {"records": record_values(records, base)}}
+    return study_sweep(document, f"<gap {os.fspath(model)}>")
 
 
 def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
@@ -458,7 +443,7 @@ def gap_study(model: str | os.PathLike, records: str | list[str] | None = None, 
               duration: float | None = None, output: str | os.PathLike | None = None, **run_options):
     """Run the gap study of *model* over *records*; returns its dataset (see :func:`assemble_gap_dataset`).
 
-    *run_options* go to :func:`pounding.studies.sweep.execution.run_sweep`
+    *run_options* go to :func:`pounding.studies.sweep.execution.run_sweep` and the study engine
     (workers, scheduler, client, progress, overwrite...).
     """
     from pounding.studies.sweep.execution import run_sweep
@@ -472,20 +457,17 @@ def gap_study(model: str | os.PathLike, records: str | list[str] | None = None, 
 # --------------------------------------------------------------------------- #
 
 
-def _finite(value: Any) -> float | None:
-    number = float(value)
-    return number if math.isfinite(number) else None
-
-
 def gap_summary(ds, model: str = "") -> dict[str, Any]:
     """The study as one JSON-ready document (SI units, metres)."""
+    from pounding.studies.common import finite_or_none
+
     ok = ds.status.values == "ok"
     records = [str(r) for r in ds.record.values]
     out: dict[str, Any] = {"model": model or ds.attrs.get("title", ""), "records": records, "contacts": {}}
     for c, label in enumerate(ds.contact.values):
         def shape(values: np.ndarray, median: Any, p84: Any, largest: Any) -> dict[str, Any]:
-            return {"per_record": {rec: _finite(v) for rec, v, good in zip(records, values, ok) if good},
-                    "median": _finite(median), "p84": _finite(p84), "max": _finite(largest)}
+            return {"per_record": {rec: finite_or_none(v) for rec, v, good in zip(records, values, ok) if good},
+                    "median": finite_or_none(median), "p84": finite_or_none(p84), "max": finite_or_none(largest)}
 
         entry = {
             "gap": float(ds.gap.values[c]),
@@ -494,9 +476,9 @@ def gap_summary(ds, model: str = "") -> dict[str, Any]:
             "rules": {str(rule): shape(ds.rule_gap.values[k, :, c], ds.rule_gap_median.values[k, c],
                                        ds.rule_gap_p84.values[k, c], ds.rule_gap_max.values[k, c])
                       for k, rule in enumerate(ds.rule.values)},
-            "unconservative_fraction": {str(rule): _finite(ds.unconservative_fraction.values[k, c])
+            "unconservative_fraction": {str(rule): finite_or_none(ds.unconservative_fraction.values[k, c])
                                         for k, rule in enumerate(ds.rule.values)},
-            "correlation": _finite(ds.correlation.values[c]),
+            "correlation": finite_or_none(ds.correlation.values[c]),
             "records_enough": int(ds.records_enough.values[c]),
             "records_ok": int(ok.sum()),
         }
@@ -539,13 +521,10 @@ def gap_table(ds) -> str:
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
-    from pounding.results.plots import pyplot
+    from pounding.results.plots import plot_directory, pyplot, save_figure
 
     plt = pyplot()
-    out = Path(directory)
-    if out.exists() and not out.is_dir():
-        raise PoundingError(f"{out} is a file; --plot needs a directory")
-    out.mkdir(parents=True, exist_ok=True)
+    out = plot_directory(directory)
     pairs = sorted({(str(a), str(b)) for a, b in zip(ds.building_left.values, ds.building_right.values)})
     fig, axes = plt.subplots(1, len(pairs), figsize=(5.2 * len(pairs), 4.6), squeeze=False)
     ok = ds.status.values == "ok"
@@ -572,8 +551,6 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower right")
     fig.suptitle(f"separation needed to avoid pounding, {int(ok.sum())} record(s)", fontsize=10)
-    fig.tight_layout()
     path = out / "gap_profile.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
     return [path]

