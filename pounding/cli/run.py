@@ -184,16 +184,25 @@ def _check_plot_dir(directory: str) -> None:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from pounding.errors import PoundingError
-    from pounding.results.archive import check_writable, save_run
-    from pounding.model.model import load_model
-    from pounding.simulation import model_inputs, simulate
+    from pounding.results.archive import check_writable, output_lock
 
     started = time.perf_counter()
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
     if args.plot:
         _check_plot_dir(args.plot)
+    with output_lock(output):   # a second run onto the same name refuses here, before computing
+        return _run_locked(args, output, started)
+
+
+def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
+    """``pounding run`` once *output* is claimed."""
+    from pounding.errors import PoundingError
+    from pounding.results.archive import check_writable, save_run
+    from pounding.model.model import load_model
+    from pounding.simulation import model_inputs, simulate
+
+    check_writable(output, overwrite=args.overwrite, inputs=[args.model])   # finished by another meanwhile?
     model = load_model(args.model)
     scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
     if args.record is None and (args.units is not None or args.dt is not None):
@@ -208,7 +217,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     ds = simulate(model, record=args.record, xi=args.xi, scale=scale, duration=args.duration,
                   rtol=args.rtol, output_dt=args.output_dt, record_units=args.units, record_dt=args.dt,
                   where="cli")
-    path = save_run(ds, output, overwrite=args.overwrite)
+    path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
     print(f"wrote {path}")
     if args.plot:
@@ -226,12 +235,14 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_rerun(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable, save_run
+    from pounding.results.archive import check_writable, output_lock, save_run
     from pounding.simulation import rerun
 
     check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
-    ds = rerun(args.run)
-    path = save_run(ds, args.output, overwrite=args.overwrite)
+    with output_lock(args.output, writer="pounding rerun"):
+        check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
+        ds = rerun(args.run)
+        path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
     print(f"wrote {path}")
     return 0

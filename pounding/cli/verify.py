@@ -60,7 +60,7 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     else:
         print(format_report(ds))
     if args.output:
-        path = save_run(ds, args.output, overwrite=args.overwrite)
+        path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
         if not args.json:
             print(f"wrote {path}")
     if args.plot:

@@ -31,7 +31,8 @@ import xarray as xr
 from pounding.errors import ArchiveError
 
 __all__ = ["save_run", "open_run", "check_writable", "atomic_path", "check_not_input", "check_regular_file",
-           "check_archive", "clean_stale_temporaries", "INTERRUPT_GRACE", "REQUIRED_VARIABLES",
+           "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
+           "REQUIRED_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
 
 #: Seconds an interrupted archive write may still take before the process exits regardless.
@@ -179,8 +180,113 @@ def clean_stale_temporaries(folder: str | os.PathLike) -> int:
     return removed
 
 
+def lock_path(output: str | os.PathLike) -> Path:
+    """``DIR/OUT.nc`` → ``DIR/.OUT.nc.lock``, the lock file of an output being written."""
+    output = Path(output)
+    return output.with_name(f".{output.name}.lock")
+
+
 @contextmanager
-def atomic_path(target: Path, *, clean_stale: bool = True) -> Iterator[str]:
+def output_lock(output: str | os.PathLike, *, writer: str = "pounding run") -> Iterator[None]:
+    """Hold an exclusive claim on *output* while it is computed and written (``.OUTPUT.lock`` beside it).
+
+    Two commands writing the same output at once would each replace the
+    other's file; the second one fails at once, naming the holder.  The claim
+    is an ``flock``: the kernel releases it when the process ends, however it
+    ends, so a crashed or killed writer never leaves a claim that blocks the
+    next one.  The lock file is removed on release; a process that locked a
+    file that was meanwhile removed (and replaced) tries again on the new one.
+
+    Parameters
+    ----------
+    writer : str
+        What this process is called in the lock file, and so in another
+        writer's error (``"pounding run"``, ``"sweep"``...).
+
+    Raises
+    ------
+    ArchiveError
+        Another live process holds the claim, or the lock file cannot be
+        created.
+    """
+    import fcntl
+    import socket
+    import time
+
+    path = lock_path(output)
+    for _ in range(100):
+        try:
+            handle = open(path, "a+")
+        except OSError as exc:
+            raise ArchiveError(f"cannot create the lock file {path}: {exc.strerror or exc}") from None
+        try:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.seek(0)
+            holder = " ".join(handle.read(200).split()) or "process"
+            handle.close()
+            raise ArchiveError(f"{output} is being written by another {holder}; wait for it to finish or "
+                               "choose another output") from None
+        try:
+            same = os.path.samestat(os.fstat(handle.fileno()), os.stat(path))
+        except OSError:   # removed by its previous holder between our open and flock
+            same = False
+        if same:
+            break
+        handle.close()
+    else:   # pragma: no cover - 100 holders in a row released under us
+        raise ArchiveError(f"cannot claim {output}: its lock file {path} keeps changing; try again")
+    try:
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"{writer} (pid {os.getpid()} on {socket.gethostname()} since "
+                     f"{time.strftime('%Y-%m-%d %H:%M:%S')})\n")
+        handle.flush()
+        yield
+    finally:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+        handle.close()
+
+
+def _link_beside(temporary: str, target: Path) -> Path:
+    """Link *temporary* to a new name beside *target* (``NAME.PID.SUFFIX``, then ``NAME.PID-2.SUFFIX``...)."""
+    for attempt in range(1, 100):
+        tag = f"{os.getpid()}" if attempt == 1 else f"{os.getpid()}-{attempt}"
+        kept = target.with_name(f"{target.stem}.{tag}{target.suffix}")
+        try:
+            _link_new(temporary, kept)
+            return kept
+        except FileExistsError:
+            continue
+    raise ArchiveError(f"{target} was written by another process while this one computed, and no free name "
+                       "was found beside it to keep this run's archive")
+
+
+def _link_new(temporary: str, target: Path) -> None:
+    """Give *temporary* the name *target* only if nothing has that name (never replaces).
+
+    Raises
+    ------
+    FileExistsError
+        *target* exists.
+    """
+    try:
+        os.link(temporary, target)
+    except FileExistsError:
+        raise
+    except OSError:   # a file system without hard links: the best it offers
+        if os.path.lexists(target):
+            raise FileExistsError(target) from None
+        os.rename(temporary, target)
+        return
+    os.unlink(temporary)
+
+
+@contextmanager
+def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True) -> Iterator[str]:
     """Yield a temporary file name beside *target* to write to.
 
     On success the file is flushed to disk and renamed over *target* (an
@@ -190,6 +296,11 @@ def atomic_path(target: Path, *, clean_stale: bool = True) -> Iterator[str]:
     writers that were killed are removed by the next writer in that folder
     (*clean_stale*; a writer of many files in one folder, such as a sweep's
     parts, cleans the folder once instead of listing it before every file).
+
+    With ``replace=False`` the file is linked to *target* only if no file has
+    that name: if one appeared while this one was computed (another process
+    wrote it), nothing is replaced, the finished file is kept as
+    ``NAME.PID.SUFFIX`` beside it and :class:`ArchiveError` says so.
     """
     folder = target.parent if str(target.parent) else Path(".")
     if clean_stale:
@@ -206,7 +317,15 @@ def atomic_path(target: Path, *, clean_stale: bool = True) -> Iterator[str]:
             with open(temporary, "rb+") as handle:
                 os.fsync(handle.fileno())
             os.chmod(temporary, 0o666 & ~_umask())   # mkstemp makes 0600; give the mode any new file gets
-            os.replace(temporary, target)
+            if replace:
+                os.replace(temporary, target)
+            else:
+                _link_new(temporary, target)
+        except FileExistsError:
+            kept = _link_beside(temporary, target)
+            raise ArchiveError(f"{target} was written by another process while this one computed; nothing was "
+                               f"replaced and this run's archive is kept as {kept} (rename it, or pass "
+                               "--overwrite to replace)") from None
         except OSError as exc:
             raise ArchiveError(f"cannot write {target}: {exc.strerror or exc}; the old file, if any, is "
                                "unchanged") from None
@@ -286,7 +405,8 @@ def _encoding(ds: xr.Dataset) -> dict:
     return encoding
 
 
-def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False,
+             keep_beside: bool = False) -> Path:
     """Write a results dataset to NetCDF atomically.
 
     Parameters
@@ -296,15 +416,21 @@ def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False
     path : path-like
         Target ``.nc`` file.
     overwrite : bool
-        Replace an existing file.
+        Replace an existing file.  Without it a file that appears under
+        *path* while this one is written is not replaced either: the new
+        archive is kept beside it as ``NAME.PID.nc`` (:func:`atomic_path`).
+    keep_beside : bool
+        Without *overwrite*, an existing file is not refused up front but
+        treated as one that appeared meanwhile (the command line: *ds* took
+        a whole run to compute and must not be lost).
 
     Returns
     -------
     pathlib.Path
         The written file.
     """
-    target = check_writable(path, overwrite=overwrite)
-    with atomic_path(target) as temporary:
+    target = check_writable(path, overwrite=overwrite or keep_beside)
+    with atomic_path(target, replace=overwrite) as temporary:
         try:
             with _interrupt_deferred(temporary), _NETCDF_LOCK:
                 ds.to_netcdf(temporary, engine="netcdf4", format="NETCDF4", encoding=_encoding(ds))

@@ -6,8 +6,6 @@ import json
 import math
 import os
 import re
-import socket
-import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
@@ -214,53 +212,24 @@ def load_parts(directory: Path, *, bad: list[str] | None = None) -> dict[str, di
     return found
 
 
-def _lock_path(output: Path) -> Path:
-    return output.with_name(f".{output.name}.lock")
-
-
 @contextmanager
 def sweep_lock(output: Path) -> Iterator[None]:
     """Hold an exclusive lock on *output* for a whole sweep (``.OUTPUT.lock`` beside it).
 
     Two sweeps writing the same output would interleave parts and replace
-    each other's results; the second one fails at once, naming the holder.
-    The lock is an ``flock``: it is released when the process ends, however
-    it ends, so a killed sweep never leaves a stale lock.
+    each other's results; the second one fails at once, naming the holder
+    (:func:`pounding.results.archive.output_lock`, released however the
+    process ends).
 
     Raises
     ------
     PoundingError
         Another process holds the lock.
     """
-    import fcntl
+    from pounding.results.archive import output_lock
 
-    path = _lock_path(output)
-    try:
-        handle = open(path, "a+")
-    except OSError as exc:
-        raise PoundingError(f"cannot create the lock file {path}: {exc.strerror or exc}") from None
-    try:
-        try:
-            fcntl.flock(handle.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            handle.seek(0)
-            holder = " ".join(handle.read(200).split()) or "another process"
-            raise PoundingError(f"{output} is being written by another sweep ({holder}); wait for it to finish "
-                                "or choose another output") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"pid {os.getpid()} on {socket.gethostname()} since "
-                     f"{time.strftime('%Y-%m-%d %H:%M:%S')}\n")
-        handle.flush()
-        try:
-            yield
-        finally:
-            try:
-                os.unlink(path)
-            except OSError:
-                pass
-    finally:
-        handle.close()
+    with output_lock(output, writer="sweep"):
+        yield
 
 
 def history_name(scenario: Scenario) -> str:
