@@ -108,3 +108,73 @@ def test_overwrite_still_replaces(case, tmp_path):
     target.write_bytes(b"old")
     assert main(["run", str(case / "model.yaml"), "-o", str(target), "--overwrite"]) == 0
     assert xr.open_dataset(target).attrs["model_name"] == "fuzz"
+
+
+# --------------------------------------------------------------------------- #
+# §4 One-line errors
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("command", ["info", "plot"])
+def test_a_study_archive_without_status(tmp_path, capsys, command):
+    # Before: AttributeError: 'Dataset' object has no attribute 'status'.
+    archive = tmp_path / "sweep.nc"
+    xr.Dataset({"peak_drift_ratio": ("scenario", [0.01, 0.02])},
+               attrs={"source": "pounding 1.0", "sweep_name": "s", "title": "sweep s"}).to_netcdf(archive)
+    args = ["info", str(archive)] if command == "info" else ["plot", str(archive), "-o", str(tmp_path / "png")]
+    assert main(args) == 2
+    line = _error(capsys)
+    assert f"damaged archive: {archive}" in line and "status" in line
+
+
+def test_an_output_name_that_is_not_utf8_is_refused_before_running(case, tmp_path, capsys, monkeypatch):
+    # Before: UnicodeEncodeError from netCDF4 after the whole simulation.
+    import pounding.simulation as simulation
+
+    monkeypatch.setattr(simulation, "simulate", lambda *a, **k: pytest.fail("simulated before refusing"))
+    name = os.fsdecode(b"bad\xff.nc")
+    assert main(["run", str(case / "model.yaml"), "-o", str(tmp_path / name)]) == 2
+    line = _error(capsys)
+    assert "bad\\xff.nc" in line and "not valid UTF-8" in line and "choose a UTF-8 name" in line
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("where", ["under-a-file", "yaml", "no-suffix", "read-only"])
+def test_records_show_plot_targets(case, tmp_path, capsys, monkeypatch, where):
+    # Before: FileNotFoundError / ValueError (format 'yaml') / PermissionError tracebacks, or `--plot foreign`
+    # wrote foreign.png and said it wrote foreign.
+    record = str(case / "quake.txt")
+    target = {"under-a-file": case / "quake.txt" / "r.png", "yaml": tmp_path / "r.yaml",
+              "no-suffix": tmp_path / "foreign", "read-only": tmp_path / "ro" / "r.png"}[where]
+    if where == "read-only":
+        (tmp_path / "ro").mkdir()
+        real = os.access
+        monkeypatch.setattr(os, "access", lambda p, mode: False if str(p) == str(tmp_path / "ro") else real(p, mode))
+        (tmp_path / "ro").chmod(0o555)
+    try:
+        assert main(["records", "show", record, "--dt", "0.01", "--units", "g", "--plot", str(target)]) == 2
+        captured = capsys.readouterr()
+    finally:
+        (tmp_path / "ro").exists() and (tmp_path / "ro").chmod(0o755)
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("pounding: error: ") and str(target) in err[0], err
+    assert {"under-a-file": "is a file", "yaml": "ending in .png", "no-suffix": "foreign.png",
+            "read-only": "not writable"}[where] in err[0]
+    assert "wrote" not in captured.out and not list(tmp_path.glob("**/*.png"))
+
+
+def test_dask_workers_that_cannot_start_are_one_line(case, tmp_path):
+    # Before: 75-164 lines of nanny tracebacks and exit 1 (here the workers run out of file descriptors).
+    import resource
+
+    (tmp_path / "s.yaml").write_text(f"model: {case / 'model.yaml'}\naxes:\n  contacts[*].gap: [0.002, 0.003]\n")
+
+    def few_files() -> None:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (30, 30))
+
+    done = subprocess.run([sys.executable, "-m", "pounding", "sweep", str(tmp_path / "s.yaml"), "-o",
+                           str(tmp_path / "s.nc"), "--workers", "2", "--no-progress"], capture_output=True, text=True,
+                          timeout=120, preexec_fn=few_files, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert verdict(done.returncode, done.stdout, done.stderr, None) is None and done.returncode == 2, done.stderr
+    assert "could not start 2 Dask worker processes (OSError: [Errno 24] Too many open files)" in done.stderr
+    assert len(done.stderr.strip().splitlines()) <= 2   # the sweep's own "N scenarios" note and the error

@@ -38,6 +38,8 @@ def _cmd_show(args: argparse.Namespace) -> int:
     from pounding.records.record import STANDARD_GRAVITY
     from pounding.records.spectra import spectral_acceleration
 
+    if args.plot:
+        _check_png(args.plot, args.name)   # before reading anything
     record = load_record(args.name, dt=args.dt, units=args.units, where="cli")
     if is_catalogue_name(args.name):
         entry = get_entry(args.name)
@@ -57,8 +59,32 @@ def _cmd_show(args: argparse.Namespace) -> int:
     print(f"  {sa} (5% damping)")
     print(f"  sha256 {record.metadata['sha256']}")
     if args.plot:
-        print(f"wrote {plot_record(record, args.plot)}")
+        try:
+            written = plot_record(record, args.plot)
+        except OSError as exc:
+            raise PoundingError(f"--plot {args.plot}: cannot write the figure ({exc.strerror or exc}); choose "
+                                "another file") from None
+        print(f"wrote {written}")
     return 0
+
+
+def _check_png(path: str, source: str) -> None:
+    """Refuse a ``--plot`` target that is not a writable ``.png`` file name, or that is the record *source*.
+
+    Raises
+    ------
+    PoundingError
+        One line naming the path and the fix.
+    """
+    from pathlib import Path
+
+    from pounding.results.archive import check_writable
+
+    target = Path(path)
+    if target.suffix.lower() != ".png":
+        raise PoundingError(f"--plot {path}: the figure is a PNG; give a file name ending in .png, such as "
+                            f"{target.with_suffix('.png')}")
+    check_writable(target, overwrite=True, inputs=[source])
 
 
 def register_cli(subparsers: Any) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -147,12 +148,13 @@ def summary(ds) -> str:
     return "\n".join(lines)
 
 
-def _safe_summary(ds, source) -> str:
-    """:func:`summary` of an archive read from disk; a garbled value is a one-line damaged-archive error."""
+@contextmanager
+def _damaged_if_garbled(source):
+    """Turn a missing or garbled variable met while reading archive *source* into a one-line error."""
     from pounding.errors import ArchiveError
 
     try:
-        return summary(ds)
+        yield
     except (KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
         raise ArchiveError(f"damaged archive: {source}: {type(exc).__name__}: "
                            f"{' '.join(str(exc).split())[:120]}") from None
@@ -275,9 +277,12 @@ def open_archive(path) -> tuple[str, object]:
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
         ds = handle.load()
-    if attrs.get("study") in ("gap", "ida"):
-        return str(attrs["study"]), ds
-    if "sweep_name" in attrs:
+    if attrs.get("study") in ("gap", "ida") or "sweep_name" in attrs:
+        if "status" not in names:   # every study archive has one status per scenario
+            raise ArchiveError(f"damaged archive: {source}: variable status missing; run the study again to "
+                               "write it again")
+        if attrs.get("study") in ("gap", "ida"):
+            return str(attrs["study"]), ds
         return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
                 else "sweep"), ds
     if is_verify:
@@ -300,8 +305,18 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print(f"{args.run}: {ds.attrs.get('title', kind)} [{kind} archive]")
     print("  " + str(ds.attrs.get("history", "")).replace("\n", "\n  "))
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
+    with _damaged_if_garbled(args.run):
+        _print_info(kind, ds)
+    if args.variables:
+        for name, var in ds.data_vars.items():
+            print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")
+    return 0
+
+
+def _print_info(kind: str, ds) -> None:
+    """The summary ``pounding info`` prints for an archive of *kind*."""
     if kind == "run":
-        print(_safe_summary(ds, args.run))
+        print(summary(ds))
     elif kind == "gap":
         from pounding.studies.gap import gap_table
 
@@ -323,58 +338,55 @@ def _cmd_info(args: argparse.Namespace) -> int:
         from pounding.studies.verify import format_report
 
         print(format_report(ds))
-    if args.variables:
-        for name, var in ds.data_vars.items():
-            print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")
-    return 0
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
     from pounding.errors import PoundingError
 
-    from pounding.errors import ArchiveError
-
     kind, ds = open_archive(args.run)
-    if kind in ("sweep", "compare", "gap", "ida") and \
-            not bool(ds.status.isin(["ok", "completed", "collapsed"]).any()):
+    with _damaged_if_garbled(args.run):
+        nothing = kind in ("sweep", "compare", "gap", "ida") and \
+            not bool(ds.status.isin(["ok", "completed", "collapsed"]).any())
+    if nothing:
         raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
                             f"`pounding info {args.run}` lists the errors")
     _check_plot_dir(args.output)
-    out = Path(args.output)
     try:
-        if kind == "run":
-            from pounding.results.plots import plot_run
-
-            written = plot_run(ds, out, drift_limit=args.drift_limit, elevation=args.elevation)
-        elif kind == "compare":
-            from pounding.studies.compare import plot_comparison
-
-            written = plot_comparison(ds, out, _reference(ds), drift_limit=args.drift_limit)
-        elif kind == "sweep":
-            from pounding.results.plots import plot_sweep
-
-            written = plot_sweep(ds, out)
-        elif kind == "gap":
-            from pounding.studies.gap import plot_gap
-
-            written = plot_gap(ds, out)
-        elif kind == "ida":
-            from pounding.studies.ida import plot_ida
-
-            written = plot_ida(ds, out)
-        else:
-            from pounding.studies.verify import plot_verification
-
-            out.mkdir(parents=True, exist_ok=True)
-            written = [plot_verification(ds, out / "verify.png")]
+        with _damaged_if_garbled(args.run):
+            written = _draw(kind, ds, Path(args.output), args)
     except OSError as exc:
         raise PoundingError(f"{args.output}: cannot write the plots ({exc.strerror or exc})") from None
-    except (KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
-        raise ArchiveError(f"damaged archive: {args.run}: {type(exc).__name__}: "
-                           f"{' '.join(str(exc).split())[:120]}") from None
     for png in written:
         print(f"wrote {png}")
     return 0
+
+
+def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
+    """The figures of an archive of *kind* written to the folder *out*; their paths."""
+    if kind == "run":
+        from pounding.results.plots import plot_run
+
+        return plot_run(ds, out, drift_limit=args.drift_limit, elevation=args.elevation)
+    if kind == "compare":
+        from pounding.studies.compare import plot_comparison
+
+        return plot_comparison(ds, out, _reference(ds), drift_limit=args.drift_limit)
+    if kind == "sweep":
+        from pounding.results.plots import plot_sweep
+
+        return plot_sweep(ds, out)
+    if kind == "gap":
+        from pounding.studies.gap import plot_gap
+
+        return plot_gap(ds, out)
+    if kind == "ida":
+        from pounding.studies.ida import plot_ida
+
+        return plot_ida(ds, out)
+    from pounding.studies.verify import plot_verification
+
+    out.mkdir(parents=True, exist_ok=True)
+    return [plot_verification(ds, out / "verify.png")]
 
 
 def _cmd_xi_list(args: argparse.Namespace) -> int:

@@ -65,6 +65,12 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
         not writable, or the name is too long.
     """
     target = Path(path)
+    try:
+        os.fspath(target).encode("utf-8")
+    except UnicodeEncodeError:   # netCDF/HDF5 take UTF-8 names only: found after the run, too late
+        shown = os.fsencode(target).decode("utf-8", "backslashreplace")
+        raise ArchiveError(f"{shown}: the output name is not valid UTF-8 (NetCDF cannot create it); choose a "
+                           "UTF-8 name") from None
     check_not_input(target, inputs)
     if target.is_dir():
         raise ArchiveError(f"{target} is a directory; give a file name such as {target / 'run.nc'}")

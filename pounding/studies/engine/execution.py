@@ -17,8 +17,9 @@ import re
 import shutil
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 from pounding.errors import PoundingError
 from pounding.studies.engine.keys import PARTS_FORMAT
@@ -90,13 +91,50 @@ def start_client(*, workers: int | None = None, scheduler: str | None = None):
     main = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
-        with dask.config.set(LOCAL_CLUSTER_CONFIG):   # the workers' nannies pass it on to their processes
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                   silence_logs=logging.ERROR)
+        with dask.config.set(LOCAL_CLUSTER_CONFIG), _held_logs() as logged:   # the nannies pass the config on
+            try:
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                       silence_logs=logging.ERROR)
+            except Exception as exc:   # noqa: BLE001 - dask raises anything a worker start met
+                cause = logged[0] if logged else exc
+                detail = one_line(cause) if isinstance(cause, BaseException) else " ".join(str(cause).split())
+                raise PoundingError(f"could not start {n} Dask worker process{'es' if n > 1 else ''} "
+                                    f"({detail[:200]}); use fewer --workers, raise the limits of this shell "
+                                    "(ulimit -n open files, ulimit -v memory) or give --scheduler") from None
     finally:
         if main:
             signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
+
+
+@contextmanager
+def _held_logs() -> Iterator[list]:
+    """Hold back what ``distributed``, ``tornado`` and ``asyncio`` log at ERROR while a cluster starts.
+
+    Yields the list of the exceptions (or messages) held.
+
+    A worker that cannot start is logged with a traceback per attempt and
+    per nanny (75-124 lines); the caller turns the first of them into one
+    line.  The logger's handlers are restored when the block ends.
+    """
+    import logging
+
+    found: list = []
+
+    class Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            found.append(record.exc_info[1] if record.exc_info and record.exc_info[1] else record.getMessage())
+
+    loggers = [logging.getLogger(name) for name in ("distributed", "tornado", "asyncio")]
+    saved = [(list(logger.handlers), logger.propagate) for logger in loggers]
+    for logger in loggers:
+        logger.handlers = [Keep(logging.ERROR)]
+        logger.propagate = False
+    try:
+        yield found
+    finally:
+        for logger, (handlers, propagate) in zip(loggers, saved):
+            logger.handlers, logger.propagate = handlers, propagate
 
 
 def run_study(source: TaskSource, output: str | os.PathLike | None = None, *, workers: int | None = None,
