@@ -30,6 +30,7 @@ from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
 from pounding.model.model import WALL, Model, column_weights, model_from_text
+from pounding.model.scales import check_work
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import run_peaks, to_dataset
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
@@ -485,6 +486,7 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
     """Integrate *model* on its *supports* up to *end_time*: ``(system, raw solution, wall time in s,
     the ground rows as given to the solver (G, ns))``."""
     settings = model.solver
+    check_work(model, end_time, where=_where(model))   # a stiff element would take hours, silently
     step = supports.time_step
     samples_needed = int(np.ceil(end_time / step - 1e-9)) + 1
     ground = np.zeros((supports.rows.shape[0], max(samples_needed, supports.rows.shape[1])))

@@ -178,3 +178,90 @@ def test_dask_workers_that_cannot_start_are_one_line(case, tmp_path):
     assert verdict(done.returncode, done.stdout, done.stderr, None) is None and done.returncode == 2, done.stderr
     assert "could not start 2 Dask worker processes (OSError: [Errno 24] Too many open files)" in done.stderr
     assert len(done.stderr.strip().splitlines()) <= 2   # the sweep's own "N scenarios" note and the error
+
+
+# --------------------------------------------------------------------------- #
+# §2 Every run and study has a bound on its work
+# --------------------------------------------------------------------------- #
+
+
+def _linked(folder: Path, law: str, **parameters) -> Path:
+    model = base_model()
+    model["ground_motion"]["duration"] = 8.0
+    model["links"] = [{"between": ["A", "B"], "levels": [[2, 2]], "law": law, **parameters}]
+    return _write_case(folder, model)
+
+
+@pytest.mark.parametrize("law, parameters, expected", [
+    ("maxwell", {"stiffness": 1.0e9, "damping": 1.0}, "relaxation time c/k = 1e-09 s is 7e+07 times shorter than "
+                                                      "the shortest period"),
+    ("viscous", {"damping": 1.0e15}, "relaxes the floors' relative motion in m/c = 1e-10 s"),
+])
+def test_a_stiff_link_is_refused_before_running(tmp_path, law, parameters, expected):
+    # Before: hours of solver steps for 8 s of record, silently (2.4e9 and 2.4e10 steps).
+    path = _linked(tmp_path, law, **parameters)
+    started = time.perf_counter()
+    status, out, err = pounding(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    assert status == 2 and verdict(status, out, err, None) is None, err
+    assert expected in err and "the solver would take about" in err and "steps for 8 s" in err
+    assert time.perf_counter() - started < 60 and not (tmp_path / "out.nc").exists()
+
+
+def test_the_step_estimate_matches_the_solver(tmp_path):
+    """The estimate behind the refusal is the step count of a stiff run, within 30 %."""
+    from pounding.model.model import load_model
+    from pounding.model.scales import check_work
+    from pounding.simulation import simulate
+
+    path = _linked(tmp_path, "maxwell", stiffness=1.0e9, damping=1.0e4)   # c/k = 1e-5 s
+    model = load_model(path)
+    ds = simulate(model, duration=0.2)
+    estimate = check_work(model, 0.2)
+    assert 0.7 < ds.attrs["solver_steps"] / estimate < 1.3
+
+
+@pytest.mark.parametrize("options, expected", [
+    (["--hunt-step", "1e-7", "--hunt-increment", "0"], "--hunt-step 1e-07 g is below the resolution of the levels"),
+    (["--hunt-ceiling", "1e9", "--hunt-step", "1e-3"], "--hunt would make up to 2e+05 runs per record"),
+    (["--hunt-ceiling", "1e9", "--hunt-step", "1e-3", "--hunt-increment", "0"], "up to 1e+12 runs per record"),
+    (["--tolerance", "1e-9"], "--tolerance 1e-09 g is below the resolution"),
+])
+def test_hunt_settings_that_never_end_are_refused(case, tmp_path, options, expected):
+    # Before: --hunt-step 1e-7 --hunt-increment 0 ran one level forever with growing memory; a ceiling of
+    # 1e9 g was accepted (~1e12 runs).
+    started = time.perf_counter()
+    status, out, err = pounding(["ida", str(case / "model.yaml"), "--hunt", *options, "--workers", "1",
+                                 "--no-progress"], tmp_path, limit=60)
+    assert status == 2 and verdict(status, out, err, None) is None, err
+    assert expected in err
+    assert time.perf_counter() - started < 60
+
+
+def test_a_hunt_never_repeats_a_level_and_stays_within_its_estimate():
+    import itertools
+
+    from pounding.studies.ida.hunt import next_hunt_level
+    from pounding.studies.ida.plan import Hunt
+
+    for start, step, increment, tolerance, runs, ceiling, collapse in itertools.product(
+            [0.1, 1.0], [1e-6, 0.01, 0.37], [0.0, 1e-6, 0.05], [2e-6, 0.05], [1, 12], [1.0, 5.0],
+            [None, 0.0, 0.25, 0.999999, 3.3]):
+        hunt = Hunt(start=start, step=step, increment=increment, tolerance=tolerance, runs=runs, ceiling=ceiling)
+        if hunt.ceiling < hunt.start or hunt.max_runs() > 5000:
+            continue
+        hunt.check()
+        done: list[tuple[float, bool]] = []
+        while (level := next_hunt_level(hunt, done)) is not None:
+            assert level not in {s for s, _ in done}
+            done.append((level, collapse is not None and level >= collapse))
+            assert len(done) <= hunt.max_runs(), hunt
+
+
+def test_an_ida_prints_its_number_of_runs_before_it_starts(case, tmp_path):
+    status, out, err = pounding(["ida", str(case / "model.yaml"), "--levels", "0.1,0.2", "--duration", "0.3",
+                                 "--workers", "1", "--no-progress"], tmp_path, limit=120)
+    assert status == 0, err
+    assert "1 records x 2 levels x 1 variant(s) = 2 runs" in err.splitlines()[0]
+    status, out, err = pounding(["ida", str(case / "model.yaml"), "--hunt", "--hunt-ceiling", "2e4",
+                                 "--hunt-increment", "0", "--workers", "1", "--no-progress"], tmp_path, limit=60)
+    assert status == 2 and "--hunt would make up to 2e+05 runs per record" in err, err

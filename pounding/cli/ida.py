@@ -32,7 +32,8 @@ def _cmd_ida(args: argparse.Namespace) -> int:
                           duration=args.duration)
     print(f"IDA of '{plan.model_name}': {len(plan.records)} records x "
           + (f"{len(plan.levels)} levels" if hunt is None else "hunt-and-fill")
-          + f" x {len(plan.variants)} variant(s); IM {plan.im.describe()}", file=sys.stderr)
+          + f" x {len(plan.variants)} variant(s) = {'up to ' if hunt is not None else ''}{plan.planned_runs()} runs; "
+          f"IM {plan.im.describe()}", file=sys.stderr)
     try:
         ds = ida_study(plan, args.output, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)

@@ -15,7 +15,7 @@ import numpy as np
 
 from pounding.studies.engine.tasks import Scenario, TaskSource
 from pounding.studies.ida.dataset import assemble_ida_dataset
-from pounding.studies.ida.plan import Hunt, IdaPlan
+from pounding.studies.ida.plan import LEVEL_DECIMALS, Hunt, IdaPlan
 from pounding.studies.ida.runs import collapsed_in, run_ida_scenario
 
 __all__ = ["next_hunt_level", "HuntTasks", "run_hunt"]
@@ -34,18 +34,19 @@ def next_hunt_level(hunt: Hunt, runs: list[tuple[float, bool]]) -> float | None:
     sequence and finds the finished runs in its parts store.
     """
     if not runs:
-        return round(hunt.start, 6)
+        return round(hunt.start, LEVEL_DECIMALS)
     collapses = [s for s, c in runs if c]
     if not collapses:                                    # hunt up
         last = runs[-1][0]
         if last >= hunt.ceiling:
             return None
         k = len(runs) - 1
-        return round(min(last + hunt.step + k * hunt.increment, hunt.ceiling), 6)
+        level = round(min(last + hunt.step + k * hunt.increment, hunt.ceiling), LEVEL_DECIMALS)
+        return level if level > last else None           # never the same level again (rounding)
     high = min(collapses)
     low = max([s for s, c in runs if not c and s < high], default=0.0)
     if high - low > hunt.tolerance * (1 + 1e-9):         # bracket
-        middle = round(0.5 * (low + high), 6)
+        middle = round(0.5 * (low + high), LEVEL_DECIMALS)
         return middle if low < middle < high else None
     if len(runs) >= hunt.runs:                           # fill
         return None
@@ -54,7 +55,8 @@ def next_hunt_level(hunt: Hunt, runs: list[tuple[float, bool]]) -> float | None:
     if gaps.size == 0 or gaps.max() <= hunt.tolerance:
         return None
     i = int(np.argmax(gaps))
-    return round(0.5 * (points[i] + points[i + 1]), 6)
+    middle = round(0.5 * (points[i] + points[i + 1]), LEVEL_DECIMALS)
+    return middle if points[i] < middle < points[i + 1] else None
 
 
 class HuntTasks(TaskSource):

@@ -22,7 +22,8 @@ from pounding.errors import PoundingError
 from pounding.model.document import dump_document
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "SA_DAMPING", "IntensityMeasure",
+__all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "SA_DAMPING", "LEVEL_DECIMALS",
+           "LEVEL_RESOLUTION", "MAX_IDA_RUNS", "IntensityMeasure",
            "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity"]
 
 #: The two variants of every scenario: the model as given, and with its contacts held open.
@@ -35,6 +36,14 @@ SCALINGS = ("auto", "record", "fema-p695")
 MAX_LEVELS = 500
 #: Damping ratio of Sa(T1).
 SA_DAMPING = 0.05
+#: Levels of a hunt are rounded to this many decimals of g (a run's key hashes its level).
+LEVEL_DECIMALS = 6
+#: The smallest step between two hunt levels, g: a smaller step, increment or tolerance rounds to
+#: the same level again and the hunt would repeat it forever.
+LEVEL_RESOLUTION = 10.0 ** -LEVEL_DECIMALS
+#: Most runs an IDA may plan (records x variants x runs per record); ~0.1-1 s each on one core,
+#: 1e5 runs is a day of a small cluster.
+MAX_IDA_RUNS = 100_000
 
 
 # --------------------------------------------------------------------------- #
@@ -104,6 +113,43 @@ class Hunt:
             raise PoundingError(f"--hunt-ceiling {self.ceiling:g} g is below the first level {self.start:g} g")
         if self.runs < 1:
             raise PoundingError(f"--runs-per-record must be >= 1 (got {self.runs})")
+        for flag, value, least in (("--hunt-step", self.step, LEVEL_RESOLUTION),
+                                   ("--tolerance", self.tolerance, 2 * LEVEL_RESOLUTION)):
+            if value < least:
+                raise PoundingError(f"{flag} {value:g} g is below the resolution of the levels ({least:g} g; "
+                                    f"levels are rounded to {LEVEL_DECIMALS} decimals): give at least {least:g}")
+        if 0 < self.increment < LEVEL_RESOLUTION:
+            raise PoundingError(f"--hunt-increment {self.increment:g} g is below the resolution of the levels "
+                                f"({LEVEL_RESOLUTION:g} g): give 0 or at least {LEVEL_RESOLUTION:g}")
+        per_record = self.max_runs()
+        if per_record > MAX_IDA_RUNS:
+            raise PoundingError(f"--hunt would make up to {per_record:.3g} runs per record (from {self.start:g} to "
+                                f"--hunt-ceiling {self.ceiling:g} g by --hunt-step {self.step:g} g, "
+                                f"--hunt-increment {self.increment:g} g); at most {MAX_IDA_RUNS} allowed: lower "
+                                "the ceiling or raise the step or increment")
+
+    def climb_runs(self) -> float:
+        """Runs of the climb from ``start`` to ``ceiling`` with no collapse (both ends included).
+
+        After j steps the level is ``start + j·step + increment·j(j−1)/2``.
+        """
+        span = self.ceiling - self.start
+        if span <= 0:
+            return 1.0
+        if self.increment > 0:   # smallest j with j·step + inc·j(j−1)/2 >= span
+            b = self.step - 0.5 * self.increment
+            j = (-b + math.sqrt(b * b + 2.0 * self.increment * span)) / self.increment
+        else:
+            j = span / self.step
+        return float(math.ceil(j - 1e-9) + 1)
+
+    def max_runs(self) -> float:
+        """Most runs of one record's hunt-and-fill: the climb, then the bisections of the widest bracket
+        (the last step of the climb, or [0, start]) down to ``tolerance``, or ``runs`` if more (the fill)."""
+        climb = self.climb_runs()
+        widest = max(self.start, self.step + max(climb - 2, 0) * self.increment)   # [0, start] if it collapses
+        bisections = max(0, math.ceil(math.log2(max(widest / self.tolerance, 1.0))))
+        return float(max(climb + bisections, self.runs))
 
 
 def _number(text: str, what: str) -> float:
@@ -272,6 +318,11 @@ class IdaPlan:
             return document, dump_document(document)
         return document, _yaml_scalar(factor).join(pieces)
 
+    def planned_runs(self) -> int:
+        """The most runs this IDA will make (a hunt may stop a record's chain earlier)."""
+        per_record = self.hunt.max_runs() if self.hunt is not None else len(self.levels)
+        return int(len(self.records) * len(self.variants) * per_record)
+
     def stripe_scenarios(self) -> list:
         """Every (variant, record, level) of the fixed stripes, variant slowest."""
         return [self.scenario(v, r, float(level)) for v in self.variants for r in range(len(self.records))
@@ -395,6 +446,11 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
         normalisation = np.ones_like(im_stored)
         unit = 1.0 / im_stored
     variants = VARIANTS if without_contacts else VARIANTS[:1]
+    runs = len(recs) * len(variants) * (hunt.max_runs() if hunt is not None else len(levels))
+    if runs > MAX_IDA_RUNS:
+        raise PoundingError(f"this IDA would make up to {runs:.3g} runs ({len(recs)} records x {len(variants)} "
+                            f"variant(s) x {runs / len(recs) / len(variants):.3g} per record); at most "
+                            f"{MAX_IDA_RUNS} allowed: use fewer records, levels or --runs-per-record")
     return IdaPlan(sweep=sweep, records=recs, documents=documents, im=measure, im_stored=im_stored,
                    normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=names,
                    variants=variants, limits=drift_limits, collapse_drift=float(collapse_drift), levels=levels,
