@@ -10,6 +10,7 @@ repeats what an archive recorded.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time as _time
 import dataclasses
@@ -25,6 +26,7 @@ from pounding import hysteresis
 from pounding.contact import laws as contact_laws
 from pounding.errors import PoundingError
 from pounding.errors import RecordError
+from pounding.memory import MEMORY_FRACTION, available_memory, check_memory
 from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
@@ -44,8 +46,6 @@ __all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "reco
 #: thousand-fold margin and marks a run whose energies (and likely peaks) are wrong.
 ENERGY_CLOSURE_LIMIT = 1e-3
 
-#: A run may plan to use at most this fraction of the memory available to it.
-MEMORY_FRACTION = 0.5
 
 
 def record_path(spec: str) -> str:
@@ -337,6 +337,7 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
         step = motion.time_step
         spec = model.ground_motion
         lag_requested = [spec.lag(name) for name in names]
+        _check_lags(model, lag_requested, step, motion.acceleration.size)
         shifts = [int(round(lag / step)) for lag in lag_requested]
         lags = [k * step for k in shifts]
         base = np.asarray(motion.acceleration, dtype=float)
@@ -359,6 +360,45 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
         rows[row, :values.size] = values
     return SupportMotions(rows, float(step), tuple(building_row), tuple(records), tuple(lag_requested),
                           tuple(lags), float(max(ends)))
+
+
+def _check_modes_memory(model: Model) -> None:
+    """Every building's dense modal matrices fit in memory (one line naming the model file if not)."""
+    from pounding.errors import ModelError
+
+    for building in model.buildings:
+        try:
+            building.check_modes_memory()
+        except PoundingError as exc:
+            raise ModelError(f"{_where(model)}{exc}") from None
+
+
+def _check_lags(model: Model, lags: list[float], step: float, samples: int) -> None:
+    """Refuse, before the lagged ground rows are built, a wave-passage lag that is not finite or whose
+    rows (one per building, ``lag / step`` leading zeros each) would not fit in memory.
+
+    Raises
+    ------
+    ModelError
+        One line naming the building, its lag and the fix.
+    """
+    from pounding.errors import ModelError
+
+    names = [b.name for b in model.buildings]
+    where = f"{_where(model)}ground_motion.wave_passage"
+    for name, lag in zip(names, lags):
+        if not (math.isfinite(lag) and lag >= 0):
+            wave = model.ground_motion.wave_passage
+            raise ModelError(f"{where}: the lag of building {name} is {lag:g} s (position difference "
+                             f"{wave.position[name] - min(wave.position.values()):g} m / apparent velocity "
+                             f"{wave.apparent_velocity:g} m/s); give positions in m along the row and a velocity "
+                             "in m/s (typically 100-3000)")
+    longest = max(lags)
+    needed = 8.0 * 3 * len(names) * (longest / step + samples)   # each row, the stacked rows and a copy
+    check_memory(needed, what=f"{where}: a lag of {longest:.3g} s (building {names[lags.index(longest)]}) on a "
+                              f"{step:g} s record step",
+                 fix="check the positions (m) and apparent_velocity (m/s): a lag of a few seconds is the most "
+                     "that a row of buildings sees")
 
 
 def simulate(model: Model, record: Record | str | None = None, xi: str | None = None, *,
@@ -401,6 +441,7 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     xarray.Dataset
         The results schema documented in the README (``pounding.results``).
     """
+    _check_modes_memory(model)
     if xi is not None:
         model = model.with_xi(xi)
     changes = {k: v for k, v in dict(rtol=rtol, atol=atol, atol_velocity=atol_velocity,
@@ -471,6 +512,7 @@ def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]
     :func:`support_motions` uses it: instead of loading the model's.  No
     histories and no dataset are made.
     """
+    _check_modes_memory(model)
     supports = support_motions(model, record, where="yaml")
     motion = supports.records[0]
     end_time = supports.end_time
@@ -545,44 +587,6 @@ def estimate_memory(model: Model, end_time: float, record_dt: float, output_dt: 
     per_sample += 5 * n + 2 * nc + 8                        # dataset histories and energies
     total = 8.0 * (2 * per_sample * n_out + n_ground)
     return int(min(total, 2 ** 62))
-
-
-def available_memory() -> int:
-    """Bytes this process can still use: the smaller of physical RAM and the address-space limit left."""
-    try:
-        ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        ram = 2 ** 40
-    try:
-        import resource
-
-        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
-        if soft != resource.RLIM_INFINITY:
-            used = 0
-            with open("/proc/self/status") as handle:
-                for line in handle:
-                    if line.startswith("VmSize:"):
-                        used = int(line.split()[1]) * 1024
-            ram = min(ram, max(0, soft - used))
-    except (ImportError, OSError, ValueError):
-        pass
-    return int(ram)
-
-
-def _bytes(n: float) -> str:
-    for unit, size in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
-        if n >= size:
-            return f"{n / size:.3g} {unit}"
-    return f"{n / 1e3:.3g} kB"
-
-
-def check_memory(needed: float, *, what: str, fix: str) -> None:
-    """Refuse, with the numbers and the fix, to start something that needs more than
-    :data:`MEMORY_FRACTION` of :func:`available_memory`."""
-    limit = MEMORY_FRACTION * available_memory()
-    if needed > limit:
-        raise PoundingError(f"{what} would need about {_bytes(needed)} of memory, more than "
-                            f"{MEMORY_FRACTION:.0%} of the {_bytes(limit / MEMORY_FRACTION)} available; {fix}")
 
 
 def model_inputs(model: Model) -> list[str]:

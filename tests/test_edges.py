@@ -265,3 +265,82 @@ def test_an_ida_prints_its_number_of_runs_before_it_starts(case, tmp_path):
     status, out, err = pounding(["ida", str(case / "model.yaml"), "--hunt", "--hunt-ceiling", "2e4",
                                  "--hunt-increment", "0", "--workers", "1", "--no-progress"], tmp_path, limit=60)
     assert status == 2 and "--hunt would make up to 2e+05 runs per record" in err, err
+
+
+# --------------------------------------------------------------------------- #
+# §3 Memory checked before allocating
+# --------------------------------------------------------------------------- #
+
+
+def _wave_model(folder: Path, position: float, velocity: float, west: float = 0.0) -> Path:
+    model = base_model()
+    model["ground_motion"]["wave_passage"] = {"apparent_velocity": velocity, "position": {"A": west, "B": position}}
+    return _write_case(folder, model)
+
+
+@pytest.mark.parametrize("position, velocity, west, expected", [
+    (1e9, 1.0, 0.0, "a lag of 1e+09 s (building B) on a 0.01 s record step would need about 4.8 TB"),
+    (3e6, 1.0, 0.0, "a lag of 3e+06 s (building B) on a 0.01 s record step would need about 14.4 GB"),
+    (1e308, 1e-300, 0.0, "the lag of building B is inf s (position difference 1e+308 m / apparent velocity"),
+    (1.7e308, 500.0, -1.7e308, "the lag of building B is inf s (position difference inf m"),
+])
+def test_wave_passage_lags_are_checked_before_allocating(tmp_path, position, velocity, west, expected):
+    # Before: MemoryError / ValueError (negative dimensions) / OverflowError tracebacks from the lag arrays.
+    path = _wave_model(tmp_path, position, velocity, west)
+    status, out, err = pounding(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    assert status == 2 and verdict(status, out, err, None) is None, err
+    assert f"{path.name}: ground_motion.wave_passage: " in err and expected in err
+
+
+@pytest.mark.parametrize("damping", [{"modal": [0.05]}, {"ratio": 0.05, "modes": [1, 2]}])
+def test_ten_thousand_storeys_are_checked_before_the_eigensolver(tmp_path, damping):
+    # Before: MemoryError from numpy's eigh (dense 10,000 x 10,000 matrices under a 3 GB cap).
+    model = base_model()
+    model["buildings"][0]["storeys"]["count"] = 10_000
+    model["buildings"][0]["damping"] = damping
+    path = _write_case(tmp_path, model)
+    status, out, err = pounding(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    assert status == 2 and verdict(status, out, err, None) is None, err
+    assert "building A: the modes of its 10000 storeys (dense 10000 x 10000 matrices) would need about" in err
+    assert "lump several storeys into one" in err
+
+
+def _huge_netcdf(path: Path, **attributes) -> None:
+    import netCDF4
+
+    with netCDF4.Dataset(path, "w") as nc:   # 2.4 GB declared, 16 kB on disk (unwritten chunks)
+        nc.createDimension("x", 300_000_000)
+        nc.createVariable("v", "f8", ("x",), zlib=True, chunksizes=(1_000_000,))[:10] = 1.0
+        for key, value in attributes.items():
+            nc.setncattr(key, value)
+
+
+@pytest.mark.parametrize("kind, command, expected", [
+    ("foreign", "rerun", "not a pounding run archive"),
+    ("run", "rerun", "reading its 1 variables (2.4 GB) would need about 4.8 GB"),
+    ("run", "info", "reading its 1 variables (2.4 GB)"),
+    ("sweep", "info", "reading its 1 variables (2.4 GB)"),
+])
+def test_a_huge_netcdf_is_not_loaded_whole(tmp_path, kind, command, expected):
+    # Before: the 2.4 GB variable was loaded (MemoryError under the cap) before anything was checked.
+    attributes = {"foreign": {}, "run": {"source": "pounding 1", "run_spec": "{}"},
+                  "sweep": {"source": "pounding 1", "sweep_name": "s"}}[kind]
+    archive = tmp_path / "big.nc"
+    _huge_netcdf(archive, **attributes)
+    args = ["rerun", str(archive), "-o", str(tmp_path / "again.nc")] if command == "rerun" else ["info", str(archive)]
+    status, out, err = pounding(args, tmp_path, limit=60)
+    assert status == 2 and verdict(status, out, err, None) is None, err
+    assert expected in err
+
+
+def test_a_sweep_over_lags_reports_the_refusal_per_scenario(case, tmp_path):
+    # Before: the scenario's error was numpy's "Unable to allocate 745 GiB for an array ...".
+    from pounding.studies.sweep import load_sweep, run_sweep
+
+    _wave_model(tmp_path, 30.0, 500.0)
+    (tmp_path / "s.yaml").write_text("model: model.yaml\naxes:\n  ground_motion.wave_passage.apparent_velocity: "
+                                     "[500.0, 3.0e-8]\n")
+    ds = run_sweep(load_sweep(tmp_path / "s.yaml"), None, workers=1, progress=False)
+    errors = [str(e) for e in ds.error.values.ravel() if str(e)]
+    assert list(ds.status.values.ravel()) == ["ok", "error"], errors
+    assert "a lag of 1e+09 s (building B) on a 0.01 s record step would need about 4.8 TB" in errors[0]

@@ -26,7 +26,7 @@ PACKAGE = Path(pounding.__file__).parent
 LAYERS: list[tuple[str, ...]] = [
     ("pounding", "pounding.errors", "pounding.data", "pounding.units", "pounding.numba_cache",
      "pounding.registry"),
-    ("pounding.records", "pounding.contact", "pounding.hysteresis"),
+    ("pounding.records", "pounding.contact", "pounding.hysteresis", "pounding.memory"),
     ("pounding.model",),
     ("pounding.solver",),
     ("pounding.results",),

@@ -255,7 +255,7 @@ def open_archive(path) -> tuple[str, object]:
     import xarray as xr
 
     from pounding.errors import ArchiveError
-    from pounding.results.archive import open_run
+    from pounding.results.archive import load_within_memory, open_run
 
     source = Path(path)
     if not source.exists():
@@ -276,7 +276,7 @@ def open_archive(path) -> tuple[str, object]:
         raise ArchiveError(f"{source}: not a pounding archive (written by pounding run, rerun, sweep, compare or "
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
-        ds = handle.load()
+        ds = load_within_memory(handle, source)
     if attrs.get("study") in ("gap", "ida") or "sweep_name" in attrs:
         if "status" not in names:   # every study archive has one status per scenario
             raise ArchiveError(f"damaged archive: {source}: variable status missing; run the study again to "

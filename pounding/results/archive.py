@@ -30,7 +30,7 @@ import xarray as xr
 
 from pounding.errors import ArchiveError
 
-__all__ = ["save_run", "open_run", "check_writable", "atomic_path", "check_not_input", "check_regular_file",
+__all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "atomic_path", "check_not_input", "check_regular_file",
            "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
            "REQUIRED_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
@@ -462,14 +462,34 @@ def open_run(path: str | os.PathLike) -> xr.Dataset:
     source = check_regular_file(path)
     try:
         with _NETCDF_LOCK, xr.open_dataset(source, engine="netcdf4") as handle:
-            ds = handle.load()
+            if not str(handle.attrs.get("source", "")).startswith("pounding") or "run_spec" not in handle.attrs:
+                raise ArchiveError(f"{source}: not a pounding run archive (no 'run_spec' attribute)")
+            ds = load_within_memory(handle, source)
     except (OSError, ValueError, RuntimeError, KeyError, TypeError, IndexError) as exc:
         raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
                            f"{' '.join(str(exc).split())[:120]})") from None
-    if not str(ds.attrs.get("source", "")).startswith("pounding") or "run_spec" not in ds.attrs:
-        raise ArchiveError(f"{source}: not a pounding run archive (no 'run_spec' attribute)")
     check_archive(ds, source)
     return ds
+
+
+def load_within_memory(handle: xr.Dataset, source: str | os.PathLike) -> xr.Dataset:
+    """Load an opened (lazy) NetCDF dataset into memory after checking that its variables fit.
+
+    The size is read from the file's metadata (shape x item size), before
+    anything is read: a foreign file with a 2.4 GB variable is refused in one
+    line instead of being loaded whole.
+
+    Raises
+    ------
+    PoundingError
+        The variables need more than half of the memory available.
+    """
+    from pounding.memory import check_memory, format_bytes
+
+    size = float(sum(var.size * var.dtype.itemsize for var in handle.variables.values()))
+    check_memory(2.0 * size, what=f"{source}: reading its {len(handle.variables)} variables ({format_bytes(size)})",
+                 fix="is it the right file? a run archive is a few MB; read it on a machine with more memory")
+    return handle.load()
 
 
 #: Variables every run archive has (the summary, plots and rerun read them).
