@@ -344,3 +344,38 @@ def test_a_sweep_over_lags_reports_the_refusal_per_scenario(case, tmp_path):
     errors = [str(e) for e in ds.error.values.ravel() if str(e)]
     assert list(ds.status.values.ravel()) == ["ok", "error"], errors
     assert "a lag of 1e+09 s (building B) on a 0.01 s record step would need about 4.8 TB" in errors[0]
+
+
+# --------------------------------------------------------------------------- #
+# §1 smaller items (not the contact numerics)
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("levels, expected", [
+    ([[1, 1], [1, {"storey": 2, "at": 1e-17}]], "levels[1][1].at: is 1e-17, within 1e-06 of the storey height of "
+                                               "floor 1: write the floor number (1)"),
+    ([[2, 2], [2, {"storey": 2, "at": 1 - 1e-12}]], "of floor 2: write the floor number (2)"),
+    ([[1, {"storey": 1, "at": 1e-9}]], "of the ground, which does not move"),
+    ([[1, {"storey": 2, "at": 0.5}], [1, {"storey": 2, "at": 0.5 + 1e-12}]], "are already joined by this entry"),
+])
+def test_equivalent_contacts_are_refused(tmp_path, capsys, levels, expected):
+    # Before: a column point at 1e-17 beside the same floor contact was accepted and its impacts counted twice.
+    model = base_model()
+    model["contacts"][0]["levels"] = levels
+    path = _write_case(tmp_path, model)
+    assert main(["run", str(path), "-o", str(tmp_path / "out.nc")]) == 2
+    line = _error(capsys)
+    assert f"{path}:" in line and expected in line
+    assert not (tmp_path / "out.nc").exists()
+
+
+def test_a_stop_drift_ratio_below_resolution_is_refused(tmp_path, capsys):
+    # Before: stop_drift_ratio 1e-300 reported a collapse at t = 0 with zero drift.
+    model = base_model()
+    model["solver"]["stop_drift_ratio"] = 1e-300
+    path = _write_case(tmp_path, model)
+    assert main(["run", str(path), "-o", str(tmp_path / "out.nc")]) == 2
+    assert "solver.stop_drift_ratio must be >= 0.0001 (0.01 %" in _error(capsys)
+    model["solver"]["stop_drift_ratio"] = 0.1   # a real collapse limit still runs
+    path = _write_case(tmp_path, model)
+    assert main(["run", str(path), "-o", str(tmp_path / "out.nc")]) == 0

@@ -69,6 +69,13 @@ DEFAULT_TOLERANCE = 0.01
 MIN_RTOL = 1e-12
 #: Most storeys a building may have (a list or ``count``); more is a typo, not a building.
 MAX_STOREYS = 10_000
+#: Smallest accepted ``solver.stop_drift_ratio`` (0.01 %).  Collapse is a drift ratio of several per
+#: cent; at 1e-300 the run "collapsed" at t = 0 with zero drift (the limit is below what the
+#: solver resolves: atol 1e-8 m over a 3 m storey is a drift ratio of 3e-9).
+MIN_STOP_DRIFT_RATIO = 1e-4
+#: A column point closer than this (as a fraction of the storey height) to a floor is that floor, and
+#: two points of one column closer than this are one point: refused, not counted twice.
+COLUMN_POINT_RESOLUTION = 1e-6
 #: ``between`` name of a fixed wall (a moat wall moving with the ground), reserved: no building may take it.
 WALL_NAME = "wall"
 #: Building index that stands for the wall in a contact's sides.
@@ -268,6 +275,12 @@ DampingRatio = Annotated[float, BeforeValidator(_pydantic(as_number)),
                          AfterValidator(_pydantic(_bound(lambda v: 0 <= v < 1, "must be in [0, 1)")))]
 PositiveInteger = Annotated[int, BeforeValidator(_pydantic(as_positive_integer))]
 Name = Annotated[str, BeforeValidator(_pydantic(as_name))]
+StopDriftRatio = Annotated[
+    float | None, BeforeValidator(_pydantic(_optional(as_number))),
+    AfterValidator(_pydantic(_optional(_bound(lambda v: v > 0, "must be > 0")))),
+    AfterValidator(_pydantic(_optional(_bound(lambda v: v >= MIN_STOP_DRIFT_RATIO,
+                                              f"must be >= {MIN_STOP_DRIFT_RATIO:g} (0.01 %; collapse is a drift "
+                                              "ratio of several per cent, e.g. 0.1)"))))]
 Rtol = Annotated[float, BeforeValidator(_pydantic(as_number)),
                  AfterValidator(_pydantic(_bound(lambda v: v >= MIN_RTOL, f"must be >= {MIN_RTOL:g}")))]
 
@@ -693,6 +706,11 @@ def _wall_sides(at: Location, left: int, right: int, names: list[str]) -> tuple[
     return left, right
 
 
+def _point_key(at: float | None) -> int | None:
+    """A column point's fraction on the grid of :data:`COLUMN_POINT_RESOLUTION` (None for a floor)."""
+    return None if at is None else int(round(at / COLUMN_POINT_RESOLUTION))
+
+
 def _side_item(value: Any, building: BuildingEntry, at: Location) -> tuple[int, float | None]:
     """One side of a level pair: a floor number, or ``{storey: s, at: x}`` (a point of storey s's column).
 
@@ -724,6 +742,12 @@ def _side_item(value: Any, building: BuildingEntry, at: Location) -> tuple[int, 
                     if fraction in (0.0, 1.0) and (fraction == 1.0 or storey > 1) else "")
             raise problem("must be in (0, 1), the fraction of the storey height above the floor below", hint=hint,
                           at=at + ("at",))
+        if min(fraction, 1.0 - fraction) < COLUMN_POINT_RESOLUTION:
+            floor = storey - 1 if fraction < 0.5 else storey
+            same = f"floor {floor}: write the floor number ({floor})" if floor else \
+                "the ground, which does not move: choose a point of the column"
+            raise problem(f"is {fraction:.3g}, within {COLUMN_POINT_RESOLUTION:g} of the storey height of {same}",
+                          kind="error", at=at + ("at",))
         return storey, fraction
     if isinstance(value, int) and not isinstance(value, bool) and value == 0:
         raise problem(f"level 0 is the ground; floors are numbered 1 to {n} from the ground up "
@@ -939,7 +963,7 @@ class SolverEntry(_Schema):
     atol: PositiveNumber = 1.0e-8
     atol_velocity: PositiveNumber = 1.0e-7
     output_dt: PositiveNumber = 0.01
-    stop_drift_ratio: OptionalPositiveNumber = Field(
+    stop_drift_ratio: StopDriftRatio = Field(
         None, description="end the run (status collapsed) when a storey's |drift ratio| exceeds this")
 
 
@@ -1025,7 +1049,7 @@ class ModelEntry(_Schema):
                 if section == "links" and (at_a is not None or at_b is not None):
                     raise problem("links join floors; a column point {storey, at} is for contacts only",
                                   kind="error", at=(index, "levels", position))
-                key = (left, right, a, at_a, b, at_b)
+                key = (left, right, a, _point_key(at_a), b, _point_key(at_b))   # one point within the resolution
                 if key in joined:
                     other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
                     names = (side_text(buildings, left, a, at_a), side_text(buildings, right, b, at_b))
