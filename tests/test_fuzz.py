@@ -16,7 +16,10 @@ The categories follow issue 17: physically absurd values (masses, dt, scale,
 output_dt, duration), non-finite and huge record samples, malformed AT2 and
 text records, hostile names (quotes, newlines, non-ASCII), outputs that are
 inputs or cannot be written, sweep files with overlapping or broken axes, and
-tampered or truncated archives.  YAML-syntax attacks (NUL bytes, deep nesting,
+tampered or truncated archives; and issue 25 (:func:`test_fuzz_edges`): work
+without bound (stiff links, hunt settings), allocations beyond memory
+(wave-passage lags, 10,000 storeys), equivalent column points, tiny collapse
+limits, output names that are not UTF-8 and two runs onto one output.  YAML-syntax attacks (NUL bytes, deep nesting,
 aliases) belong to the model-validation tests.
 
 Cost: every case is a fresh interpreter (~1 s to import and load the cached
@@ -53,6 +56,7 @@ N_MODELS = max(1, int(24 * SCALE))
 N_RECORDS = max(1, int(16 * SCALE))
 N_ARCHIVES = max(1, int(10 * SCALE))
 N_SWEEPS = max(1, int(4 * SCALE))
+N_EDGES = max(1, int(16 * SCALE))
 
 
 def _limits() -> None:  # runs in the child before exec
@@ -369,3 +373,67 @@ def test_fuzz_outputs(tmp_path, where):
     status, out, err = pounding(["run", str(path), "-o", str(target), "--overwrite"], tmp_path)
     assert verdict(status, out, err, None) is None and status == 2, err
     assert {p: p.read_bytes() for p in before} == before
+
+
+EDGE_LINKS = [{"law": "maxwell", "stiffness": 1.0e9, "damping": 1.0}, {"law": "maxwell", "stiffness": 1e12,
+                                                                       "damping": 1e-3},
+              {"law": "maxwell", "stiffness": 2.0e8, "damping": 3.0e7}, {"law": "viscous", "damping": 1.0e15},
+              {"law": "viscous", "damping": 1.0e20}, {"law": "viscous", "damping": 3.0e6},
+              {"law": "kelvin", "stiffness": 1.0e25, "damping": 1.0e3}, {"law": "kelvin", "stiffness": 1.0e7,
+                                                                         "damping": 1.0e6}]
+EDGE_LAGS = [(1e9, 1.0), (3e6, 1.0), (1e308, 1e-300), (1.7e308, 500.0), (30.0, 500.0), (30.0, 3e-8)]
+EDGE_POINTS = [1e-17, 1e-9, 1 - 1e-12, 0.5, 1e-3]
+
+
+def mutate_edge(rng: random.Random, kind: int) -> dict:
+    """The base model with one issue-25 hazard of class *kind* (0-4): a stiff link, a wave-passage lag, a tall
+    modal building, a column point at or near a floor, or a tiny collapse limit."""
+    model = base_model()
+    if kind == 0:
+        model["links"] = [{"between": ["A", "B"], "levels": [[2, 2]], **rng.choice(EDGE_LINKS)}]
+    elif kind == 1:
+        position, velocity = rng.choice(EDGE_LAGS)
+        model["ground_motion"]["wave_passage"] = {"apparent_velocity": velocity,
+                                                  "position": {"A": rng.choice([0.0, -position]), "B": position}}
+    elif kind == 2:
+        model["buildings"][0]["storeys"]["count"] = rng.choice([2_000, 10_000])
+        model["buildings"][0]["damping"] = rng.choice([{"modal": [0.05]}, {"ratio": 0.05, "modes": [1, 2]}])
+        model["ground_motion"]["duration"] = 0.05
+    elif kind == 3:
+        model["contacts"][0]["levels"] = [[1, 1], [1, {"storey": 2, "at": rng.choice(EDGE_POINTS)}]]
+    else:
+        model["solver"]["stop_drift_ratio"] = rng.choice([1e-300, 1e-9, 0.0, 0.1, 1e300])
+    return model
+
+
+def test_fuzz_edges(tmp_path):
+    """Issue 25: work and memory bounded, equivalent elements refused, every output claimed once."""
+    rng = random.Random(SEED + 4)
+    cases = []
+    for i in range(N_EDGES):
+        folder = tmp_path / f"e{i}"
+        path = _write_case(folder, mutate_edge(rng, i % 5))   # every class, values drawn
+        cases.append((f"edge case {i}", ["run", str(path), "-o", str(folder / "out.nc")], folder, folder / "out.nc",
+                      TIME_LIMIT))
+    folder = tmp_path / "hunt"
+    path = _write_case(folder, base_model())
+    hunts = [["--hunt-step", "1e-7", "--hunt-increment", "0"], ["--hunt-ceiling", "1e9", "--hunt-step", "1e-3"],
+             ["--tolerance", "0"], ["--hunt-increment", "1e-9"], ["--hunt-ceiling", "0.3", "--runs-per-record", "3"]]
+    for i, options in enumerate(rng.sample(hunts, k=min(len(hunts), max(2, N_EDGES // 4)))):
+        cases.append((f"hunt case {i} {options}", ["ida", str(path), "--hunt", *options, "--workers", "1",
+                                                  "--no-progress"], folder, None, SWEEP_TIME_LIMIT))
+    name = os.fsdecode(b"out\xff.nc")
+    cases.append(("output name not UTF-8", ["run", str(path), "-o", str(folder / name)], folder, None, TIME_LIMIT))
+    _check_all(cases)
+    race = tmp_path / "race"
+    path = _write_case(race, base_model())
+    outcomes = _race(["run", str(path), "-o", str(race / "same.nc")], race)
+    assert sorted(status for status, _, _ in outcomes) == [0, 2], outcomes
+    assert all(verdict(*outcome, None) is None for outcome in outcomes)
+    assert sorted(p.name for p in race.iterdir() if p.suffix == ".nc") == ["same.nc"]
+
+
+def _race(args: list[str], cwd: Path) -> list:
+    """Start ``pounding ARGS`` twice at once; both outcomes."""
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        return list(pool.map(lambda _: pounding(args, cwd), range(2)))
