@@ -19,6 +19,23 @@ def client():
 
 
 @pytest.fixture(scope="module")
+def case(tmp_path_factory):
+    """A small model (two buildings of 3 and 2 floors, 1.5 s text record; tests/test_fuzz.py) and its archive."""
+    import sys
+    from pathlib import Path
+
+    from pounding.cli import main
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from test_fuzz import _write_case, base_model
+
+    folder = tmp_path_factory.mktemp("case")
+    path = _write_case(folder, base_model())
+    assert main(["run", str(path), "-o", str(folder / "run.nc")]) == 0
+    return folder
+
+
+@pytest.fixture(scope="module")
 def in_process_client():
     """A LocalCluster of threads in this process (no worker start-up; monkeypatches reach the runs)."""
     from dask.distributed import Client, LocalCluster

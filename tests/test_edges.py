@@ -20,23 +20,9 @@ from pounding.cli import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_fuzz import _write_case, base_model, pounding, verdict  # noqa: E402
+from test_hostile import _error  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-@pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    """A small model (5 floors, 1.5 s text record) and its archive."""
-    folder = tmp_path_factory.mktemp("edges")
-    path = _write_case(folder, base_model())
-    assert main(["run", str(path), "-o", str(folder / "run.nc")]) == 0
-    return folder
-
-
-def _error(capsys) -> str:
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("pounding: error: "), err
-    return err[0]
 
 
 # --------------------------------------------------------------------------- #

@@ -29,15 +29,6 @@ from test_fuzz import RECORD_TEXT, _write_case, base_model, pounding, verdict  #
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    """A small model (5 floors, 1.5 s text record) and its archive."""
-    folder = tmp_path_factory.mktemp("hostile")
-    path = _write_case(folder, base_model())
-    assert main(["run", str(path), "-o", str(folder / "run.nc")]) == 0
-    return folder
-
-
 def _error(capsys) -> str:
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("pounding: error: "), err
