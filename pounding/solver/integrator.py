@@ -102,7 +102,8 @@ from pounding.solver.layout import (ContactState, Contacts, Events, Forcing, Gro
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_COLUMNS,
                                       IMPACT_ROW_LIMIT, Outputs, Peaks, close_open_impacts, grown, new_outputs,
-                                      new_peaks, record_contacts, record_floor_peaks, record_sample, trimmed_outputs)
+                                      new_peaks, record_contacts, record_floor_peaks, record_sample, trace_rows,
+                                      trimmed_outputs, TRACE_ROW_LIMIT)
 from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
                                     STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT)
@@ -407,24 +408,26 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     zero = nc - nc
     work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc))
     y, ynew, ystage, k1, k2, k7 = work.y, work.ynew, work.ystage, work.K[0], work.K[1], work.K[6]
+    # Arrays are taken out of the records once, here: each ``record.member`` in the loop counts a reference.
+    ag, below, forces, rtol = forcing.acceleration, structure.below, work.forces, settings.rtol
     for i in range(2 * n):
         y[i] = y_initial[i]
     cstate = ContactState(np.zeros(nc, dtype=np.bool_), np.zeros(nc), np.zeros(nc, dtype=np.int64),
                           np.empty(nc, dtype=np.int64))
     events = Events(np.empty(nc), np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.empty(nh),
                     np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64))
-    tol = np.empty(S)
+    tol = np.empty(S)  # each state's absolute tolerance in the error norm
     fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, storey)
     out = new_outputs(n_out, lay, n_ground)
     peaks = new_peaks(lay)
-    table = ImpactTable(grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero)
+    impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     for c in range(nc):
         cstate.open_row[c] = -1
         cstate.closed[c] = kernels.is_permanent(contacts.law[c])  # links are engaged from the start, never open
     t, seg = 0.0, zero
     ag_t = _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground)
-    record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces, storey, ground, out)
+    record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
     for c in range(nc):
         out.force[0, c] = 0.0
     i_out = zero + 1
@@ -448,8 +451,8 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
-            stages(work, h_try, t, seg, forcing.acceleration, dt_rec, lay, structure, contacts, cstate, storey, ground)
-            err, finite = error_norm(work, h_try, tol, settings.rtol)
+            stages(work, h_try, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground)
+            err, finite = error_norm(work, h_try, tol, rtol)
             if not finite or err > 1.0:
                 n_rej += 1
                 rejected = True
@@ -468,7 +471,8 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
                     status = STATUS_COLLAPSED
                     break
                 table, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
-                                                              events, table, storey, ground)
+                                                              events, ImpactTable(impacts, n_imp), storey, ground)
+                impacts, n_imp = table
                 window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
                 if window_events > event_cap:
                     status = STATUS_EVENT_LIMIT
@@ -493,9 +497,12 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             break
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
-        record_floor_peaks(work, h_used, n, structure.below, peaks)
-        trace, n_trace, status = record_contacts(work, h_used, t, lay, contacts, cstate, ground, peaks, table.rows,
-                                                 trace, n_trace)
+        record_floor_peaks(work, h_used, n, below, peaks)
+        rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
+        if rows > trace.shape[0]:
+            trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
+        n_trace, status = record_contacts(work, h_used, t, lay, contacts, cstate, ground, peaks, impacts, trace,
+                                          n_trace)
         if status != 0:
             break
         while i_out < n_out and i_out * output_dt <= t_new + 1e-9 * output_dt:  # output samples in (t, t_new]
@@ -504,7 +511,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             for i in range(S):
                 ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
             ag_o = _rates_at(t_o, seg, ystage, k2, forcing, lay, structure, contacts, cstate, work, storey, ground)
-            record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, work.forces, storey, ground, out)
+            record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, forces, storey, ground, out)
             i_out += 1
         t = t_new  # accept
         for i in range(S):
@@ -518,7 +525,8 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             break
         if any_events:
             table, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
-                                                          events, table, storey, ground)
+                                                          events, ImpactTable(impacts, n_imp), storey, ground)
+            impacts, n_imp = table
         if any_events and n_applied > 0:
             window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
             if window_events > event_cap:
@@ -531,16 +539,16 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
                 break
         else:
             h = h_used * step_factor(err, True, rejected)
-    close_open_impacts(y, lay, cstate, table.rows)
+    close_open_impacts(y, lay, cstate, impacts)
     if status == 0 and i_out < n_out:
         # t_end reached within round-off before the last output sample: fill it.
         for i2 in range(i_out, n_out):
             ag_t = _rates_at(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground)
-            record_sample(i2, t, y, k1, ag_t, lay, structure, contacts, work.forces, storey, ground, out)
+            record_sample(i2, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
         i_out = n_out
     if status != STATUS_COLLAPSED:
         collapse_floor = zero - 1
-    return Integration(trimmed_outputs(out, i_out), peaks, table.rows[:table.count], trace[:n_trace], y,
+    return Integration(trimmed_outputs(out, i_out), peaks, impacts[:n_imp], trace[:n_trace], y,
                        collapse_floor, n_steps, n_rej, status, t)
 
 

@@ -27,7 +27,7 @@ from pounding.solver.status import STATUS_TABLE_LIMIT
 
 __all__ = ["FORCE_SAMPLES", "IMPACT_COLUMNS", "IMPACT_ROW_LIMIT", "TRACE_ROW_LIMIT", "Outputs", "Peaks", "grown",
            "new_outputs", "new_peaks", "closed_contact_samples", "peak_magnitude", "contact_energy",
-           "storey_outputs", "record_sample", "record_floor_peaks", "record_contacts", "close_open_impacts",
+           "storey_outputs", "record_sample", "record_floor_peaks", "trace_rows", "record_contacts", "close_open_impacts",
            "trimmed_outputs",
            "IMP_CONTACT", "IMP_TIME", "IMP_VELOCITY", "IMP_CONSTANT", "IMP_PEAK_FORCE", "IMP_END", "IMP_IMPULSE",
            "IMP_SEPARATION", "IMP_WORK"]
@@ -264,11 +264,22 @@ def record_floor_peaks(work, h, n, below, peaks) -> None:
                 peak_drift[j] = v
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def trace_rows(contacts, cstate) -> int:
+    """Most rows a step adds to the trace: FORCE_SAMPLES + 1 per closed contact, neither a link nor stuck."""
+    rows = 0
+    for c in range(cstate.closed.size):
+        if cstate.closed[c] and not kernels.is_permanent(contacts.law[c]) and cstate.mode[c] != kernels.MODE_STUCK:
+            rows += FORCE_SAMPLES + 1
+    return rows
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, trace, n_trace):
     """Peak force of every contact over an accepted step from *t* of *h* s, and the samples of every
-    closed one appended to the *trace* (its first *n_trace* rows used); an open impact row gets its
-    peak.  Returns ``(trace, n_trace, status)`` (the trace grown if needed; STATUS_TABLE_LIMIT at its cap).
+    closed one appended to the *trace* (its first *n_trace* rows used; the caller makes room for
+    :func:`trace_rows` more, up to TRACE_ROW_LIMIT); an open impact row gets its peak.  Returns
+    ``(n_trace, status)``, STATUS_TABLE_LIMIT when the trace would pass its cap.
     """
     y, ynew, K, forces_end = work.y, work.ynew, work.K, work.forces_end
     k1, k7 = K[0], K[6]
@@ -301,8 +312,7 @@ def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, t
                                          (y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c]), h, fractions, deltas,
                                          values)
             if n_trace + FORCE_SAMPLES + 1 > TRACE_ROW_LIMIT:
-                return trace, n_trace, STATUS_TABLE_LIMIT
-            trace = grown(trace, n_trace, n_trace + FORCE_SAMPLES + 1, zero + TRACE_ROW_LIMIT)
+                return n_trace, STATUS_TABLE_LIMIT
             for i in range(FORCE_SAMPLES + 1):
                 if i == 0 and n_trace > 0 and trace[n_trace - 1, 1] == c and trace[n_trace - 1, 0] == t:
                     continue  # the previous step already recorded its end point
@@ -316,7 +326,7 @@ def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, t
             row = open_imp[c]
             if row >= 0 and fpk > impacts[row, IMP_PEAK_FORCE]:
                 impacts[row, IMP_PEAK_FORCE] = fpk
-    return trace, n_trace, zero
+    return n_trace, zero
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
