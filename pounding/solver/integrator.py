@@ -69,12 +69,8 @@ record) and the Python entry point :func:`integrate`; the parts it drives:
 ``status``          how a run ended
 ==================  ===========================================================
 
-References
-----------
-Dormand, J.R. & Prince, P.J. (1980). A family of embedded Runge-Kutta
-formulae. J. Comput. Appl. Math. 6, 19-26.
-Hairer, E., Nørsett, S.P. & Wanner, G. (1993). Solving Ordinary Differential
-Equations I, 2nd ed., §II.4 (step control) and §II.6 (dense output).
+The method's references (Dormand & Prince 1980; Hairer, Nørsett & Wanner 1993) are in
+:mod:`pounding.solver.dormand_prince`.
 """
 
 
@@ -406,7 +402,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     # Sizes and counters are non-literal (``zero``): a literal (0, 64, False) reaching np.empty or a
     # callee makes numba compile a throw-away literal specialisation of it (seconds in all).
     zero = nc - nc
-    work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc))
+    work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((zero + 7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc))
     y, ynew, ystage, k1, k2, k7 = work.y, work.ynew, work.ystage, work.K[0], work.K[1], work.K[6]
     # Arrays are taken out of the records once, here: each ``record.member`` in the loop counts a reference.
     ag, below, forces, rtol = forcing.acceleration, structure.below, work.forces, settings.rtol

@@ -176,7 +176,7 @@ def step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground):
     return d0, r0, d1, r1, a0, a1, size
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def contact_sums(y, n, cf, cw, c):
     """Contact *c*'s ``(Σ w·u, Σ w·v)`` of state *y* (its δ + gap and δ̇ without the ground offsets),
     summed term by term from 0 (the right-hand side's form, as :func:`step_kinematics`)."""
@@ -204,7 +204,7 @@ step_kinematics_inline = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrap
 (as a call it measured ~5 % slower on pair.yaml, min of 6 alternated runs, 9.2 against 8.7 ms)."""
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def drift(y, offset, j, b) -> float:
     """Drift of the storey under floor *j* (floor below *b*, −1 for the ground) from ``y[offset:]``.
 

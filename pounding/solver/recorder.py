@@ -75,7 +75,7 @@ def new_outputs(n_out, lay, n_ground):
     n, nc = lay.n_floors, lay.n_contacts
     return Outputs(np.empty(n_out), np.empty((n_out, lay.size)), np.empty((n_out, n)), np.empty((n_out, nc)),
                    np.empty(n_out), np.empty((n_out, n_ground)), np.empty(n_out), np.empty((n_out, n)),
-                   np.empty((n_out, 2)))
+                   np.empty((n_out, n_ground - n_ground + 2)))  # non-literal 2: no extra np.empty specialisation
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
