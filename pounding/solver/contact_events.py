@@ -19,7 +19,7 @@ from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
 from pounding.solver.kinematics import (SIDE_TERMS, combo, compliance, contact_delta, effective_mass, fill_grounds,
                                         ground_at, ground_offset, kick, step_kinematics_inline)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
-                                      IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_ROW_LIMIT, grown)
+                                      IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_ROW_LIMIT)
 from pounding.solver.rhs import rhs
 from pounding.solver.status import STATUS_TABLE_LIMIT
 
@@ -262,7 +262,7 @@ def plastic_jump(c, y, lay, mass, contacts, dvg):
     return impulse
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.
 
@@ -280,10 +280,11 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
       turning tensile): the impact row is closed.
     * Mode switch: the next mode of the law, internal state put on its branch.
 
-    Returns ``(impacts, n_imp, n_applied, first_step_cap, status)``;
+    Returns ``(n_imp, n_applied, first_step_cap, status)``;
     *first_step_cap* (s) is the duration estimate of the shortest newly
     closed compliant contact over STEPS_PER_CONTACT (inf if none).  The
-    impact table *impacts* (its first *n_imp* rows used) is grown as needed.
+    impact table *impacts* (its first *n_imp* rows used) has room for a row per
+    contact (up to IMPACT_ROW_LIMIT; the caller grows it, :func:`recorder.grown`).
     ``work.ystage``, ``work.K[1]``, ``work.fbuf`` and ``work.forces`` serve as scratch.
     """
     y, scratch, deriv, fbuf, forces = work.y, work.ystage, work.K[1], work.fbuf, work.forces
@@ -309,7 +310,6 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
             if n_imp + 1 > IMPACT_ROW_LIMIT:
                 status = STATUS_TABLE_LIMIT
                 break
-            impacts = grown(impacts, n_imp, n_imp + 1, n_imp - n_imp + IMPACT_ROW_LIMIT)
             if kernels.is_instantaneous(claw[c]):
                 if rate <= 0.0:
                     n_applied -= 1  # touching without approach: no impact
@@ -369,7 +369,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
             delta = contact_delta(y, contacts, ground, c)
             y[iq + c] = kernels.snapped_internal(claw[c], cprm[c], new_mode, delta, rate, y[iq + c])
             cmode[c] = new_mode
-    return impacts, n_imp, n_applied, cap, status
+    return n_imp, n_applied, cap, status
 
 
 jit.stamp_solver_kernels(globals())

@@ -305,18 +305,31 @@ def _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work,
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _with_room(impacts, n_imp, nc):
+    """The impact table *impacts* (its first *n_imp* rows used) with room for *nc* more rows (up to its cap)."""
+    if n_imp + nc <= impacts.shape[0] or impacts.shape[0] >= IMPACT_ROW_LIMIT:
+        return impacts
+    return grown(impacts, n_imp, min(n_imp + nc, n_imp - n_imp + IMPACT_ROW_LIMIT), n_imp - n_imp + IMPACT_ROW_LIMIT)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, events, table, storey, ground):
     """Apply the storey events ``events.storey_kind`` and the contact events ``events.kind`` at *t*, in
-    place: ``(table, n_applied, first_step_cap, status)`` (:func:`contact_events.apply_contact_events`)."""
-    n_storey = lay.n_floors - lay.n_floors
+    place: ``(n_imp, n_applied, first_step_cap, status)`` (:func:`contact_events.apply_contact_events`;
+    *table* with room for a row per contact, :func:`_with_room`)."""
+    zero = lay.n_floors - lay.n_floors
+    n_storey = zero
     if storey is not None:
         n_storey = apply_storey_events(events.storey_kind, work.y, lay, structure.below, storey)
-    if ground is not None:
-        fill_grounds(ground, forcing.record_step, seg, t, ground.now)
-    impacts, n_imp, n_applied, cap, status = apply_contact_events(
-        events.kind, t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay, structure, contacts,
-        cstate, work, table.rows, table.count, storey, ground)
-    return ImpactTable(impacts, n_imp), n_applied + n_storey, cap, status
+    for c in range(lay.n_contacts):
+        if events.kind[c] != EVENT_NONE:  # the contact events' applier is called only when there is one
+            if ground is not None:
+                fill_grounds(ground, forcing.record_step, seg, t, ground.now)
+            n_imp, n_applied, cap, status = apply_contact_events(
+                events.kind, t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay, structure,
+                contacts, cstate, work, table.rows, table.count, storey, ground)
+            return n_imp, n_applied + n_storey, cap, status
+    return table.count, n_storey, np.inf, zero
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
@@ -369,38 +382,32 @@ def _count_events(t, n_applied, start, count, record_step):
     return start, count + n_applied
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _locate(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground):
-    """First located event in a trial step: ``(s_first, collapse_s, collapse_floor)`` (fractions of the
-    step; s_first 2.0 if none, collapse_s −1 if the drift limit is not crossed)."""
-    s_first = locate_contact_events(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey,
-                                    ground)
-    collapse_s = -1.0
-    collapse_at = lay.n_floors - lay.n_floors - 1
-    if storey is not None:
-        s = locate_storey_events(work, h, lay, structure.below, storey, events.storey_s, events.storey_kind)
-        if s < s_first:
-            s_first = s
-        if storey.stop_ratio > 0.0:
-            collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, structure.below, storey.height,
-                                                        storey.stop_ratio, h)
-            if collapse_s >= 0.0 and collapse_s < s_first:
-                s_first = collapse_s
-    return s_first, collapse_s, collapse_at
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _new_contact_state(contacts):
+    """Every contact open (a link: closed, engaged from the start and never open), no impact row."""
+    nc = contacts.gap.size
+    cstate = ContactState(np.zeros(nc, dtype=np.bool_), np.zeros(nc), np.zeros(nc, dtype=np.int64),
+                          np.empty(nc, dtype=np.int64))
+    for c in range(nc):
+        cstate.open_row[c] = -1
+        cstate.closed[c] = kernels.is_permanent(contacts.law[c])
+    return cstate
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def _new_events(nc, nh):
+    """No event located, none pending, for *nc* contacts and *nh* yielding storeys."""
+    return Events(np.empty(nc), np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.empty(nh),
+                  np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64))
 
 
 @njit(cache=True)
 def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_initial):
-    """The run (see the module's docstring): *storey* None for linear elastic storeys without P-Delta or a
-    collapse limit, *ground* None with one common ground (their blocks are then pruned at compile time)."""
+    """The run (module docstring); *storey*, *ground* None: their blocks are pruned at compile time."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
     dt_rec, t_end, output_dt = forcing.record_step, settings.end_time, settings.output_step
-    n_ground = nc - nc + 1
-    if ground is not None:
-        n_ground = ground.acceleration.shape[0]
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
-    # Sizes and counters are non-literal (``zero``): a literal (0, 64, False) reaching np.empty or a
-    # callee makes numba compile a throw-away literal specialisation of it (seconds in all).
+    # Sizes and counters non-literal (``zero``): a literal reaching np.empty or a callee compiles a throw-away one.
     zero = nc - nc
     work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((zero + 7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc))
     y, ynew, ystage, k1, k2, k7 = work.y, work.ynew, work.ystage, work.K[0], work.K[1], work.K[6]
@@ -408,30 +415,23 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     ag, below, forces, rtol = forcing.acceleration, structure.below, work.forces, settings.rtol
     for i in range(2 * n):
         y[i] = y_initial[i]
-    cstate = ContactState(np.zeros(nc, dtype=np.bool_), np.zeros(nc), np.zeros(nc, dtype=np.int64),
-                          np.empty(nc, dtype=np.int64))
-    events = Events(np.empty(nc), np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.empty(nh),
-                    np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64))
+    cstate, events = _new_contact_state(contacts), _new_events(nc, nh)
+    storey_s, storey_kind = events.storey_s, events.storey_kind
+    if storey is not None:
+        heights, stop_ratio = storey.height, storey.stop_ratio
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
     fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, storey)
-    out = new_outputs(n_out, lay, n_ground)
+    out = new_outputs(n_out, lay, ground)
     peaks = new_peaks(lay)
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
-    for c in range(nc):
-        cstate.open_row[c] = -1
-        cstate.closed[c] = kernels.is_permanent(contacts.law[c])  # links are engaged from the start, never open
     t, seg = 0.0, zero
     ag_t = _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground)
-    record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
-    for c in range(nc):
-        out.force[0, c] = 0.0
-    i_out = zero + 1
-    h, n_steps, n_rej, status, collapse_floor = settings.first_step, zero, zero, zero, zero - 1
-    tiny = 1e-12 * max(dt_rec, 1.0)
-    event_cap = EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
-    window_start, window_events = 0.0, zero
-    err, collapse_s, n_applied, cap = 0.0, -1.0, zero, np.inf
+    # No contact force in the first sample (work.forces_end is still all 0; a link's first force is not kept).
+    record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces_end, storey, ground, out)
+    h, n_steps, n_rej, status, collapse_floor, i_out = settings.first_step, zero, zero, zero, zero - 1, zero + 1
+    tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
+    window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
     while t < t_end - tiny and i_out <= n_out:
         while (seg + 1) * dt_rec <= t + 1e-9 * dt_rec:
             seg += 1
@@ -456,19 +456,25 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
                 h_before_events, n_retake, collapse_pending = h_try, zero, False
                 _set_pending(events, -1.0)
                 continue
-            s_first, collapse_s, collapse_at = _locate(work, h_try, t, seg, forcing, lay, structure, contacts, cstate,
-                                                       events, storey, ground)
-            if collapse_s >= 0.0:
-                collapse_floor = collapse_at
+            s_first = locate_contact_events(work, h_try, t, seg, forcing, lay, structure, contacts, cstate, events,
+                                            storey, ground)
+            collapse_s = -1.0
+            if storey is not None:
+                s_first = min(s_first, locate_storey_events(work, h_try, lay, below, storey, storey_s, storey_kind))
+                if stop_ratio > 0.0:
+                    collapse_s, collapse_at = collapse_crossing(work, n, below, heights, stop_ratio, h_try)
+                    if collapse_s >= 0.0:
+                        collapse_floor = collapse_at
+                        s_first = min(s_first, collapse_s)
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 _keep_events_within(events, h_try, tiny)
                 if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
                     status = STATUS_COLLAPSED
                     break
-                table, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
+                impacts = _with_room(impacts, n_imp, nc)
+                n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
                                                               events, ImpactTable(impacts, n_imp), storey, ground)
-                impacts, n_imp = table
                 window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
                 if window_events > event_cap:
                     status = STATUS_EVENT_LIMIT
@@ -520,9 +526,9 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
             break
         if any_events:
-            table, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
+            impacts = _with_room(impacts, n_imp, nc)
+            n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
                                                           events, ImpactTable(impacts, n_imp), storey, ground)
-            impacts, n_imp = table
         if any_events and n_applied > 0:
             window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
             if window_events > event_cap:

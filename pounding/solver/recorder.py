@@ -70,9 +70,12 @@ class Peaks(NamedTuple):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def new_outputs(n_out, lay, n_ground):
-    """Empty :class:`Outputs` of *n_out* samples."""
+def new_outputs(n_out, lay, ground):
+    """Empty :class:`Outputs` of *n_out* samples (*ground*: the solver's, None with one ground)."""
     n, nc = lay.n_floors, lay.n_contacts
+    n_ground = nc - nc + 1
+    if ground is not None:
+        n_ground = ground.acceleration.shape[0]
     return Outputs(np.empty(n_out), np.empty((n_out, lay.size)), np.empty((n_out, n)), np.empty((n_out, nc)),
                    np.empty(n_out), np.empty((n_out, n_ground)), np.empty(n_out), np.empty((n_out, n)),
                    np.empty((n_out, n_ground - n_ground + 2)))  # non-literal 2: no extra np.empty specialisation
