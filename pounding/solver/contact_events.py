@@ -25,7 +25,7 @@ from pounding.solver.status import STATUS_TABLE_LIMIT
 
 __all__ = ["EVENT_NONE", "EVENT_CLOSE", "EVENT_SEPARATE", "EVENT_RELEASE", "EVENT_SWITCH0", "EVENT_SAMPLES",
            "STEPS_PER_CONTACT", "EVENTS_PER_WINDOW_BASE", "EVENTS_PER_WINDOW_PER_CONTACT", "switch_crossing",
-           "locate_contact_events", "velocity_jump", "switch_contact", "plastic_jump", "apply_contact_events"]
+           "locate_contact_events", "locate_releases", "velocity_jump", "switch_contact", "plastic_jump", "apply_contact_events"]
 
 #: Sub-intervals sampled on the interpolant when searching for a contact event.
 EVENT_SAMPLES = 8
@@ -92,20 +92,20 @@ def switch_crossing(claw, prm, const, mode, which, gap, kin, internal, h) -> flo
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def locate_contact_events(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground):
+def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, events, ground):
     """Each contact's first event inside a trial step from *t* of *h* s into ``events.s`` (fraction of
-    the step, −1 if none) and ``events.kind`` (EVENT_*); returns the earliest fraction (2.0 if none).
+    the step, −1 if none) and ``events.kind`` (EVENT_*): ``(earliest fraction, 2.0 if none; number of
+    stuck contacts whose release is still to be located by :func:`locate_releases`)``.
 
     Keeps the forces at the step's end (the last stage evaluation) in ``work.forces_end``; with
     several grounds fills ``ground.start`` and ``ground.end``.  δ is the Hermite cubic of the total
     displacements: each side's weighted floors over its own ground plus the contact's differential
     ground motion (itself a cubic within a record step, so the interpolant reproduces it exactly).
-    A stuck contact's release (its constraint force turning tensile) is bisected on the interpolant.
     """
-    y, ynew, ystage, K, fbuf, forces, forces_end = work
-    k1, k2, k7 = K[0], K[1], K[6]
-    ag, dt_rec = forcing.acceleration, forcing.record_step
-    n, S, iq = lay.n_floors, lay.size, lay.internal
+    y, ynew, K, forces, forces_end = work.y, work.ynew, work.K, work.forces, work.forces_end
+    k1, k7 = K[0], K[6]
+    dt_rec = forcing.record_step
+    n, iq = lay.n_floors, lay.internal
     cf, cw, cgap, claw, cprm = contacts
     closed, cconst, cmode = cstate.closed, cstate.constant, cstate.mode
     event_s, event_kind = events.s, events.kind
@@ -116,6 +116,7 @@ def locate_contact_events(work, h, t, seg, forcing, lay, structure, contacts, cs
         fill_grounds(ground, dt_rec, seg, t, ground.start)
         fill_grounds(ground, dt_rec, seg, t + h_try, ground.end)
     s_first = 2.0
+    n_release = 0
     for c in range(lay.n_contacts):
         event_s[c] = -1.0
         event_kind[c] = EVENT_NONE
@@ -132,26 +133,8 @@ def locate_contact_events(work, h, t, seg, forcing, lay, structure, contacts, cs
             s = first_crossing(d0, r0, d1, r1, h_try, True, floor)
             kind = EVENT_CLOSE
         elif cmode[c] == kernels.MODE_STUCK:
-            kind = EVENT_RELEASE
             if forces_end[c] < 0.0:
-                # The constraint force turns tensile inside the step: bisect on the interpolant.
-                lo = 0.0
-                hi = 1.0
-                for _ in range(60):
-                    mid = 0.5 * (lo + hi)
-                    for i in range(S):
-                        ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
-                    if ground is not None:
-                        fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground.now)
-                    rhs(ystage, ground_at(ag, dt_rec, seg, t + mid * h_try), lay, structure, contacts, cstate, k2,
-                        fbuf, forces, storey, ground)
-                    if forces[c] < 0.0:
-                        hi = mid
-                    else:
-                        lo = mid
-                    if hi - lo < 1e-13:
-                        break
-                s = hi
+                n_release += 1  # the constraint force turns tensile inside the step: locate_releases
         else:
             s = first_crossing(d0, r0, d1, r1, h_try, False, floor)
             kind = EVENT_SEPARATE
@@ -168,6 +151,45 @@ def locate_contact_events(work, h, t, seg, forcing, lay, structure, contacts, cs
             event_kind[c] = kind
             if s < s_first:
                 s_first = s
+    return s_first, n_release
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground):
+    """Release of every stuck contact whose constraint force is tensile at the end of a trial step from
+    *t* of *h* s (``work.forces_end``): bisected on the interpolant, into ``events.s`` and
+    ``events.kind`` (EVENT_RELEASE); returns the earliest fraction (2.0 if none).  Kept out of
+    :func:`locate_contact_events` (rare, and it needs the whole right-hand side)."""
+    y, ynew, ystage, K, fbuf, forces, forces_end = work
+    k1, k2, k7 = K[0], K[1], K[6]
+    ag, dt_rec = forcing.acceleration, forcing.record_step
+    S = lay.size
+    closed, cmode = cstate.closed, cstate.mode
+    h_try = h
+    s_first = 2.0
+    for c in range(lay.n_contacts):
+        if kernels.is_permanent(contacts.law[c]) or not closed[c] or cmode[c] != kernels.MODE_STUCK:
+            continue
+        if forces_end[c] < 0.0:
+            lo = 0.0
+            hi = 1.0
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                for i in range(S):
+                    ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
+                if ground is not None:
+                    fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground.now)
+                rhs(ystage, ground_at(ag, dt_rec, seg, t + mid * h_try), lay, structure, contacts, cstate, k2,
+                    fbuf, forces, storey, ground)
+                if forces[c] < 0.0:
+                    hi = mid
+                else:
+                    lo = mid
+                if hi - lo < 1e-13:
+                    break
+            events.s[c] = hi
+            events.kind[c] = EVENT_RELEASE
+            s_first = min(s_first, hi)
     return s_first
 
 

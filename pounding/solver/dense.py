@@ -15,7 +15,7 @@ from numba import njit
 
 from pounding.solver import jit
 
-__all__ = ["DELTA_ROUNDOFF", "hermite", "extremum_in_step", "first_crossing"]
+__all__ = ["DELTA_ROUNDOFF", "hermite", "interpolate", "extremum_in_step", "first_crossing"]
 
 #: Grazing floor: an overlap smaller than this multiple of the round-off of
 #: δ = u_L − u_R − gap (``eps·(|u_L| + |u_R| + gap)``) is indistinguishable from zero and is
@@ -133,6 +133,15 @@ def first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward:
             near = True
         lo = hi
     return -1.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def interpolate(work, h, s, out) -> None:
+    """The state at fraction *s* of the trial step of *h* s in ``work`` (a :class:`~pounding.solver.layout.Work`)
+    into *out*: every state's Hermite cubic from its values and rates (``K[0]``, ``K[6]``) at both ends."""
+    y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
+    for i in range(y.size):
+        out[i] = hermite(y[i], k1[i], ynew[i], k7[i], h, s)
 
 
 jit.stamp_solver_kernels(globals())

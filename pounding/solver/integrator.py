@@ -87,8 +87,8 @@ from pounding import hysteresis
 from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
-                                            apply_contact_events, locate_contact_events)
-from pounding.solver.dense import hermite
+                                            apply_contact_events, locate_contact_events, locate_releases)
+from pounding.solver.dense import interpolate
 from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, stages,
                                             step_factor)
 from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
@@ -382,6 +382,31 @@ def _count_events(t, n_applied, start, count, record_step):
     return start, count + n_applied
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def _locate_storeys(work, h, lay, below, storey, events, s_first, collapse_floor):
+    """The yielding storeys' first events in a trial step of *h* s and the collapse limit's crossing:
+    ``(first event fraction, *s_first* if earlier; collapse fraction, −1 if none; its floor, else
+    *collapse_floor*)``.  A kernel of its own, so the driver's loop has no branch of its own for the
+    storeys (its branches cost reference counts of the tables it grows, at every step)."""
+    s_first = min(s_first, locate_storey_events(work, h, lay, below, storey, events.storey_s, events.storey_kind))
+    collapse_s = -1.0
+    if storey.stop_ratio > 0.0:
+        collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio, h)
+        if collapse_s >= 0.0:
+            s_first = min(s_first, collapse_s)
+            collapse_floor = collapse_at
+    return s_first, collapse_s, collapse_floor
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def _accept(work) -> None:
+    """Accept the trial step: its end state and rate become the next step's start (first same as last)."""
+    y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
+    for i in range(y.size):
+        y[i] = ynew[i]
+        k1[i] = k7[i]
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _new_contact_state(contacts):
     """Every contact open (a link: closed, engaged from the start and never open), no impact row."""
@@ -410,15 +435,12 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     # Sizes and counters non-literal (``zero``): a literal reaching np.empty or a callee compiles a throw-away one.
     zero = nc - nc
     work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((zero + 7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc))
-    y, ynew, ystage, k1, k2, k7 = work.y, work.ynew, work.ystage, work.K[0], work.K[1], work.K[6]
+    y, ystage, k1, k2 = work.y, work.ystage, work.K[0], work.K[1]
     # Arrays are taken out of the records once, here: each ``record.member`` in the loop counts a reference.
     ag, below, forces, rtol = forcing.acceleration, structure.below, work.forces, settings.rtol
     for i in range(2 * n):
         y[i] = y_initial[i]
     cstate, events = _new_contact_state(contacts), _new_events(nc, nh)
-    storey_s, storey_kind = events.storey_s, events.storey_kind
-    if storey is not None:
-        heights, stop_ratio = storey.height, storey.stop_ratio
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
     fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, storey)
     out = new_outputs(n_out, lay, ground)
@@ -456,16 +478,15 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
                 h_before_events, n_retake, collapse_pending = h_try, zero, False
                 _set_pending(events, -1.0)
                 continue
-            s_first = locate_contact_events(work, h_try, t, seg, forcing, lay, structure, contacts, cstate, events,
-                                            storey, ground)
+            s_first, n_release = locate_contact_events(work, h_try, t, seg, forcing, lay, contacts, cstate, events,
+                                                       ground)
+            if n_release > 0:
+                s_first = min(s_first, locate_releases(work, h_try, t, seg, forcing, lay, structure, contacts, cstate,
+                                                       events, storey, ground))
             collapse_s = -1.0
             if storey is not None:
-                s_first = min(s_first, locate_storey_events(work, h_try, lay, below, storey, storey_s, storey_kind))
-                if stop_ratio > 0.0:
-                    collapse_s, collapse_at = collapse_crossing(work, n, below, heights, stop_ratio, h_try)
-                    if collapse_s >= 0.0:
-                        collapse_floor = collapse_at
-                        s_first = min(s_first, collapse_s)
+                s_first, collapse_s, collapse_floor = _locate_storeys(work, h_try, lay, below, storey, events, s_first,
+                                                                      collapse_floor)
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 _keep_events_within(events, h_try, tiny)
@@ -510,20 +531,18 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
         while i_out < n_out and i_out * output_dt <= t_new + 1e-9 * output_dt:  # output samples in (t, t_new]
             t_o = min(i_out * output_dt, t_new)
             s = (t_o - t) / h_used
-            for i in range(S):
-                ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h_used, s)
+            interpolate(work, h_used, s, ystage)
             ag_o = _rates_at(t_o, seg, ystage, k2, forcing, lay, structure, contacts, cstate, work, storey, ground)
             record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, forces, storey, ground, out)
             i_out += 1
         t = t_new  # accept
-        for i in range(S):
-            y[i] = ynew[i]
-            k1[i] = k7[i]
+        _accept(work)
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
         any_events = _with_pending(events)
-        if storey is not None and (collapse_s >= 0.0 or collapse_pending):
-            status = STATUS_COLLAPSED  # located: this step ends where the drift limit is first exceeded
+        if storey is not None:  # located: this step ends where the drift limit is first exceeded
+            status = STATUS_COLLAPSED if collapse_s >= 0.0 or collapse_pending else status
+        if status != 0:
             break
         if any_events:
             impacts = _with_room(impacts, n_imp, nc)
@@ -578,8 +597,8 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
                    np.ascontiguousarray(system.storey_state, dtype=np.int64),
                    np.ascontiguousarray(system.p_delta_stiffness, dtype=np.float64),
                    np.ascontiguousarray(system.storey_height, dtype=np.float64),
-                   float(system.stop_drift_ratio), np.zeros(floors.size, dtype=np.int64), state_floor,
-                   np.ascontiguousarray(tolerance, dtype=np.float64))
+                   np.zeros(floors.size, dtype=np.int64), state_floor, np.ascontiguousarray(tolerance, dtype=np.float64),
+                   float(system.stop_drift_ratio))
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,

@@ -105,10 +105,10 @@ class Storeys(NamedTuple):
     state_index: np.ndarray  #: (N,) int, the storey's hysteretic state among the nh, −1 if elastic
     p_delta: np.ndarray      #: (N,) N/m, geometric stiffness −P/h
     height: np.ndarray       #: (N,) m
-    stop_ratio: float        #: drift ratio that ends the run (0: never)
     mode: np.ndarray         #: (nh,) int, bilinear mode of each yielding storey (changed by the solver)
     floor: np.ndarray        #: (nh,) int, floor of each hysteretic state
     tolerance: np.ndarray    #: (nh,) absolute tolerance of each hysteretic state
+    stop_ratio: float        #: drift ratio that ends the run (0: never)
 
 
 class Grounds(NamedTuple):
