@@ -305,7 +305,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                end_time: float, wall_time: float, supports=None) -> xr.Dataset:
     """Build the results dataset of one simulation.
 
-    *supports* (:class:`pounding.simulation.SupportMotions`, rows as given to
+    *supports* (:class:`pounding.records.supports.SupportMotions`, rows as given to
     the solver) describes the ground under each building; without it every
     building stands on *record* (row 0 of the solution's ground).
     """
@@ -321,7 +321,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     drift = _storey_drift(u, system.below)
     heights = labels["height"]
     ground = _grounds(model, record, system, raw, supports)
-    # Contacts first, then links (pounding.simulation.assemble puts the links after the gap elements).
+    # Contacts first, then links (pounding.solver.assembly.assemble puts the links after the gap elements).
     ng = len(model.gaps)
     # Total displacements: the differential ground displacement of each gap element's two sides joins
     # (0 on one common ground, and for a wall, which moves with the ground of the building it faces).

@@ -152,7 +152,7 @@ class System:
         (all 0 with one common ground motion)
     contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
         side of each gap element: their differential displacement enters the penetration
-        (``pounding.simulation.assemble``; a wall takes the row of the building it faces)
+        (``pounding.solver.assembly.assemble``; a wall takes the row of the building it faces)
     """
 
     mass: np.ndarray
@@ -610,7 +610,7 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     Parameters
     ----------
     system : System
-        Flat arrays from :func:`pounding.simulation.assemble`.
+        Flat arrays from :func:`pounding.solver.assembly.assemble`.
     ground_acceleration : (ns,) ndarray
         Samples of a_g, m/s², uniform step *time_step*; must cover *duration*.
     time_step : float
