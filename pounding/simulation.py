@@ -1,10 +1,12 @@
-"""Run a model under a record: assemble flat arrays, integrate, label the result.
+"""Run a model under a record: the pipeline that joins the stages of the data flow.
 
-This is the one place that joins the stages of the data flow:
-:mod:`pounding.model` (YAML → buildings and gap elements) →
-:mod:`pounding.records` (record) → :mod:`pounding.solver` (compiled
-integration) → :mod:`pounding.results` (xarray Dataset).  :func:`rerun`
-repeats what an archive recorded.
+:func:`simulate` reads as that pipeline: the model with the call's overrides
+(:func:`with_overrides`) → its support motions (records read, processed and
+scaled, then put on one grid by :mod:`pounding.records.supports`) → checks of
+the simulated time and memory → the model flattened into the solver's arrays
+(:func:`pounding.solver.assembly.assemble`) and integrated
+(:mod:`pounding.solver`) → the labelled results (:mod:`pounding.results`).
+:func:`rerun` repeats what an archive recorded.
 """
 
 from __future__ import annotations
@@ -14,7 +16,6 @@ import math
 import os
 import time as _time
 import dataclasses
-from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -22,8 +23,6 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from pounding import hysteresis
-from pounding.contact import laws as contact_laws
 from pounding.errors import PoundingError
 from pounding.errors import RecordError
 from pounding.memory import MEMORY_FRACTION, available_memory, check_memory
@@ -31,14 +30,16 @@ from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
-from pounding.model.model import WALL, Model, column_weights, model_from_text
+from pounding.model.model import Model, model_from_text
 from pounding.model.scales import check_work
+from pounding.records.supports import SupportMotions, common_step, lagged, on_step, support_motions_from
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import run_peaks, to_dataset
-from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, System, integrate
+from pounding.solver.assembly import assemble, contact_side_terms
+from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, integrate
 
-__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_peaks", "record_for", "processed_record_for",
-           "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
+__all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
+           "processed_record_for", "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs"]
 
 #: Energy closure error above which a run is flagged (attribute ``status``, summary
@@ -61,141 +62,6 @@ def record_path(spec: str) -> str:
     if not text or CATALOGUE_REFERENCE.match(text) or is_catalogue_name(text):
         return text
     return os.path.abspath(os.path.expanduser(text))
-
-
-def assemble(model: Model, building_ground: Any = None) -> System:
-    """Flatten a model into the arrays the compiled integrator works on.
-
-    Floors of all buildings are concatenated left to right.  Rayleigh damping
-    stays tridiagonal (``a0·M + a1·K`` acts storey by storey); modal damping
-    is stored as one dense block per building.  *building_ground* gives, per
-    building, its row of the ground-acceleration array (default: one common
-    ground, row 0); each gap element's two sides take the rows of their
-    buildings (``System.contact_ground_left/right``): the place where a new
-    kind of contact (a wall, a link) says which ground moves each of its ends.
-    """
-    rows = [0] * len(model.buildings) if building_ground is None else [int(r) for r in building_ground]
-    masses, stiffness, below, a0, a1 = [], [], [], [], []
-    dense_start, dense_size, dense_offset, dense_values = [], [], [], []
-    offset = 0
-    dense_used = 0
-    for building in model.buildings:
-        n = building.n_floors
-        masses.append(building.mass)
-        stiffness.append(building.stiffness)
-        below.append(np.r_[-1, np.arange(offset, offset + n - 1)])
-        if building.damping.kind == "rayleigh":
-            c_mass, c_stiff = building.rayleigh_coefficients
-            a0.append(np.full(n, c_mass))
-            a1.append(np.full(n, c_stiff))
-            dense_start.append(offset)
-            dense_size.append(0)
-            dense_offset.append(dense_used)
-        else:
-            a0.append(np.zeros(n))
-            a1.append(np.zeros(n))
-            block = np.asarray(building.damping_matrix(), dtype=float)
-            dense_start.append(offset)
-            dense_size.append(n)
-            dense_offset.append(dense_used)
-            dense_values.append(block.ravel())
-            dense_used += n * n
-        offset += n
-
-    models, parameters, heights, p_delta = [], [], [], []
-    for building in model.buildings:
-        for law, k, h in zip(building.hysteresis, building.stiffness, building.height):
-            models.append(hysteresis.MODEL_ELASTIC if law is None else law.model_id)
-            parameters.append(np.zeros(hysteresis.N_HYSTERESIS_PARAMETERS) if law is None
-                              else law.kernel_parameters(k, h))
-        heights.append(building.height)
-        p_delta.append(building.p_delta_stiffness)
-    yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
-    storey_state = np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64)
-
-    left, right, gaps, laws, params, floors, weights, ground_left, ground_right = [], [], [], [], [], [], [], [], []
-    mass_all = np.concatenate(masses)
-    for gap in model.gaps:
-        terms_left = contact_side_terms(model, gap.left, gap.level_left, gap.at_left)
-        terms_right = contact_side_terms(model, gap.right, gap.level_right, gap.at_right)
-        left.append(terms_left[-1][0] if terms_left[-1][1] != 0.0 else terms_left[0][0])
-        right.append(terms_right[-1][0] if terms_right[-1][1] != 0.0 else terms_right[0][0])
-        floors.append([f for f, _ in terms_left] + [f for f, _ in terms_right])
-        weights.append([w for _, w in terms_left] + [-w for _, w in terms_right])
-        # Each side moves with its building's ground (a column point too); a wall moves with the ground of the
-        # building it faces (docs/physics.md §11), so a wall contact sees no differential ground motion.
-        ground_left.append(rows[gap.right if gap.left == WALL else gap.left])
-        ground_right.append(rows[gap.left if gap.right == WALL else gap.right])
-        gaps.append(gap.gap)
-        laws.append(gap.law.law_id)
-        params.append(gap.law.kernel_parameters(_side_mass(terms_left, mass_all), _side_mass(terms_right, mass_all)))
-    # Links follow the contacts in the same arrays: elements engaged from the start, gap 0, never open.
-    for link in model.links:
-        lf = model.floor_offset(link.left) + link.level_left - 1
-        rf = model.floor_offset(link.right) + link.level_right - 1
-        left.append(lf)
-        right.append(rf)
-        floors.append([lf, -1, rf, -1])
-        weights.append([1.0, 0.0, -1.0, 0.0])
-        ground_left.append(rows[link.left])     # a link's ends move with their own buildings' grounds
-        ground_right.append(rows[link.right])
-        gaps.append(0.0)
-        laws.append(link.law.law_id)
-        params.append(link.law.kernel_parameters())
-
-    return System(
-        mass=np.ascontiguousarray(mass_all, dtype=float),
-        storey_stiffness=np.ascontiguousarray(np.concatenate(stiffness), dtype=float),
-        below=np.ascontiguousarray(np.concatenate(below), dtype=np.int64),
-        rayleigh_mass=np.ascontiguousarray(np.concatenate(a0), dtype=float),
-        rayleigh_stiffness=np.ascontiguousarray(np.concatenate(a1), dtype=float),
-        dense_start=np.asarray(dense_start, dtype=np.int64),
-        dense_size=np.asarray(dense_size, dtype=np.int64),
-        dense_offset=np.asarray(dense_offset, dtype=np.int64),
-        dense_values=np.ascontiguousarray(np.concatenate(dense_values) if dense_values else np.zeros(0)),
-        contact_left=np.asarray(left, dtype=np.int64),
-        contact_right=np.asarray(right, dtype=np.int64),
-        contact_gap=np.asarray(gaps, dtype=float),
-        contact_law=np.asarray(laws, dtype=np.int64),
-        contact_parameters=np.ascontiguousarray(
-            np.array(params, dtype=float).reshape(len(params), contact_laws.N_PARAMETERS)),
-        storey_model=np.asarray(models, dtype=np.int64),
-        storey_parameters=np.ascontiguousarray(np.array(parameters, dtype=float)),
-        storey_state=storey_state,
-        p_delta_stiffness=np.ascontiguousarray(np.concatenate(p_delta), dtype=float),
-        storey_height=np.ascontiguousarray(np.concatenate(heights), dtype=float),
-        stop_drift_ratio=float(model.solver.stop_drift_ratio or 0.0),
-        floor_ground=np.repeat(np.asarray(rows, dtype=np.int64), [b.n_floors for b in model.buildings]),
-        contact_ground_left=np.asarray(ground_left, dtype=np.int64),
-        contact_ground_right=np.asarray(ground_right, dtype=np.int64),
-        contact_floors=np.ascontiguousarray(np.array(floors, dtype=np.int64).reshape(len(floors), 4)),
-        contact_weights=np.ascontiguousarray(np.array(weights, dtype=float).reshape(len(weights), 4)),
-    )
-
-
-def contact_side_terms(model: Model, building: int, level: int, at: float | None) -> list[tuple[int, float]]:
-    """The two ``(floor index, weight)`` terms of one contact side (floor index −1: ground or wall, weight 0).
-
-    A floor is ``[(floor, 1), (−1, 0)]``; a wall ``[(−1, 0), (−1, 0)]``; a point
-    at fraction *at* of storey *level*'s column ``[(floor below, N1), (floor
-    above, N2)]`` with the Hermite shape functions of
-    :func:`pounding.model.model.column_weights` (the floor below of storey 1
-    is the ground: its term has floor −1).
-    """
-    if building == WALL:
-        return [(-1, 0.0), (-1, 0.0)]
-    offset = model.floor_offset(building)
-    if at is None:
-        return [(offset + level - 1, 1.0), (-1, 0.0)]
-    n1, n2 = column_weights(at)
-    below = offset + level - 2 if level > 1 else -1
-    return [(below, n1 if below >= 0 else 0.0), (offset + level - 1, n2)]
-
-
-def _side_mass(terms: list[tuple[int, float]], mass: np.ndarray) -> float:
-    """Generalised mass of a contact side, kg: ``1/Σ w²/m`` (a floor: its mass; a wall: inf)."""
-    compliance = sum(w * w / mass[f] for f, w in terms if f >= 0 and w != 0.0)
-    return 1.0 / compliance if compliance > 0.0 else float("inf")
 
 
 def record_for(model: Model, *, factor: float | None = None, where: str = "yaml",
@@ -250,58 +116,6 @@ def processed_record_for(model: Model, *, where: str = "yaml", building: int | s
     return process(record, spec.processing)
 
 
-@dataclass(frozen=True)
-class SupportMotions:
-    """The ground motion under every building, on one time grid.
-
-    Attributes
-    ----------
-    rows : (G, ns) ndarray
-        Ground accelerations, m/s², one row per distinct ground (G = 1 when
-        every building sees the same motion at the same time).
-    time_step : float
-        Their common sampling interval, s.
-    building_row : tuple of int
-        Row of each building, left to right.
-    records : tuple of Record
-        The record under each building (scaled and processed; before any lag or resampling).
-    lag_requested, lag : tuple of float
-        Per building: the wave-passage lag asked for, ``(d_b − min d)/c`` (s), and the
-        one applied, rounded to the record step (0 without wave passage).
-    end_time : float
-        Default simulated time, s: the longest record plus its lag.
-    """
-
-    rows: np.ndarray
-    time_step: float
-    building_row: tuple
-    records: tuple
-    lag_requested: tuple
-    lag: tuple
-    end_time: float
-
-
-def _common_step(records: list[Record], names: list[str]) -> float:
-    """The finest time step of *records*; every other must be a whole multiple of it (else one line)."""
-    finest = min(r.time_step for r in records)
-    for record, name in zip(records, names):
-        ratio = record.time_step / finest
-        if abs(ratio - round(ratio)) > 1e-6 * ratio:
-            raise PoundingError(f"the records under the buildings have time steps {finest:g} s and "
-                                f"{record.time_step:g} s (building {name}), not whole multiples of one another; "
-                                "resample one record to the other's step")
-    return finest
-
-
-def _on_step(record: Record, step: float) -> np.ndarray:
-    """*record*'s acceleration sampled every *step* s (a whole fraction of its own): exact for piecewise-linear data."""
-    ratio = int(round(record.time_step / step))
-    if ratio == 1:
-        return np.asarray(record.acceleration, dtype=float)
-    fine = np.arange((record.acceleration.size - 1) * ratio + 1) * step
-    return np.interp(fine, record.time, record.acceleration)
-
-
 def support_motions(model: Model, record: Record | list | tuple | None = None, *, where: str = "yaml") -> SupportMotions:
     """Load the ground motion of every building and put them on one time grid.
 
@@ -328,8 +142,8 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
         else:
             raise PoundingError(f"model '{model.name}' gives each building its own record: pass one Record per "
                                 f"building ({len(names)}), or none to use the model's")
-        step = _common_step(records, names)
-        series = [_on_step(r, step) for r in records]
+        step = common_step(records, names)
+        series = [on_step(r, step) for r in records]
         lag_requested = lags = [0.0] * len(names)
         ends = [(model.ground_motion_of(i).duration or r.duration) for i, r in enumerate(records)]
     else:
@@ -338,28 +152,10 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
         spec = model.ground_motion
         lag_requested = [spec.lag(name) for name in names]
         _check_lags(model, lag_requested, step, motion.acceleration.size)
-        shifts = [int(round(lag / step)) for lag in lag_requested]
-        lags = [k * step for k in shifts]
-        base = np.asarray(motion.acceleration, dtype=float)
-        series = [np.concatenate([np.zeros(k), base]) if k else base for k in shifts]
+        series, lags = lagged(motion, lag_requested)
         records = [motion] * len(names)
         ends = [(spec.duration or motion.duration + max(lags))] * len(names)
-    distinct: list[np.ndarray] = []
-    building_row = []
-    for values in series:
-        for row, known in enumerate(distinct):
-            if known.size == values.size and np.array_equal(known, values):
-                building_row.append(row)
-                break
-        else:
-            building_row.append(len(distinct))
-            distinct.append(values)
-    size = max(v.size for v in distinct)
-    rows = np.zeros((len(distinct), size))
-    for row, values in enumerate(distinct):
-        rows[row, :values.size] = values
-    return SupportMotions(rows, float(step), tuple(building_row), tuple(records), tuple(lag_requested),
-                          tuple(lags), float(max(ends)))
+    return support_motions_from(series, step, records, lag_requested, lags, ends)
 
 
 def _check_modes_memory(model: Model) -> None:
@@ -442,6 +238,27 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
         The results schema documented in the README (``pounding.results``).
     """
     _check_modes_memory(model)
+    model = with_overrides(model, record, xi=xi, scale=scale, duration=duration, rtol=rtol, atol=atol,
+                           atol_velocity=atol_velocity, output_dt=output_dt, record_units=record_units,
+                           record_dt=record_dt, where=where)
+    supports = _supports_for_call(model, record, scale, where)
+    end_time = _checked_end_time(model, supports)
+    system, raw, wall, rows = _solve(model, supports, end_time, model.solver.output_dt)
+    ds = to_dataset(model, supports.records[0], system, raw, end_time=end_time, wall_time=wall,
+                    supports=dataclasses.replace(supports, rows=rows))
+    mark_energy_status(ds)
+    return ds
+
+
+def with_overrides(model: Model, record: Record | str | list | None = None, *, xi: str | None = None,
+                   scale: Any = None, duration: float | None = None, rtol: float | None = None,
+                   atol: float | None = None, atol_velocity: float | None = None, output_dt: float | None = None,
+                   record_units: str | None = None, record_dt: float | None = None, where: str = "api") -> Model:
+    """*model* with what a call of :func:`simulate` overrides: ξ, solver settings, record spec, scale, duration.
+
+    A record given as a spec (str) replaces the model's ``ground_motion.record`` (a file path made absolute
+    and its units read from its header line); a loaded :class:`Record` leaves the model's spec alone.
+    """
     if xi is not None:
         model = model.with_xi(xi)
     changes = {k: v for k, v in dict(rtol=rtol, atol=atol, atol_velocity=atol_velocity,
@@ -450,51 +267,55 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
         model = model.with_solver(**changes)
     gm_changes: dict[str, Any] = {}
     if isinstance(record, str):
-        spec = record_path(record)
-        if os.path.isabs(spec) and not Path(spec).exists():
-            here = "the command line" if where == "cli" else "the Python API"
-            raise RecordError(f"no such record file; a path given on {here} is relative to the current "
-                              f"directory ({os.getcwd()}), a path inside a YAML file to that file's folder",
-                              file=record)
-        if record_units is None and os.path.isabs(spec) and Path(spec).suffix.lower() != ".at2":
-            record_units = declared_in_header(spec).get("units")   # '# units: g; dt = 0.005 s'
-            if record_units is None and Path(spec).is_file():
-                raise RecordError(FIXES.get(where, FIXES["api"])["units"], file=record)
-        gm_changes.update(record=spec, units=record_units, dt=record_dt)
+        gm_changes.update(_record_spec_changes(record, record_units, record_dt, where))
     elif record_units is not None or record_dt is not None:
         raise PoundingError("record_units and record_dt apply only to a record file given as record=")
     if scale is not None:
         gm_changes["scale"] = scale
     if duration is not None:
         gm_changes["duration"] = duration
-    if gm_changes:
-        model = model.with_ground_motion(**gm_changes)
+    return model.with_ground_motion(**gm_changes) if gm_changes else model
 
+
+def _record_spec_changes(record: str, record_units: str | None, record_dt: float | None, where: str) -> dict:
+    """The ``ground_motion`` keys a record spec given to :func:`simulate` sets (one-line errors for a bad file)."""
+    spec = record_path(record)
+    if os.path.isabs(spec) and not Path(spec).exists():
+        here = "the command line" if where == "cli" else "the Python API"
+        raise RecordError(f"no such record file; a path given on {here} is relative to the current "
+                          f"directory ({os.getcwd()}), a path inside a YAML file to that file's folder",
+                          file=record)
+    if record_units is None and os.path.isabs(spec) and Path(spec).suffix.lower() != ".at2":
+        record_units = declared_in_header(spec).get("units")   # '# units: g; dt = 0.005 s'
+        if record_units is None and Path(spec).is_file():
+            raise RecordError(FIXES.get(where, FIXES["api"])["units"], file=record)
+    return dict(record=spec, units=record_units, dt=record_dt)
+
+
+def _supports_for_call(model: Model, record: Record | str | list | None, scale: Any, where: str) -> SupportMotions:
+    """The support motions of a :func:`simulate` call: a loaded record (rescaled to *scale*), one per
+    building, or the model's own (a record spec is already in *model*)."""
     if isinstance(record, Record):
         model.refuse_building_records("a record given to simulate()")
-        supports = support_motions(model, record if scale is None else record.scaled(scale / record.scale))
-    elif isinstance(record, (list, tuple)):
-        supports = support_motions(model, list(record))
-    else:
-        supports = support_motions(model, where=where if isinstance(record, str) else "yaml")
-    motion = supports.records[0]
+        return support_motions(model, record if scale is None else record.scaled(scale / record.scale))
+    if isinstance(record, (list, tuple)):
+        return support_motions(model, list(record))
+    return support_motions(model, where=where if isinstance(record, str) else "yaml")
+
+
+def _checked_end_time(model: Model, supports: SupportMotions) -> float:
+    """The simulated time (s), after checking it, the output interval and the memory the run needs."""
     end_time = supports.end_time
     if end_time <= 0.0:
-        raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
-
+        raise PoundingError(f"record {supports.records[0].name}: duration must be > 0 (got {end_time} s)")
     settings = model.solver
     if settings.output_dt > end_time:
         raise PoundingError(f"{_where(model)}solver.output_dt is {settings.output_dt:g} s, longer than the simulated "
                             f"{end_time:g} s: no history (and no energy balance) would be stored; use an output_dt "
                             f"well below the duration, e.g. {min(0.01, end_time / 100):g} s")
-    step = supports.time_step
-    check_memory(estimate_memory(model, end_time, step, settings.output_dt) * supports.rows.shape[0],
+    check_memory(estimate_memory(model, end_time, supports.time_step, settings.output_dt) * supports.rows.shape[0],
                  what=f"{_where(model)}this run", fix="shorten ground_motion.duration or raise solver.output_dt")
-    system, raw, wall, rows = _solve(model, supports, end_time, settings.output_dt)
-    ds = to_dataset(model, motion, system, raw, end_time=end_time, wall_time=wall,
-                    supports=dataclasses.replace(supports, rows=rows))
-    mark_energy_status(ds)
-    return ds
+    return end_time
 
 
 def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]:

@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pounding.solver import integrator as solver
+from pounding.solver import dense
+from pounding.solver import dormand_prince as solver
 
 TOL = 1e-14  # a few ulp of O(1) sums of ~10 products; see the module docstring
 
@@ -164,7 +165,7 @@ def test_step_controller_exponent_matches_the_embedded_order():
 # The interpolant used for events, peaks and output (cubic Hermite)
 # --------------------------------------------------------------------------- #
 
-hermite = solver._hermite.py_func  # the pure-Python body of the compiled kernel
+hermite = dense.hermite.py_func  # the pure-Python body of the compiled kernel
 
 
 def test_hermite_matches_end_values_and_rates():

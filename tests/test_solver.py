@@ -142,7 +142,7 @@ def test_bilinear_loop_dissipates_and_returns_to_zero_force():
 # Issue 11 §1: event location, grazing contacts, internal states, step control
 # --------------------------------------------------------------------------- #
 
-from pounding.solver.integrator import _first_crossing  # noqa: E402
+from pounding.solver.dense import first_crossing as _first_crossing  # noqa: E402
 
 
 def pairs(mass_left, mass_right, k_left, k_right, gaps, law) -> System:

@@ -49,7 +49,8 @@ from pounding.contact import links as contact_links
 from pounding.records.record import Record
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
-from pounding.solver.integrator import RawSolution, System, ground_state_at
+from pounding.solver.integrator import RawSolution, System
+from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
 
 __all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
@@ -123,7 +124,7 @@ def _link_results(system: System, raw: RawSolution, ng: int,
     in a dashpot (the solver's ``kernels.potential`` of the same elements, vectorised here).
     """
     n = system.n_floors
-    nc = system.n_contacts
+    lay = system.layout
     u = raw.state[:, :n]
     left, right = system.contact_left[ng:], system.contact_right[ng:]
     deformation = np.take(u, left, axis=1) - np.take(u, right, axis=1)
@@ -131,8 +132,8 @@ def _link_results(system: System, raw: RawSolution, ng: int,
         # Total displacements: the differential ground displacement of the link's two ends (docs/physics.md §10).
         deformation = deformation + (np.take(ground_displacement, system.contact_ground_left[ng:], axis=1)
                                      - np.take(ground_displacement, system.contact_ground_right[ng:], axis=1))
-    work = raw.state[:, 2 * n + nc + ng:2 * n + 2 * nc]
-    internal = raw.state[:, 2 * n + 2 * nc + ng:2 * n + 3 * nc]
+    work = raw.state[:, lay.work + ng:lay.internal]
+    internal = raw.state[:, lay.internal + ng:lay.input_energy]
     law = system.contact_law[ng:]
     stiffness = system.contact_parameters[ng:, 0]
     stored = np.zeros_like(deformation)
@@ -156,11 +157,10 @@ def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray) ->
         ductility = raw.peak_drift / yield_drift
     dissipated = np.zeros(n)
     if yielding.any():
-        first = 2 * n + 3 * system.n_contacts + 2
-        nh = system.n_hysteretic
+        lay = system.layout
         index = system.storey_state[yielding]
-        state = final[first + index]
-        work = final[first + nh + index]
+        state = final[lay.hysteretic + index]
+        work = final[lay.storey_work + index]
         table = np.ascontiguousarray(system.storey_parameters, dtype=np.float64)
         recoverable = np.array([_recoverable(int(system.storey_model[j]), table, int(j),
                                              float(system.storey_stiffness[j]), float(drift[j]), float(r))
@@ -176,24 +176,16 @@ def _recoverable(model: int, table: np.ndarray, row: int, stiffness: float, drif
 
 
 def _penetration(u: np.ndarray, system: System, ground_displacement: np.ndarray) -> np.ndarray:
-    """(nt, nc) penetration ``Σ_k w_k·u[floor_k] + u_g,L − u_g,R − gap`` of every contact.
+    """(nt, nc) penetration ``Σ_k w_k·u[floor_k] + u_g,L − u_g,R − gap`` of every contact, by the solver's
+    kinematics (:func:`pounding.solver.kinematics.penetration`).
 
     Walls and the ground contribute no floor term; *ground_displacement* (nt, G)
     holds each ground row's displacement (a wall's row is the one of the
     building it faces, so a wall contact's ground difference is 0).
     """
-    floors = system.contact_floors
-    weights = system.contact_weights
-    out = np.empty((u.shape[0], floors.shape[0]))
     differential = (np.take(ground_displacement, system.contact_ground_left, axis=1)
                     - np.take(ground_displacement, system.contact_ground_right, axis=1))
-    for c in range(floors.shape[0]):
-        total = np.zeros(u.shape[0])
-        for f, w in zip(floors[c], weights[c]):
-            if f >= 0 and w != 0.0:
-                total = total + w * u[:, f] if w != 1.0 else total + u[:, f]
-        out[:, c] = total + differential[:, c] - system.contact_gap[c]
-    return out
+    return kinematics.penetration(u, system.contact_floors, system.contact_weights, system.contact_gap, differential)
 
 
 def _column_point_coords(gaps) -> dict:
@@ -313,23 +305,23 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                end_time: float, wall_time: float, supports=None) -> xr.Dataset:
     """Build the results dataset of one simulation.
 
-    *supports* (:class:`pounding.simulation.SupportMotions`, rows as given to
+    *supports* (:class:`pounding.records.supports.SupportMotions`, rows as given to
     the solver) describes the ground under each building; without it every
     building stands on *record* (row 0 of the solution's ground).
     """
     n = system.n_floors
-    nc = system.n_contacts
     labels = _labels(model)
     u = raw.state[:, :n]
     v = raw.state[:, n:2 * n]
-    work = raw.state[:, 2 * n + nc:2 * n + 2 * nc]
-    e_input = raw.state[:, 2 * n + 3 * nc]
-    e_damping = raw.state[:, 2 * n + 3 * nc + 1]
+    lay = system.layout
+    work = raw.state[:, lay.work:lay.internal]
+    e_input = raw.state[:, lay.input_energy]
+    e_damping = raw.state[:, lay.damping_energy]
 
     drift = _storey_drift(u, system.below)
     heights = labels["height"]
     ground = _grounds(model, record, system, raw, supports)
-    # Contacts first, then links (pounding.simulation.assemble puts the links after the gap elements).
+    # Contacts first, then links (pounding.solver.assembly.assemble puts the links after the gap elements).
     ng = len(model.gaps)
     # Total displacements: the differential ground displacement of each gap element's two sides joins
     # (0 on one common ground, and for a wall, which moves with the ground of the building it faces).
@@ -340,9 +332,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     # Recoverable storey energy (with the P-Delta potential), summed by the solver at each output time;
     # a yielding storey's dissipated energy is its work ∫F dΔ minus its recoverable part.
     strain = raw.storey_energy[:, 0]
-    nh = system.n_hysteretic
-    first_hysteretic = 2 * n + 3 * nc + 2
-    storey_work = raw.state[:, first_hysteretic + nh:first_hysteretic + 2 * nh]
+    storey_work = raw.state[:, lay.storey_work:lay.ground_work]
     hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
     inelastic = _inelastic_summary(system, raw, heights)
     peaks = run_peaks(model, system, raw)
@@ -569,7 +559,7 @@ def _grounds(model: Model, record: Record, system: System, raw: RawSolution, sup
     if step is None:
         vel = disp = np.zeros_like(acc)
     else:
-        _, vel, disp = ground_state_at(rows, step, raw.time)
+        _, vel, disp = kinematics.ground_state_at(rows, step, raw.time)
     return {"record": np.array([r.name for r in records], dtype=object),
             "source": np.array([r.source for r in records], dtype=object),
             "scale": np.array([float(r.scale) for r in records]),

@@ -36,7 +36,8 @@ from typing import Iterable
 
 __all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "shortcuts_supported", "load_registries_without_scipy",
            "load_from_cache_without_refresh",
-           "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES"]
+           "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES", "solver_sources",
+           "stamp_solver_kernels"]
 
 #: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with
 #: the ``numba`` pin in pyproject.toml, and widen both only after tests/test_jit.py passes.
@@ -149,3 +150,22 @@ def stamp_caches_with_sources(dispatchers: Iterable, files: Iterable[str | os.Pa
         cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
         if cache_file is not None and hasattr(cache_file, "_source_stamp"):
             cache_file._source_stamp = stamp
+
+
+def solver_sources() -> list[str]:
+    """Every source file compiled into the solver's kernels: the modules of ``pounding/solver``
+    and the contact-law, link and hysteresis modules whose ids and sizes they inline."""
+    solver = os.path.dirname(os.path.abspath(__file__))
+    package = os.path.dirname(solver)
+    own = sorted(os.path.join(solver, name) for name in os.listdir(solver) if name.endswith(".py"))
+    return own + [os.path.join(package, "contact", "laws.py"), os.path.join(package, "contact", "links.py"),
+                  os.path.join(package, "hysteresis.py")]
+
+
+def stamp_solver_kernels(namespace: dict) -> None:
+    """Key the cache of every compiled kernel in *namespace* (a solver module's ``globals()``) on
+    :func:`solver_sources`: a kernel calls and inlines kernels of the other solver modules, so its
+    cached code is stale when any of them changes.  Called at the end of each solver module."""
+    from numba.core.dispatcher import Dispatcher
+
+    stamp_caches_with_sources([f for f in namespace.values() if isinstance(f, Dispatcher)], solver_sources())

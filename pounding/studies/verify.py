@@ -401,7 +401,7 @@ def production_system(law: contact.ContactLaw, *, mass: float, height: float, gr
     (δ = u_ball − u_surface − height, the ball moving in +u towards the
     surface), with the law's kernel parameters
     taken with the floor masses ``(mass, RIGID_MASS)`` exactly as
-    :func:`pounding.simulation.assemble` takes them.
+    :func:`pounding.solver.assembly.assemble` takes them.
 
     Returns
     -------

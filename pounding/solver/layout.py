@@ -1,0 +1,167 @@
+"""The solver's data layout: the offsets of the state vector and the named records it passes around.
+
+The state vector of a run is, in this order (docs/numerics.md)::
+
+    [u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]
+
+``u``, ``v``: floor displacements (m) and velocities (m/s) relative to each
+floor's ground; per contact its impulse ∫F dt (N·s), its work ∫F·δ̇ dt (J)
+and its law's internal state ``q``; the input and the Rayleigh-damped energy
+(J); per yielding storey its hysteretic state ``r`` and its work ∫F dΔ (J);
+the work of the contact forces on the differential ground motion (J).
+:func:`state_layout` builds the offsets once (:class:`Layout`); the solver
+and :mod:`pounding.results.dataset` both read them from there.
+
+The other records are the compiled solver's arguments, numba named tuples of
+arrays (numba passes a named tuple's members as flat arguments, so a record
+costs nothing at a call):
+
+* :class:`Structure` — floors, storey springs and damping;
+* :class:`Contacts` — every gap element's floor terms, gap, law and parameters;
+* :class:`ContactState` — what changes at contact events (closed, onset constant, mode);
+* :class:`Storeys` — yielding storeys, P-Delta and the collapse limit (None when there are none);
+* :class:`Grounds` — the support motions with several grounds (None with one common ground);
+* :class:`Settings` — record step, duration, tolerances and output step;
+* :class:`Forcing` — the ground acceleration of ground row 0 and its sample interval;
+* :class:`Events` — the events located in a trial step;
+* :class:`Work` — the step's scratch arrays (state, trial state, stage rates, force buffers).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "Storeys", "Grounds", "Settings",
+           "Forcing", "Events", "Work"]
+
+
+class Layout(NamedTuple):
+    """Offsets of the parts of the state vector (indices into it) and its length."""
+
+    n_floors: int        #: N
+    n_contacts: int      #: nc, gap elements and links
+    n_hysteretic: int    #: nh, yielding storeys
+    velocity: int        #: first floor velocity, N
+    impulse: int         #: first contact impulse, 2N
+    work: int            #: first contact work, 2N + nc
+    internal: int        #: first contact internal state, 2N + 2nc
+    input_energy: int    #: E_input, 2N + 3nc
+    damping_energy: int  #: E_damping, 2N + 3nc + 1
+    hysteretic: int      #: first storey hysteretic state, 2N + 3nc + 2
+    storey_work: int     #: first storey work, 2N + 3nc + 2 + nh
+    ground_work: int     #: W_g, the last state
+    size: int            #: length of the state vector
+
+
+def state_layout(n_floors: int, n_contacts: int, n_hysteretic: int) -> Layout:
+    """The :class:`Layout` of *n_floors* floors, *n_contacts* contacts and *n_hysteretic* yielding storeys."""
+    n, nc, nh = int(n_floors), int(n_contacts), int(n_hysteretic)
+    hysteretic = 2 * n + 3 * nc + 2
+    size = hysteretic + 2 * nh + 1
+    return Layout(n, nc, nh, n, 2 * n, 2 * n + nc, 2 * n + 2 * nc, 2 * n + 3 * nc, 2 * n + 3 * nc + 1, hysteretic,
+                  hysteretic + nh, size - 1, size)
+
+
+class Structure(NamedTuple):
+    """Floors of every building, concatenated left to right (N floors; B buildings)."""
+
+    mass: np.ndarray                #: (N,) kg
+    storey_stiffness: np.ndarray    #: (N,) N/m, storey under each floor
+    below: np.ndarray               #: (N,) int, floor below, −1 for the ground
+    rayleigh_mass: np.ndarray       #: (N,) Rayleigh a0 of the floor's building, 1/s
+    rayleigh_stiffness: np.ndarray  #: (N,) Rayleigh a1, s
+    dense_start: np.ndarray         #: (B,) int, first floor of each modal damping block
+    dense_size: np.ndarray          #: (B,) int, its size (0: Rayleigh)
+    dense_offset: np.ndarray        #: (B,) int, its first value in *dense_values*
+    dense_values: np.ndarray        #: flat dense damping blocks, N·s/m
+
+
+class Contacts(NamedTuple):
+    """Gap elements and links (nc); term k of contact c at ``SIDE_TERMS·c + k`` (:mod:`.kinematics`)."""
+
+    floors: np.ndarray      #: (nc·SIDE_TERMS,) int, floor of each term (an absent term: floor 0, weight 0)
+    weights: np.ndarray     #: (nc·SIDE_TERMS,) its weight (left ≥ 0, right ≤ 0)
+    gap: np.ndarray         #: (nc,) m
+    law: np.ndarray         #: (nc,) int, kernel branch (pounding.contact)
+    parameters: np.ndarray  #: (nc, N_PARAMETERS)
+
+
+class ContactState(NamedTuple):
+    """What the contact events change (nc each)."""
+
+    closed: np.ndarray    #: bool, contact closed (a link: always)
+    constant: np.ndarray  #: law constant fixed at onset (ξ of Hertz-damp)
+    mode: np.ndarray      #: int, mode of a closed contact (pounding.contact.MODE_*)
+    open_row: np.ndarray  #: int, row of the contact's open impact in the impact table, −1 if none
+
+
+class Storeys(NamedTuple):
+    """Yielding storeys, P-Delta and the collapse limit (the solver's *storey* argument)."""
+
+    model: np.ndarray        #: (N,) int, hysteresis kernel branch of the storey under each floor (0: elastic)
+    parameters: np.ndarray   #: (N, N_HYSTERESIS_PARAMETERS) kernel vectors
+    state_index: np.ndarray  #: (N,) int, the storey's hysteretic state among the nh, −1 if elastic
+    p_delta: np.ndarray      #: (N,) N/m, geometric stiffness −P/h
+    height: np.ndarray       #: (N,) m
+    mode: np.ndarray         #: (nh,) int, bilinear mode of each yielding storey (changed by the solver)
+    floor: np.ndarray        #: (nh,) int, floor of each hysteretic state
+    tolerance: np.ndarray    #: (nh,) absolute tolerance of each hysteretic state
+    stop_ratio: float        #: drift ratio that ends the run (0: never)
+
+
+class Grounds(NamedTuple):
+    """Several support motions (the solver's *ground* argument; G grounds, ns record samples)."""
+
+    acceleration: np.ndarray  #: (G, ns) m/s²
+    displacement: np.ndarray  #: (G, ns) m, at the samples, from rest
+    velocity: np.ndarray      #: (G, ns) m/s
+    floor_row: np.ndarray     #: (N,) int, ground of each floor's building
+    left_row: np.ndarray      #: (nc,) int, ground under each contact's left side
+    right_row: np.ndarray     #: (nc,) int, and its right side
+    now: np.ndarray           #: (3, G) [acceleration, velocity, displacement] now (scratch)
+    start: np.ndarray         #: (3, G) at the start of the step (scratch)
+    end: np.ndarray           #: (3, G) at its end (scratch)
+
+
+class Settings(NamedTuple):
+    """Run settings, SI."""
+
+    record_step: float   #: s, ground-motion sample interval (steps never straddle a sample)
+    end_time: float      #: s
+    rtol: float
+    atol: float          #: m, displacements
+    atol_velocity: float  #: m/s
+    output_step: float   #: s
+    first_step: float    #: s
+
+
+class Forcing(NamedTuple):
+    """The ground acceleration the floors of ground row 0 feel (piecewise linear between samples)."""
+
+    acceleration: np.ndarray  #: (ns,) m/s²
+    record_step: float        #: s
+
+
+class Events(NamedTuple):
+    """Events located in a trial step (nc contacts, nh yielding storeys)."""
+
+    s: np.ndarray               #: (nc,) fraction of the step where each contact's next event lies (−1: none)
+    kind: np.ndarray            #: (nc,) int, its kind (contact_events.EVENT_*)
+    pending: np.ndarray         #: (nc,) int, events the current (retaken) step was shortened to end at
+    storey_s: np.ndarray        #: (nh,) likewise for the yielding storeys
+    storey_kind: np.ndarray     #: (nh,) int (storey_events.STOREY_*)
+    storey_pending: np.ndarray  #: (nh,) int
+
+
+class Work(NamedTuple):
+    """A step's arrays (S states, N floors, nc contacts)."""
+
+    y: np.ndarray           #: (S,) state at the step's start
+    ynew: np.ndarray        #: (S,) 5th-order state at its end
+    ystage: np.ndarray      #: (S,) scratch: a stage's state, an interpolated state
+    K: np.ndarray           #: (7, S) stage rates k1..k7
+    fbuf: np.ndarray        #: (N,) scratch: floor forces
+    forces: np.ndarray      #: (nc,) contact forces of the last right-hand side
+    forces_end: np.ndarray  #: (nc,) contact forces at the end of the last accepted trial step
