@@ -80,10 +80,12 @@ def measure(trees: dict[str, Path], cold: int, warm: int) -> dict[str, dict[str,
 
 
 def report(found: dict[str, dict[str, list[float]]]) -> dict[str, dict[str, float]]:
-    medians = {name: {figure: statistics.median(values) for figure, values in figures.items()}
+    medians = {name: {figure: statistics.median(values) for figure, values in figures.items() if values}
                for name, figures in found.items()}
     print(f"\n{'figure':<12} {'baseline':>10} {'this tree':>10} {'ratio':>7}")
     for figure in ("first_wall", "first_cpu", "warm_wall", "warm_cpu"):
+        if figure not in medians["this"]:
+            continue  # --cold 0 or --warm 0
         base, this = medians["baseline"][figure], medians["this"][figure]
         print(f"{figure:<12} {base:>9.2f}s {this:>9.2f}s {this / base:>7.2f}")
     print("targets (issue 24): first run <= 0.50, warm run <= 0.80 (wall, medians)")
@@ -93,7 +95,7 @@ def report(found: dict[str, dict[str, list[float]]]) -> dict[str, dict[str, floa
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", type=Path, required=True, help="another checkout of pounding")
-    parser.add_argument("--cold", type=int, default=3, help="first runs of each tree (median)")
+    parser.add_argument("--cold", type=int, default=3, help="first runs of each tree (median; 0: none)")
     parser.add_argument("--warm", type=int, default=5, help="warm runs of each tree (median)")
     add_output_arguments(parser, "startup")
     args = parser.parse_args(argv)
