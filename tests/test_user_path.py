@@ -220,8 +220,10 @@ def test_unknown_flag_shows_the_subcommands_usage():
     assert done.stderr.splitlines()[-1] == "pounding run: error: unrecognized arguments: --bogus"
 
 
-def test_debug_after_the_subcommand():
-    done = _pounding("run", "models/pair.yaml", "--record", "nofile.txt", "--debug")
+def test_debug_after_the_subcommand(tmp_path):
+    # -o into tmp_path: the README's first command leaves pair.nc in the checkout, and an existing
+    # output is refused before the record is read.
+    done = _pounding("run", "models/pair.yaml", "--record", "nofile.txt", "-o", str(tmp_path / "r.nc"), "--debug")
     assert done.returncode != 0 and "Traceback" in done.stderr and "RecordError" in done.stderr
 
 
