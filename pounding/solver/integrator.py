@@ -426,7 +426,7 @@ def _new_events(nc, nh):
                   np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_initial):
     """The run (module docstring); *storey*, *ground* None: their blocks are pruned at compile time."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
