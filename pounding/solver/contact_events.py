@@ -130,13 +130,14 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
         if kernels.is_permanent(claw[c]):
             continue  # a link has no events
         if not closed[c]:
-            s = first_crossing(d0, r0, d1, r1, h_try, True, floor)
+            # not closed[c], a run-time bool: one specialisation of first_crossing, not one per literal
+            s = first_crossing(d0, r0, d1, r1, h_try, not closed[c], floor)  # upward: closure
             kind = EVENT_CLOSE
         elif cmode[c] == kernels.MODE_STUCK:
             if forces_end[c] < 0.0:
                 n_release += 1  # the constraint force turns tensile inside the step: locate_releases
         else:
-            s = first_crossing(d0, r0, d1, r1, h_try, False, floor)
+            s = first_crossing(d0, r0, d1, r1, h_try, not closed[c], floor)  # downward: separation
             kind = EVENT_SEPARATE
             for which in range(kernels.switch_count(claw[c], cprm[c])):
                 # The interpolants are linear in the data: δ's from the combined side data.
@@ -376,14 +377,15 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
                 else:
                     kick(y, n, mass, cf, cw, c, rate / compliance(mass, cf, cw, c))
                 rate = 0.0
-            n_imp = switch_contact(c, True, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
+            # kind == EVENT_CLOSE (a run-time True, like the separation's False): one specialisation
+            n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
             m_eff = effective_mass(mass, cf, cw, c)
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
                 cap = min(cap, duration / STEPS_PER_CONTACT)
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
-            n_imp = switch_contact(c, False, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
+            n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = 0
         else:
             which = kind - EVENT_SWITCH0

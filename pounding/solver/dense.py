@@ -60,7 +60,7 @@ def extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> fl
     return best
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)  # with a Python wrapper: tested directly
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)  # with a Python wrapper: tested directly
 def first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward: bool,
                     threshold: float) -> float:
     """Fraction of the step where the Hermite cubic of δ first crosses into the far side.

@@ -27,7 +27,7 @@ from pounding.solver.kinematics import fill_grounds, ground_at
 from pounding.solver.rhs import rhs_inline
 
 __all__ = ["STAGE_TIME", "SAFETY", "MIN_FACTOR", "MAX_FACTOR", "EXCLUDED", "stages", "fill_tolerances",
-           "error_norm", "step_factor"]
+           "normed_states", "error_norm", "step_factor"]
 
 # Dormand–Prince 5(4) tableau.
 C2, C3, C4, C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
@@ -109,24 +109,41 @@ def fill_tolerances(tol, lay, contacts, atol, atol_velocity, storey) -> None:
             tol[lay.hysteretic + hi] = storey.tolerance[hi]
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+def normed_states(tol):
+    """Indices of the states in the error norm (*tol* from :func:`fill_tolerances` not EXCLUDED), ascending."""
+    count = 0
+    for i in range(tol.size):
+        if tol[i] >= 0.0:
+            count += 1
+    index = np.empty(count, dtype=np.int64)
+    count = 0
+    for i in range(tol.size):
+        if tol[i] >= 0.0:
+            index[count] = i
+            count += 1
+    return index
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def error_norm(work, h, tol, rtol):
+def error_norm(work, h, tol, normed, rtol):
     """``(err, finite)``: the max over the states of |local error| / (tol + rtol·max(|y|, |y_new|)).
 
-    *tol* from :func:`fill_tolerances` (EXCLUDED states left out); *finite* is False (and *err*
+    *tol* from :func:`fill_tolerances`, *normed* the states it does not exclude (:func:`normed_states`:
+    a loop over them only, in order, costs no branch per state); *finite* is False (and *err*
     meaningless) as soon as one ratio is not finite: the step is rejected and shrunk.
     """
     y, ynew, K = work.y, work.ynew, work.K
     k1, k3, k4, k5, k6, k7 = K[0], K[2], K[3], K[4], K[5], K[6]
     err = 0.0
-    for i in range(y.size):
-        if tol[i] >= 0.0:
-            e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
-            r = abs(e) / (tol[i] + rtol * max(abs(y[i]), abs(ynew[i])))
-            if not (r < 1e300):
-                return err, False
-            if r > err:
-                err = r
+    for m in range(normed.size):
+        i = normed[m]
+        e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+        r = abs(e) / (tol[i] + rtol * max(abs(y[i]), abs(ynew[i])))
+        if not (r < 1e300):
+            return err, False
+        if r > err:
+            err = r
     return err, True
 
 

@@ -89,8 +89,8 @@ from pounding.solver import kernels
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
 from pounding.solver.dense import interpolate
-from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, stages,
-                                            step_factor)
+from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, normed_states,
+                                            stages, step_factor)
 from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
                                         kernel_terms)
 from pounding.solver.layout import (ContactState, Contacts, Events, Forcing, Grounds, Layout, Settings, Storeys,
@@ -426,7 +426,7 @@ def _new_events(nc, nh):
                   np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_initial):
     """The run (module docstring); *storey*, *ground* None: their blocks are pruned at compile time."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
@@ -443,6 +443,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     cstate, events = _new_contact_state(contacts), _new_events(nc, nh)
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
     fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, storey)
+    normed = normed_states(tol)
     out = new_outputs(n_out, lay, ground)
     peaks = new_peaks(lay)
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
@@ -470,7 +471,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
                 status = STATUS_STEP_TOO_SMALL
                 break
             stages(work, h_try, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground)
-            err, finite = error_norm(work, h_try, tol, rtol)
+            err, finite = error_norm(work, h_try, tol, normed, rtol)
             if not finite or err > 1.0:
                 n_rej += 1
                 rejected = True

@@ -105,13 +105,13 @@ _plugin_internal_tolerance = _chain("internal_tolerance")
 _plugin_contact_duration = _chain("contact_duration")
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def is_permanent(law_id: int) -> bool:
     """True for link elements (pounding.contact.links): always engaged, no gap, no events, tension allowed."""
     return law_id >= FIRST_LINK_ID
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def link_force(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
     """Force of a link (N, may be negative: a pull) at relative displacement *delta* and its rate."""
     if law_id == LINK_VISCOUS:
@@ -123,7 +123,7 @@ def link_force(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q:
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
     """Per-impact constant fixed at the located gap closure (ξ for Hertz-damp, the rubber's ξb for a bumper)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -133,13 +133,13 @@ def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def is_instantaneous(law_id: int) -> bool:
     """True for laws applied as a velocity jump at closure (stereo-mechanical)."""
     return law_id == LAW_STEREO
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
     """Impulse (N·s) of an instantaneous law for approach velocity *v0*: (1+e)·m_eff·v0."""
     if law_id == LAW_STEREO:
@@ -252,7 +252,7 @@ BUMPER_HARD_CLAMPED = 8
 N_SWITCHES = 3
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
     """Mode of a contact at its located gap closure with approach velocity *v0* (m/s)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -264,7 +264,7 @@ def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
     return 0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def switch_count(law_id: int, prm: np.ndarray) -> int:
     """How many switch functions the law has (0: the force is one formula while closed)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -282,7 +282,7 @@ def switch_count(law_id: int, prm: np.ndarray) -> int:
     return 0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, delta: float,
                delta_rate: float, q: float) -> float:
     """Contact force (N) of a closed contact in *mode* (no branch on the state inside a mode).
@@ -329,7 +329,7 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
     return 0.0  # stereo-mechanical: no force history (a velocity jump; a stuck contact's force is the solver's)
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float) -> float:
     """Rate of the internal state in *mode* (N/s): the bilinear force follows K1 (elastic) or K2 (yielding)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -341,7 +341,7 @@ def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, de
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def link_internal_rate(law_id: int, prm: np.ndarray, delta_rate: float, q: float) -> float:
     """Rate of a link's internal state (N/s): a Maxwell element's force, ``k·(δ̇ − q/c)``."""
     if law_id == LINK_MAXWELL:
@@ -349,7 +349,7 @@ def link_internal_rate(law_id: int, prm: np.ndarray, delta_rate: float, q: float
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, which: int, delta: float,
                  delta_rate: float, q: float) -> float:
     """Switch function *which* of *mode*: positive while the mode holds, crossing 0 where it ends.
@@ -394,7 +394,7 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
     return 1.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def next_mode(law_id: int, mode: int, which: int) -> int:
     """Mode entered when switch function *which* of *mode* crosses zero."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -412,7 +412,7 @@ def next_mode(law_id: int, mode: int, which: int) -> int:
     return 1 - mode
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float, q: float) -> float:
     """Internal state put exactly on the branch *mode* starts on (removes the event's round-off).
 
@@ -436,7 +436,7 @@ def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delt
     return q
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def implied_mode(law_id: int, prm: np.ndarray, impact_constant: float, delta: float, delta_rate: float,
                  q: float) -> int:
     """Mode a closed contact's state implies, without the history the solver's located events carry.
@@ -474,7 +474,7 @@ def implied_mode(law_id: int, prm: np.ndarray, impact_constant: float, delta: fl
     return 0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
           delta_rate: float, q: float) -> float:
     """Contact force (N) at penetration *delta* (m), its rate (m/s) and internal state *q*, no mode given.
@@ -487,7 +487,7 @@ def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
     return mode_force(law_id, prm, impact_constant, mode, delta, delta_rate, q)
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
     """Rate of the internal state (N/s) in the mode the state implies (:func:`mode_internal_rate`); links too."""
     if law_id >= FIRST_LINK_ID:
@@ -497,7 +497,7 @@ def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float,
     return mode_internal_rate(law_id, prm, implied_mode(law_id, prm, 0.0, delta, delta_rate, q), delta, delta_rate)
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -> float:
     """Absolute error tolerance of the internal state (N): K1·atol for the bilinear force, 0 if unused."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -507,7 +507,7 @@ def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: float) -> float:
     """Duration estimate (s) of a free impact at approach velocity *v0* (m/s); 0 for instantaneous laws.
 
@@ -527,7 +527,7 @@ def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: fl
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def rest_velocity(law_id: int, prm: np.ndarray) -> float:
     """Approach velocity (m/s) at or below which an instantaneous law's closure may become a resting contact.
 

@@ -48,9 +48,11 @@ def storey_event(y, ynew, k1, k7, lay, j, b, hi, model, uy, mode, h):
         if max(abs(e0), abs(e1)) + 0.25 * h * (abs(r0) + abs(r1)) < uy:
             return -1.0, STOREY_NONE
         floor = DELTA_ROUNDOFF * (abs(d0) + abs(plastic) + uy)
-        s = first_crossing(e0 - uy, r0, e1 - uy, r1, h, True, floor)
+        # A run-time bool (True here), not a literal: first_crossing is compiled once, not per literal.
+        upward = mode == storeys.ELASTIC
+        s = first_crossing(e0 - uy, r0, e1 - uy, r1, h, upward, floor)
         kind = STOREY_YIELD_POSITIVE
-        s2 = first_crossing(e0 + uy, r0, e1 + uy, r1, h, False, floor)
+        s2 = first_crossing(e0 + uy, r0, e1 + uy, r1, h, not upward, floor)
         if s2 >= 0.0 and (s < 0.0 or s2 < s):
             s = s2
             kind = STOREY_YIELD_NEGATIVE

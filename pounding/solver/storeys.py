@@ -31,7 +31,7 @@ YIELD_POSITIVE = 1
 YIELD_NEGATIVE = -1
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def restoring_force(model, table, row, k, drift, r):
     """Storey (column) shear, N, at *drift* (m) with state *r*; P-Delta and damping not included."""
     if model == MODEL_BILINEAR:
@@ -43,7 +43,7 @@ def restoring_force(model, table, row, k, drift, r):
     return k * drift
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def state_rate(model, table, row, mode, drift_rate, r):
     """Time derivative of the state *r* at drift rate *drift_rate* (m/s) in *mode*."""
     if model == MODEL_BILINEAR:
@@ -56,7 +56,7 @@ def state_rate(model, table, row, mode, drift_rate, r):
     return 0.0
 
 
-@njit(cache=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def recoverable_energy(model, table, row, k, drift, r):
     """Energy the storey would give back on unloading to zero force, J.
 
