@@ -303,11 +303,17 @@ def _supports_for_call(model: Model, record: Record | str | list | None, scale: 
     return support_motions(model, where=where if isinstance(record, str) else "yaml")
 
 
-def _checked_end_time(model: Model, supports: SupportMotions) -> float:
-    """The simulated time (s), after checking it, the output interval and the memory the run needs."""
+def _positive_end_time(supports: SupportMotions) -> float:
+    """The simulated time (s) of *supports*, refused in one line unless > 0."""
     end_time = supports.end_time
     if end_time <= 0.0:
         raise PoundingError(f"record {supports.records[0].name}: duration must be > 0 (got {end_time} s)")
+    return end_time
+
+
+def _checked_end_time(model: Model, supports: SupportMotions) -> float:
+    """The simulated time (s), after checking it, the output interval and the memory the run needs."""
+    end_time = _positive_end_time(supports)
     settings = model.solver
     if settings.output_dt > end_time:
         raise PoundingError(f"{_where(model)}solver.output_dt is {settings.output_dt:g} s, longer than the simulated "
@@ -336,9 +342,7 @@ def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]
     _check_modes_memory(model)
     supports = support_motions(model, record, where="yaml")
     motion = supports.records[0]
-    end_time = supports.end_time
-    if end_time <= 0.0:
-        raise PoundingError(f"record {motion.name}: duration must be > 0 (got {end_time} s)")
+    end_time = _positive_end_time(supports)
     system, raw, wall, _ = _solve(model, supports, end_time, end_time)
     peaks = run_peaks(model, system, raw)
     peaks.update(record_scale=float(motion.scale), wall_time=wall)
