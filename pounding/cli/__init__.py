@@ -23,7 +23,7 @@ __all__ = ["main", "console_main", "build_parser", "SUBCOMMAND_MODULES"]
 SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sweep",
                       "compare": "pounding.cli.compare", "records": "pounding.cli.records",
                       "export": "pounding.cli.export", "gap": "pounding.cli.gap", "ida": "pounding.cli.ida",
-                      "init": "pounding.cli.init"}
+                      "init": "pounding.cli.init", "table": "pounding.cli.table"}
 
 
 # --------------------------------------------------------------------------- #
@@ -154,7 +154,7 @@ def _silence_stdout() -> None:
 
 
 #: Subcommands that never use dask in their own process (everything but sweep/compare).
-LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export"})
+LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table"})
 
 
 def console_main() -> int:

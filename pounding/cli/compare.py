@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.cli.sweep import add_cluster_options, check_study_options, raise_if_all_failed
 from pounding.studies.compare import REFERENCE, compare, comparison_table, plot_comparison
 
@@ -15,6 +16,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
+    check_csv(args, [args.model])
     try:
         ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,
                      reference=args.reference, workers=args.workers, scheduler=args.scheduler,
@@ -30,6 +32,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     print(comparison_table(ds, args.reference))
     if args.output:
         print(f"wrote {args.output}")
+    write_csv_option(args, "compare", ds)
     if args.plot:
         for png in plot_comparison(ds, args.plot, args.reference, drift_limit=args.drift_limit):
             print(f"wrote {png}")
@@ -59,6 +62,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--plot", metavar="DIR", help="write xi_drift_profiles.png and xi_drift_distribution.png")
     parser.add_argument("--drift-limit", type=float, metavar="PCT",
                         help="draw a drift-ratio limit line on the profiles, in %% (e.g. 2.0)")
+    add_csv_option(parser)
     add_cluster_options(parser)
     parser.set_defaults(func=_cmd_compare)
     return parser

@@ -8,6 +8,7 @@ import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
 from pounding.cli.sweep import add_cluster_options, check_study_options
+from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
 __all__ = ["register_cli"]
@@ -18,6 +19,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
+    check_csv(args, [args.model])
     scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
         ds = gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
@@ -44,6 +46,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
         raise PoundingError(f"every record failed ({len(ok)}); nothing to report")
     if args.output:
         print(f"wrote {args.output}", file=sys.stderr if args.json else sys.stdout)
+    write_csv_option(args, "gap", ds, sys.stderr if args.json else sys.stdout)
     if args.plot:
         for png in plot_gap(ds, args.plot):
             print(f"wrote {png}", file=sys.stderr if args.json else sys.stdout)
@@ -71,6 +74,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--json", action="store_true", help="print the results as one JSON document (metres)")
     parser.add_argument("--plot", metavar="DIR", help="write gap_profile.png to DIR")
+    add_csv_option(parser)
     add_cluster_options(parser)
     parser.set_defaults(func=_cmd_gap)
     return parser

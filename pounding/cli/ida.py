@@ -7,6 +7,7 @@ import json
 import sys
 
 from pounding.cli.sweep import add_cluster_options, check_study_options
+from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
 __all__ = ["register_cli"]
@@ -18,6 +19,7 @@ def _cmd_ida(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
+    check_csv(args, [args.model])
     hunt = None
     if args.hunt:
         hunt = Hunt(start=args.hunt_start, step=args.hunt_step, increment=args.hunt_increment,
@@ -65,6 +67,7 @@ def _cmd_ida(args: argparse.Namespace) -> int:
         print(f"ran {ds.attrs['n_run']} runs in {ds.attrs['elapsed_time']:.1f} s ({rate:.2f} runs/s)", file=out)
     if args.output:
         print(f"wrote {args.output}", file=out)
+    write_csv_option(args, "ida", ds, out)
     if args.plot:
         for png in plot_ida(ds, args.plot):
             print(f"wrote {png}", file=out)
@@ -118,6 +121,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--json", action="store_true", help="print the fragility as one JSON document (g)")
     parser.add_argument("--plot", metavar="DIR", help="write ida_curves.png and fragility.png to DIR")
+    add_csv_option(parser)
     add_cluster_options(parser)
     parser.set_defaults(func=_cmd_ida)
     return parser

@@ -7,6 +7,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 
 __all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options"]
 
@@ -193,6 +194,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
     if args.plot:
         _check_plot_dir(args.plot)
+    check_csv(args, [args.model])
     with output_lock(output):   # a second run onto the same name refuses here, before computing
         return _run_locked(args, output, started)
 
@@ -222,6 +224,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
     print(f"wrote {path}")
+    write_csv_option(args, "run", ds)
     if args.plot:
         from pounding.results.plots import plot_run
 
@@ -293,11 +296,9 @@ def open_archive(path) -> tuple[str, object]:
 
 def _reference(ds) -> str:
     """The formula a compare archive is compared with (``exact`` unless it was not run)."""
-    from pounding.studies.compare import REFERENCE
+    from pounding.studies.compare import reference_formula
 
-    formulas = [str(x) for x in ds.xi.values]
-    reference = str(ds.attrs.get("reference_xi", REFERENCE))
-    return reference if reference in formulas else formulas[-1]
+    return reference_formula(ds)
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
@@ -422,6 +423,7 @@ def register_cli(sub) -> None:
     run.add_argument("-o", "--output", help="NetCDF archive (default: MODEL-STEM.nc)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing archive")
     run.add_argument("--plot", metavar="DIR", help="also write the four PNG figures to DIR (see pounding plot)")
+    add_csv_option(run)
     add_plot_options(run)
     run.set_defaults(func=_cmd_run)
 

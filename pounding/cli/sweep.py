@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 from pounding.studies.engine.execution import default_workers
 
@@ -67,6 +68,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
     sweep = load_sweep(args.sweep)
+    check_csv(args, [args.sweep])
     output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
     invalid = sweep.invalid_values()
     if invalid and args.strict:
@@ -92,6 +94,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if ds.attrs["n_run"]:
         print(f"ran {ds.attrs['n_run']} scenarios in {ds.attrs['elapsed_time']:.1f} s ({rate:.2f} scenarios/s)")
     print(f"wrote {output}")
+    write_csv_option(args, "sweep", ds)
     return 0
 
 
@@ -108,6 +111,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--keep-histories", metavar="DIR", help="also archive each scenario's full results in DIR")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--keep-parts", action="store_true", help="keep OUTPUT.parts/ after writing OUTPUT")
+    add_csv_option(parser)
     parser.add_argument("--strict", action="store_true",
                         help="stop if an axis value makes the model invalid (default: record the error)")
     parser.set_defaults(func=_cmd_sweep)

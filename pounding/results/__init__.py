@@ -3,4 +3,5 @@
 ``dataset``  solver output → ``xarray.Dataset`` with units and long names
 ``archive``  atomic NetCDF writing, reopening
 ``plots``    PNG figures of a run
+``tables``   report tables of a run or sweep archive, and CSV writing (units in the headers)
 """

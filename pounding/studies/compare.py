@@ -20,7 +20,7 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "comparison_table", "differences", "plot_comparison"]
+__all__ = ["compare", "comparison_table", "compare_tables", "differences", "reference_formula", "plot_comparison"]
 
 REFERENCE = "exact"
 
@@ -163,6 +163,29 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
         for i, row in enumerate(rows):
             lines.append(f"  {row:>6}  " + "  ".join(f"{cells[f][i]:>{w}}" for f, w in zip(formulas, widths)))
     return "\n".join(lines)
+
+
+def reference_formula(ds) -> str:
+    """The formula a compare archive is compared with (``exact`` unless it was not run: then the last one)."""
+    formulas = [str(x) for x in ds.xi.values]
+    reference = str(ds.attrs.get("reference_xi", REFERENCE))
+    return reference if reference in formulas else formulas[-1]
+
+
+def compare_tables(ds, reference: str | None = None) -> dict:
+    """Tables of a compare archive: those of a sweep (:func:`pounding.results.tables.sweep_tables`), the
+    storey table with ``difference_from_REFERENCE [-]``, (d − d_ref) / d_ref of each record (see
+    :func:`differences`), when the archive has an ``xi`` dimension holding *reference*
+    (default :func:`reference_formula`)."""
+    from pounding.results.tables import sweep_tables
+
+    tables = sweep_tables(ds)
+    if reference is None and "xi" in ds.dims:
+        reference = reference_formula(ds)
+    if "xi" in ds.dims and reference in [str(x) for x in ds.xi.values]:
+        column = differences(ds, reference).transpose(*ds.peak_drift_ratio.dims).values.ravel()
+        tables["storeys"][f"difference_from_{reference} [-]"] = column
+    return tables
 
 
 def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE, *,

@@ -52,7 +52,7 @@ from pounding.registry import add_unique
 
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "open_contacts",
            "required_separations", "run_gap_scenario", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
-           "gap_summary", "gap_table", "plot_gap", "OPEN_GAP"]
+           "gap_summary", "gap_table", "gap_tables", "plot_gap", "OPEN_GAP"]
 
 #: Gap (m) given to every contact of the contact-free run: no floor ever travels this far.
 OPEN_GAP = 1.0e6
@@ -517,6 +517,24 @@ def gap_table(ds) -> str:
     lines.append("unsafe: fraction of records for which the rule is below the required separation; "
                  f"ddc uses rho = CQC of the first modes ({', '.join(f'{x:.3f}' for x in ds.correlation.values)})")
     return "\n".join(lines)
+
+
+def gap_tables(ds) -> dict:
+    """Tables of a gap archive (metres): ``contacts`` (the model's gap, the required separation's median,
+    84th percentile and maximum, the records it suffices for), ``rules`` (each rule's separation and how
+    often it is unconservative), ``records`` (per record and contact: the required separation and the
+    peak displacements it came from) and ``rule_records`` (each rule per record and contact)."""
+    from pounding.results.tables import long_table
+
+    place = ["building_left", "level_left", "elevation_left", "building_right", "level_right", "elevation_right"]
+    return {
+        "contacts": long_table(ds, ["gap", "required_gap_median", "required_gap_p84", "required_gap_max",
+                                    "records_enough", "correlation"], extra=place),
+        "rules": long_table(ds, ["rule_gap_median", "rule_gap_p84", "rule_gap_max", "unconservative_fraction"]),
+        "records": long_table(ds, ["required_gap", "peak_displacement_left", "peak_displacement_right"],
+                              extra=["status", "scale_factor", "gap"]),
+        "rule_records": long_table(ds, ["rule_gap", "rule_ratio"], extra=["status"]),
+    }
 
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:

@@ -108,6 +108,7 @@ __all__ = [
     "production_system",
     "impact_velocity",
     "run_verification",
+    "verify_tables",
     "format_table_i",
     "format_models",
     "format_report",
@@ -887,6 +888,18 @@ def to_json(ds: xr.Dataset) -> dict:
         settings["production_integrator"] = ds.attrs["production_integrator"]
         out["production"] = rows("production_e_post", "production_relative_error")
     return out
+
+
+def verify_tables(ds: xr.Dataset) -> dict:
+    """Tables of a verify archive: ``laws`` (per contact law and e_pre: e_post, its error, the impact
+    velocity, peak penetration and contact duration, and the production solver's e_post when run) and
+    ``published`` (Ye, Li & Zhu's Table I as printed)."""
+    from pounding.results.tables import long_table
+
+    names = [n for n in ("e_post", "relative_error", "impact_velocity", "max_penetration", "contact_duration",
+                         "production_e_post") if n in ds.variables]
+    return {"laws": long_table(ds, names),
+            "published": long_table(ds, ["e_post_published", "relative_error_published"])}
 
 
 def format_report(ds: xr.Dataset) -> str:

@@ -71,13 +71,13 @@ from pounding.studies.ida.hunt import HuntTasks, next_hunt_level, run_hunt
 from pounding.studies.ida.plan import (DEFAULT_LIMITS, IM_NAMES, MAX_LEVELS, SA_DAMPING, SCALINGS, VARIANTS, Hunt,
                                        IdaPlan, IntensityMeasure, build_ida_plan, limit_label, parse_intensity,
                                        parse_levels, parse_limits)
-from pounding.studies.ida.report import ida_summary, ida_table, plot_ida
+from pounding.studies.ida.report import ida_summary, ida_table, ida_tables, plot_ida
 from pounding.studies.ida.runs import IDA_PART, building_drifts, collapsed_in, run_ida_scenario, run_outcome
 
 __all__ = ["IDA_PART", "VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "MAX_BETA", "SA_DAMPING",
            "IntensityMeasure", "Hunt", "IdaPlan", "parse_levels", "parse_limits", "build_ida_plan",
            "run_ida_scenario", "next_hunt_level", "HuntTasks", "run_hunt", "ida_study", "assemble_ida_dataset", "ida_fragility",
-           "ida_summary", "ida_table", "plot_ida", "run_outcome", "parse_intensity", "limit_label", "exceeds",
+           "ida_summary", "ida_table", "ida_tables", "plot_ida", "run_outcome", "parse_intensity", "limit_label", "exceeds",
            "building_drifts", "collapsed_in"]
 
 

@@ -13,7 +13,7 @@ from pounding.studies.ida.dataset import exceeds
 from pounding.studies.ida.plan import SA_DAMPING
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["ida_summary", "ida_table", "plot_ida"]
+__all__ = ["ida_summary", "ida_table", "ida_tables", "plot_ida"]
 
 
 def ida_summary(ds) -> dict[str, Any]:
@@ -104,6 +104,19 @@ def ida_table(ds) -> str:
         lines.append("not fitted or partly fitted:")
         lines += notes
     return "\n".join(lines)
+
+
+def ida_tables(ds) -> dict:
+    """Tables of an IDA archive: ``fragility`` (θ in m s-2 and in g, β, the note, per variant, building
+    and limit) and ``runs`` (per variant, record, level and building: the intensity reached, the scale
+    factor, the status, the largest storey drift ratio and whether the building collapsed)."""
+    from pounding.results.tables import long_table
+
+    fragility = long_table(ds, ["fragility_theta", "fragility_beta", "fragility_note"])
+    fragility.insert(fragility.columns.get_loc("fragility_theta [m s-2]") + 1, "fragility_theta [g]",
+                     fragility["fragility_theta [m s-2]"] / STANDARD_GRAVITY)
+    extra = [n for n in ("level_value", "intensity", "scale_factor", "status") if n in ds.variables]
+    return {"fragility": fragility, "runs": long_table(ds, ["max_drift_ratio", "collapsed"], extra=extra)}
 
 
 # --------------------------------------------------------------------------- #
