@@ -86,9 +86,10 @@ def summary(ds) -> str:
 
     import numpy as np
 
+    from pounding.results.describe import record_event
+
     lines = []
-    meta = json.loads(ds.attrs.get("record_metadata", "{}"))
-    event = ", ".join(str(meta[k]) for k in ("event", "year", "station", "component") if meta.get(k))
+    event = record_event(ds)
     lines.append(f"model '{ds.attrs['model_name']}' under {ds.attrs['record_name']} x{ds.attrs['record_scale']:g}"
                  f"{f' ({event})' if event else ''}, {ds.attrs['duration']:.2f} s")
     if ds.attrs.get("multi_support") and "ground" in ds.dims:

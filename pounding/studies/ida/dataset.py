@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import PoundingError
+from pounding.studies.common import records_text
 from pounding.studies.ida.plan import SA_DAMPING, IdaPlan, limit_label
 from pounding.studies.ida.runs import building_drifts, run_outcome
 from pounding.units import STANDARD_GRAVITY
@@ -17,6 +18,17 @@ __all__ = ["MAX_BETA", "assemble_ida_dataset", "exceeds", "ida_fragility"]
 
 #: Largest dispersion reported; a larger one means the data do not define a fragility.
 MAX_BETA = 5.0
+
+
+def _levels_text(plan: IdaPlan) -> str:
+    """The intensities of an IDA in words: ``at 0.5, 1.5 g``, ``at 15 stripes 0.1-1.5 g``, ``hunt-and-fill ...``."""
+    how = "the set's median, FEMA P695 scaling" if plan.scaling == "fema-p695" else "each record scaled to it"
+    if plan.hunt is not None:
+        return f"hunted from {plan.hunt.start:g} g up to {plan.hunt.ceiling:g} g ({how})"
+    levels = [float(x) for x in plan.levels]
+    shown = ", ".join(f"{x:g}" for x in levels) if len(levels) <= 4 else \
+        f"{len(levels)} stripes {min(levels):g}-{max(levels):g}"
+    return f"at {shown} g ({how})"
 
 
 def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
@@ -158,7 +170,9 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
                                                                 "long_name": "peak storey drift ratio limit"}),
     }
     ds = xr.Dataset(data_vars, coords=coords, attrs={
-        "title": f"pounding IDA: {plan.model_name}",
+        "title": f"pounding IDA of model '{plan.model_name}' under {records_text(plan.records)}, "
+                 f"{plan.im.describe()} {_levels_text(plan)}",
+        "model_name": plan.model_name,
         "source": f"pounding {__version__}",
         "study": "ida",
         "history": f"{time.strftime('%Y-%m-%d %H:%M:%S')} pounding ida ({'stripes' if stripes else 'hunt-and-fill'}, "

@@ -62,7 +62,7 @@ def ida_table(ds) -> str:
     status = ds.status.values
     counts = {s: int((status == s).sum()) for s in ("completed", "collapsed", "failed")}
     variants = [str(v) for v in ds.variant.values]
-    lines = [f"IDA of {ds.attrs['title'].split(': ', 1)[-1]}: {ds.record.size} records, "
+    lines = [f"IDA of {ds.attrs.get('model_name') or ds.attrs['title'].split(': ', 1)[-1]}: {ds.record.size} records, "
              f"{ds.attrs['method']}, {status.size if ds.attrs['method'] == 'stripes' else ds.attrs['n_runs']} runs "
              f"({counts['completed']} completed, {counts['collapsed']} collapsed, {counts['failed']} failed)",
              f"IM: {ds.attrs['im_description']}, in g; scaling: "
@@ -146,7 +146,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     ``fragility.png`` (fitted curves with the stripe fractions as points), per building."""
     from scipy.special import ndtr
 
-    from pounding.results.plots import plot_directory, pyplot, save_figure
+    from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -165,16 +165,18 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     for b, building in enumerate(buildings):
         for i, variant in enumerate(variants):
             ax = axes[b, i]
+            collapse_labelled = False
             for r in range(ds.record.size):
                 levels, drift, collapsed = _curve(ds, i, r, b)
                 if levels.size == 0:
                     continue
                 shown = np.where(collapsed, top, 100 * np.minimum(drift, top / 100))
                 ax.plot(shown, levels, color="0.65", lw=0.8, marker=".", ms=3,
-                        label="one record" if r == 0 else None)
-                if collapsed.any():
+                        label=None if any(line.get_label() == "one record" for line in ax.lines) else "one record")
+                if collapsed.any():   # the legend names the marker with the first collapse drawn, whichever record
                     ax.plot(shown[collapsed][:1], levels[collapsed][:1], "x", color="C3", ms=6,
-                            label="collapse" if r == 0 else None)
+                            label=None if collapse_labelled else "collapse")
+                    collapse_labelled = True
             if stripes:
                 drift = np.where(ds.collapsed.values[i, :, :, b].astype(bool), np.inf,
                                  ds.max_drift_ratio.values[i, :, :, b])
@@ -197,7 +199,8 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
             ax.set_title(f"building {building}, {titles.get(variant, variant)}", fontsize=10)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="lower right")
-    fig.suptitle(f"IDA curves, {ds.record.size} records; IM = {ds.attrs['im_description']}", fontsize=10)
+    suptitle(fig, f"IDA curves, {ds.record.size} records; IM = {ds.attrs['im_description']}\n{ds.attrs.get('title', '')}",
+                 9)
     path = out / "ida_curves.png"
     save_figure(fig, path)
     paths.append(path)
@@ -243,7 +246,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
         if handles:   # below the axes
             ax.legend(handles, names, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
                       frameon=False)
-    fig.suptitle(f"fragility, {ds.record.size} records ({ds.attrs['method']})", fontsize=10)
+    suptitle(fig, f"fragility, {ds.record.size} records ({ds.attrs['method']})\n{ds.attrs.get('title', '')}", 9)
     path = out / "fragility.png"
     save_figure(fig, path)
     paths.append(path)

@@ -8,6 +8,7 @@ from typing import Any, Iterable
 
 from pounding import __version__
 from pounding.model.document import dump_document
+from pounding.studies.common import sweep_heading
 from pounding.studies.sweep.spec import Axis, Sweep
 
 __all__ = ["build_dataset"]
@@ -137,7 +138,7 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     attrs = {
         "Conventions": "CF-1.10",
-        "title": f"pounding sweep '{sweep.name}' ({sweep.size} scenarios)",
+        "title": f"pounding sweep '{sweep.name}' ({sweep.size} scenarios) of {sweep_heading(sweep)}",
         "source": f"pounding {__version__}",
         "history": f"{now} swept with pounding {__version__} from {sweep.label}",
         "sweep_name": sweep.name,

