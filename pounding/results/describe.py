@@ -14,8 +14,9 @@ __all__ = ["record_event", "scale_text", "run_title"]
 
 def record_event(ds) -> str:
     """The record's event, year, station and component from a run archive's metadata (``""`` if none)."""
-    meta = json.loads(ds.attrs.get("record_metadata", "{}") or "{}")
-    return ", ".join(str(meta[k]) for k in ("event", "year", "station", "component") if meta.get(k))
+    from pounding.records.record import event_text
+
+    return event_text(json.loads(ds.attrs.get("record_metadata", "{}") or "{}"))
 
 
 def scale_text(scale: float, method: str = "factor", description: str = "") -> str:

@@ -20,17 +20,6 @@ __all__ = ["MAX_BETA", "assemble_ida_dataset", "exceeds", "ida_fragility"]
 MAX_BETA = 5.0
 
 
-def _levels_text(plan: IdaPlan) -> str:
-    """The intensities of an IDA in words: ``at 0.5, 1.5 g``, ``at 15 stripes 0.1-1.5 g``, ``hunt-and-fill ...``."""
-    how = "the set's median, FEMA P695 scaling" if plan.scaling == "fema-p695" else "each record scaled to it"
-    if plan.hunt is not None:
-        return f"hunted from {plan.hunt.start:g} g up to {plan.hunt.ceiling:g} g ({how})"
-    levels = [float(x) for x in plan.levels]
-    shown = ", ".join(f"{x:g}" for x in levels) if len(levels) <= 4 else \
-        f"{len(levels)} stripes {min(levels):g}-{max(levels):g}"
-    return f"at {shown} g ({how})"
-
-
 def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
                          entries: list[tuple[str, int, float, str]], *, elapsed: float = float("nan"),
                          ran: int = 0):
@@ -171,7 +160,7 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
     }
     ds = xr.Dataset(data_vars, coords=coords, attrs={
         "title": f"pounding IDA of model '{plan.model_name}' under {records_text(plan.records)}, "
-                 f"{plan.im.describe()} {_levels_text(plan)}",
+                 f"{plan.im.describe()} {plan.describe_levels()}",
         "model_name": plan.model_name,
         "source": f"pounding {__version__}",
         "study": "ida",

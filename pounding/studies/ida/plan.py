@@ -257,6 +257,23 @@ class IdaPlan:
     errors: list[str | None] = field(default_factory=list)   # per record: why it cannot run (or None)
     _cache: dict = field(default_factory=dict, repr=False)
 
+    def describe_levels(self) -> str:
+        """The intensities in words: ``at 0.5, 1.5 g (...)``, ``at 15 stripes 0.1-1.5 g (...)``, ``hunted from ...``."""
+        how = "the set's median, FEMA P695 scaling" if self.scaling == "fema-p695" else "each record scaled to it"
+        if self.hunt is not None:
+            return f"hunted from {self.hunt.start:g} g up to {self.hunt.ceiling:g} g ({how})"
+        levels = [float(x) for x in self.levels]
+        shown = ", ".join(f"{x:g}" for x in levels) if len(levels) <= 4 else \
+            f"{len(levels)} stripes {min(levels):g}-{max(levels):g}"
+        return f"at {shown} g ({how})"
+
+    def __repr__(self) -> str:
+        return (f"<IdaPlan of model '{self.model_name}': {len(self.records)} records x "
+                + (f"{len(self.levels)} levels" if self.hunt is None else "hunt-and-fill")
+                + f" x {len(self.variants)} variant{'s' if len(self.variants) != 1 else ''} = "
+                f"{'up to ' if self.hunt is not None else ''}{self.planned_runs()} runs; "
+                f"{self.im.describe()} {self.describe_levels()}>")
+
     def factor(self, record: int, level_g: float) -> float:
         """The factor on record *record* (as stored) at level *level_g* (g)."""
         return float(level_g * STANDARD_GRAVITY * self.unit_factor[record])

@@ -511,6 +511,10 @@ class Sweep:
     def shape(self) -> tuple[int, ...]:
         return tuple(d.size for d in self.dimensions)
 
+    def __repr__(self) -> str:
+        return (f"<Sweep '{self.name}' of model '{self.model_name}': {self.size} scenarios = "
+                + " x ".join(f"{d.size} {d.name}" for d in self.dimensions) + f" ({self.label})>")
+
     @property
     def size(self) -> int:
         return math.prod(self.shape)
