@@ -154,13 +154,14 @@ def test_every_inline_command_names_a_command_and_options_that_exist(where, comm
         pytest.fail(f"{where}: `{command}`: {exc}")
 
 
-def _dotted_names() -> dict[str, str]:
-    names: dict[str, str] = {}
+def _mentions(pattern: re.Pattern) -> dict[str, str]:
+    """Every distinct text *pattern* finds in the docs, with where it first appears."""
+    found: dict[str, str] = {}
     for path in DOCS:
         text = path.read_text(encoding="utf-8")
-        for m in DOTTED.finditer(text):
-            names.setdefault(m.group(0), f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}")
-    return names
+        for m in pattern.finditer(text):
+            found.setdefault(m.group(0), f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}")
+    return found
 
 
 def _resolve(dotted: str) -> None:
@@ -178,7 +179,7 @@ def _resolve(dotted: str) -> None:
     raise ModuleNotFoundError(dotted)
 
 
-@pytest.mark.parametrize("name, where", sorted(_dotted_names().items()))
+@pytest.mark.parametrize("name, where", sorted(_mentions(DOTTED).items()))
 def test_every_dotted_name_in_the_docs_exists(name, where):
     try:
         _resolve(name)
@@ -186,16 +187,7 @@ def test_every_dotted_name_in_the_docs_exists(name, where):
         pytest.fail(f"{where}: {name} does not exist ({type(exc).__name__}: {exc})")
 
 
-def _package_paths() -> dict[str, str]:
-    paths: dict[str, str] = {}
-    for path in DOCS:
-        text = path.read_text(encoding="utf-8")
-        for m in PACKAGE_PATH.finditer(text):
-            paths.setdefault(m.group(0), f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}")
-    return paths
-
-
-@pytest.mark.parametrize("name, where", sorted(_package_paths().items()))
+@pytest.mark.parametrize("name, where", sorted(_mentions(PACKAGE_PATH).items()))
 def test_every_package_path_in_the_docs_exists(name, where):
     assert (ROOT / name).exists(), f"{where}: {name} does not exist"
 
