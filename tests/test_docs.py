@@ -21,6 +21,7 @@ conventions):
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib
 import io
 import os
@@ -331,6 +332,22 @@ def _sweep_size(name: str) -> int:
     return _sweep(name).size
 
 
+@functools.lru_cache(maxsize=None)
+def _impacts(model: str) -> dict[str, int]:
+    """Impacts per contact of a shipped model's own run, and ``all``."""
+    import pounding
+
+    ds = pounding.simulate(pounding.load_model(ROOT / "models" / model))
+    counts = {str(c): int(n) for c, n in zip(ds.contact.values, ds.impact_count.values)}
+    return {**counts, "all": sum(counts.values())}
+
+
+def _stripes(levels: str) -> int:
+    from pounding.studies.ida import parse_levels
+
+    return len(parse_levels(levels))
+
+
 #: Counts the docs quote: (file, pattern whose groups are the numbers, the numbers now).
 COUNTS = [
     ("README.md", r"the (\d+) far-field records \((\d+) in all\)", lambda: _catalogue_counts()[1::-1]),
@@ -338,6 +355,12 @@ COUNTS = [
     ("docs/ground_motions.md", r"names (\d+) records with readable keys", lambda: _catalogue_counts()[:1]),
     ("docs/ground_motions.md", r"all (\d+) components of the FEMA P695 far-field", lambda: _catalogue_counts()[1:2]),
     ("docs/ground_motions.md", r"all (\d+) components of the FEMA P695 near-field", lambda: _catalogue_counts()[2:]),
+    ("README.md", r"the same pair pounds (\d+)\s+times", lambda: (_impacts("pair.yaml")["all"],)),
+    ("README.md", r"`pounding run models/pair.yaml`: (\d+) impacts,\s+(\d+) at floor 1",
+     lambda: (_impacts("pair.yaml")["all"], _impacts("pair.yaml")["A:1-B:1"])),
+    ("README.md", r"the floor-1 contact pounds (\d+) times", lambda: (_impacts("pair_wave_passage.yaml")["A:1-B:1"],)),
+    ("README.md", r"all (\d+) far-field\s+components at (\d+) stripes of Sa\(T₁ of A\) \((\d+) runs",
+     lambda: (_catalogue_counts()[1], _stripes("0.1:1.5:0.1"), _catalogue_counts()[1] * _stripes("0.1:1.5:0.1") * 2)),
     ("docs/sweeps.md", r"gap_restitution.yaml: (\d+) gaps x (\d+) restitutions x (\d+) records = (\d+) scenarios",
      lambda: (*(d.size for d in _sweep("gap_restitution.yaml").dimensions), _sweep_size("gap_restitution.yaml"))),
 ]
