@@ -161,3 +161,14 @@ def test_csv_onto_an_input_or_a_folder_is_refused_before_anything_runs(written, 
     assert main(["run", PAIR, "-o", str(tmp_path / "x.nc"), "--csv", str(tmp_path)]) == 2
     assert "is a directory" in capsys.readouterr().err
     assert not (tmp_path / "x.nc").exists()
+
+
+def test_a_verify_archive_has_tables_too(tmp_path):
+    archive = tmp_path / "verify.nc"
+    assert main(["verify", "--models", "ye,exact", "--e-pre", "0.5,0.9", "-o", str(archive)]) == 0
+    assert main(["table", str(archive), "--csv", str(tmp_path / "verify.csv")]) == 0
+    ds = xr.open_dataset(archive)
+    laws = _read(tmp_path / "verify.csv")
+    np.testing.assert_array_equal(laws["e_post [-]"], ds.e_post.values.ravel())
+    assert list(laws["e_pre [-]"]) == [0.5, 0.9, 0.5, 0.9]
+    assert (tmp_path / "verify.published.csv").exists()
