@@ -546,6 +546,10 @@ class SolverSettings:
     stop_drift_ratio : float or None
         End the run (status ``collapsed``) when a storey's |drift ratio| first
         exceeds this; None: never.
+    tolerance_scaling : bool
+        Tighten ``atol`` and ``atol_velocity`` for a building far stiffer than
+        the row moves (its static drift scale below 100·atol;
+        :mod:`pounding.solver.tolerances`).  False: the given values for every floor.
     """
 
     rtol: float = 1e-6
@@ -553,6 +557,7 @@ class SolverSettings:
     atol_velocity: float = 1e-7
     output_dt: float = 0.01
     stop_drift_ratio: float | None = None
+    tolerance_scaling: bool = True
 
     def __post_init__(self) -> None:
         entry = _checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))

@@ -965,6 +965,8 @@ class SolverEntry(_Schema):
     output_dt: PositiveNumber = 0.01
     stop_drift_ratio: StopDriftRatio = Field(
         None, description="end the run (status collapsed) when a storey's |drift ratio| exceeds this")
+    tolerance_scaling: bool = Field(
+        True, description="tighten atol per building to its own static drift scale (docs/numerics.md)")
 
 
 def _buildings_shape(value: Any) -> Any:
