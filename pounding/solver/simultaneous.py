@@ -24,7 +24,6 @@ start to penetrate.
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from pounding.solver import jit
