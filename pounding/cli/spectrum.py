@@ -40,7 +40,10 @@ def spectrum_from_args(args: argparse.Namespace, *, code: str | None = None):
 
 
 def add_spectrum_options(parser: argparse.ArgumentParser, code: str, *, q: bool = True) -> None:
-    """The options of one code's spectrum (shared by ``pounding spectrum`` and ``pounding gap --code``)."""
+    """The options of one code's spectrum (shared by ``pounding spectrum`` and ``pounding gap --code``).
+
+    Without *q* (``pounding gap``, where each building brings its own q) neither ``--q`` nor ``--damping``.
+    """
     if code == "asce7-22":
         parser.add_argument("--sds", type=float, help="S_DS, design spectral acceleration at short periods, g")
         parser.add_argument("--sd1", type=float, help="S_D1, design spectral acceleration at 1 s, g")
@@ -53,8 +56,8 @@ def add_spectrum_options(parser: argparse.ArgumentParser, code: str, *, q: bool 
         if q:
             parser.add_argument("--q", type=float, help="behaviour factor q: the design spectrum of §3.2.2.5 "
                                                         "(default: the elastic spectrum of §3.2.2.2)")
-        parser.add_argument("--damping", type=float, default=0.05,
-                            help="damping ratio of the elastic spectrum (eta of (3.6); default 0.05)")
+            parser.add_argument("--damping", type=float, default=0.05,
+                                help="damping ratio of the elastic spectrum (eta of (3.6); default 0.05)")
         parser.add_argument("--beta", type=float, default=0.2, help="lower-bound factor beta of §3.2.2.5 (default 0.2)")
 
 

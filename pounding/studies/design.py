@@ -281,3 +281,283 @@ def ntc2004_separation(setback_left: float, setback_right: float, *, alike: bool
     """
     total = setback_left + setback_right
     return Separation(0.5 * total if alike else total, setback_left, setback_right)
+
+
+# --------------------------------------------------------------------------- #
+# The code's separations beside the simulated requirement (pounding gap --code)
+# --------------------------------------------------------------------------- #
+
+#: Fraction of the target spectrum the record set's mean spectrum must reach over the period range
+#: (ASCE 7-22 §16.2.3; EN 1998-1 §3.2.3.1.2(4)b).
+SUITE_FRACTION = 0.90
+#: Periods of the scaling range [0.2 T_min, 2 T_max] at which the mean spectrum is checked.
+SUITE_PERIODS = 40
+#: Records below which Eurocode 8 §4.3.3.4.3(3) takes the most unfavourable response instead of the mean.
+EC8_MEAN_RECORDS = 7
+#: Records ASCE 7-22 chapter 16 asks for (§16.2.2); its response is their mean.
+ASCE_RECORDS = 11
+
+
+def suite_scale_factor(psa: Any, target: Any, *, fraction: float = SUITE_FRACTION, pga: Any = None,
+                       pga_target: float | None = None) -> float:
+    """The least factor on every record for the set's mean spectrum to reach *fraction* of *target* everywhere.
+
+    Parameters
+    ----------
+    psa : (r, p) array
+        Each record's 5 % pseudo-spectral acceleration at p periods, g.
+    target : (p,) array
+        The target spectrum at those periods, g.
+    fraction : float
+        0.9: the mean must not fall below 90 % of the target (ASCE 7-22 §16.2.3;
+        EN 1998-1 §3.2.3.1.2(4)b).
+    pga, pga_target : (r,) array and float, optional
+        Each record's PGA (g) and the least mean PGA (Eurocode 8
+        §3.2.3.1.2(4)a: a_g S).
+
+    Returns
+    -------
+    float
+        ``max(max_T fraction·target(T)/mean(T), pga_target/mean PGA)``.
+    """
+    mean = np.mean(np.atleast_2d(np.asarray(psa, dtype=float)), axis=0)
+    factor = float(np.max(fraction * np.asarray(target, dtype=float) / mean))
+    if pga is not None and pga_target is not None:
+        factor = max(factor, float(pga_target / np.mean(np.asarray(pga, dtype=float))))
+    return factor
+
+
+@dataclass(frozen=True)
+class Intensity:
+    """One intensity the record set is scaled to.
+
+    Attributes
+    ----------
+    name : str
+        ``design`` or ``MCE_R``.
+    spectrum : DesignSpectrum
+        The target spectrum.
+    why : str
+        The clause that prescribes it (or why it is reported).
+    pga_target : float or None
+        Least mean PGA, g (Eurocode 8 a_g S).
+    """
+
+    name: str
+    spectrum: Any
+    why: str
+    pga_target: float | None = None
+
+
+def record_set_spectra(model, records: list[str], periods: Any, *, duration: float | None = None):
+    """Each record's 5 % pseudo-spectral acceleration (g) at *periods*, and its PGA (g), as the model reads it.
+
+    The record is read and processed as the model's ``ground_motion`` says
+    (units, dt, processing), unscaled, and cut to *duration*.
+    """
+    from pounding.records.spectra import response_spectrum
+    from pounding.simulation import processed_record_for
+
+    psa, pga = [], []
+    for spec in records:
+        record = processed_record_for(model.with_ground_motion(record=spec, scale=1.0), where="cli")
+        acc = np.asarray(record.acceleration)
+        if duration is not None:
+            acc = acc[:int(round(duration / record.time_step)) + 1]
+        spectrum = response_spectrum(acc, record.time_step, periods, 0.05)
+        psa.append(spectrum.psa / STANDARD_GRAVITY)
+        pga.append(spectrum.pga / STANDARD_GRAVITY)
+    return np.array(psa), np.array(pga)
+
+
+def _design_of(model, code: str, key: str, example: str):
+    """Each building's design factors for *code* (``design.<key>``), refused in one line when missing."""
+    from pounding.errors import ModelError
+
+    found = []
+    for index, b in enumerate(model.buildings):
+        entry = getattr(b.design, key, None) if b.design is not None else None
+        if entry is None:
+            where = f"{model.path}: " if model.path else ""
+            raise ModelError(f"{where}buildings[{index}] ({b.name}) has no design.{key}: --code {code} needs each "
+                             f"building's factors, e.g. design: {{{key}: {example}}} (docs/design-codes.md)")
+        found.append(entry)
+    return found
+
+
+def code_displacements(model, code: str, spectrum_options: dict[str, Any]) -> dict[str, Any]:
+    """Per building: the RSA and the code's design displacement per floor (m), with the code's spectra.
+
+    Parameters
+    ----------
+    model : Model
+    code : {"asce7-22", "ec8"}
+    spectrum_options : dict
+        ASCE 7-22: ``sds``, ``sd1``, ``tl``; Eurocode 8: ``type``, ``ground``, ``ag``, ``beta``.
+
+    Returns
+    -------
+    dict
+        ``displacement`` {building: (n,) m}, ``rsa`` {building: ModalResponse},
+        ``spectra`` {building: DesignSpectrum of the RSA}, ``intensities``
+        [Intensity], ``statistic`` (how the records' results are combined),
+        ``rule`` (the clause).
+    """
+    from pounding.records.design_spectra import asce7_22_spectrum, ec8_spectrum
+
+    rsa, spectra, displacement = {}, {}, {}
+    if code == "asce7-22":
+        factors = _design_of(model, code, "asce7_22", "{R: 8, Cd: 5.5, Ie: 1.0}")
+        design = asce7_22_spectrum(spectrum_options["sds"], spectrum_options["sd1"], spectrum_options["tl"])
+        mce = asce7_22_spectrum(spectrum_options["sds"], spectrum_options["sd1"], spectrum_options["tl"], mce=True)
+        for b, f in zip(model.buildings, factors):
+            rsa[b.name] = modal_response(b, design)
+            spectra[b.name] = design
+            displacement[b.name] = asce7_22_displacements(rsa[b.name].displacement, f.R, f.Cd, f.Ie)
+        intensities = [
+            Intensity("design", design, "the level of §12.12.2's delta_M (design spectrum, §11.4.5; 2/3 of MCE_R)"),
+            Intensity("MCE_R", mce, "the target spectrum of response-history analysis, ASCE 7-22 ch. 16 (§16.2.1)")]
+        return {"displacement": displacement, "rsa": rsa, "spectra": spectra, "intensities": intensities,
+                "statistic": "mean", "rule": "ASCE 7-22 §12.12.2: delta_M = Cd delta_max / Ie; delta_MT = SRSS"}
+    if code == "ec8":
+        factors = _design_of(model, code, "ec8", "{q: 3.9}")
+        kind, ground, ag, beta = (spectrum_options[k] for k in ("type", "ground", "ag", "beta"))
+        elastic = ec8_spectrum(kind, ground, ag)
+        for b, f in zip(model.buildings, factors):
+            spectra[b.name] = ec8_spectrum(kind, ground, ag, q=f.q, beta=beta)
+            rsa[b.name] = modal_response(b, spectra[b.name])
+            displacement[b.name] = ec8_design_displacement(rsa[b.name].displacement, f.qd or f.q)
+        soil = elastic.sa([0.0])[0]   # a_g S
+        intensities = [Intensity("design", elastic, "the elastic spectrum of the design seismic action, EN 1998-1 "
+                                                    "§3.2.3.1.2(4) (mean >= 90 % over 0.2-2 T1, mean PGA >= a_g S)",
+                                 pga_target=float(soil))]
+        return {"displacement": displacement, "rsa": rsa, "spectra": spectra, "intensities": intensities,
+                "statistic": "mean (>= 7 records) or max (fewer), EN 1998-1 §4.3.3.4.3(3)",
+                "rule": "EN 1998-1 §4.4.2.7: d_s = q_d d_e (4.23); SRSS; x0.7 where floor levels coincide"}
+    raise ValueError(f"unknown code {code!r}")
+
+
+def code_separations(model, code: str, displacement: dict[str, np.ndarray], *,
+                     tolerance: float = 0.01) -> list[dict[str, Any]]:
+    """The code's separation at every floor-to-floor contact of *model*, from each building's design displacement.
+
+    Eurocode 8's 0.7 applies where the two floors of the pair stand within
+    *tolerance* (m) of each other.
+    """
+    names = [b.name for b in model.buildings]
+    rows = []
+    for g in model.gaps:
+        left, right = model.buildings[g.left], model.buildings[g.right]
+        d1 = float(displacement[left.name][g.level_left - 1])
+        d2 = float(displacement[right.name][g.level_right - 1])
+        z1, z2 = float(left.elevation[g.level_left - 1]), float(right.elevation[g.level_right - 1])
+        same = abs(z1 - z2) <= tolerance + 1e-9
+        sep = asce7_22_separation(d1, d2) if code == "asce7-22" else ec8_separation(d1, d2, same_levels=same)
+        rows.append({"contact": g.label(names), "left": d1, "right": d2, "elevation": max(z1, z2),
+                     "same_levels": same, "separation": sep})
+    return rows
+
+
+def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], records: Any = None, *,
+                   duration: float | None = None, **run_options) -> dict[str, Any]:
+    """Each code separation per level pair beside the simulated requirement of records scaled to the code's spectrum.
+
+    The record set is scaled by one factor per intensity
+    (:func:`suite_scale_factor` over 0.2 T_min to 2 T_max of the buildings'
+    first periods) and run with the contacts open (:func:`pounding.studies.gap.gap_study`).
+
+    Returns
+    -------
+    dict
+        ``code``, ``rule``, ``statistic``, ``buildings`` (RSA per building),
+        ``contacts`` (per level pair: the code's separation, and per intensity
+        the simulated mean and max and whether the code is below the one used),
+        ``intensities`` (factor, period range, clause), ``records``.
+    """
+    from pounding.model.model import load_model
+    from pounding.studies.common import record_values
+    from pounding.studies.gap import build_gap_sweep, gap_study
+
+    model = load_model(model_path)
+    model.refuse_building_records("the code check (it runs the model under one record at a time)")
+    build_gap_sweep(model_path, records, duration=duration)   # the gap study's own refusals (walls, no contacts...)
+    found = code_displacements(model, code, spectrum_options)
+    rows = code_separations(model, code, found["displacement"])
+    specs = record_values(records, model)
+    first = [float(b.periods[0]) for b in model.buildings]
+    periods = np.geomspace(0.2 * min(first), 2.0 * max(first), SUITE_PERIODS)
+    psa, pga = record_set_spectra(model, specs, periods, duration=duration)
+    intensities = []
+    for intensity in found["intensities"]:
+        factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
+        ds = gap_study(model_path, specs, scale=factor, duration=duration, **run_options)
+        ok = ds.status.values == "ok"
+        required = ds.required_gap.values[ok]
+        n_ok = int(ok.sum())
+        use_max = code == "ec8" and n_ok < EC8_MEAN_RECORDS
+        intensities.append({"name": intensity.name, "why": intensity.why, "target": intensity.spectrum.name,
+                            "factor": factor, "period_range": (float(periods[0]), float(periods[-1])),
+                            "records_ok": n_ok, "statistic": "max" if use_max else "mean",
+                            "failed": {str(r): str(e) for r, e, good in zip(ds.record.values, ds.error.values, ok)
+                                       if not good}})
+        for c, row in enumerate(rows):
+            values = required[:, c] if n_ok else np.full(1, np.nan)
+            mean, largest = float(np.mean(values)), float(np.max(values))
+            used = largest if use_max else mean
+            row.setdefault("simulated", {})[intensity.name] = {
+                "mean": mean, "max": largest, "used": used,
+                "unconservative": bool(row["separation"].same_property < used)}
+    return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
+            "records": specs, "intensities": intensities, "contacts": rows,
+            "buildings": {name: {"modes": r.n_modes, "mass_fraction": r.mass_fraction,
+                                 "periods": r.periods.tolist(), "spectrum": found["spectra"][name].name,
+                                 "elastic_displacement": r.displacement.tolist(),
+                                 "design_displacement": np.asarray(found["displacement"][name]).tolist()}
+                          for name, r in found["rsa"].items()}}
+
+
+def code_gap_table(result: dict[str, Any]) -> str:
+    """The code check as a printed table (millimetres)."""
+    def mm(value: float) -> str:
+        return "-" if not math.isfinite(value) else f"{1000 * value:.1f}"
+
+    lines = [f"code {result['code']}: {result['rule']}"]
+    for name, b in result["buildings"].items():
+        lines.append(f"  {name}: RSA with {b['spectrum']}, {b['modes']} mode(s), "
+                     f"{100 * b['mass_fraction']:.1f} % of the mass, CQC")
+    for item in result["intensities"]:
+        low, high = item["period_range"]
+        lines.append(f"records at {item['name']} level: x{item['factor']:.3f} on every record (mean spectrum >= 90 % "
+                     f"of {item['target']} over {low:.3f}-{high:.3f} s) - {item['why']}; "
+                     f"{item['records_ok']} record(s), {item['statistic']} used")
+        for record, error in item["failed"].items():
+            lines.append(f"  record failed at {item['name']} level: {record}: {error}")
+    if result["code"] == "asce7-22" and any(i["records_ok"] < ASCE_RECORDS for i in result["intensities"]):
+        lines.append(f"  (ASCE 7-22 ch. 16 asks for {ASCE_RECORDS} records; fewer were run)")
+    names = [i["name"] for i in result["intensities"]]
+    head = (f"{'contact':<12} {'code L':>7} {'code R':>7} {'same prop':>9} {'prop lines':>10}  "
+            + "  ".join(f"{'sim ' + n + ' mean/max':>22}" for n in names) + "  flag")
+    lines.append("separations (mm): the code's design displacements of the left and right floors, the code's separation "
+                 "on one property and between property lines, and the simulated requirement")
+    lines.append(head)
+    for row in result["contacts"]:
+        sep = row["separation"]
+        cells = "  ".join(f"{mm(row['simulated'][n]['mean']) + '/' + mm(row['simulated'][n]['max']):>22}" for n in names)
+        unsafe = [n for n in names if row["simulated"][n]["unconservative"]]
+        flag = ("UNCONSERVATIVE at " + ", ".join(unsafe)) if unsafe else "ok"
+        lines.append(f"{row['contact']:<12} {mm(row['left']):>7} {mm(row['right']):>7} {mm(sep.same_property):>9} "
+                     f"{mm(sep.property_lines):>10}  {cells}  {flag}")
+    lines.append("flag: the code's same-property separation is below the simulated requirement (the statistic used) "
+                 "at that intensity")
+    return "\n".join(lines)
+
+
+def code_gap_summary(result: dict[str, Any]) -> dict[str, Any]:
+    """The code check as one JSON-ready document (metres)."""
+    out = dict(result)
+    out["contacts"] = [{**{k: v for k, v in row.items() if k != "separation"},
+                        "same_property": row["separation"].same_property,
+                        "setback_left": row["separation"].setback_left,
+                        "setback_right": row["separation"].setback_right,
+                        "property_lines": row["separation"].property_lines} for row in result["contacts"]]
+    return out
