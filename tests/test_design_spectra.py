@@ -99,10 +99,17 @@ def test_bad_user_files_are_one_line(tmp_path, text, message):
         read_user_spectrum(tmp_path / "missing.txt")
 
 
-def test_tabulated_refuses_periods_below_the_table():
+def test_tabulated_refuses_periods_outside_the_table(tmp_path, capsys):
     spectrum = tabulated_spectrum([0.5, 1.0], [1.0, 0.5])
-    with pytest.raises(PoundingError, match="below the table's first period"):
+    with pytest.raises(PoundingError, match=r"period 0.2 s is outside the spectrum \(0.5 to 1 s\)"):
         spectrum.sa([0.2])
+    # the command's table starts at the table's first period
+    path = tmp_path / "late.txt"
+    path.write_text("0.5 1.0\n1.0 0.5\n", encoding="utf-8")
+    assert main(["spectrum", "user", str(path)]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[3:]]
+    assert [float(r[0]) for r in rows] == pytest.approx([0.5, 0.6, 0.7, 0.8, 0.9, 1.0])
+    assert float(rows[-1][1]) == pytest.approx(0.5)
 
 
 def test_cli_prints_plots_and_writes_csv(tmp_path, capsys):

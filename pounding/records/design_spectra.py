@@ -96,6 +96,8 @@ class DesignSpectrum:
         Corner periods, s (always tabulated by :func:`spectrum_periods`).
     max_period : float
         Longest period the spectrum is defined for, s (inf: no bound).
+    min_period : float
+        Shortest period the spectrum is defined for, s (0 but for a table starting later).
     """
 
     name: str
@@ -104,14 +106,15 @@ class DesignSpectrum:
     damping: float = 0.05
     corners: tuple[float, ...] = ()
     max_period: float = math.inf
+    min_period: float = 0.0
 
     def sa(self, periods: Any) -> np.ndarray:
         """Sa (g) at *periods* (s); a period outside the spectrum is refused in one line."""
         t = np.atleast_1d(np.asarray(periods, dtype=float))
-        bad = t[~np.isfinite(t) | (t < 0) | (t > self.max_period)]
+        bad = t[~np.isfinite(t) | (t < self.min_period) | (t > self.max_period)]
         if bad.size:
             raise PoundingError(f"{self.name}: period {bad[0]:g} s is outside the spectrum "
-                                f"(0 to {self.max_period:g} s)")
+                                f"({self.min_period:g} to {self.max_period:g} s)")
         return np.asarray(self.function(t), dtype=float)
 
 
@@ -313,13 +316,8 @@ def tabulated_spectrum(periods: Any, sa: Any, *, name: str = "user spectrum", da
     t.setflags(write=False)
     a.setflags(write=False)
 
-    def function(x: np.ndarray) -> np.ndarray:
-        below = x[x < t[0]]
-        if below.size:
-            raise PoundingError(f"{name}: period {below[0]:g} s is below the table's first period {t[0]:g} s")
-        return np.interp(x, t, a)
-
-    return DesignSpectrum(name=name, clause=clause, function=function, damping=damping, max_period=float(t[-1]))
+    return DesignSpectrum(name=name, clause=clause, function=lambda x: np.interp(x, t, a), damping=damping,
+                          max_period=float(t[-1]), min_period=float(t[0]))
 
 
 def read_user_spectrum(path: str | os.PathLike, *, damping: float = 0.05) -> DesignSpectrum:
@@ -375,8 +373,8 @@ def read_user_spectrum(path: str | os.PathLike, *, damping: float = 0.05) -> Des
 
 
 def spectrum_periods(spectrum: DesignSpectrum, longest: float = 4.0, step: float = 0.1) -> np.ndarray:
-    """Periods for a printed table: 0 to *longest* s every *step*, with the spectrum's corners added."""
-    top = min(longest, spectrum.max_period)
+    """Periods for a printed table: 0 to *longest* s every *step* (within the spectrum), with its corners added."""
+    low, top = spectrum.min_period, min(longest, spectrum.max_period)
     grid = np.round(np.arange(0.0, top + 0.5 * step, step), 10)
-    corners = [c for c in spectrum.corners if 0 <= c <= top]
-    return np.unique(np.concatenate([grid[grid <= top], corners, [top]]))
+    corners = [c for c in spectrum.corners if low <= c <= top]
+    return np.unique(np.concatenate([grid[(grid >= low) & (grid <= top)], corners, [low, top]]))
