@@ -486,7 +486,9 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
     specs = record_values(records, model)
     first = [float(b.periods[0]) for b in model.buildings]
     periods = np.geomspace(0.2 * min(first), 2.0 * max(first), SUITE_PERIODS)
-    psa, pga = record_set_spectra(model, specs, periods, duration=duration)
+    # the records' spectra over what is simulated: --duration, else the model's ground_motion.duration
+    simulated = duration if duration is not None else model.ground_motion.duration
+    psa, pga = record_set_spectra(model, specs, periods, duration=simulated)
     intensities = []
     for intensity in found["intensities"]:
         factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
