@@ -106,9 +106,10 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print the results as one JSON document (metres)")
     parser.add_argument("--plot", metavar="DIR", help="write gap_profile.png to DIR")
     parser.add_argument("--code", choices=("asce7-22", "ec8"),
-                        help="also compute the code's separation per level pair from design spectra (modal "
+                        help="report the code's separation per level pair from design spectra (modal "
                              "response-spectrum analysis of each building with its design: factors in the model) "
-                             "and scale the records to the code's spectrum (refuses --scale); docs/design-codes.md")
+                             "beside the requirement of the records scaled to the code's spectrum (refuses --scale, "
+                             "-o, --plot); docs/design-codes.md")
     add_spectrum_options(parser, "asce7-22")
     add_spectrum_options(parser, "ec8", q=False)
     add_cluster_options(parser)

@@ -34,7 +34,13 @@ import numpy as np
 from pounding.studies.gap import cqc_correlation
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION"]
+__all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION",
+           "Separation", "asce7_22_inelastic_displacement", "asce7_22_separation", "asce7_22_displacements",
+           "EC8_SAME_LEVELS_FACTOR", "ec8_design_displacement", "ec8_separation", "is1893_separation",
+           "nzs1170_5_separation", "NTC_2004_HEIGHT", "NTC_2004_SIMPLIFIED", "NTC_2004_MINIMUM", "ntc2004_setback",
+           "ntc2004_separation", "SUITE_FRACTION", "SUITE_PERIODS", "EC8_MEAN_RECORDS", "ASCE_RECORDS",
+           "suite_scale_factor", "Intensity", "record_set_spectra", "code_displacements", "code_separations",
+           "code_gap_study", "code_gap_table", "code_gap_summary"]
 
 #: Participating mass the modes of a response-spectrum analysis must reach (ASCE 7-22 §12.9.1.1, EC8 §4.3.3.3.1).
 MASS_FRACTION = 0.90
