@@ -366,7 +366,7 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
     started = _time.perf_counter()
     raw = integrate(system, ground, step, end_time, rtol=settings.rtol,
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
-                    output_dt=output_dt)
+                    output_dt=output_dt, scale_tolerances=settings.tolerance_scaling)
     wall = _time.perf_counter() - started
     if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
@@ -445,6 +445,7 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     if isinstance(run, xr.Dataset):
         check_archive(ds, name)
     spec = json.loads(ds.attrs["run_spec"])
+    _archived_tolerances(spec)
     model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
                             path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
     if model.has_building_records:
@@ -465,6 +466,15 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
     return again
+
+
+def _archived_tolerances(spec: dict) -> None:
+    """An archive written before tolerances followed the model's scales (issue 25) reruns with its own:
+    ``solver.tolerance_scaling`` off where its effective model does not name it."""
+    model = spec.get("model")
+    if isinstance(model, dict):
+        solver = model.setdefault("solver", {})
+        solver.setdefault("tolerance_scaling", False)
 
 
 def _archived_records(model: Model, spec: dict, name: str) -> list[Record]:

@@ -179,6 +179,10 @@ class Building:
     p_delta : bool
         Leaning-column P-Delta: storey i carries ``P_i = g·Σ_(j≥i) m_j`` and its
         force gains ``−(P_i/h_i)·Δ_i`` (docs/physics.md §7).
+    design : DesignEntry, optional
+        The building's design factors per code (``design:`` in the YAML:
+        ``{asce7_22: {R, Cd, Ie}, ec8: {q, qd}}``), used by the code separation
+        rules of ``pounding gap --code``; None: not given.
 
     Arrays are read-only copies.  Equality is identity (arrays do not compare
     as booleans); compare the arrays to test two buildings for equal content.
@@ -191,6 +195,7 @@ class Building:
     damping: Damping
     hysteresis: tuple = ()
     p_delta: bool = False
+    design: Any = None
 
     def __post_init__(self) -> None:
         arrays = [np.array(getattr(self, key), dtype=float).reshape(-1) for key in ("mass", "stiffness", "height")]
@@ -203,8 +208,11 @@ class Building:
                              f"(got {len(hysteresis)} for {arrays[0].size} storeys)")
         storeys = [_storey_document(m, k, h, law) for m, k, h, law in zip(*arrays, hysteresis)]
         damping = self.damping.to_document() if isinstance(self.damping, Damping) else self.damping
-        entry = _checked(schema.BuildingEntry, {"name": self.name, "storeys": storeys, "damping": damping,
-                                                "p_delta": self.p_delta}, prefix=f"building {self.name}:")
+        document = {"name": self.name, "storeys": storeys, "damping": damping, "p_delta": self.p_delta}
+        if self.design is not None:
+            document["design"] = _design_document(self.design)
+        entry = _checked(schema.BuildingEntry, document, prefix=f"building {self.name}:")
+        object.__setattr__(self, "design", entry.design)
         for key, array in zip(("mass", "stiffness", "height"), arrays):
             array.setflags(write=False)
             object.__setattr__(self, key, array)
@@ -557,6 +565,10 @@ class SolverSettings:
     stop_drift_ratio : float or None
         End the run (status ``collapsed``) when a storey's |drift ratio| first
         exceeds this; None: never.
+    tolerance_scaling : bool
+        Tighten ``atol`` and ``atol_velocity`` for a building far stiffer than
+        the row moves (its static drift scale below 100·atol;
+        :mod:`pounding.solver.tolerances`).  False: the given values for every floor.
     """
 
     rtol: float = 1e-6
@@ -564,6 +576,7 @@ class SolverSettings:
     atol_velocity: float = 1e-7
     output_dt: float = 0.01
     stop_drift_ratio: float | None = None
+    tolerance_scaling: bool = True
 
     def __post_init__(self) -> None:
         entry = _checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
@@ -889,7 +902,14 @@ def _building_document(b: Building) -> dict[str, Any]:
     document = {"name": b.name, "storeys": storeys, "damping": damping}
     if b.p_delta:
         document["p_delta"] = True
+    if b.design is not None:
+        document["design"] = _design_document(b.design)
     return document
+
+
+def _design_document(design: Any) -> Any:
+    """A building's ``design`` mapping as plain data (keys given only)."""
+    return design.model_dump(mode="json", exclude_none=True) if hasattr(design, "model_dump") else design
 
 
 def _check_keys(section: str, changes: dict[str, Any], cls: type) -> None:
@@ -919,7 +939,7 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
             array.setflags(write=False)
             arrays[key] = array
         buildings.append(_trusted(Building, name=b.name, damping=damping, hysteresis=b.column("hysteresis"),
-                                  p_delta=b.p_delta, **arrays))
+                                  p_delta=b.p_delta, design=b.design, **arrays))
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters, at_a, at_r)
                  for index, c in enumerate(entry.contacts) for (a, r), (at_a, at_r) in zip(c.pairs, c.points))
     links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)
