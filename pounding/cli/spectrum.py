@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import csv
 import os
 from pathlib import Path
 
@@ -95,17 +94,16 @@ def _cmd_spectrum(args: argparse.Namespace) -> int:
     spectrum = spectrum_from_args(args)
     periods = _periods(args.periods, spectrum)
     print(spectrum_table(spectrum, periods))
-    if args.csv:
-        target = Path(args.csv)
-        target.parent.mkdir(parents=True, exist_ok=True)
+    if args.csv:   # the headers and the atomic writing of every pounding CSV (pounding.results.tables)
+        import pandas as pd
+
+        from pounding.results.tables import write_csv
+
         sa = spectrum.sa(periods)
-        with open(target, "w", newline="", encoding="utf-8") as stream:
-            writer = csv.writer(stream)
-            writer.writerow(["period (s)", "Sa (g)", "Sd (m)"])
-            for t, a in zip(periods, sa):
-                writer.writerow([repr(float(t)), repr(float(a)),
-                                 repr(float(a * STANDARD_GRAVITY * (t / (2 * np.pi)) ** 2))])
-        print(f"wrote {target}")
+        table = pd.DataFrame({"period [s]": periods, "Sa [g]": sa,
+                              "Sd [m]": sa * STANDARD_GRAVITY * (periods / (2 * np.pi)) ** 2})
+        for path in write_csv({"spectrum": table}, args.csv):
+            print(f"wrote {path}")
     if args.plot:
         from pounding.results.plots import pyplot, save_figure
 
