@@ -371,3 +371,15 @@ def test_the_counts_the_docs_quote_are_the_code_s(file, pattern, actual):
     m = re.search(pattern, (ROOT / file).read_text(encoding="utf-8"))
     assert m, f"{file}: no longer says {pattern!r}; update COUNTS in tests/test_docs.py with the text"
     assert tuple(int(x) for x in m.groups()) == tuple(actual()), f"{file}: {m.group(0)!r}"
+
+
+def test_every_far_or_near_field_count_in_the_docs_is_the_catalogue_s():
+    """``44 far-field records``, ``56 near-field components``... anywhere in the docs."""
+    _, far, near = _catalogue_counts()
+    wrong = []
+    for path in DOCS:
+        text = path.read_text(encoding="utf-8")
+        for m in re.finditer(r"\b(\d+)\s+(?:FEMA P695\s+)?(far|near)-field\b", text):
+            if int(m.group(1)) != {"far": far, "near": near}[m.group(2)]:
+                wrong.append(f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}: {m.group(0)!r}")
+    assert not wrong, f"the catalogue has {far} far-field and {near} near-field components: " + "; ".join(wrong)
