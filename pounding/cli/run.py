@@ -96,6 +96,8 @@ def summary(ds) -> str:
             g = ds.sel(ground=name)
             lines.append(f"  {name}: {g.ground_record.item()} x{float(g.ground_scale):g}, lag {float(g.ground_lag):.3g} s, "
                          f"peak ground displacement {float(np.abs(g.building_ground_displacement).max()):.3g} m")
+    if ds.attrs.get("contacts"):
+        lines.append(f"contacts {ds.attrs['contacts']}")
     periods = json.loads(ds.attrs["periods"])
     lines.append("periods (s):")
     for name, values in periods.items():
@@ -218,7 +220,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
         check_writable(output, overwrite=args.overwrite, inputs=model_inputs(model))
     ds = simulate(model, record=args.record, xi=args.xi, scale=scale, duration=args.duration,
                   rtol=args.rtol, output_dt=args.output_dt, record_units=args.units, record_dt=args.dt,
-                  where="cli")
+                  contacts=not args.no_contacts, where="cli")
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
     print(f"wrote {path}")
@@ -283,7 +285,7 @@ def open_archive(path) -> tuple[str, object]:
                                "write it again")
         if attrs.get("study") in ("gap", "ida"):
             return str(attrs["study"]), ds
-        return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
+        return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and names & {"xi", "pounding"}
                 else "sweep"), ds
     if is_verify:
         return "verify", ds
@@ -295,6 +297,8 @@ def _reference(ds) -> str:
     """The formula a compare archive is compared with (``exact`` unless it was not run)."""
     from pounding.studies.compare import REFERENCE
 
+    if "xi" not in ds:   # a with/without-pounding compare: no formula
+        return REFERENCE
     formulas = [str(x) for x in ds.xi.values]
     reference = str(ds.attrs.get("reference_xi", REFERENCE))
     return reference if reference in formulas else formulas[-1]
@@ -416,6 +420,7 @@ def register_cli(sub) -> None:
                      "without a '# dt = 0.005 s' header, s")
     run.add_argument("--scale", metavar="X", help=SCALE_HELP)
     run.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
+    run.add_argument("--no-contacts", action="store_true", help="every contact held open: the run without pounding")
     run.add_argument("--duration", type=float, help="simulated time, s")
     run.add_argument("--rtol", type=float, help="relative tolerance of the solver")
     run.add_argument("--output-dt", type=float, help="sampling of stored histories, s")

@@ -541,6 +541,10 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
+    if model.contacts_held_open:   # the run without pounding (pounding run --no-contacts)
+        ds.attrs["title"] += ", contacts held open"
+        ds.attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
+                                "(the run without pounding)")
     return ds
 
 

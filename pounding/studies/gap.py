@@ -37,7 +37,6 @@ See ``docs/gap.md``.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 import time
@@ -50,12 +49,10 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.registry import add_unique
 
-__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "open_contacts",
+__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite",
            "required_separations", "run_gap_scenario", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
-           "gap_summary", "gap_table", "plot_gap", "OPEN_GAP"]
+           "gap_summary", "gap_table", "plot_gap"]
 
-#: Gap (m) given to every contact of the contact-free run: no floor ever travels this far.
-OPEN_GAP = 1.0e6
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 GAP_PART = "gap-1"
 
@@ -183,19 +180,14 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     return best
 
 
-def open_contacts(model):
-    """The model with every contact held open (gap :data:`OPEN_GAP`): the contact-free run, labels kept."""
-    gaps = tuple(dataclasses.replace(g, gap=OPEN_GAP) for g in model.gaps)
-    return dataclasses.replace(model, gaps=gaps)
-
-
 def required_separations(ds) -> dict[str, np.ndarray]:
     """Required separation and peak floor displacements per contact of a contact-free run.
 
     Parameters
     ----------
     ds : xarray.Dataset
-        Results of :func:`pounding.simulation.simulate` on :func:`open_contacts` of a model.
+        Results of :func:`pounding.simulation.simulate` on a model with its contacts held open
+        (:meth:`pounding.model.model.Model.with_contacts_open`).
 
     Returns
     -------
@@ -238,7 +230,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
                               "format": PARTS_FORMAT}
     try:
         model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
-        ds = simulate(open_contacts(model))
+        ds = simulate(model.with_contacts_open())
         found = required_separations(ds)
         names = [b.name for b in model.buildings]
         modes = {b.name: _first_mode(b) for b in model.buildings}

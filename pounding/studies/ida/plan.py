@@ -299,14 +299,13 @@ class IdaPlan:
         seconds of serial work on the client before the first run.  The documents share everything but their
         ``ground_motion`` mapping; nothing changes a scenario's data after it is made.
         """
-        from pounding.studies.gap import OPEN_GAP
+        from pounding.model.model import hold_contacts_open
 
         template = self._cache.get(("template", variant, record))
         if template is None:
             base = copy.deepcopy(self.documents[record])
             if variant == "without_contacts":
-                for contact in base.get("contacts") or []:
-                    contact["gap"] = OPEN_GAP
+                hold_contacts_open(base)
             base["ground_motion"]["scale"] = _SCALE_PLACEHOLDER
             pieces = dump_document(base).split(_yaml_scalar(_SCALE_PLACEHOLDER))
             template = (base, pieces)

@@ -166,7 +166,8 @@ def _coord_values(labels: tuple[Any, ...]):
 
 def _axis_attrs(axis: Axis) -> dict[str, str]:
     long_name = {"record": "ground-motion record", "scale": "scale factor on the record",
-                 "xi": "xi formula of every hertz-damp contact"}.get(axis.kind, f"swept model value {axis.key}")
+                 "xi": "xi formula of every hertz-damp contact",
+                 "contacts": "with: the contacts as modelled; without: every contact held open (no pounding)"}.get(axis.kind, f"swept model value {axis.key}")
     attrs = {"long_name": long_name, "sweep_axis": axis.key}
     if axis.units:
         attrs["units"] = axis.units
