@@ -221,6 +221,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     ``status = "error"`` and the message.
     """
     from pounding.model.model import model_from_text
+    from pounding.results.dataset import record_pga
     from pounding.simulation import simulate
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
@@ -252,6 +253,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "peak_left": found["peak_left"].tolist(),
             "peak_right": found["peak_right"].tolist(),
             "scale_factor": float(ds.attrs.get("record_scale", 1.0)),
+            "intensity": record_pga(ds)[1],
             "solver_wall_time": float(ds.attrs["wall_time"]),
         })
     except Exception as exc:  # noqa: BLE001 - a failing record is a result, not a crash
@@ -312,6 +314,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import xarray as xr
 
     from pounding import __version__
+    from pounding.results.dataset import PGA_LONG_NAME
 
     scenarios = sweep.scenarios()
     parts = []
@@ -329,6 +332,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     peak_left = np.full((nr, nc), np.nan)
     peak_right = np.full((nr, nc), np.nan)
     scale_factor = np.full(nr, np.nan)
+    intensity = np.full(nr, np.nan)
     status = np.array([p.get("status", "error") for p in parts], dtype=object)
     error = np.array([p.get("error", "") or "" for p in parts], dtype=object)
     for r, part in enumerate(parts):
@@ -338,6 +342,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         peak_left[r] = part["peak_left"]
         peak_right[r] = part["peak_right"]
         scale_factor[r] = part.get("scale_factor", np.nan)
+        intensity[r] = part.get("intensity", np.nan)
 
     def info(name: str, dtype=float):
         return np.array(first[name] if first else [], dtype=dtype)
@@ -395,6 +400,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "correlation": var(("contact",), rho, "1",
                                "CQC correlation of the two buildings' first modes (Der Kiureghian 1981)"),
             "scale_factor": var(("record",), scale_factor, "1", "factor applied to the record"),
+            "intensity": var(("record",), intensity, "m s-2", PGA_LONG_NAME),
             "status": (("record",), status, {"long_name": "ok, or error (see variable error)"}),
             "error": (("record",), error, {"long_name": "error message of a failed record"}),
         },
