@@ -112,8 +112,35 @@ def processed_record_for(model: Model, *, where: str = "yaml", building: int | s
     from pounding.records.processing import process
 
     spec = model.ground_motion if building is None else model.ground_motion_of(building)
+    if where == "yaml":
+        _check_record_file(model, spec, building)
     record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where)
     return process(record, spec.processing)
+
+
+def _check_record_file(model: Model, spec, building: int | str | None) -> None:
+    """A record file named in a model file that does not exist: one line naming the model file and line.
+
+    Raises
+    ------
+    ModelError
+        ``<model file>:<line>: ground_motion.record: record file '<as written>' not found (looked for <path>)``.
+    """
+    from pounding.errors import ModelError
+    from pounding.model.document import format_location, parse_document
+
+    path = spec.record_path
+    if path is None or path.exists() or not getattr(model, "path", None):
+        return
+    loc = ("ground_motion", "record") if building is None else \
+        ("buildings", model.building_index(building), "ground_motion", "record")
+    try:
+        document = parse_document(model.source, str(model.path))
+        line = document.line(loc) if document.has(loc) else None
+    except PoundingError:   # a model built in Python: its source is no YAML to point into
+        line = None
+    raise ModelError(f"{format_location(loc)}: record file '{spec.record}' not found (looked for {path}); a path in a model file "
+                     "is relative to the model file's folder", file=str(model.path), line=line)
 
 
 def support_motions(model: Model, record: Record | list | tuple | None = None, *, where: str = "yaml") -> SupportMotions:

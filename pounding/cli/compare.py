@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
-from pounding.cli.sweep import add_cluster_options, check_study_options, raise_if_all_failed
+from pounding.cli.sweep import add_cluster_options, check_study_options, print_study_warnings, raise_if_all_failed
 from pounding.studies.compare import DEFAULT_FORMULAS, REFERENCE, compare, comparison_table, plot_comparison
 
 __all__ = ["register_cli"]
@@ -31,6 +31,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         return 130
     raise_if_all_failed(ds, args.output)
     print(comparison_table(ds, args.reference))
+    print_study_warnings(ds)
     if args.output:
         print(f"wrote {args.output}")
     if args.plot:

@@ -88,7 +88,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--building", help="the building of Sa(T1) and of the hunt's collapse (default: the first)")
     levels = parser.add_mutually_exclusive_group()
     levels.add_argument("--levels", metavar="A:B:STEP",
-                        help="fixed stripes in g: START:STOP:STEP (both ends included) or a list 0.2,0.4,0.8")
+                        help="fixed stripes in g (or with units, as --mce: 0.1g, 1 m/s2, 100 gal): START:STOP:STEP "
+                        "(both ends included) or a list 0.2,0.4,0.8")
     levels.add_argument("--hunt", action="store_true",
                         help="hunt-and-fill (Vamvatsikos & Cornell): bracket each record's collapse intensity")
     parser.add_argument("--hunt-start", type=float, default=0.1, metavar="G", help="first level of a hunt (g; 0.1)")

@@ -79,6 +79,16 @@ def _fmt_force(newtons: float) -> str:
     return f"{newtons:.3g} N"
 
 
+def _pga_line(ds) -> str:
+    """``record PGA 0.416 g (4.08 m/s2) as recorded, 0.832 g (8.16 m/s2) as run (x2)``."""
+    from pounding.results.dataset import record_pga
+    from pounding.units import STANDARD_GRAVITY
+
+    own, scaled = record_pga(ds)
+    return (f"record PGA {own / STANDARD_GRAVITY:.3g} g ({own:.3g} m/s2) as recorded, "
+            f"{scaled / STANDARD_GRAVITY:.3g} g ({scaled:.3g} m/s2) as run (x{ds.attrs['record_scale']:.4g})")
+
+
 def summary(ds) -> str:
     """Compact text summary of a results dataset."""
     import json
@@ -90,6 +100,7 @@ def summary(ds) -> str:
     event = ", ".join(str(meta[k]) for k in ("event", "year", "station", "component") if meta.get(k))
     lines.append(f"model '{ds.attrs['model_name']}' under {ds.attrs['record_name']} x{ds.attrs['record_scale']:g}"
                  f"{f' ({event})' if event else ''}, {ds.attrs['duration']:.2f} s")
+    lines.append(_pga_line(ds))
     if ds.attrs.get("multi_support") and "ground" in ds.dims:
         lines.append(f"ground under each building ({ds.attrs['multi_support']}):")
         for name in ds.ground.values:
@@ -167,15 +178,12 @@ def _check_plot_dir(directory: str) -> None:
     import os
 
     from pounding.errors import PoundingError
+    from pounding.results.archive import nearest_existing
 
     target = Path(directory)
     if target.exists() and not target.is_dir():
         raise PoundingError(f"{target} is a file; --plot needs a directory")
-    probe = target
-    while not probe.exists():
-        if probe.parent == probe:
-            break
-        probe = probe.parent
+    probe = nearest_existing(target)
     if probe.exists() and not probe.is_dir():
         raise PoundingError(f"--plot {target}: {probe} is a file, not a directory")
     if not os.access(probe, os.W_OK | os.X_OK):
@@ -203,6 +211,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     """``pounding run`` once *output* is claimed."""
     from pounding.errors import PoundingError
     from pounding.results.archive import check_writable, save_run
+    from pounding.results.checks import print_warnings, run_warnings
     from pounding.model.model import load_model
     from pounding.simulation import model_inputs, simulate
 
@@ -223,6 +232,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
                   contacts=not args.no_contacts, where="cli")
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
+    print_warnings(run_warnings(ds).values())
     print(f"wrote {path}")
     if args.plot:
         from pounding.results.plots import plot_run

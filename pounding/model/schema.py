@@ -53,6 +53,7 @@ from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
+from pounding.registry import lookup
 from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
 __all__ = [
@@ -575,6 +576,9 @@ class _JoinEntry(_Schema):
             return data
         law = data.get("law")
         names = list(cls.REGISTRY)
+        if lookup(cls.REGISTRY, law) not in (None, law):   # Hertz-Damp: the law hertz-damp
+            data = {**data, "law": lookup(cls.REGISTRY, law)}
+            law = data["law"]
         if "law" in data and not (isinstance(law, str) and law in cls.REGISTRY):
             if isinstance(law, str):
                 raise problem(f"unknown {cls.KIND} '{law}'{did_you_mean(law, names)}; "

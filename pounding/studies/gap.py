@@ -37,6 +37,7 @@ See ``docs/gap.md``.
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import time
@@ -221,6 +222,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     ``status = "error"`` and the message.
     """
     from pounding.model.model import model_from_text
+    from pounding.results.checks import run_warnings
     from pounding.results.dataset import record_pga
     from pounding.simulation import simulate
     from pounding.studies.engine.keys import PARTS_FORMAT
@@ -254,6 +256,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "peak_right": found["peak_right"].tolist(),
             "scale_factor": float(ds.attrs.get("record_scale", 1.0)),
             "intensity": record_pga(ds)[1],
+            "warnings": run_warnings(ds, gaps=[g.gap for g in model.gaps]),
             "solver_wall_time": float(ds.attrs["wall_time"]),
         })
     except Exception as exc:  # noqa: BLE001 - a failing record is a result, not a crash
@@ -314,6 +317,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import xarray as xr
 
     from pounding import __version__
+    from pounding.results.checks import study_warnings
     from pounding.results.dataset import PGA_LONG_NAME
 
     scenarios = sweep.scenarios()
@@ -434,6 +438,9 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "Conventions": "CF-1.8",
         },
     )
+    warnings = study_warnings(p.get("warnings") for p in parts if p.get("status") == "ok")
+    if warnings:   # each kind once for the study (pounding.results.checks)
+        ds.attrs["warnings"] = json.dumps(warnings)
     return ds
 
 

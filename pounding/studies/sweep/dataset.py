@@ -39,6 +39,7 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import numpy as np
     import xarray as xr
 
+    from pounding.results.checks import study_warnings
     from pounding.results.dataset import PGA_LONG_NAME
 
     scenarios = sweep.scenarios()
@@ -160,6 +161,9 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "n_run": int(ran),
         "elapsed_time": float(elapsed),
     }
+    warnings = study_warnings(part.get("warnings") for part in parts if part.get("status") == "ok")
+    if warnings:   # each kind once for the study (pounding.results.checks)
+        attrs["warnings"] = json.dumps(warnings)
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 

@@ -79,6 +79,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from pounding.model import schema
 from pounding.model.document import Document, dump_document
 from pounding.records.catalogue import is_catalogue_reference, is_catalogued
+from pounding.registry import lookup
 from pounding.errors import ModelError, PoundingError, did_you_mean
 from pounding.studies.engine.keys import (catalogue_entries, code_fingerprint, content_key,
                                           record_fingerprint, scenario_key)
@@ -251,8 +252,8 @@ def _set_leaf(node: dict, key: str, value: Any, schema_loc: tuple[str, ...]) -> 
         return
     if schema_loc == ("contacts",) and key == "law" and isinstance(value, str) and value != node.get("law"):
         keep = set(schema.ContactGeometry.KEYS)
-        if value in LAWS:
-            keep |= set(LAWS[value].model_fields)
+        if lookup(LAWS, value) is not None:
+            keep |= set(LAWS[lookup(LAWS, value)].model_fields)
         for old in [k for k in node if k not in keep]:
             del node[old]
     node[key] = value
