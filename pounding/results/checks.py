@@ -29,12 +29,12 @@ import json
 import math
 from typing import Any, Iterable, Sequence
 
-from pounding.model.model import OPEN_GAP
+from pounding.model.model import OPEN_GAP, WALL
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["PGA_LIMIT_G", "G_RECORD_LIMIT_G", "SI_RECORD_FLOOR", "ELASTIC_DRIFT_LIMIT", "AXIS_JUMP",
            "record_warnings", "gap_warnings", "drift_warnings", "run_warnings", "study_warnings", "axis_warning",
-           "print_warnings"]
+           "model_warnings", "print_warnings"]
 
 #: Scaled PGA (g) above which a run outside an IDA is flagged.
 PGA_LIMIT_G = 3.0
@@ -123,6 +123,14 @@ def run_warnings(ds, *, gaps: Sequence[float] | None = None, ida: bool = False) 
     found.update(drift_warnings([str(b) for b in ds.storey_building.values], ds.peak_drift_ratio.values,
                                 [name for name in heights if name not in inelastic]))
     return found
+
+
+def model_warnings(model) -> dict[str, str]:
+    """The ``gap`` warning of a :class:`~pounding.model.model.Model` before any run (what ``pounding ida`` checks
+    once: its runs are not checked one by one)."""
+    names = [b.name for b in model.buildings]
+    lowest = [min(float(min(model.buildings[i].height)) for i in (g.left, g.right) if i != WALL) for g in model.gaps]
+    return gap_warnings([g.label(names) for g in model.gaps], [g.gap for g in model.gaps], lowest)
 
 
 def study_warnings(per_run: Iterable[dict[str, str] | None]) -> list[str]:
