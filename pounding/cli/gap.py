@@ -8,7 +8,7 @@ import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
 from pounding.cli.spectrum import add_spectrum_options
-from pounding.cli.sweep import add_cluster_options, check_study_options
+from pounding.cli.sweep import add_cluster_options, check_study_options, print_study_warnings
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
@@ -78,6 +78,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
               f"{', ...' if len(records) > 3 else ''}): {message}", file=sys.stderr)
     if not ok.any():
         raise PoundingError(f"every record failed ({len(ok)}); nothing to report")
+    print_study_warnings(ds)
     if args.output:
         print(f"wrote {args.output}", file=sys.stderr if args.json else sys.stdout)
     write_csv_option(args, "gap", ds, sys.stderr if args.json else sys.stdout)

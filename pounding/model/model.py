@@ -53,7 +53,25 @@ __all__ = [
     "read_yaml_text",
     "WALL",
     "column_weights",
+    "OPEN_GAP",
+    "hold_contacts_open",
 ]
+
+#: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
+#: without pounding of ``pounding run --no-contacts``, ``pounding gap``, ``ida --without-contacts`` and
+#: ``compare --contacts with,without``).
+OPEN_GAP = 1.0e6
+
+
+def hold_contacts_open(document: dict[str, Any]) -> dict[str, Any]:
+    """Set every contact of a plain model *document* to :data:`OPEN_GAP` (in place; returned).
+
+    The document form of :meth:`Model.with_contacts_open`, for the studies that edit model documents.
+    """
+    for contact in document.get("contacts") or []:
+        contact["gap"] = OPEN_GAP
+    return document
+
 
 #: Building index of a fixed wall in a gap element's sides (:data:`pounding.model.schema.WALL`).
 WALL = schema.WALL
@@ -666,7 +684,7 @@ class Model:
             groups.setdefault((law, float(g.gap)), []).append(g.label(names))
         for (law, gap), labels in groups.items():
             shown = ", ".join(labels) if len(labels) <= 3 else f"{labels[0]} ... {labels[-1]} ({len(labels)})"
-            rows.append(("contacts", f"{shown}: {law}, gap {1000 * gap:.4g} mm"))
+            rows.append(("contacts", f"{shown}: {law}, " + ("held open" if gap >= OPEN_GAP else f"gap {1000 * gap:.4g} mm")))
         for link in self.links:
             rows.append(("link", f"{names[link.left]}:{link.level_left}-{names[link.right]}:{link.level_right}: "
                                  f"{link.law.describe()}"))
@@ -767,6 +785,26 @@ class Model:
 
         gaps = tuple(dataclasses.replace(g, law=renamed(g.law)) for g in self.gaps)
         return self._derived(gaps=gaps)
+
+    def with_contacts_open(self) -> Model:
+        """The same model with every contact held open (gap :data:`OPEN_GAP`): the run without pounding.
+
+        Labels, laws and everything else are kept, so the results line up with the model's own run.
+
+        Raises
+        ------
+        ModelError
+            The model has no contacts (holding them open would change nothing).
+        """
+        if not self.gaps:
+            where = f"{self.path}: " if self.path else ""
+            raise ModelError(f"{where}model '{self.name}' has no contacts; there is no pounding to leave out")
+        return self._derived(gaps=tuple(dataclasses.replace(g, gap=OPEN_GAP) for g in self.gaps))
+
+    @property
+    def contacts_held_open(self) -> bool:
+        """True if the model has contacts and every one is held open (gap >= :data:`OPEN_GAP`)."""
+        return bool(self.gaps) and all(g.gap >= OPEN_GAP for g in self.gaps)
 
     def with_ground_motion(self, **changes: Any) -> Model:
         """The same model with ground-motion fields changed (record, scale, duration, dt, units, base_dir).

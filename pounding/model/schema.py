@@ -53,6 +53,7 @@ from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
+from pounding.registry import lookup
 from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
 __all__ = [
@@ -607,6 +608,9 @@ class _JoinEntry(_Schema):
             return data
         law = data.get("law")
         names = list(cls.REGISTRY)
+        if lookup(cls.REGISTRY, law) not in (None, law):   # Hertz-Damp: the law hertz-damp
+            data = {**data, "law": lookup(cls.REGISTRY, law)}
+            law = data["law"]
         if "law" in data and not (isinstance(law, str) and law in cls.REGISTRY):
             if isinstance(law, str):
                 raise problem(f"unknown {cls.KIND} '{law}'{did_you_mean(law, names)}; "
@@ -973,7 +977,8 @@ def _header_lacks_units(record: str, context: Any) -> bool:
     read.  Without a context (a model rebuilt from data already checked, e.g.
     ``Model.with_xi``), a relative path cannot be resolved and is left for
     the reader, whose error names the file and the fix.  A malformed header
-    is left for the reader too: it reports the line.
+    is left for the reader too: it reports the line; so is a file that does
+    not exist (the run names the model file, its line and where it looked).
     """
     from pounding.records.readers import header_declares_units
 
@@ -983,7 +988,8 @@ def _header_lacks_units(record: str, context: Any) -> bool:
             return False
         if context["base_dir"] is not None:
             path = Path(context["base_dir"]) / path
-    return header_declares_units(path) is False
+    # a missing file has no header to ask: reading it names the model file, line and path (simulation)
+    return path.exists() and header_declares_units(path) is False
 
 
 class SolverEntry(_Schema):

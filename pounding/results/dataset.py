@@ -53,11 +53,33 @@ from pounding.model.schema import WALL_NAME
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
+from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
+__all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
+           "RAGGED_DIMS"]
 
 #: Dimensions whose length depends on the run (impacts, full-resolution contact samples).
 RAGGED_DIMS = ("impact", "trace")
+
+
+#: long_name of a study's ``intensity`` variable when it is the PGA of :func:`record_pga` (compare, sweep, gap).
+PGA_LONG_NAME = "peak ground acceleration (PGA) of the scaled record: the record's own PGA times scale_factor"
+
+
+def record_pga(ds: xr.Dataset) -> tuple[float, float]:
+    """Peak ground acceleration of a run's record, m/s²: as recorded (unscaled) and as run (scaled).
+
+    The unscaled PGA is the record file's own (``pga_g`` of ``record_metadata``, before processing and
+    truncation), the scaled one that times ``record_scale``.  A record given as samples without that
+    metadata falls back on the stored ``ground_acceleration`` (sampled at ``output_dt``).
+    """
+    scale = float(ds.attrs.get("record_scale", 1.0))
+    pga_g = json.loads(ds.attrs.get("record_metadata", "{}")).get("pga_g")
+    if pga_g is None:
+        scaled = float(np.max(np.abs(ds.ground_acceleration.values))) if "ground_acceleration" in ds else np.nan
+        return scaled / scale, scaled
+    unscaled = float(pga_g) * STANDARD_GRAVITY
+    return unscaled, unscaled * scale
 
 
 def drop_ragged(ds: xr.Dataset) -> xr.Dataset:
@@ -542,6 +564,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
+    if model.contacts_held_open:   # the run without pounding (pounding run --no-contacts)
+        ds.attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
+                                "(the run without pounding)")
     ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"
     return ds
 

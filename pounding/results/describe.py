@@ -38,11 +38,14 @@ def run_title(ds) -> str:
     if attrs.get("multi_support") == "per-building records" and "ground_record" in ds:
         under = "; ".join(f"{g}: {rec} x{float(s):.4g}" for g, rec, s in
                           zip(ds.ground.values, ds.ground_record.values, ds.ground_scale.values))
-        return f"model '{name}' under {under}"
-    event = record_event(ds)
-    text = (f"model '{name}' under {attrs.get('record_name', '')}{f' ({event})' if event else ''}, "
-            + scale_text(float(attrs.get("record_scale", 1.0)), str(attrs.get("record_scale_method", "factor")),
-                         str(attrs.get("record_scale_description", ""))))
+        text = f"model '{name}' under {under}"
+    else:
+        event = record_event(ds)
+        text = (f"model '{name}' under {attrs.get('record_name', '')}{f' ({event})' if event else ''}, "
+                + scale_text(float(attrs.get("record_scale", 1.0)), str(attrs.get("record_scale_method", "factor")),
+                             str(attrs.get("record_scale_description", ""))))
     if attrs.get("multi_support") == "wave passage":
         text += ", wave passage"
+    if str(attrs.get("contacts", "")).startswith("held open"):   # pounding run --no-contacts
+        text += ", contacts held open"
     return text
