@@ -168,3 +168,180 @@ def test_a_statically_unstable_building_is_refused_before_the_run(tmp_path):
     assert status == 2 and verdict(status, out, err, None) is None, (status, out, err)
     assert f"{path}:" in err and "building A unstable at rest: storey 1 has P/h = 1.961e+06 N/m" in err
     assert "k = 1e+05 N/m" in err and not (tmp_path / "out.nc").exists()
+
+
+# --------------------------------------------------------------------------- #
+# Loss of stability during the run
+# --------------------------------------------------------------------------- #
+
+
+LEANING = """\
+name: leaning
+buildings:
+  - name: L
+    storeys:
+      - {{mass: 1.0e5, stiffness: 2.0e6, height: 3.0,
+         hysteresis: {{model: bilinear, yield_drift_ratio: 0.01, post_yield_ratio: 0.05}}}}
+    damping: {{modal: [0.0]}}
+    p_delta: true
+ground_motion: {{record: push.txt, units: m/s2, dt: 0.01}}
+solver: {{{solver}}}
+"""
+# m = 1e5 kg, k = 2e6 N/m, h = 3 m: P/h = m·g/h = 3.27e5 N/m < k (stands at rest, θ = 0.16), but
+# αk = 1e5 N/m < P/h: once yielding, the storey's tangent αk − P/h is negative.  u_y = 0.03 m,
+# F_y = 6e4 N, zero-resistance drift Δ* = (1 − α)F_y / (P/h − αk) = 0.2512 m.
+M, K, H, ALPHA, UY = 1.0e5, 2.0e6, 3.0, 0.05, 0.03
+
+
+def push_record(folder: Path, pushes: list[tuple[float, float]]) -> None:
+    """A piecewise-constant ground acceleration (m/s², 0.01 s samples): (until t in s, value) pairs."""
+    times = np.arange(0.0, pushes[-1][0] + 1e-9, 0.01)
+    values = np.select([times <= until + 1e-9 for until, _ in pushes], [value for _, value in pushes])
+    (folder / "push.txt").write_text("".join(f"{t:.2f} {a:.6f}\n" for t, a in zip(times, values)))
+
+
+def leaning_model(folder: Path, pushes, solver: str = "output_dt: 0.01") -> Path:
+    push_record(folder, pushes)
+    path = folder / "leaning.yaml"
+    path.write_text(LEANING.format(solver=solver))
+    return path
+
+
+def reference_instability_time(push: float) -> float:
+    """When the storey pushed by a constant ground acceleration −*push* loses its resistance: scipy solve_ivp.
+
+    Elastic until the drift reaches u_y (an event), then yielding: m ü = m·push − R(u) with
+    R = αk·u + (1 − α)F_y − (P/h)·u, until R = 0 (a terminal event).  DOP853 at rtol 1e-12.
+    """
+    from scipy.integrate import solve_ivp
+
+    p_over_h, fy = M * G / H, K * UY
+    tight = dict(method="DOP853", rtol=1e-12, atol=1e-14)
+
+    def elastic(t, y):
+        return [y[1], push - (K - p_over_h) * y[0] / M]
+
+    def yielding(t, y):
+        return [y[1], push - (ALPHA * K * y[0] + (1 - ALPHA) * fy - p_over_h * y[0]) / M]
+
+    def yields(t, y):
+        return y[0] - UY
+
+    def resistance(t, y):
+        return ALPHA * K * y[0] + (1 - ALPHA) * fy - p_over_h * y[0]
+
+    yields.terminal = resistance.terminal = True
+    first = solve_ivp(elastic, (0.0, 5.0), [0.0, 0.0], events=yields, **tight)
+    t1 = first.t_events[0][0]
+    second = solve_ivp(yielding, (t1, 5.0), first.y_events[0][0], events=resistance, **tight)
+    return float(second.t_events[0][0])
+
+
+def test_a_storey_pushed_past_its_zero_resistance_drift_stops_the_run_located(tmp_path):
+    path = leaning_model(tmp_path, [(3.0, -1.0)])
+    ds = pounding.simulate(pounding.load_model(path))
+    assert ds.attrs["status"] == "unstable" and ds.attrs["collapse_storey"] == "L:1"
+    expected = reference_instability_time(1.0)                      # 0.824900 s
+    assert ds.attrs["collapse_time"] == pytest.approx(expected, abs=1e-6)   # measured 4e-12 s
+    assert ds.attrs["status_message"].startswith(f"unstable: storey L:1 lost its lateral resistance at t = "
+                                                 f"{ds.attrs['collapse_time']:.6g} s")
+    # The drift there is the zero-resistance drift (1 − α)F_y/(P/h − αk).
+    zero_resistance = (1 - ALPHA) * K * UY / (M * G / H - ALPHA * K)
+    assert float(ds.residual_drift_ratio.item()) * H == pytest.approx(zero_resistance, rel=1e-6)
+    # The same run for its peaks only (what ida runs) stops at the same instant.
+    peaks = pounding.simulation.simulate_peaks(pounding.load_model(path))
+    assert peaks["status"] == "unstable" and peaks["collapse_time"] == ds.attrs["collapse_time"]
+
+
+def test_a_storey_that_yields_with_a_negative_tangent_but_returns_is_not_unstable(tmp_path):
+    # Pushed past yield (u_y = 0.03 m) but not to Δ* = 0.25 m, then pulled back and released: it
+    # unloads past zero force toward its plastic offset (Δ·R < 0 while the drift moves back), never
+    # losing its resistance while its drift grows.
+    path = leaning_model(tmp_path, [(0.45, -1.0), (0.9, 1.5), (3.0, 0.0)])
+    ds = pounding.simulate(pounding.load_model(path))
+    assert ds.attrs["status"] == "completed", ds.attrs.get("status_message")
+    assert float(ds.peak_drift_ratio.item()) * H > 1.5 * UY          # it yielded
+
+
+def test_the_command_line_and_the_studies_report_an_unstable_run_as_a_collapse(tmp_path, capsys):
+    from pounding.cli import main
+    from pounding.results.archive import open_run
+    from pounding.studies import ida
+
+    path = leaning_model(tmp_path, [(3.0, -1.0)])
+    assert main(["run", str(path), "-o", str(tmp_path / "u.nc")]) == 0
+    out = capsys.readouterr().out
+    assert "UNSTABLE: storey L:1 lost its lateral resistance at t = 0.8249 s" in out
+    assert open_run(tmp_path / "u.nc").attrs["status"] == "unstable"
+    part = ida.run_ida_scenario(_task(path))
+    assert part["status"] == "ok" and part["run_status"] == "unstable"
+    assert ida.run_outcome(part) == "collapsed" and part["collapse_storey"] == "L:1"
+
+
+def _task(path: Path) -> dict:
+    """A study worker's task for the model file *path* as it stands (no scale factor: its own record)."""
+    import yaml
+
+    text = path.read_text()
+    return {"key": "k", "data": yaml.safe_load(text), "document": text, "base_dir": str(path.parent),
+            "name": path.stem, "where": path.name}
+
+
+# --------------------------------------------------------------------------- #
+# Contacts that dissipate more energy than the run received
+# --------------------------------------------------------------------------- #
+
+
+ZENO = """\
+name: zeno
+buildings:
+  - name: Soft
+    storeys: [{{mass: 1.0e5, stiffness: 9.8696e5, height: 3.0}}]
+    damping: {{modal: [0.0]}}
+  - name: Stiff
+    storeys: [{{mass: 1.0e5, stiffness: 5.0e14, height: 3.0}}]
+    damping: {{modal: [0.0]}}
+contacts:
+  - {{between: [Soft, Stiff], levels: matching, gap: 0.06, law: stereo-mechanical, restitution: 0.5}}
+ground_motion: {{record: push.txt, units: m/s2, dt: 0.01}}
+solver: {{atol: {atol}, atol_velocity: {atol_velocity}}}
+"""
+# The issue's Zeno case: a soft floor (T = 2 s) pushed by a constant 5 m/s² onto a stiff undamped
+# neighbour (5e14 N/m: the contact force deflects it by ~1e-9 m), e = 0.5.
+
+
+def zeno_model(folder: Path, atol: float) -> Path:
+    push_record(folder, [(5.0, -5.0)])
+    path = folder / "zeno.yaml"
+    path.write_text(ZENO.format(atol=atol, atol_velocity=10 * atol))
+    return path
+
+
+def test_contacts_that_dissipate_more_than_the_run_received_are_not_a_completed_run(tmp_path, capsys):
+    from pounding.cli import main
+    from pounding.studies import ida
+    from pounding.studies.sweep.scenario import run_scenario
+
+    # At atol 1e-4 m the impact sequence is not resolved: the contact dissipates 7.9e5 J of the
+    # 1.7e4 J the ground put in (measured 45x).
+    path = zeno_model(tmp_path, 1e-4)
+    ds = pounding.simulate(pounding.load_model(path))
+    assert ds.attrs["status"] == "energy_inconsistent"
+    message = ds.attrs["status_message"]
+    assert "\n" not in message and "tighten solver.atol" in message
+    assert message.startswith("energy_inconsistent: the contacts dissipated 7.")
+    assert main(["run", str(path), "-o", str(tmp_path / "z.nc")]) == 0
+    assert "ENERGY INCONSISTENT: the contacts dissipated" in capsys.readouterr().out
+    # ida and sweeps count it as failed, with the message.
+    part = ida.run_ida_scenario(_task(path))
+    assert ida.run_outcome(part) == "failed" and "tighten solver.atol" in part["error"]
+    result = run_scenario(_task(path))
+    assert result["status"] == "error" and "tighten solver.atol" in result["error"]
+
+
+def test_a_resolved_impact_sequence_stays_completed(tmp_path):
+    path = zeno_model(tmp_path, 1e-8)
+    ds = pounding.simulate(pounding.load_model(path))
+    assert ds.attrs["status"] == "completed" and "status_message" not in ds.attrs
+    dissipated = float(ds.energy_contact_dissipated[-1])
+    assert 0.0 < dissipated <= float(ds.energy_input[-1])

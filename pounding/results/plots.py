@@ -269,8 +269,8 @@ def _storey_hysteresis(plt, ds: xr.Dataset, path: Path) -> None:
                      f"residual {100 * float(ds.residual_drift_ratio.values[i]):+.2f} %", fontsize=8)
         ax.grid(alpha=0.3)
     title = "storey hysteresis (column shear, without P-Delta and damping; dashed: yield force ±F_y)"
-    if ds.attrs.get("status") == "collapsed":
-        title += f" - COLLAPSED at {ds.attrs['collapse_time']:.2f} s (storey {ds.attrs['collapse_storey']})"
+    if ds.attrs.get("status") in ("collapsed", "unstable"):
+        title += f" - {ds.attrs['status'].upper()} at {ds.attrs['collapse_time']:.2f} s (storey {ds.attrs['collapse_storey']})"
     fig.suptitle(title, fontsize=9)
     save_figure(fig, path)
 

@@ -28,7 +28,7 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT}
     try:
         from pounding.model.model import model_from_data, model_from_text
-        from pounding.simulation import simulate
+        from pounding.simulation import refuse_failed_run, simulate
 
         try:
             if task.get("data") is not None:
@@ -39,6 +39,7 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
         except ModelError as exc:
             raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
         ds = simulate(model)
+        refuse_failed_run(ds.attrs["status"], ds.attrs.get("status_message", ""))   # energy_inconsistent: an error
         result.update({
             "status": "ok",
             "storey": [str(x) for x in ds.storey.values],
