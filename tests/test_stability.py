@@ -253,6 +253,33 @@ def test_a_storey_pushed_past_its_zero_resistance_drift_stops_the_run_located(tm
     assert peaks["status"] == "unstable" and peaks["collapse_time"] == ds.attrs["collapse_time"]
 
 
+def test_a_bouc_wen_storey_loses_its_resistance_where_an_independent_integration_does(tmp_path):
+    # Bouc–Wen (α = 0, n = 1, β = γ = 0.5, A = 1): R = F_y·z − (P/h)·u softens from the first drift
+    # (no elastic branch to skip); z' = (u'/u_y)(1 − z) while loading.  R = 0 near u = F_y/(P/h) = 0.18 m.
+    from scipy.integrate import solve_ivp
+
+    push_record(tmp_path, [(3.0, -1.0)])
+    path = tmp_path / "bw.yaml"
+    path.write_text(LEANING.format(solver="output_dt: 0.01").replace(
+        "{model: bilinear, yield_drift_ratio: 0.01, post_yield_ratio: 0.05}",
+        "{model: bouc-wen, yield_drift_ratio: 0.01, post_yield_ratio: 0.0, n: 1}"))
+    ds = pounding.simulate(pounding.load_model(path))
+    assert ds.attrs["status"] == "unstable" and ds.attrs["collapse_storey"] == "L:1"
+    p_over_h, fy = M * G / H, K * UY
+
+    def motion(t, y):
+        u, v, z = y
+        return [v, 1.0 - (fy * z - p_over_h * u) / M, v / UY * (1.0 - abs(z) * (0.5 * np.sign(v * z) + 0.5))]
+
+    def resistance(t, y):
+        return fy * y[2] - p_over_h * y[0]
+
+    resistance.terminal, resistance.direction = True, -1
+    ref = solve_ivp(motion, (0.0, 3.0), [0.0, 0.0, 0.0], events=resistance, method="DOP853", rtol=1e-12,
+                    atol=1e-14)
+    assert ds.attrs["collapse_time"] == pytest.approx(ref.t_events[0][0], abs=1e-6)   # measured 7e-11 s
+
+
 def test_a_storey_that_yields_with_a_negative_tangent_but_returns_is_not_unstable(tmp_path):
     # Pushed past yield (u_y = 0.03 m) but not to Δ* = 0.25 m, then pulled back and released: it
     # unloads past zero force toward its plastic offset (Δ·R < 0 while the drift moves back), never

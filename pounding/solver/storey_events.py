@@ -151,19 +151,23 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
     Beyond it gravity's overturning moment exceeds what the storey can resist:
     the building cannot stand (a bilinear storey with αk < P/h, past its
     zero-resistance drift ``(1 − α)F_y / (P/h − αk)``).  F is linear in (Δ, r)
-    for every storey model (:mod:`pounding.solver.storeys`), so R's Hermite
-    cubic on the step is that combination of the cubics of Δ and r and its
-    crossing is found exactly, as the collapse limit's.  Only a crossing from
+    for the bilinear and Bouc–Wen storeys (:mod:`pounding.solver.storeys`), so
+    R's Hermite cubic on the step is that combination of the cubics of Δ and r
+    (its rate F(Δ̇, ṙ) + k_pd·Δ̇) and its crossing is found exactly, as the
+    collapse limit's; a model whose force is not linear in its state is not
+    searched until it brings its own rate here.  Only a crossing from
     the near side counts: a step that starts with ``σR ≤ 0`` (a storey unloaded
     past zero force, moving back toward its plastic offset) has none.
 
-    Only yielding storeys beyond their yield drift u_y are searched: a storey
-    whose static stiffness ``k0 − P/h`` is positive (the model's check) keeps a
-    positive tangent while elastic, and a bilinear storey's zero-resistance
-    drift ``(1 − α)F_y / (P/h − αk)`` exceeds u_y whenever ``P/h < k``; below u_y
-    the drift and the hysteretic state carry only integration noise (a storey
-    drifting 1e-23 m with its Bouc–Wen z a tolerance away from AΔ/u_y would
-    "cross" there), and most steps are skipped by one comparison.
+    A crossing counts only from a resistance above the noise the tolerances
+    leave in it, ``(k + P/h)·atol`` (atol: the storey state's tolerance in m):
+    a storey drifting 1e-23 m with its Bouc–Wen z a tolerance away from AΔ/u_y
+    would otherwise "cross" there.  A bilinear storey is searched only beyond
+    its yield drift u_y, one comparison for most steps: while elastic its
+    tangent ``k − P/h`` is positive (the model's check), and its
+    zero-resistance drift ``(1 − α)F_y / (P/h − αk)`` exceeds u_y whenever
+    ``P/h < k``.  (A Bouc–Wen storey softens from its first drift, and with
+    ``k0 − P/h`` small loses its resistance well below u_y.)
     """
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     n, ih = lay.n_floors, lay.hysteretic
@@ -172,18 +176,20 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
     where = -1
     for j in range(n):
         hi = sidx[j]
-        if kpd[j] == 0.0 or hi < 0:
+        model = smodel[j]
+        if kpd[j] == 0.0 or hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
             continue
-        uy = sprm[j, 0]
+        bilinear = model == hysteresis.MODEL_BILINEAR
+        reach = sprm[j, 0] if bilinear else 0.0
         d0, v0, d1, v1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, below[j])
         # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|v0| + |v1|) (collapse_crossing).
-        if max(abs(d0), abs(d1)) + 0.25 * h * (abs(v0) + abs(v1)) < uy:
+        if max(abs(d0), abs(d1)) + 0.25 * h * (abs(v0) + abs(v1)) < reach:
             continue
         sign = 1.0 if d0 > 0.0 else -1.0
         q0, q1, dq0, dq1 = y[ih + hi], ynew[ih + hi], k1[ih + hi], k7[ih + hi]
-        k, model = stiffness[j], smodel[j]
+        k = stiffness[j]
         r0 = sign * (storeys.restoring_force(model, sprm, j, k, d0, q0) + kpd[j] * d0)
-        if r0 <= 0.0:
+        if r0 <= (k - kpd[j]) * storey.tolerance[hi] * (1.0 if bilinear else sprm[j, 0]):
             continue
         r1 = sign * (storeys.restoring_force(model, sprm, j, k, d1, q1) + kpd[j] * d1)
         rate0 = sign * (storeys.restoring_force(model, sprm, j, k, v0, dq0) + kpd[j] * v0)
@@ -191,7 +197,8 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
         s = first_crossing(r0, rate0, r1, rate1, h, False, DELTA_ROUNDOFF * (abs(k * d0) + abs(kpd[j] * d0)))
         if s < 0.0 or (best >= 0.0 and s >= best):
             continue
-        if sign * hermite(d0, v0, d1, v1, h, s) >= uy and sign * hermite(v0, a0, v1, a1, h, s) > 0.0:
+        drift_s = sign * hermite(d0, v0, d1, v1, h, s)
+        if drift_s > 0.0 and drift_s >= reach and sign * hermite(v0, a0, v1, a1, h, s) > 0.0:
             best = s
             where = j
     return best, where
