@@ -162,12 +162,15 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
     A crossing counts only from a resistance above the noise the tolerances
     leave in it, ``(k + P/h)·atol`` (atol: the storey state's tolerance in m):
     a storey drifting 1e-23 m with its Bouc–Wen z a tolerance away from AΔ/u_y
-    would otherwise "cross" there.  A bilinear storey is searched only beyond
-    its yield drift u_y, one comparison for most steps: while elastic its
-    tangent ``k − P/h`` is positive (the model's check), and its
-    zero-resistance drift ``(1 − α)F_y / (P/h − αk)`` exceeds u_y whenever
+    would otherwise "cross" there.  A bilinear storey is searched only while
+    it yields and beyond its yield drift u_y, two comparisons for most steps:
+    while elastic its tangent ``k − P/h`` is positive (the model's check), and
+    its zero-resistance drift ``(1 − α)F_y / (P/h − αk)`` exceeds u_y whenever
     ``P/h < k``.  (A Bouc–Wen storey softens from its first drift, and with
-    ``k0 − P/h`` small loses its resistance well below u_y.)
+    ``k0 − P/h`` small loses its resistance well below u_y.)  A storey whose
+    post-yield tangent ``αk − P/h`` is ≥ 0 is not searched at all (bilinear,
+    and Bouc–Wen with β ≥ 0, whose z, within ±(A/(β + γ))^(1/n), does not fall
+    while the drift grows: its resistance cannot fall either).
     """
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     n, ih = lay.n_floors, lay.hysteretic
@@ -180,6 +183,11 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
         if kpd[j] == 0.0 or hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
             continue
         bilinear = model == hysteresis.MODEL_BILINEAR
+        k = stiffness[j]
+        if (bilinear or sprm[j, 3] >= 0.0) and sprm[j, 1] * k + kpd[j] >= 0.0:
+            continue
+        if bilinear and storey.mode[hi] == storeys.ELASTIC:
+            continue
         reach = sprm[j, 0] if bilinear else 0.0
         d0, v0, d1, v1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, below[j])
         # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|v0| + |v1|) (collapse_crossing).
@@ -187,7 +195,6 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
             continue
         sign = 1.0 if d0 > 0.0 else -1.0
         q0, q1, dq0, dq1 = y[ih + hi], ynew[ih + hi], k1[ih + hi], k7[ih + hi]
-        k = stiffness[j]
         r0 = sign * (storeys.restoring_force(model, sprm, j, k, d0, q0) + kpd[j] * d0)
         if r0 <= (k - kpd[j]) * storey.tolerance[hi] * (1.0 if bilinear else sprm[j, 0]):
             continue
