@@ -278,24 +278,26 @@ ENERGY_CLOSURE_LIMIT = 1e-3
 
 
 def contact_energy_budget(system: System, raw: RawSolution, n_gaps: int) -> tuple[float, float]:
-    """``(absorbed, received)``, J, at the run's last output sample: what the gap elements absorbed, what the run received.
+    """``(absorbed, received)``, J, at the end of the run: what the gap elements absorbed, what the run received.
 
     *absorbed* is the gap elements' work ∫F·δ̇ dt (dissipated, plus what a closed
     contact still stores); *received* the initial energy (kinetic, storey and
     contact strain at the first sample), the input work E_in, the work W_g of
-    the differential ground motion and gravity's work under P-Delta (−U_s when
-    the storeys' recoverable energy U_s, P-Delta potential included, is
-    negative).  Every other term of the balance ``E_0 + E_in + W_g = KE + U_s +
-    damping + hysteretic + contacts + links`` is ≥ 0, so in a solution that
-    conserves energy ``absorbed ≤ received`` at every instant; the last output
-    sample is the one :func:`simulate_peaks <pounding.simulation.simulate_peaks>`
-    keeps too, so a run and its IDA twin agree.
+    the differential ground motion and gravity's work under P-Delta, at most
+    ``½·Σ (P/h)·Δ²`` (the storeys' P-Delta potential, negative, is all that can
+    make their recoverable energy negative).  Every other term of the balance
+    ``E_0 + E_in + W_g = KE + U_s + damping + hysteretic + contacts + links`` is
+    ≥ 0, so in a solution that conserves energy ``absorbed ≤ received`` at every
+    instant.  Read from the solver's final state, so a run and its IDA twin
+    (:func:`simulate_peaks <pounding.simulation.simulate_peaks>`, same steps) agree.
     """
     lay = system.layout
-    first, last = raw.state[0], raw.state[-1]
-    v0 = first[lay.n_floors:2 * lay.n_floors]
+    n = lay.n_floors
+    first, last = raw.state[0], raw.final_state
+    v0 = first[n:2 * n]
     initial = 0.5 * float(v0 @ (v0 * system.mass)) + float(raw.storey_energy[0, 0]) + float(raw.contact_potential[0])
-    gravity = max(0.0, -float(raw.storey_energy[-1, 0]))
+    drift = _storey_drift(last[None, :n], system.below)[0]
+    gravity = -0.5 * float(drift @ (drift * system.p_delta_stiffness))
     received = initial + float(last[lay.input_energy]) + float(last[lay.ground_work]) + gravity
     absorbed = float(last[lay.work:lay.work + n_gaps].sum())
     return absorbed, received
