@@ -67,6 +67,29 @@ def test_static_stiffness_is_positive_definite_exactly_when_every_storey_is():
     assert abs(np.linalg.eigvalsh(static_stiffness(k_eff))).min() < 1e-12
 
 
+def test_the_rule_holds_for_the_project_s_own_matrices(tmp_path):
+    # The building's stiffness matrix (pounding.model.model.Building) is Bᵀ diag(k) B, and the solver's
+    # P-Delta term (pounding.solver.assembly: −P/h per storey, applied to the storey drift in
+    # pounding.solver.rhs) adds Bᵀ diag(−P/h) B: their sum is the static stiffness the rule is about.
+    from pounding.solver.assembly import storey_arrays
+
+    path = tmp_path / "ok.yaml"
+    path.write_text(ONE_BUILDING.format(k2=1.2 * P_OVER_H, hysteresis=""))
+    model = pounding.load_model(path)
+    building = model.buildings[0]
+    np.testing.assert_allclose(building.stiffness_matrix(), static_stiffness(building.stiffness), rtol=1e-15)
+    kpd = storey_arrays(model)["p_delta_stiffness"]
+    np.testing.assert_allclose(kpd, -storey_gravity_load(building.mass) / building.height, rtol=1e-15)
+    total = building.stiffness_matrix() + static_stiffness(kpd)
+    assert np.linalg.eigvalsh(total).min() > 0 and unstable_storey(
+        building.mass, building.stiffness, building.height, building.hysteresis) is None
+    softer = building.stiffness.copy()
+    softer[1] = 0.8 * P_OVER_H                         # storey 2 below P/h: one negative eigenvalue
+    eigenvalues = np.linalg.eigvalsh(static_stiffness(softer) + static_stiffness(kpd))
+    assert int((eigenvalues < 0).sum()) == 1
+    assert unstable_storey(building.mass, softer, building.height, building.hysteresis)[0] == 1
+
+
 def test_links_and_column_points_only_add_stiffness():
     # Contacts (column points included) are open at rest: no stiffness.  A Kelvin link adds
     # k_l (e_i − e_j)(e_i − e_j)ᵀ, positive semi-definite (Maxwell and viscous links: none at rest),
