@@ -395,3 +395,27 @@ def test_a_resolved_impact_sequence_stays_completed(tmp_path):
     assert ds.attrs["status"] == "completed" and "status_message" not in ds.attrs
     dissipated = float(ds.energy_contact_dissipated[-1])
     assert 0.0 < dissipated <= float(ds.energy_input[-1])
+
+
+def test_the_energy_status_is_decided_by_the_budget_alone(tmp_path):
+    # Independent of how the solver's tolerances resolve the sequence: the resolved run's own solution
+    # with its contact work raised just past what the run received (by more than the 1e-3 margin) is
+    # energy_inconsistent, and just below it is completed.
+    import dataclasses
+
+    from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, contact_energy_budget, run_status
+    from pounding.simulation import _checked_end_time, _solve, support_motions
+
+    model = pounding.load_model(zeno_model(tmp_path, 1e-8))
+    supports = support_motions(model)
+    system, raw, _, _ = _solve(model, supports, _checked_end_time(model, supports), model.solver.output_dt)
+    absorbed, received = contact_energy_budget(system, raw, 1)
+    assert 0.0 < absorbed < received and run_status(system, raw, 1, "") == ("completed", "")
+    work = system.layout.work
+    for factor, expected in ((1.0 + 0.5 * ENERGY_CLOSURE_LIMIT, "completed"),
+                             (1.0 + 2.0 * ENERGY_CLOSURE_LIMIT, "energy_inconsistent")):
+        state = raw.final_state.copy()
+        state[work] = factor * received
+        status, message = run_status(system, dataclasses.replace(raw, final_state=state), 1, "")
+        assert status == expected
+        assert (message == "") == (expected == "completed")
