@@ -40,5 +40,6 @@ def did_you_mean(name: str, choices: list[str] | tuple[str, ...]) -> str:
     """Return ``' (did you mean 'x'?)'`` for the closest of *choices*, or ``''``."""
     import difflib
 
-    close = difflib.get_close_matches(name, list(choices), n=1, cutoff=0.5)
-    return f" (did you mean '{close[0]}'?)" if close else ""
+    folded = {str(c).lower(): str(c) for c in reversed(list(choices))}   # case-blind; the first spelling wins
+    close = difflib.get_close_matches(str(name).lower(), list(folded), n=1, cutoff=0.5)
+    return f" (did you mean '{folded[close[0]]}'?)" if close else ""

@@ -1,7 +1,9 @@
 """Registries keyed by name (contact laws, link laws, ξ formulas, storey hysteresis, separation rules).
 
 Each registry is a plain ``dict``; :func:`add_unique` is how every one of them
-takes a new entry, so a name is taken once everywhere.  Registries whose
+takes a new entry, so a name is taken once everywhere.  :func:`lookup` is how
+every one of them is read by name: exactly, by an alias, or ignoring case
+(``Hertz-Damp``, ``YE``, ``--xi Exact``).  Registries whose
 entries select a branch of the compiled solver number them with
 :func:`add_numbered`: the id is the entry's place in the registry, so no id is
 written by hand and none is taken twice.
@@ -9,9 +11,9 @@ written by hand and none is taken twice.
 
 from __future__ import annotations
 
-from typing import Any, MutableMapping
+from typing import Any, Mapping, MutableMapping
 
-__all__ = ["add_unique", "add_numbered"]
+__all__ = ["add_unique", "add_numbered", "lookup"]
 
 
 def add_unique(registry: MutableMapping[str, Any], key: str, value: Any, kind: str) -> None:
@@ -43,3 +45,21 @@ def add_numbered(registry: MutableMapping[str, Any], cls: type, kind: str, id_at
     add_unique(registry, cls.name, cls, kind)
     setattr(cls, id_attribute, number)
     return cls
+
+
+def lookup(registry: Mapping[str, Any], name: object, aliases: Mapping[str, str] | None = None) -> str | None:
+    """The key of *registry* that *name* names, or None if it names none.
+
+    *name* matches a key or an alias (alias → key) as written, else ignoring
+    case and surrounding spaces, so ``Hertz-Damp``, ``YE`` and ``' exact '``
+    name ``hertz-damp``, ``ye`` and ``exact``.  Callers word the unknown-name
+    error with :func:`pounding.errors.did_you_mean` (also case-blind).
+    """
+    if not isinstance(name, str):
+        return None
+    aliases = aliases or {}
+    key = aliases.get(name, name)
+    if key in registry:
+        return key
+    folded = {k.lower(): aliases.get(k, k) for k in (*aliases, *registry)}
+    return folded.get(name.strip().lower())

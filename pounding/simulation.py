@@ -114,8 +114,35 @@ def processed_record_for(model: Model, *, where: str = "yaml", building: int | s
     from pounding.records.processing import process
 
     spec = model.ground_motion if building is None else model.ground_motion_of(building)
+    if where == "yaml":
+        _check_record_file(model, spec, building)
     record = load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where)
     return process(record, spec.processing)
+
+
+def _check_record_file(model: Model, spec, building: int | str | None) -> None:
+    """A record file named in a model file that does not exist: one line naming the model file and line.
+
+    Raises
+    ------
+    ModelError
+        ``<model file>:<line>: ground_motion.record: record file '<as written>' not found (looked for <path>)``.
+    """
+    from pounding.errors import ModelError
+    from pounding.model.document import format_location, parse_document
+
+    path = spec.record_path
+    if path is None or path.exists() or not getattr(model, "path", None):
+        return
+    loc = ("ground_motion", "record") if building is None else \
+        ("buildings", model.building_index(building), "ground_motion", "record")
+    try:
+        document = parse_document(model.source, str(model.path))
+        line = document.line(loc) if document.has(loc) else None
+    except PoundingError:   # a model built in Python: its source is no YAML to point into
+        line = None
+    raise ModelError(f"{format_location(loc)}: record file '{spec.record}' not found (looked for {path}); a path in a model file "
+                     "is relative to the model file's folder", file=str(model.path), line=line)
 
 
 def support_motions(model: Model, record: Record | list | tuple | None = None, *, where: str = "yaml") -> SupportMotions:
@@ -203,7 +230,7 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
              scale: Any = None, duration: float | None = None, rtol: float | None = None,
              atol: float | None = None, atol_velocity: float | None = None,
              output_dt: float | None = None, record_units: str | None = None,
-             record_dt: float | None = None, where: str = "api") -> xr.Dataset:
+             record_dt: float | None = None, contacts: bool = True, where: str = "api") -> xr.Dataset:
     """Simulate a row of buildings under a ground-acceleration record.
 
     Parameters
@@ -230,6 +257,9 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
         Units (``g``, ``m/s2``, ``cm/s2``, ``gal``) and time step (s) of a
         plain-text *record* file that does not declare them in a
         ``# units: g; dt = 0.005 s`` first line.
+    contacts : bool
+        False: every contact held open (:meth:`Model.with_contacts_open`), the
+        run without pounding; its archive says so in the attribute ``contacts``.
     where : str
         ``api`` or ``cli``: how an error about a record given here says to
         fix it (``record_units=`` or ``--units``).
@@ -242,7 +272,7 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     _check_modes_memory(model)
     model = with_overrides(model, record, xi=xi, scale=scale, duration=duration, rtol=rtol, atol=atol,
                            atol_velocity=atol_velocity, output_dt=output_dt, record_units=record_units,
-                           record_dt=record_dt, where=where)
+                           record_dt=record_dt, contacts=contacts, where=where)
     supports = _supports_for_call(model, record, scale, where)
     end_time = _checked_end_time(model, supports)
     system, raw, wall, rows = _solve(model, supports, end_time, model.solver.output_dt)
@@ -255,14 +285,18 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
 def with_overrides(model: Model, record: Record | str | list | None = None, *, xi: str | None = None,
                    scale: Any = None, duration: float | None = None, rtol: float | None = None,
                    atol: float | None = None, atol_velocity: float | None = None, output_dt: float | None = None,
-                   record_units: str | None = None, record_dt: float | None = None, where: str = "api") -> Model:
-    """*model* with what a call of :func:`simulate` overrides: ξ, solver settings, record spec, scale, duration.
+                   record_units: str | None = None, record_dt: float | None = None, contacts: bool = True,
+                   where: str = "api") -> Model:
+    """*model* with what a call of :func:`simulate` overrides: ξ, contacts held open, solver settings, record
+    spec, scale, duration.
 
     A record given as a spec (str) replaces the model's ``ground_motion.record`` (a file path made absolute
     and its units read from its header line); a loaded :class:`Record` leaves the model's spec alone.
     """
     if xi is not None:
         model = model.with_xi(xi)
+    if not contacts:
+        model = model.with_contacts_open()
     changes = {k: v for k, v in dict(rtol=rtol, atol=atol, atol_velocity=atol_velocity,
                                      output_dt=output_dt).items() if v is not None}
     if changes:
@@ -368,7 +402,7 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
     started = _time.perf_counter()
     raw = integrate(system, ground, step, end_time, rtol=settings.rtol,
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
-                    output_dt=output_dt)
+                    output_dt=output_dt, scale_tolerances=settings.tolerance_scaling)
     wall = _time.perf_counter() - started
     if raw.status not in (STATUS_OK, STATUS_COLLAPSED, STATUS_UNSTABLE):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
@@ -456,6 +490,7 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     if isinstance(run, xr.Dataset):
         check_archive(ds, name)
     spec = json.loads(ds.attrs["run_spec"])
+    _archived_tolerances(spec)
     model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
                             path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
     if model.has_building_records:
@@ -476,6 +511,15 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
     return again
+
+
+def _archived_tolerances(spec: dict) -> None:
+    """An archive written before tolerances followed the model's scales (issue 25) reruns with its own:
+    ``solver.tolerance_scaling`` off where its effective model does not name it."""
+    model = spec.get("model")
+    if isinstance(model, dict):
+        solver = model.setdefault("solver", {})
+        solver.setdefault("tolerance_scaling", False)
 
 
 def _archived_records(model: Model, spec: dict, name: str) -> list[Record]:

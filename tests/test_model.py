@@ -273,7 +273,7 @@ def test_with_xi_needs_a_hertz_damp_contact():
         model.with_xi("ye")
 
 
-def test_with_ground_motion_and_solver():
+def test_with_ground_motion_and_solver(tmp_path):
     model = load_model(MODELS / "pair.yaml")
     scaled = model.with_ground_motion(scale=2.0, duration=10.0)
     assert (scaled.ground_motion.scale, scaled.ground_motion.duration) == (2.0, 10.0)
@@ -288,8 +288,10 @@ def test_with_ground_motion_and_solver():
         model.with_ground_motion(scal=2.0)
     with pytest.raises(ModelError, match=r"solver.rtol must be >= 1e-12 \(got 1e-14\)"):
         model.with_solver(rtol=1e-14)
-    with pytest.raises(ModelError, match=r"ground_motion\.record: the plain-text record 'x.txt' needs ground_motion\.units"):
-        model.with_ground_motion(record="x.txt")
+    plain = tmp_path / "x.txt"     # a text record without a '# units:' line (a missing one is for the reader)
+    plain.write_text("0.0\n0.1\n")
+    with pytest.raises(ModelError, match=r"ground_motion\.record: the plain-text record '.*x.txt' needs ground_motion\.units"):
+        model.with_ground_motion(record=str(plain))
 
 
 def test_ground_motion_spec_paths_and_units(tmp_path):

@@ -66,6 +66,8 @@ def assert_message(tmp_path: Path, text: str, line: int | None, message: str) ->
     """Write *text* to a file, load it, and check the whole one-line message."""
     path = tmp_path / "model.yaml"
     path.write_text(text, encoding="utf-8")
+    (tmp_path / "data").mkdir(exist_ok=True)   # a text record without a units header, for the cases that name it
+    (tmp_path / "data" / "northridge.txt").write_text("0.0\n0.1\n")
     with pytest.raises(ModelError) as info:
         load_model(path)
     error = info.value

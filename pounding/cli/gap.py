@@ -7,10 +7,38 @@ import json
 import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
-from pounding.cli.sweep import add_cluster_options, check_study_options
+from pounding.cli.spectrum import add_spectrum_options
+from pounding.cli.sweep import add_cluster_options, check_study_options, print_study_warnings
 from pounding.errors import PoundingError
 
 __all__ = ["register_cli"]
+
+
+def _cmd_code_gap(args: argparse.Namespace) -> int:
+    """``pounding gap MODEL --code CODE ...``: the code's separations beside the simulated requirement."""
+    from pounding.studies.design import code_gap_study, code_gap_summary, code_gap_table
+
+    for given, option in ((args.scale, "--scale"), (args.output, "-o"), (args.plot, "--plot")):
+        if given is not None:
+            why = ("the records are scaled to the code's spectrum" if option == "--scale"
+                   else "not available with --code yet; run without --code for the archive and figure")
+            raise PoundingError(f"--code refuses {option}: {why}")
+    if args.code == "asce7-22":
+        missing = [f"--{name}" for name in ("sds", "sd1") if getattr(args, name) is None]
+        if missing:
+            raise PoundingError(f"--code asce7-22 needs {' and '.join(missing)} (g)")
+        options = {"sds": args.sds, "sd1": args.sd1, "tl": args.tl}
+    else:
+        if args.ag is None:
+            raise PoundingError("--code ec8 needs --ag (design ground acceleration on ground type A, g)")
+        options = {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
+    result = code_gap_study(args.model, args.code, options, args.records, duration=args.duration,
+                            workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
+    if args.json:
+        print(json.dumps(code_gap_summary(result), indent=2))
+    else:
+        print(code_gap_table(result))
+    return 0
 
 
 def _cmd_gap(args: argparse.Namespace) -> int:
@@ -18,6 +46,12 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
+    if args.code:
+        return _cmd_code_gap(args)
+    given = [option for option, value in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag))
+             if value is not None]
+    if given:
+        raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
     scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
         ds = gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
@@ -42,6 +76,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
               f"{', ...' if len(records) > 3 else ''}): {message}", file=sys.stderr)
     if not ok.any():
         raise PoundingError(f"every record failed ({len(ok)}); nothing to report")
+    print_study_warnings(ds)
     if args.output:
         print(f"wrote {args.output}", file=sys.stderr if args.json else sys.stdout)
     if args.plot:
@@ -71,6 +106,13 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--json", action="store_true", help="print the results as one JSON document (metres)")
     parser.add_argument("--plot", metavar="DIR", help="write gap_profile.png to DIR")
+    parser.add_argument("--code", choices=("asce7-22", "ec8"),
+                        help="report the code's separation per level pair from design spectra (modal "
+                             "response-spectrum analysis of each building with its design: factors in the model) "
+                             "beside the requirement of the records scaled to the code's spectrum (refuses --scale, "
+                             "-o, --plot); docs/design-codes.md")
+    add_spectrum_options(parser, "asce7-22")
+    add_spectrum_options(parser, "ec8", q=False)
     add_cluster_options(parser)
     parser.set_defaults(func=_cmd_gap)
     return parser

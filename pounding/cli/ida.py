@@ -15,6 +15,8 @@ __all__ = ["register_cli"]
 def _cmd_ida(args: argparse.Namespace) -> int:
     from pounding.studies.ida import Hunt, build_ida_plan, ida_study, ida_summary, ida_table, parse_intensity, \
         plot_ida
+    from pounding.model.model import load_model
+    from pounding.results.checks import model_warnings, print_warnings
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
@@ -34,6 +36,7 @@ def _cmd_ida(args: argparse.Namespace) -> int:
           + (f"{len(plan.levels)} levels" if hunt is None else "hunt-and-fill")
           + f" x {len(plan.variants)} variant(s) = {'up to ' if hunt is not None else ''}{plan.planned_runs()} runs; "
           f"IM {plan.im.describe()}", file=sys.stderr)
+    print_warnings(model_warnings(load_model(args.model)).values())   # its runs are not checked one by one
     try:
         ds = ida_study(plan, args.output, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)
@@ -88,7 +91,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--building", help="the building of Sa(T1) and of the hunt's collapse (default: the first)")
     levels = parser.add_mutually_exclusive_group()
     levels.add_argument("--levels", metavar="A:B:STEP",
-                        help="fixed stripes in g: START:STOP:STEP (both ends included) or a list 0.2,0.4,0.8")
+                        help="fixed stripes in g (or with units, as --mce: 0.1g, 1 m/s2, 100 gal): START:STOP:STEP "
+                        "(both ends included) or a list 0.2,0.4,0.8")
     levels.add_argument("--hunt", action="store_true",
                         help="hunt-and-fill (Vamvatsikos & Cornell): bracket each record's collapse intensity")
     parser.add_argument("--hunt-start", type=float, default=0.1, metavar="G", help="first level of a hunt (g; 0.1)")

@@ -79,6 +79,16 @@ def _fmt_force(newtons: float) -> str:
     return f"{newtons:.3g} N"
 
 
+def _pga_line(ds) -> str:
+    """``record PGA 0.416 g (4.08 m/s2) as recorded, 0.832 g (8.16 m/s2) as run (x2)``."""
+    from pounding.results.dataset import record_pga
+    from pounding.units import STANDARD_GRAVITY
+
+    own, scaled = record_pga(ds)
+    return (f"record PGA {own / STANDARD_GRAVITY:.3g} g ({own:.3g} m/s2) as recorded, "
+            f"{scaled / STANDARD_GRAVITY:.3g} g ({scaled:.3g} m/s2) as run (x{ds.attrs['record_scale']:.4g})")
+
+
 def summary(ds) -> str:
     """Compact text summary of a results dataset."""
     import json
@@ -90,12 +100,15 @@ def summary(ds) -> str:
     event = ", ".join(str(meta[k]) for k in ("event", "year", "station", "component") if meta.get(k))
     lines.append(f"model '{ds.attrs['model_name']}' under {ds.attrs['record_name']} x{ds.attrs['record_scale']:g}"
                  f"{f' ({event})' if event else ''}, {ds.attrs['duration']:.2f} s")
+    lines.append(_pga_line(ds))
     if ds.attrs.get("multi_support") and "ground" in ds.dims:
         lines.append(f"ground under each building ({ds.attrs['multi_support']}):")
         for name in ds.ground.values:
             g = ds.sel(ground=name)
             lines.append(f"  {name}: {g.ground_record.item()} x{float(g.ground_scale):g}, lag {float(g.ground_lag):.3g} s, "
                          f"peak ground displacement {float(np.abs(g.building_ground_displacement).max()):.3g} m")
+    if ds.attrs.get("contacts"):
+        lines.append(f"contacts {ds.attrs['contacts']}")
     periods = json.loads(ds.attrs["periods"])
     lines.append("periods (s):")
     for name, values in periods.items():
@@ -168,15 +181,12 @@ def _check_plot_dir(directory: str) -> None:
     import os
 
     from pounding.errors import PoundingError
+    from pounding.results.archive import nearest_existing
 
     target = Path(directory)
     if target.exists() and not target.is_dir():
         raise PoundingError(f"{target} is a file; --plot needs a directory")
-    probe = target
-    while not probe.exists():
-        if probe.parent == probe:
-            break
-        probe = probe.parent
+    probe = nearest_existing(target)
     if probe.exists() and not probe.is_dir():
         raise PoundingError(f"--plot {target}: {probe} is a file, not a directory")
     if not os.access(probe, os.W_OK | os.X_OK):
@@ -204,6 +214,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     """``pounding run`` once *output* is claimed."""
     from pounding.errors import PoundingError
     from pounding.results.archive import check_writable, save_run
+    from pounding.results.checks import print_warnings, run_warnings
     from pounding.model.model import load_model
     from pounding.simulation import model_inputs, simulate
 
@@ -221,9 +232,10 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
         check_writable(output, overwrite=args.overwrite, inputs=model_inputs(model))
     ds = simulate(model, record=args.record, xi=args.xi, scale=scale, duration=args.duration,
                   rtol=args.rtol, output_dt=args.output_dt, record_units=args.units, record_dt=args.dt,
-                  where="cli")
+                  contacts=not args.no_contacts, where="cli")
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
+    print_warnings(run_warnings(ds).values())
     print(f"wrote {path}")
     if args.plot:
         from pounding.results.plots import plot_run
@@ -286,7 +298,7 @@ def open_archive(path) -> tuple[str, object]:
                                "write it again")
         if attrs.get("study") in ("gap", "ida"):
             return str(attrs["study"]), ds
-        return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and "xi" in names
+        return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and names & {"xi", "pounding"}
                 else "sweep"), ds
     if is_verify:
         return "verify", ds
@@ -298,6 +310,8 @@ def _reference(ds) -> str:
     """The formula a compare archive is compared with (``exact`` unless it was not run)."""
     from pounding.studies.compare import REFERENCE
 
+    if "xi" not in ds:   # a with/without-pounding compare: no formula
+        return REFERENCE
     formulas = [str(x) for x in ds.xi.values]
     reference = str(ds.attrs.get("reference_xi", REFERENCE))
     return reference if reference in formulas else formulas[-1]
@@ -419,6 +433,7 @@ def register_cli(sub) -> None:
                      "without a '# dt = 0.005 s' header, s")
     run.add_argument("--scale", metavar="X", help=SCALE_HELP)
     run.add_argument("--xi", help="xi formula for every hertz-damp contact (see `pounding xi list`)")
+    run.add_argument("--no-contacts", action="store_true", help="every contact held open: the run without pounding")
     run.add_argument("--duration", type=float, help="simulated time, s")
     run.add_argument("--rtol", type=float, help="relative tolerance of the solver")
     run.add_argument("--output-dt", type=float, help="sampling of stored histories, s")

@@ -9,7 +9,8 @@ from pathlib import Path
 from pounding.errors import PoundingError
 from pounding.studies.engine.execution import default_workers
 
-__all__ = ["register_cli", "add_cluster_options", "check_study_options", "summary_lines", "raise_if_all_failed"]
+__all__ = ["register_cli", "add_cluster_options", "check_study_options", "summary_lines", "raise_if_all_failed",
+           "print_study_warnings"]
 
 # --------------------------------------------------------------------------- #
 # Command line
@@ -48,6 +49,15 @@ def summary_lines(ds) -> list[str]:
     return lines + failure_report(ds)
 
 
+def print_study_warnings(ds) -> None:
+    """The study's warnings (archive attribute ``warnings``: each kind once, pounding.results.checks) on stderr."""
+    import json
+
+    from pounding.results.checks import print_warnings
+
+    print_warnings(json.loads(ds.attrs.get("warnings", "[]")))
+
+
 def raise_if_all_failed(ds, output) -> None:
     """Print each distinct error on stderr and stop (status 2) when no scenario ran."""
     from pounding.studies.sweep.execution import failure_report
@@ -62,6 +72,7 @@ def raise_if_all_failed(ds, output) -> None:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
     from pounding.studies.sweep.execution import run_sweep
+    from pounding.results.checks import axis_warning, print_warnings
     from pounding.studies.sweep.spec import load_sweep
 
     if args.workers is not None and args.workers < 1:
@@ -73,6 +84,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise PoundingError(invalid[0])
     for message in invalid:
         print(f"pounding: warning: {message}; its scenarios will record this error", file=sys.stderr)
+    print_warnings(filter(None, (axis_warning(a.name, a.values, a.units) for a in sweep.axes if a.kind == "path")))
     print(f"sweep '{sweep.name}': {sweep.size} scenarios = "
           + " x ".join(f"{d.size} {d.name}" for d in sweep.dimensions), file=sys.stderr)
     try:
@@ -88,6 +100,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     raise_if_all_failed(ds, output)
     for line in summary_lines(ds):
         print(line)
+    print_study_warnings(ds)
     rate = ds.attrs["n_run"] / ds.attrs["elapsed_time"] if ds.attrs["elapsed_time"] > 0 else float("nan")
     if ds.attrs["n_run"]:
         print(f"ran {ds.attrs['n_run']} scenarios in {ds.attrs['elapsed_time']:.1f} s ({rate:.2f} scenarios/s)")

@@ -55,7 +55,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from pounding.contact import xi as xi_formulas
 from pounding.errors import PoundingError, did_you_mean
-from pounding.registry import add_numbered
+from pounding.registry import add_numbered, lookup
 
 __all__ = [
     "ContactLaw",
@@ -333,11 +333,10 @@ class HertzDamp(ContactLaw):
     @field_validator("xi")
     @classmethod
     def _known_formula(cls, value: str) -> str:
-        if xi_formulas.ALIASES.get(value, value) not in xi_formulas.FORMULAS:
-            choices = list(xi_formulas.FORMULAS) + list(xi_formulas.ALIASES)
-            raise ValueError(f"unknown xi formula '{value}'{did_you_mean(value, choices)}; "
-                             f"choose one of: {', '.join(xi_formulas.FORMULAS)}")
-        return xi_formulas.ALIASES.get(value, value)
+        try:
+            return xi_formulas.get(value).key
+        except PoundingError as exc:
+            raise ValueError(str(exc)) from None
 
     @property
     def p(self) -> float:
@@ -601,12 +600,13 @@ def law_from_mapping(fields: dict) -> ContactLaw:
     """
     from pydantic import ValidationError
 
-    name = fields.get("law")
-    if name not in LAWS:
-        raise PoundingError(f"unknown contact law '{name}'{did_you_mean(str(name), list(LAWS))}; "
+    given = fields.get("law")
+    name = lookup(LAWS, given)
+    if name is None:
+        raise PoundingError(f"unknown contact law '{given}'{did_you_mean(str(given), list(LAWS))}; "
                             f"choose one of: {', '.join(LAWS)}")
     try:
-        return LAWS[name](**fields)
+        return LAWS[name](**{**fields, "law": name})
     except ValidationError as exc:
         first = exc.errors()[0]
         where = ".".join(str(x) for x in first["loc"])

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from pounding.errors import PoundingError, did_you_mean
-from pounding.registry import add_unique
+from pounding.registry import add_unique, lookup
 
 __all__ = [
     "XiFormula",
@@ -310,22 +310,19 @@ def names() -> list[str]:
 
 
 def get(name: str) -> XiFormula:
-    """Return the formula registered as *name* (or an alias of it).
+    """Return the formula registered as *name* (or an alias of it; case is ignored, :func:`pounding.registry.lookup`).
 
     Raises
     ------
     PoundingError
         For an unknown name, with a "did you mean" suggestion.
     """
-    key = ALIASES.get(name, name)
-    try:
-        return FORMULAS[key]
-    except KeyError:
+    key = lookup(FORMULAS, name, ALIASES)
+    if key is None:
         choices = list(FORMULAS) + list(ALIASES)
-        raise PoundingError(
-            f"unknown xi formula '{name}'{did_you_mean(name, choices)}; "
-            f"choose one of: {', '.join(FORMULAS)}"
-        ) from None
+        raise PoundingError(f"unknown xi formula '{name}'{did_you_mean(str(name), choices)}; "
+                            f"choose one of: {', '.join(FORMULAS)}")
+    return FORMULAS[key]
 
 
 def p(name: str, restitution: float) -> float:

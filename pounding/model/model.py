@@ -52,7 +52,25 @@ __all__ = [
     "read_yaml_text",
     "WALL",
     "column_weights",
+    "OPEN_GAP",
+    "hold_contacts_open",
 ]
+
+#: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
+#: without pounding of ``pounding run --no-contacts``, ``pounding gap``, ``ida --without-contacts`` and
+#: ``compare --contacts with,without``).
+OPEN_GAP = 1.0e6
+
+
+def hold_contacts_open(document: dict[str, Any]) -> dict[str, Any]:
+    """Set every contact of a plain model *document* to :data:`OPEN_GAP` (in place; returned).
+
+    The document form of :meth:`Model.with_contacts_open`, for the studies that edit model documents.
+    """
+    for contact in document.get("contacts") or []:
+        contact["gap"] = OPEN_GAP
+    return document
+
 
 #: Building index of a fixed wall in a gap element's sides (:data:`pounding.model.schema.WALL`).
 WALL = schema.WALL
@@ -178,6 +196,10 @@ class Building:
     p_delta : bool
         Leaning-column P-Delta: storey i carries ``P_i = g·Σ_(j≥i) m_j`` and its
         force gains ``−(P_i/h_i)·Δ_i`` (docs/physics.md §7).
+    design : DesignEntry, optional
+        The building's design factors per code (``design:`` in the YAML:
+        ``{asce7_22: {R, Cd, Ie}, ec8: {q, qd}}``), used by the code separation
+        rules of ``pounding gap --code``; None: not given.
 
     Arrays are read-only copies.  Equality is identity (arrays do not compare
     as booleans); compare the arrays to test two buildings for equal content.
@@ -190,6 +212,7 @@ class Building:
     damping: Damping
     hysteresis: tuple = ()
     p_delta: bool = False
+    design: Any = None
 
     def __post_init__(self) -> None:
         arrays = [np.array(getattr(self, key), dtype=float).reshape(-1) for key in ("mass", "stiffness", "height")]
@@ -202,8 +225,11 @@ class Building:
                              f"(got {len(hysteresis)} for {arrays[0].size} storeys)")
         storeys = [_storey_document(m, k, h, law) for m, k, h, law in zip(*arrays, hysteresis)]
         damping = self.damping.to_document() if isinstance(self.damping, Damping) else self.damping
-        entry = _checked(schema.BuildingEntry, {"name": self.name, "storeys": storeys, "damping": damping,
-                                                "p_delta": self.p_delta}, prefix=f"building {self.name}:")
+        document = {"name": self.name, "storeys": storeys, "damping": damping, "p_delta": self.p_delta}
+        if self.design is not None:
+            document["design"] = _design_document(self.design)
+        entry = _checked(schema.BuildingEntry, document, prefix=f"building {self.name}:")
+        object.__setattr__(self, "design", entry.design)
         for key, array in zip(("mass", "stiffness", "height"), arrays):
             array.setflags(write=False)
             object.__setattr__(self, key, array)
@@ -545,6 +571,10 @@ class SolverSettings:
     stop_drift_ratio : float or None
         End the run (status ``collapsed``) when a storey's |drift ratio| first
         exceeds this; None: never.
+    tolerance_scaling : bool
+        Tighten ``atol`` and ``atol_velocity`` for a building far stiffer than
+        the row moves (its static drift scale below 100·atol;
+        :mod:`pounding.solver.tolerances`).  False: the given values for every floor.
     """
 
     rtol: float = 1e-6
@@ -552,6 +582,7 @@ class SolverSettings:
     atol_velocity: float = 1e-7
     output_dt: float = 0.01
     stop_drift_ratio: float | None = None
+    tolerance_scaling: bool = True
 
     def __post_init__(self) -> None:
         entry = _checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
@@ -700,6 +731,26 @@ class Model:
         gaps = tuple(dataclasses.replace(g, law=renamed(g.law)) for g in self.gaps)
         return self._derived(gaps=gaps)
 
+    def with_contacts_open(self) -> Model:
+        """The same model with every contact held open (gap :data:`OPEN_GAP`): the run without pounding.
+
+        Labels, laws and everything else are kept, so the results line up with the model's own run.
+
+        Raises
+        ------
+        ModelError
+            The model has no contacts (holding them open would change nothing).
+        """
+        if not self.gaps:
+            where = f"{self.path}: " if self.path else ""
+            raise ModelError(f"{where}model '{self.name}' has no contacts; there is no pounding to leave out")
+        return self._derived(gaps=tuple(dataclasses.replace(g, gap=OPEN_GAP) for g in self.gaps))
+
+    @property
+    def contacts_held_open(self) -> bool:
+        """True if the model has contacts and every one is held open (gap >= :data:`OPEN_GAP`)."""
+        return bool(self.gaps) and all(g.gap >= OPEN_GAP for g in self.gaps)
+
     def with_ground_motion(self, **changes: Any) -> Model:
         """The same model with ground-motion fields changed (record, scale, duration, dt, units, base_dir).
 
@@ -834,7 +885,14 @@ def _building_document(b: Building) -> dict[str, Any]:
     document = {"name": b.name, "storeys": storeys, "damping": damping}
     if b.p_delta:
         document["p_delta"] = True
+    if b.design is not None:
+        document["design"] = _design_document(b.design)
     return document
+
+
+def _design_document(design: Any) -> Any:
+    """A building's ``design`` mapping as plain data (keys given only)."""
+    return design.model_dump(mode="json", exclude_none=True) if hasattr(design, "model_dump") else design
 
 
 def _check_keys(section: str, changes: dict[str, Any], cls: type) -> None:
@@ -864,7 +922,7 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
             array.setflags(write=False)
             arrays[key] = array
         buildings.append(_trusted(Building, name=b.name, damping=damping, hysteresis=b.column("hysteresis"),
-                                  p_delta=b.p_delta, **arrays))
+                                  p_delta=b.p_delta, design=b.design, **arrays))
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters, at_a, at_r)
                  for index, c in enumerate(entry.contacts) for (a, r), (at_a, at_r) in zip(c.pairs, c.points))
     links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)

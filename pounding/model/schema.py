@@ -53,10 +53,11 @@ from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
+from pounding.registry import lookup
 from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
 __all__ = [
-    "ModelEntry", "BuildingEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
+    "ModelEntry", "BuildingEntry", "DesignEntry", "Asce722DesignEntry", "Ec8DesignEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
     "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
@@ -486,6 +487,35 @@ def unstable_storey(mass: Any, stiffness: Any, height: Any, hysteresis: Any) -> 
     return None
 
 
+class Asce722DesignEntry(_Schema):
+    """A building's ASCE 7-22 design factors (Table 12.2-1 and §11.5.1): R, C_d, I_e."""
+
+    WHAT: ClassVar[str] = "a mapping {R, Cd, Ie}, e.g. {R: 8, Cd: 5.5, Ie: 1.0}"
+
+    R: PositiveNumber = Field(description="response modification coefficient R (ASCE 7-22 Table 12.2-1)")
+    Cd: PositiveNumber = Field(description="deflection amplification factor C_d (ASCE 7-22 Table 12.2-1)")
+    Ie: PositiveNumber = Field(1.0, description="seismic importance factor I_e (ASCE 7-22 Table 1.5-2), default 1")
+
+
+class Ec8DesignEntry(_Schema):
+    """A building's Eurocode 8 behaviour factor q (and the displacement behaviour factor q_d, default q)."""
+
+    WHAT: ClassVar[str] = "a mapping {q}, e.g. {q: 3.9}"
+
+    q: PositiveNumber = Field(description="behaviour factor q (EN 1998-1 §3.2.2.5, §5.2.2.2)")
+    qd: OptionalPositiveNumber = Field(None, description="displacement behaviour factor q_d of (4.23), default q")
+
+
+class DesignEntry(_Schema):
+    """A building's design factors per code, for the code separation rules (``pounding gap --code``)."""
+
+    WHAT: ClassVar[str] = "a mapping {asce7_22: {R, Cd, Ie}, ec8: {q}}"
+    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"asce7_22": Asce722DesignEntry, "ec8": Ec8DesignEntry}
+
+    asce7_22: Asce722DesignEntry | None = Field(None, description="ASCE 7-22 factors {R, Cd, Ie}")
+    ec8: Ec8DesignEntry | None = Field(None, description="Eurocode 8 factors {q, qd}")
+
+
 class BuildingEntry(_Schema):
     """One building: ``name``, ``storeys``, ``damping``."""
 
@@ -500,6 +530,9 @@ class BuildingEntry(_Schema):
         False, description="leaning-column P-Delta from the floor weights, true or false")
     ground_motion: GroundMotionEntry | None = Field(
         None, description="this building's own record (every building then needs one; no model-level ground_motion)")
+    design: DesignEntry | None = Field(
+        None, description="design factors per code for pounding gap --code, e.g. {asce7_22: {R: 8, Cd: 5.5, Ie: 1}, "
+                          "ec8: {q: 3.9}}")
 
     def column(self, key: str) -> tuple[Any, ...]:
         """Per-floor values of ``mass``, ``stiffness``, ``height`` or ``hysteresis``, from the ground up."""
@@ -615,6 +648,9 @@ class _JoinEntry(_Schema):
             return data
         law = data.get("law")
         names = list(cls.REGISTRY)
+        if lookup(cls.REGISTRY, law) not in (None, law):   # Hertz-Damp: the law hertz-damp
+            data = {**data, "law": lookup(cls.REGISTRY, law)}
+            law = data["law"]
         if "law" in data and not (isinstance(law, str) and law in cls.REGISTRY):
             if isinstance(law, str):
                 raise problem(f"unknown {cls.KIND} '{law}'{did_you_mean(law, names)}; "
@@ -981,7 +1017,8 @@ def _header_lacks_units(record: str, context: Any) -> bool:
     read.  Without a context (a model rebuilt from data already checked, e.g.
     ``Model.with_xi``), a relative path cannot be resolved and is left for
     the reader, whose error names the file and the fix.  A malformed header
-    is left for the reader too: it reports the line.
+    is left for the reader too: it reports the line; so is a file that does
+    not exist (the run names the model file, its line and where it looked).
     """
     from pounding.records.readers import header_declares_units
 
@@ -991,7 +1028,8 @@ def _header_lacks_units(record: str, context: Any) -> bool:
             return False
         if context["base_dir"] is not None:
             path = Path(context["base_dir"]) / path
-    return header_declares_units(path) is False
+    # a missing file has no header to ask: reading it names the model file, line and path (simulation)
+    return path.exists() and header_declares_units(path) is False
 
 
 class SolverEntry(_Schema):
@@ -1005,6 +1043,8 @@ class SolverEntry(_Schema):
     output_dt: PositiveNumber = 0.01
     stop_drift_ratio: StopDriftRatio = Field(
         None, description="end the run (status collapsed) when a storey's |drift ratio| exceeds this")
+    tolerance_scaling: bool = Field(
+        True, description="tighten atol per building to its own static drift scale (docs/numerics.md)")
 
 
 def _buildings_shape(value: Any) -> Any:
@@ -1152,7 +1192,7 @@ def _check_period_building(ground_motion: GroundMotionEntry, names: list[str], a
 
 #: The document's top-level keys (kept for the sweep's key lists).
 TopLevel = ModelEntry
-BuildingEntry.CHILDREN = {"storeys": StoreyEntry, "ground_motion": GroundMotionEntry}
+BuildingEntry.CHILDREN = {"storeys": StoreyEntry, "ground_motion": GroundMotionEntry, "design": DesignEntry}
 GroundMotionEntry.CHILDREN = {"wave_passage": WavePassageEntry}
 BuildingEntry.model_rebuild()
 ModelEntry.model_rebuild()

@@ -29,8 +29,11 @@ def plot_record(record, path: str | os.PathLike, damping: float = 0.05) -> Path:
     import matplotlib.pyplot as plt
 
     target = Path(path)
-    if target.parent and not target.parent.exists():
-        raise PoundingError(f"{target}: directory {target.parent} does not exist; create it first")
+    if target.parent and not target.parent.exists():   # created, as --plot creates its folder
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise PoundingError(f"{target}: cannot create the folder {target.parent} ({exc.strerror or exc})") from None
     acc = record.acceleration
     t = record.time
     velocity, displacement = trapezoid_integrals(acc, record.time_step)

@@ -30,7 +30,7 @@ import xarray as xr
 
 from pounding.errors import ArchiveError
 
-__all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "atomic_path", "check_not_input", "check_regular_file",
+__all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing", "atomic_path", "check_not_input", "check_regular_file",
            "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
            "REQUIRED_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
@@ -47,6 +47,37 @@ _COMPRESSION = {"zlib": True, "complevel": 4}
 _NETCDF_LOCK = threading.RLock()
 
 
+def nearest_existing(path: str | os.PathLike) -> Path:
+    """*path* itself if it exists, else its closest ancestor that does (``.`` for a relative path)."""
+    probe = Path(path)
+    while not probe.exists() and not probe.is_symlink():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    return probe
+
+
+def make_folder(folder: str | os.PathLike, *, what: str) -> Path:
+    """Create *folder* and its missing parents; one line naming *what* (the output) if it cannot be.
+
+    Raises
+    ------
+    ArchiveError
+        An ancestor is a file, or the closest existing one is not writable, or the system refuses.
+    """
+    folder = Path(folder)
+    base = nearest_existing(folder)
+    if base.exists() and not base.is_dir():
+        raise ArchiveError(f"{what}: {base} is a file, not a directory; choose another output path")
+    if base.exists() and not os.access(base, os.W_OK | os.X_OK):
+        raise ArchiveError(f"{what}: directory {base} is not writable; choose another output folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ArchiveError(f"{what}: cannot create the folder {folder} ({exc.strerror or exc})") from None
+    return folder
+
+
 def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
                    inputs: tuple | list = ()) -> Path:
     """Fail early (before any computation) if *path* cannot be written.
@@ -61,8 +92,9 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
     ------
     ArchiveError
         If the file exists and *overwrite* is false, is not a regular file,
-        is one of *inputs*, or its directory is missing, not a directory or
-        not writable, or the name is too long.
+        is one of *inputs*, or its directory is not a directory, not writable or
+        cannot be created (a missing one is created, with its parents), or the
+        name is too long.
     """
     target = Path(path)
     try:
@@ -82,8 +114,8 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
             raise ArchiveError(f"{target} is not a regular file (a FIFO, device or socket); choose another "
                                "output file")
     parent = target.parent if str(target.parent) else Path(".")
-    if not parent.exists():
-        raise ArchiveError(f"{target}: directory {parent} does not exist; create it first")
+    if not parent.exists():   # created, as --plot creates its folder
+        make_folder(parent, what=str(target))
     if not parent.is_dir():
         raise ArchiveError(f"{target}: {parent} is a file, not a directory; choose another output path")
     if not os.access(parent, os.W_OK | os.X_OK):

@@ -53,11 +53,33 @@ from pounding.solver.integrator import RawSolution, System
 from pounding.solver.status import STATUS_ENERGY_INCONSISTENT, STATUS_MESSAGES, STATUS_NAMES, STATUS_OK
 from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
+from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "REFERENCES", "RAGGED_DIMS"]
+__all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
+           "RAGGED_DIMS"]
 
 #: Dimensions whose length depends on the run (impacts, full-resolution contact samples).
 RAGGED_DIMS = ("impact", "trace")
+
+
+#: long_name of a study's ``intensity`` variable when it is the PGA of :func:`record_pga` (compare, sweep, gap).
+PGA_LONG_NAME = "peak ground acceleration (PGA) of the scaled record: the record's own PGA times scale_factor"
+
+
+def record_pga(ds: xr.Dataset) -> tuple[float, float]:
+    """Peak ground acceleration of a run's record, m/s²: as recorded (unscaled) and as run (scaled).
+
+    The unscaled PGA is the record file's own (``pga_g`` of ``record_metadata``, before processing and
+    truncation), the scaled one that times ``record_scale``.  A record given as samples without that
+    metadata falls back on the stored ``ground_acceleration`` (sampled at ``output_dt``).
+    """
+    scale = float(ds.attrs.get("record_scale", 1.0))
+    pga_g = json.loads(ds.attrs.get("record_metadata", "{}")).get("pga_g")
+    if pga_g is None:
+        scaled = float(np.max(np.abs(ds.ground_acceleration.values))) if "ground_acceleration" in ds else np.nan
+        return scaled / scale, scaled
+    unscaled = float(pga_g) * STANDARD_GRAVITY
+    return unscaled, unscaled * scale
 
 
 def drop_ragged(ds: xr.Dataset) -> xr.Dataset:
@@ -311,7 +333,7 @@ def energy_inconsistent(absorbed: float, received: float) -> bool:
     balance is ≥ 0), so a run that passes the energy audit's limit is never
     flagged here; converged runs close to ~1e-6, and a contact sequence the
     solver did not resolve (a chattering contact at loose tolerances) exceeds it
-    many times over (tests/test_stability.py: 45x at atol 1e-4 m).
+    many times over (tests/test_stability.py: 45x at atol 1e-4 m unscaled).
     """
     return absorbed - received > ENERGY_CLOSURE_LIMIT * max(abs(received), absorbed)
 
@@ -604,6 +626,10 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     }
     if peaks["status_message"]:   # not completed: why (a completed run's archive is as before)
         ds.attrs["status_message"] = peaks["status_message"]
+    if model.contacts_held_open:   # the run without pounding (pounding run --no-contacts)
+        ds.attrs["title"] += ", contacts held open"
+        ds.attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
+                                "(the run without pounding)")
     return ds
 
 

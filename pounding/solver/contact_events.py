@@ -21,11 +21,12 @@ from pounding.solver.kinematics import (SIDE_TERMS, combo, compliance, contact_d
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_ROW_LIMIT)
 from pounding.solver.rhs import rhs
+from pounding.solver.simultaneous import delassus, solve_lcp
 from pounding.solver.status import STATUS_TABLE_LIMIT
 
 __all__ = ["EVENT_NONE", "EVENT_CLOSE", "EVENT_SEPARATE", "EVENT_RELEASE", "EVENT_SWITCH0", "EVENT_SAMPLES",
            "STEPS_PER_CONTACT", "EVENTS_PER_WINDOW_BASE", "EVENTS_PER_WINDOW_PER_CONTACT", "switch_crossing",
-           "locate_contact_events", "locate_releases", "velocity_jump", "switch_contact", "plastic_jump", "apply_contact_events"]
+           "locate_contact_events", "locate_releases", "velocity_jump", "switch_contact", "plastic_jump", "resolve_rigid_contacts", "apply_contact_events"]
 
 #: Sub-intervals sampled on the interpolant when searching for a contact event.
 EVENT_SAMPLES = 8
@@ -130,6 +131,8 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
         if kernels.is_permanent(claw[c]):
             continue  # a link has no events
         if not closed[c]:
+            if cstate.resting[c]:
+                floor = max(floor, cstate.rest_band[c])  # released at rest: re-closing takes a resolved overlap
             # not closed[c], a run-time bool: one specialisation of first_crossing, not one per literal
             s = first_crossing(d0, r0, d1, r1, h_try, not closed[c], floor)  # upward: closure
             kind = EVENT_CLOSE
@@ -137,6 +140,8 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
             if forces_end[c] < 0.0:
                 n_release += 1  # the constraint force turns tensile inside the step: locate_releases
         else:
+            if cstate.resting[c]:
+                floor = max(floor, cstate.rest_band[c])  # at rest: parting within the solver's resolution is not
             s = first_crossing(d0, r0, d1, r1, h_try, not closed[c], floor)  # downward: separation
             kind = EVENT_SEPARATE
             for which in range(kernels.switch_count(claw[c], cprm[c])):
@@ -286,6 +291,112 @@ def plastic_jump(c, y, lay, mass, contacts, dvg):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def _rigid_set(kinds, contacts, cstate):
+    """Instantaneous contacts to resolve together at this instant into ``cstate.rigid.active``, the
+    closing ones first, then the stuck ones: ``(number closing, number in all)``; 0 in all when
+    fewer than two, or none closing (a single closure keeps the rule of :func:`apply_contact_events`)."""
+    active = cstate.rigid.active
+    n_closing = 0
+    n_all = 0
+    for c in range(kinds.size):
+        if kernels.is_instantaneous(contacts.law[c]) and kinds[c] == EVENT_CLOSE:
+            active[n_all] = c
+            n_closing += 1
+            n_all += 1
+    for c in range(kinds.size):
+        if (kernels.is_instantaneous(contacts.law[c]) and kinds[c] == EVENT_NONE and cstate.closed[c]
+                and cstate.mode[c] == kernels.MODE_STUCK):
+            active[n_all] = c
+            n_all += 1
+    if n_closing == 0 or n_all < 2:
+        n_all = 0
+    return n_closing, n_all
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def resolve_rigid_contacts(kinds, n_closing, na, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp,
+                           storey, ground):
+    """Closures of the instantaneous contacts ``cstate.rigid.active[:n_closing]`` together with the stuck
+    ones after them (*na* in all): one impulse each from Newton's restitution as an LCP
+    (:mod:`pounding.solver.simultaneous`).
+
+    A closure at or below the rest velocity is plastic (e = 0) and becomes stuck where the
+    constraint forces after the impulses press it (else it leaves at rest, a plastic impact);
+    a stuck contact that takes no impulse and is left separating is released.  Every contact's
+    impulse and work ``P·(w + w⁺)/2`` go to its energy-audit states (their sum is the kinetic
+    energy lost), ``P·dvg`` to the ground work.  Clears ``kinds`` of the closures handled;
+    returns the new impact-row count.
+    """
+    y, scratch, deriv, fbuf, forces = work.y, work.ystage, work.K[1], work.fbuf, work.forces
+    mass = structure.mass
+    cf, cw, claw, cprm = contacts.floors, contacts.weights, contacts.law, contacts.parameters
+    rigid = cstate.rigid
+    active, rate, dvg, impulse = rigid.active, rigid.rate, rigid.dvg, rigid.impulse
+    n = mass.size
+    for i in range(na):
+        c = active[i]
+        dvg[i] = 0.0
+        if ground is not None:
+            dvg[i] = ground_offset(ground, ground.now, c, 1)
+        rate[i] = combo(y, n, cf, cw, c) + dvg[i]
+        e = 0.0
+        if i < n_closing and rate[i] > kernels.rest_velocity(claw[c], cprm[c]):
+            e = kernels.jump_impulse(claw[c], cprm[c], 1.0) / effective_mass(mass, cf, cw, c) - 1.0
+        rigid.target[i] = rate[i] + e * max(rate[i], 0.0)
+    delassus(mass, cf, cw, active, na, rigid.delassus)
+    solve_lcp(rigid, na)
+    for i in range(na):
+        kick(y, n, mass, cf, cw, active[i], impulse[i])
+    first_row = n_imp
+    for i in range(na):
+        c = active[i]
+        after = combo(y, n, cf, cw, c) + dvg[i]
+        y[lay.impulse + c] += impulse[i]
+        y[lay.work + c] += impulse[i] * 0.5 * (rate[i] + after)
+        y[lay.ground_work] += impulse[i] * dvg[i]
+        if i >= n_closing:
+            if impulse[i] == 0.0 and after < 0.0:  # left separating: released
+                n_imp = switch_contact(c, False, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg[i])
+                cstate.mode[c] = 0
+                cstate.resting[c] = True
+            continue
+        kinds[c] = EVENT_NONE
+        cstate.resting[c] = False
+        impacts[n_imp, IMP_CONTACT] = c
+        impacts[n_imp, IMP_TIME] = t
+        impacts[n_imp, IMP_VELOCITY] = rate[i]
+        impacts[n_imp, IMP_CONSTANT] = np.nan
+        impacts[n_imp, IMP_PEAK_FORCE] = np.nan
+        impacts[n_imp, IMP_END] = t
+        impacts[n_imp, IMP_IMPULSE] = impulse[i]
+        impacts[n_imp, IMP_SEPARATION] = -after
+        impacts[n_imp, IMP_WORK] = impulse[i] * 0.5 * (rate[i] + after)
+        if rate[i] <= kernels.rest_velocity(claw[c], cprm[c]):
+            cstate.closed[c] = True  # tentatively stuck: kept where the constraint force presses it
+            cstate.mode[c] = kernels.MODE_STUCK
+        n_imp += 1
+    for i in range(y.size):
+        scratch[i] = y[i]
+    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground)
+    for i in range(n_closing):
+        c = active[i]
+        row = first_row + i
+        if not cstate.closed[c]:
+            continue
+        if forces[c] >= 0.0:
+            # an open row, as a stuck contact's: the impulse and work states at onset, the end at release
+            impacts[row, IMP_PEAK_FORCE] = 0.0
+            impacts[row, IMP_IMPULSE] = y[lay.impulse + c] - impacts[row, IMP_IMPULSE]
+            impacts[row, IMP_WORK] = y[lay.work + c] - impacts[row, IMP_WORK]
+            cstate.open_row[c] = row
+            cstate.constant[c] = 0.0
+        else:
+            cstate.closed[c] = False
+            cstate.mode[c] = 0
+    return n_imp
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
     """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.
 
@@ -320,6 +431,13 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
     n_applied = 0
     cap = np.inf
     status = 0
+    n_closing, n_rigid = _rigid_set(kinds, contacts, cstate)
+    if n_rigid > 0:
+        if n_imp + n_closing > IMPACT_ROW_LIMIT:
+            return n_imp, n_applied, cap, STATUS_TABLE_LIMIT
+        n_imp = resolve_rigid_contacts(kinds, n_closing, n_rigid, t, ag_t, lay, structure, contacts, cstate, work,
+                                       impacts, n_imp, storey, ground)
+        n_applied += n_closing
     for c in range(nc):
         kind = kinds[c]
         if kind == EVENT_NONE:
@@ -334,9 +452,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
                 status = STATUS_TABLE_LIMIT
                 break
             if kernels.is_instantaneous(claw[c]):
-                if rate <= 0.0:
-                    n_applied -= 1  # touching without approach: no impact
-                    continue
+                cstate.resting[c] = False
                 stick = False
                 if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
@@ -345,9 +461,12 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
                     rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground)
-                    stick = forces[c] > 0.0
+                    # touching without approach (v0 ≤ 0, e.g. at gap 0) sticks at zero force too
+                    stick = forces[c] > 0.0 or (rate <= 0.0 and forces[c] >= 0.0)
                     closed[c] = False
                     cmode[c] = 0
+                if not stick and rate <= 0.0:
+                    continue  # touching without approach and not pressed: no impact (still an event: counted)
                 if not stick:
                     n_imp = velocity_jump(c, t, y, lay, mass, contacts, impacts, n_imp, dvg)
                     continue
@@ -380,6 +499,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
             # kind == EVENT_CLOSE (a run-time True, like the separation's False): one specialisation
             n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
+            cstate.resting[c] = rate <= kernels.rest_velocity(claw[c], cprm[c])
             m_eff = effective_mass(mass, cf, cw, c)
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
@@ -387,6 +507,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
             n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = 0
+            cstate.resting[c] = kind == EVENT_RELEASE
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)

@@ -92,14 +92,17 @@ def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def fill_tolerances(tol, lay, contacts, atol, atol_velocity, storey) -> None:
+def fill_tolerances(tol, lay, contacts, atol, atol_velocity, floor_factor, storey) -> None:
     """Each state's absolute tolerance into *tol* (S,): *atol* (m) for displacements, *atol_velocity*
-    (m/s) for velocities, each contact law's internal tolerance (:func:`kernels.internal_tolerance`;
+    (m/s) for velocities, each times its floor's *floor_factor* (:mod:`pounding.solver.tolerances`),
+    each contact law's internal tolerance (:func:`kernels.internal_tolerance`;
     none: EXCLUDED), each yielding storey's ``storey.tolerance``; EXCLUDED for the energy quadratures."""
     for i in range(tol.size):
         tol[i] = EXCLUDED
-    for i in range(2 * lay.n_floors):
-        tol[i] = atol if i < lay.n_floors else atol_velocity
+    n = lay.n_floors
+    for i in range(n):
+        tol[i] = atol * floor_factor[i]
+        tol[n + i] = atol_velocity * floor_factor[i]
     for c in range(lay.n_contacts):
         internal = kernels.internal_tolerance(contacts.law[c], contacts.parameters[c], atol)
         if internal > 0.0:

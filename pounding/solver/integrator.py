@@ -95,7 +95,7 @@ from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, erro
                                             stages, step_factor)
 from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
                                         kernel_terms)
-from pounding.solver.layout import (ContactState, Contacts, Events, Forcing, Grounds, Layout, Settings, Storeys,
+from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, Forcing, Grounds, Layout, Settings, Storeys,
                                     Structure, Work, state_layout)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_COLUMNS,
@@ -107,6 +107,7 @@ from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS
                                     STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT, STATUS_UNSTABLE)
 from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, instability_crossing,
                                            locate_storey_events)
+from pounding.solver.tolerances import floor_tolerance_factors
 
 __all__ = ["System", "RawSolution", "integrate", "ground_kinematics", "ground_state_at", "STATUS_OK",
            "STATUS_STEP_TOO_SMALL", "STATUS_EVENT_LIMIT", "STATUS_TABLE_LIMIT", "STATUS_COLLAPSED", "STATUS_UNSTABLE",
@@ -420,15 +421,37 @@ def _accept(work) -> None:
         k1[i] = k7[i]
 
 
+#: A stuck rigid contact released at rest re-closes only past this fraction of its displacement tolerance.
+RIGID_BAND_FRACTION = 1e-3
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _new_contact_state(contacts):
-    """Every contact open (a link: closed, engaged from the start and never open), no impact row."""
+def _new_contact_state(contacts, tol):
+    """Every contact open (a link: closed, engaged from the start and never open), no impact row.
+
+    A resting contact's band is the displacement tolerance of its floors (*tol*: the error norm's
+    per-state tolerances; the smallest over the contact's floor terms): parting by less than the
+    solver resolves is not a separation (docs/numerics.md, "Contacts at rest")."""
     nc = contacts.gap.size
+    ni = nc - nc
+    for c in range(nc):
+        if kernels.is_instantaneous(contacts.law[c]):
+            ni += 1
+    rigid = RigidWork(np.zeros(ni, dtype=np.int64), np.zeros(ni), np.zeros(ni), np.zeros(ni), np.zeros(ni),
+                      np.zeros(ni), np.zeros(ni, dtype=np.int64), np.zeros((ni, ni)), np.zeros((ni, ni + 1)))
     cstate = ContactState(np.zeros(nc, dtype=np.bool_), np.zeros(nc), np.zeros(nc, dtype=np.int64),
-                          np.empty(nc, dtype=np.int64))
+                          np.empty(nc, dtype=np.int64), np.zeros(nc, dtype=np.bool_), np.empty(nc), rigid)
     for c in range(nc):
         cstate.open_row[c] = -1
         cstate.closed[c] = kernels.is_permanent(contacts.law[c])
+        band = np.inf
+        for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+            if contacts.weights[k] != 0.0:
+                band = min(band, tol[contacts.floors[k]])
+        if band == np.inf:
+            band = 0.0
+        # a rigid contact's band only needs to clear the interpolant's round-off: 1e-3 of it (≪ 1e-9 m)
+        cstate.rest_band[c] = band * RIGID_BAND_FRACTION if kernels.is_instantaneous(contacts.law[c]) else band
     return cstate
 
 
@@ -453,9 +476,9 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     ag, below, forces, rtol = forcing.acceleration, structure.below, work.forces, settings.rtol
     for i in range(2 * n):
         y[i] = y_initial[i]
-    cstate, events = _new_contact_state(contacts), _new_events(nc, nh)
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
-    fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, storey)
+    fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, settings.floor_factor, storey)
+    cstate, events = _new_contact_state(contacts, tol), _new_events(nc, nh)
     normed = normed_states(tol)
     out = new_outputs(n_out, lay, ground)
     peaks = new_peaks(lay)
@@ -618,7 +641,7 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,
               *, rtol: float, atol: float, atol_velocity: float, output_dt: float,
-              initial_displacement: np.ndarray | None = None,
+              scale_tolerances: bool = True, initial_displacement: np.ndarray | None = None,
               initial_velocity: np.ndarray | None = None) -> RawSolution:
     """Integrate the row of buildings under a piecewise-linear ground motion.
 
@@ -635,6 +658,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     rtol, atol, atol_velocity : float
         Error control: each displacement (velocity) component's local error is
         kept below ``atol (atol_velocity) + rtol·|y|``.
+    scale_tolerances : bool
+        Tighten atol and atol_velocity per building to its own static drift scale
+        (:mod:`pounding.solver.tolerances`; False: the given values for every floor, as before).
     output_dt : float
         Sampling interval of the stored histories, s (peaks and impacts are
         tracked at full solver resolution regardless).
@@ -660,8 +686,12 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                           system.rayleigh_stiffness, system.dense_start, system.dense_size, system.dense_offset,
                           system.dense_values)
     contacts = Contacts(floors, weights, system.contact_gap, system.contact_law, system.contact_parameters)
+    factors = np.ones(system.n_floors)
+    if scale_tolerances:
+        factors = floor_tolerance_factors(system.mass, system.storey_stiffness, system.below,
+                                          float(np.max(np.abs(rows))) if rows.size else 0.0, float(atol))
     settings = Settings(float(time_step), float(duration), float(rtol), float(atol), float(atol_velocity),
-                        float(output_dt), float(first_step))
+                        float(output_dt), float(first_step), factors)
     raw = _integrate(system.layout, structure, contacts, _storey_arguments(system, float(atol)), ground,
                      Forcing(ag, float(time_step)), settings, y_initial)
     out, impacts, trace = raw.outputs, raw.impacts, raw.trace

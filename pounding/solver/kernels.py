@@ -529,15 +529,20 @@ def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: fl
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def rest_velocity(law_id: int, prm: np.ndarray) -> float:
-    """Approach velocity (m/s) at or below which an instantaneous law's closure may become a resting contact.
+    """Approach velocity (m/s) at or below which a closure is a contact at rest (docs/numerics.md).
 
-    :data:`MIN_IMPACT_VELOCITY` (1 mm/s), the same floor as Hertz-damp's v0:
-    what remains of a rigid impact sequence below it lasts at most
-    ``2·e·v/((1 − e)·a)`` and moves the floors by at most ``v·`` that.
+    Stereo-mechanical: :data:`MIN_IMPACT_VELOCITY` (1 mm/s): what remains of a
+    rigid impact sequence below it lasts at most ``2·e·v/((1 − e)·a)`` and moves
+    the floors by at most ``v·`` that; the closure may become a stuck contact.
+    Compliant laws: their own floor on v0 (``min_impact_velocity`` of Hertz-damp
+    and the bumper, 1 mm/s for the others): the contact is then *resting*, and
+    parting by less than the solver resolves is not a separation.  Links: 0.
     """
-    if law_id == LAW_STEREO:
-        return MIN_IMPACT_VELOCITY
-    return 0.0
+    if law_id >= FIRST_LINK_ID:
+        return 0.0
+    if law_id == LAW_HERTZ_DAMP or law_id == LAW_BUMPER:
+        return prm[2]  # their min_impact_velocity (contact/laws.py: kernel_parameters)
+    return MIN_IMPACT_VELOCITY
 
 
 # The kernels inline the law ids and sizes of contact/laws.py: their cached code is stale when it changes.

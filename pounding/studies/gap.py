@@ -37,7 +37,7 @@ See ``docs/gap.md``.
 
 from __future__ import annotations
 
-import dataclasses
+import json
 import math
 import os
 import time
@@ -50,12 +50,10 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.registry import add_unique
 
-__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "open_contacts",
+__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite",
            "required_separations", "run_gap_scenario", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
-           "gap_summary", "gap_table", "plot_gap", "OPEN_GAP"]
+           "gap_summary", "gap_table", "plot_gap"]
 
-#: Gap (m) given to every contact of the contact-free run: no floor ever travels this far.
-OPEN_GAP = 1.0e6
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 GAP_PART = "gap-1"
 
@@ -183,19 +181,14 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     return best
 
 
-def open_contacts(model):
-    """The model with every contact held open (gap :data:`OPEN_GAP`): the contact-free run, labels kept."""
-    gaps = tuple(dataclasses.replace(g, gap=OPEN_GAP) for g in model.gaps)
-    return dataclasses.replace(model, gaps=gaps)
-
-
 def required_separations(ds) -> dict[str, np.ndarray]:
     """Required separation and peak floor displacements per contact of a contact-free run.
 
     Parameters
     ----------
     ds : xarray.Dataset
-        Results of :func:`pounding.simulation.simulate` on :func:`open_contacts` of a model.
+        Results of :func:`pounding.simulation.simulate` on a model with its contacts held open
+        (:meth:`pounding.model.model.Model.with_contacts_open`).
 
     Returns
     -------
@@ -229,6 +222,8 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     ``status = "error"`` and the message.
     """
     from pounding.model.model import model_from_text
+    from pounding.results.checks import run_warnings
+    from pounding.results.dataset import record_pga
     from pounding.simulation import simulate
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
@@ -238,7 +233,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
                               "format": PARTS_FORMAT}
     try:
         model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
-        ds = simulate(open_contacts(model))
+        ds = simulate(model.with_contacts_open())
         found = required_separations(ds)
         names = [b.name for b in model.buildings]
         modes = {b.name: _first_mode(b) for b in model.buildings}
@@ -260,6 +255,8 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "peak_left": found["peak_left"].tolist(),
             "peak_right": found["peak_right"].tolist(),
             "scale_factor": float(ds.attrs.get("record_scale", 1.0)),
+            "intensity": record_pga(ds)[1],
+            "warnings": run_warnings(ds, gaps=[g.gap for g in model.gaps]),
             "solver_wall_time": float(ds.attrs["wall_time"]),
         })
     except Exception as exc:  # noqa: BLE001 - a failing record is a result, not a crash
@@ -320,6 +317,8 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import xarray as xr
 
     from pounding import __version__
+    from pounding.results.checks import study_warnings
+    from pounding.results.dataset import PGA_LONG_NAME
 
     scenarios = sweep.scenarios()
     parts = []
@@ -337,6 +336,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     peak_left = np.full((nr, nc), np.nan)
     peak_right = np.full((nr, nc), np.nan)
     scale_factor = np.full(nr, np.nan)
+    intensity = np.full(nr, np.nan)
     status = np.array([p.get("status", "error") for p in parts], dtype=object)
     error = np.array([p.get("error", "") or "" for p in parts], dtype=object)
     for r, part in enumerate(parts):
@@ -346,6 +346,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         peak_left[r] = part["peak_left"]
         peak_right[r] = part["peak_right"]
         scale_factor[r] = part.get("scale_factor", np.nan)
+        intensity[r] = part.get("intensity", np.nan)
 
     def info(name: str, dtype=float):
         return np.array(first[name] if first else [], dtype=dtype)
@@ -403,6 +404,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "correlation": var(("contact",), rho, "1",
                                "CQC correlation of the two buildings' first modes (Der Kiureghian 1981)"),
             "scale_factor": var(("record",), scale_factor, "1", "factor applied to the record"),
+            "intensity": var(("record",), intensity, "m s-2", PGA_LONG_NAME),
             "status": (("record",), status, {"long_name": "ok, or error (see variable error)"}),
             "error": (("record",), error, {"long_name": "error message of a failed record"}),
         },
@@ -436,6 +438,9 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "Conventions": "CF-1.8",
         },
     )
+    warnings = study_warnings(p.get("warnings") for p in parts if p.get("status") == "ok")
+    if warnings:   # each kind once for the study (pounding.results.checks)
+        ds.attrs["warnings"] = json.dumps(warnings)
     return ds
 
 

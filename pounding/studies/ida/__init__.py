@@ -3,7 +3,7 @@
 Every record of a set is scaled to a series of intensities and the model is
 run at each (Vamvatsikos & Cornell 2002, "Incremental dynamic analysis",
 EESD 31 491–514).  With ``--without-contacts`` every run is repeated with
-the contacts held open (:func:`pounding.studies.gap.open_contacts`), so the
+the contacts held open (:meth:`pounding.model.model.Model.with_contacts_open`), so the
 effect of pounding is measured on identical records and intensities.  See
 ``docs/physics.md`` §8 and ``docs/ida.md``.
 

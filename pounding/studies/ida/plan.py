@@ -162,15 +162,26 @@ def _number(text: str, what: str) -> float:
     return value
 
 
+def _level(text: str, what: str) -> float:
+    """One ``--levels`` value in g: a number (``0.4``) or an intensity with units as ``--mce`` takes it
+    (``0.4g``, ``3.9 m/s2``, ``390 gal``; :func:`parse_intensity`)."""
+    try:
+        float(text)
+    except ValueError:
+        return parse_intensity(text, what) / STANDARD_GRAVITY
+    return _number(text, what)
+
+
 def parse_levels(text: str) -> np.ndarray:
-    """``--levels``: ``START:STOP:STEP`` (both ends included) or a comma-separated list, in g; sorted, > 0."""
+    """``--levels``: ``START:STOP:STEP`` (both ends included) or a comma-separated list, in g (or each value with
+    units, as ``--mce``: ``0.1g:1.5g:0.1g``, ``1,2,4 m/s2``); sorted, > 0."""
     raw = str(text).strip()
     what = f"--levels {raw!r}"
     if ":" in raw:
         pieces = raw.split(":")
         if len(pieces) != 3:
             raise PoundingError(f"{what}: write START:STOP:STEP in g, e.g. 0.1:3.0:0.1, or a list 0.2,0.4,0.8")
-        start, stop, step = (_number(p, what) for p in pieces)
+        start, stop, step = (_level(p.strip(), what) for p in pieces)
         if not step > 0:
             raise PoundingError(f"{what}: STEP must be > 0")
         if stop < start:
@@ -183,7 +194,7 @@ def parse_levels(text: str) -> np.ndarray:
         items = [p for p in raw.split(",") if p.strip()]
         if not items:
             raise PoundingError(f"{what}: write START:STOP:STEP in g, e.g. 0.1:3.0:0.1, or a list 0.2,0.4,0.8")
-        levels = np.array(sorted({_number(p.strip(), what) for p in items}))
+        levels = np.array(sorted({_level(p.strip(), what) for p in items}))
         if levels.size > MAX_LEVELS:
             raise PoundingError(f"{what} gives {levels.size} levels; at most {MAX_LEVELS}")
     if not np.all(levels > 0):
@@ -299,14 +310,13 @@ class IdaPlan:
         seconds of serial work on the client before the first run.  The documents share everything but their
         ``ground_motion`` mapping; nothing changes a scenario's data after it is made.
         """
-        from pounding.studies.gap import OPEN_GAP
+        from pounding.model.model import hold_contacts_open
 
         template = self._cache.get(("template", variant, record))
         if template is None:
             base = copy.deepcopy(self.documents[record])
             if variant == "without_contacts":
-                for contact in base.get("contacts") or []:
-                    contact["gap"] = OPEN_GAP
+                hold_contacts_open(base)
             base["ground_motion"]["scale"] = _SCALE_PLACEHOLDER
             pieces = dump_document(base).split(_yaml_scalar(_SCALE_PLACEHOLDER))
             template = (base, pieces)

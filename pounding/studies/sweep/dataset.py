@@ -39,6 +39,9 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import numpy as np
     import xarray as xr
 
+    from pounding.results.checks import study_warnings
+    from pounding.results.dataset import PGA_LONG_NAME
+
     scenarios = sweep.scenarios()
     parts = [results.get(s.key, {"status": "error", "error": "not run"}) for s in scenarios]
     storeys, storey_info = _union(parts, "storey", ("storey_building", "storey_level", "height"))
@@ -58,6 +61,8 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     closure = full(None, np.nan, float)
     wall = full(None, np.nan, float)
     solver_wall = full(None, np.nan, float)
+    scale_factor = full(None, np.nan, float)
+    intensity = full(None, np.nan, float)
     status = np.empty(shape, dtype=object)
     error = np.empty(shape, dtype=object)
     scenario_id = np.empty(shape, dtype=object)
@@ -80,6 +85,8 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             force[at + (contact_at[label],)] = f
             impacts[at + (contact_at[label],)] = n
         closure[at] = part["energy_closure_error"]
+        scale_factor[at] = part.get("scale_factor", np.nan)
+        intensity[at] = part.get("intensity", np.nan)
         solver_wall[at] = part["solver_wall_time"]
 
     def var(extra_dim, data, units, long_name, **attrs):
@@ -94,6 +101,9 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "impact_count": var("contact", impacts, "1", "number of impacts (gap closures)",
                             comment="-1 where the scenario has no result (status != ok)"),
         "energy_closure_error": var(None, closure, "1", "max |E_in - sum of energies| / max |E_in|"),
+        "scale_factor": var(None, scale_factor, "1",
+                            "factor applied to the record as stored (catalogue or file), after processing"),
+        "intensity": var(None, intensity, "m s-2", PGA_LONG_NAME),
         "wall_time": var(None, wall, "s", "wall time of the scenario on its worker (model, record, solver)"),
         "solver_wall_time": var(None, solver_wall, "s", "wall time of the integration alone"),
         "status": var(None, status.astype(str), None, "scenario status: ok or error"),
@@ -151,6 +161,9 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "n_run": int(ran),
         "elapsed_time": float(elapsed),
     }
+    warnings = study_warnings(part.get("warnings") for part in parts if part.get("status") == "ok")
+    if warnings:   # each kind once for the study (pounding.results.checks)
+        attrs["warnings"] = json.dumps(warnings)
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
@@ -166,7 +179,8 @@ def _coord_values(labels: tuple[Any, ...]):
 
 def _axis_attrs(axis: Axis) -> dict[str, str]:
     long_name = {"record": "ground-motion record", "scale": "scale factor on the record",
-                 "xi": "xi formula of every hertz-damp contact"}.get(axis.kind, f"swept model value {axis.key}")
+                 "xi": "xi formula of every hertz-damp contact",
+                 "contacts": "with: the contacts as modelled; without: every contact held open (no pounding)"}.get(axis.kind, f"swept model value {axis.key}")
     attrs = {"long_name": long_name, "sweep_axis": axis.key}
     if axis.units:
         attrs["units"] = axis.units

