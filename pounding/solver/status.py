@@ -34,5 +34,5 @@ STATUS_MESSAGES = {
     STATUS_ENERGY_INCONSISTENT: ("energy_inconsistent: the contacts dissipated {dissipated:.4g} J, more than the "
                                  "{available:.4g} J the run received (input work, initial energy, gravity under "
                                  "P-Delta); the contact events were not resolved: tighten solver.atol (and "
-                                 "atol_velocity), e.g. by 100"),
+                                 "atol_velocity), e.g. by 100, and keep solver.tolerance_scaling on"),
 }
