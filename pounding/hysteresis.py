@@ -21,6 +21,9 @@ Contract of a model
 ``kernel_parameters(stiffness, height)``
     A float64 vector of length :data:`N_HYSTERESIS_PARAMETERS`:
     ``[u_y, α, n, β, γ, A]`` (the last four used by Bouc–Wen only).
+``initial_stiffness(stiffness)``
+    The tangent dF/dΔ at rest (Δ = 0, virgin state), N/m: what P-Delta must stay
+    below for the storey to stand (the static stability check of a model).
 
 Adding a model is one subclass with its citation and one ``register`` line,
 plus one branch in each kernel of :mod:`pounding.solver.storeys`.
@@ -87,6 +90,13 @@ class StoreyHysteresis(BaseModel):
         if self.yield_force is not None:
             return float(self.yield_force)
         return float(self.yield_drift_ratio) * float(height) * float(stiffness)
+
+    def initial_stiffness(self, stiffness: float) -> float:
+        """Tangent stiffness dF/dΔ at rest (Δ = 0, virgin state), N/m, of a storey of elastic *stiffness* (N/m).
+
+        The elastic stiffness k for a model whose first branch is elastic (bilinear).
+        """
+        return float(stiffness)
 
     def kernel_parameters(self, stiffness: float, height: float) -> np.ndarray:
         """``[u_y, α, n, β, γ, A]`` for the compiled kernels."""
@@ -162,6 +172,11 @@ class BoucWenStorey(StoreyHysteresis):
             raise ValueError(f"beta + gamma must be > 0 for a bounded loop (got {self.beta + self.gamma:g}); "
                              "beta = gamma = 0.5 is the usual choice")
         return self
+
+    def initial_stiffness(self, stiffness: float) -> float:
+        """``k·(α + (1 − α)·A)``, N/m: dF/dΔ = αk + (1 − α)F_y·dz/dΔ with dz/dΔ = A/u_y at z = 0 (k when A = 1)."""
+        alpha = float(self.post_yield_ratio)
+        return float(stiffness) * (alpha + (1.0 - alpha) * float(self.A))
 
     def kernel_parameters(self, stiffness: float, height: float) -> np.ndarray:
         out = super().kernel_parameters(stiffness, height)

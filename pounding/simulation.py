@@ -34,18 +34,20 @@ from pounding.model.model import Model, model_from_text
 from pounding.model.scales import check_work
 from pounding.records.supports import SupportMotions, common_step, lagged, on_step, support_motions_from
 from pounding.results.archive import check_archive, open_run
-from pounding.results.dataset import run_peaks, to_dataset
+from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, run_peaks, to_dataset
 from pounding.solver.assembly import assemble, contact_side_terms
-from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, integrate
+from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, STATUS_UNSTABLE, integrate
 
 __all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
            "processed_record_for", "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
-           "estimate_memory", "available_memory", "check_memory", "model_inputs"]
+           "estimate_memory", "available_memory", "check_memory", "model_inputs", "FAILED_STATUSES",
+           "refuse_failed_run"]
 
-#: Energy closure error above which a run is flagged (attribute ``status``, summary
-#: line): converged runs of the shipped models close to ~1e-6, so 1e-3 is a
-#: thousand-fold margin and marks a run whose energies (and likely peaks) are wrong.
-ENERGY_CLOSURE_LIMIT = 1e-3
+#: Run statuses that studies (``ida``, sweeps) count as failed: the run ended, but its numbers are
+#: not an answer (``energy_inconsistent``: the contacts dissipated energy the run never received).
+#: ``collapsed`` and ``unstable`` are answers: the building fell (docs/reliability.md).
+FAILED_STATUSES = ("energy_inconsistent",)
+
 
 
 
@@ -402,10 +404,19 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
                     output_dt=output_dt, scale_tolerances=settings.tolerance_scaling)
     wall = _time.perf_counter() - started
-    if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
+    if raw.status not in (STATUS_OK, STATUS_COLLAPSED, STATUS_UNSTABLE):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
         raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     return system, raw, wall, rows
+
+
+def refuse_failed_run(status: str, message: str) -> None:
+    """Raise the run's one-line *message* (PoundingError) if its *status* is one of :data:`FAILED_STATUSES`.
+
+    What a study's worker calls on each run, so that such a run is that scenario's error.
+    """
+    if status in FAILED_STATUSES:
+        raise PoundingError(message)
 
 
 def mark_energy_status(ds: xr.Dataset) -> str:

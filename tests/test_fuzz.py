@@ -437,3 +437,44 @@ def _race(args: list[str], cwd: Path) -> list:
     """Start ``pounding ARGS`` twice at once; both outcomes."""
     with ThreadPoolExecutor(max_workers=2) as pool:
         return list(pool.map(lambda _: pounding(args, cwd), range(2)))
+
+
+#: Issue 25 §1, three classes drawn in turn: P-Delta at or above the first storey's initial stiffness
+#: (θ = P/(k·h) of storey A:1 ≥ 1: refused), well below it (a run), and below it on storeys whose
+#: tangent P-Delta turns negative once they yield, shaken hard (a run that may end unstable).
+STABILITY_CLASSES = [
+    ([1.0, 1.001, 3.0, 1e3], [None, {"model": "bilinear", "yield_drift_ratio": 0.002},
+                              {"model": "bouc-wen", "yield_drift_ratio": 0.002, "A": 0.3}], [1.0]),
+    ([0.2, 0.9], [None, {"model": "bouc-wen", "yield_drift_ratio": 0.002, "n": 2}], [1.0, 5.0]),
+    ([0.3, 0.6], [{"model": "bilinear", "yield_drift_ratio": 0.001, "post_yield_ratio": 0.0},
+                  {"model": "bouc-wen", "yield_drift_ratio": 0.001, "post_yield_ratio": 0.0}], [30.0, 60.0]),
+]
+
+
+def test_fuzz_stability(tmp_path):
+    """Buildings on the edge of P-Delta stability: refused in one line, or a run whose archive says how it ended."""
+    rng = random.Random(SEED + 5)
+    cases = []
+    for i in range(max(3, N_EDGES // 3)):
+        thetas, laws, scales = STABILITY_CLASSES[i % 3]
+        model = base_model()
+        building = model["buildings"][0]
+        building["p_delta"] = True
+        load = 9.80665 * building["storeys"]["mass"] * building["storeys"]["count"] / building["storeys"]["height"]
+        building["storeys"]["stiffness"] = load / rng.choice(thetas)
+        law = rng.choice(laws)
+        if law is not None:
+            building["storeys"]["hysteresis"] = law
+        model["ground_motion"]["scale"] = rng.choice(scales)
+        folder = tmp_path / f"s{i}"
+        path = _write_case(folder, model)
+        cases.append((f"stability case {i}", ["run", str(path), "-o", str(folder / "out.nc")], folder,
+                      folder / "out.nc", TIME_LIMIT))
+    _check_all(cases)
+    from pounding.results.archive import open_run
+
+    for i, (_, _, folder, archive, _) in enumerate(cases):
+        assert i % 3 != 0 or not archive.exists(), folder   # the first class is refused
+        if archive.exists():
+            status = open_run(archive).attrs["status"]
+            assert status in ("completed", "collapsed", "unstable", "energy_inconsistent"), (folder, status)

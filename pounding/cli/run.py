@@ -136,6 +136,9 @@ def summary(ds) -> str:
     if ds.attrs.get("status") == "collapsed":
         lines.append(f"COLLAPSED: storey {ds.attrs['collapse_storey']} passed drift ratio "
                      f"{ds.attrs['stop_drift_ratio']:g} at t = {ds.attrs['collapse_time']:.4f} s; the run ended there")
+    elif ds.attrs.get("status") in ("unstable", "energy_inconsistent"):
+        status, _, why = str(ds.attrs.get("status_message", ds.attrs["status"])).partition(": ")
+        lines.append(f"{status.upper().replace('_', ' ')}: {why}")
     if ds.sizes.get("contact", 0):
         lines.append("contacts (gap element: impacts, peak force, formula):")
         for i in range(ds.sizes["contact"]):
@@ -360,7 +363,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     kind, ds = open_archive(args.run)
     with _damaged_if_garbled(args.run):
         nothing = kind in ("sweep", "compare", "gap", "ida") and \
-            not bool(ds.status.isin(["ok", "completed", "collapsed"]).any())
+            not bool(ds.status.isin(["ok", "completed", "collapsed", "unstable"]).any())
     if nothing:
         raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
                             f"`pounding info {args.run}` lists the errors")

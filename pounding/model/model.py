@@ -37,7 +37,6 @@ from pounding.contact.links import LinkLaw
 from pounding.errors import ModelError, PoundingError, did_you_mean
 from pounding.memory import check_memory
 from pounding.records.catalogue import is_catalogued
-from pounding.units import STANDARD_GRAVITY
 
 __all__ = [
     "Damping",
@@ -267,7 +266,7 @@ class Building:
     @property
     def gravity_load(self) -> np.ndarray:
         """(n,) axial load P_i = g·Σ_(j≥i) m_j carried by each storey, N."""
-        return STANDARD_GRAVITY * np.cumsum(self.mass[::-1])[::-1]
+        return schema.storey_gravity_load(self.mass)
 
     @property
     def p_delta_stiffness(self) -> np.ndarray:

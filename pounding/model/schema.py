@@ -54,7 +54,7 @@ from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import Document, Location, parse_document, plural
 from pounding.registry import lookup
-from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
+from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
 __all__ = [
     "ModelEntry", "BuildingEntry", "DesignEntry", "Asce722DesignEntry", "Ec8DesignEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
@@ -462,6 +462,31 @@ Damping = Annotated[
 TAGS.update({"~rayleigh": RayleighEntry, "~modal": ModalEntry})
 
 
+def storey_gravity_load(mass: Any) -> np.ndarray:
+    """(n,) axial load ``P_i = g·Σ_(j≥i) m_j`` carried by each storey, N, of floor masses *mass* (kg, from the ground up)."""
+    return STANDARD_GRAVITY * np.cumsum(np.asarray(mass, dtype=float)[::-1])[::-1]
+
+
+def unstable_storey(mass: Any, stiffness: Any, height: Any, hysteresis: Any) -> tuple[int, float, float] | None:
+    """The first storey that P-Delta makes unstable at rest: ``(index from 0, P/h in N/m, k in N/m)``, or None.
+
+    A shear building's static stiffness with P-Delta is ``K = Bᵀ diag(k_j − P_j/h_j) B``
+    with B the (invertible, unit lower-bidiagonal) map from floor displacements to
+    storey drifts, so K is positive definite exactly when every storey's effective
+    stiffness ``k_j − P_j/h_j`` is > 0 (tests/test_stability.py checks this against
+    the eigenvalues); k is the storey's initial tangent
+    (:meth:`pounding.hysteresis.StoreyHysteresis.initial_stiffness`; its elastic stiffness
+    without hysteresis).  The condition is the building's own (P/(k·h) < 1, the stability
+    coefficient θ of ASCE 7 §12.8.7 below 1): a link to a neighbour is not counted on to prop it.
+    """
+    geometric = storey_gravity_load(mass) / np.asarray(height, dtype=float)
+    for j, (k, law, kg) in enumerate(zip(stiffness, hysteresis, geometric)):
+        initial = float(k) if law is None else law.initial_stiffness(k)
+        if initial - kg <= 0.0:
+            return j, float(kg), initial
+    return None
+
+
 class Asce722DesignEntry(_Schema):
     """A building's ASCE 7-22 design factors (Table 12.2-1 and §11.5.1): R, C_d, I_e."""
 
@@ -544,6 +569,21 @@ class BuildingEntry(_Schema):
                 raise problem(f"mode {mode} does not exist: building {self.name} has {plural(n, 'storey')}, "
                               f"so {plural(n, 'mode')}{hint}", kind="error", at=("damping", "modes", position))
         return self
+
+    @model_validator(mode="after")
+    def _statically_stable(self) -> BuildingEntry:
+        if not self.p_delta:
+            return self
+        found = unstable_storey(self.column("mass"), self.column("stiffness"), self.column("height"),
+                                self.column("hysteresis"))
+        if found is None:
+            return self
+        j, geometric, initial = found
+        raise problem(f"makes building {self.name} unstable at rest: storey {j + 1} has P/h = {geometric:.4g} N/m "
+                      f"of P-Delta against an initial stiffness k = {initial:.4g} N/m (k - P/h <= 0, it would "
+                      "lean over under its own weight); make the storey stiffer than P/h, lighten the floors "
+                      "above it, or set p_delta: false", kind="error", at=("p_delta",), line="key", colon=False,
+                      fallback=True)
 
 
 class ContactGeometry(_Schema):

@@ -51,6 +51,7 @@ from pounding.results.describe import run_title
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.solver.integrator import RawSolution, System
+from pounding.solver.status import STATUS_ENERGY_INCONSISTENT, STATUS_MESSAGES, STATUS_NAMES, STATUS_OK
 from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
 from pounding.units import STANDARD_GRAVITY
@@ -293,15 +294,73 @@ def energy_closure(ds: xr.Dataset) -> float:
     return float(np.abs(inputs - parts).max()) / scale
 
 
+#: Energy closure error above which a run is flagged (attribute ``energy_status``, summary
+#: line): converged runs of the shipped models close to ~1e-6, so 1e-3 is a
+#: thousand-fold margin and marks a run whose energies (and likely peaks) are wrong.
+ENERGY_CLOSURE_LIMIT = 1e-3
+
+
+def contact_energy_budget(system: System, raw: RawSolution, n_gaps: int) -> tuple[float, float]:
+    """``(absorbed, received)``, J, at the end of the run: what the gap elements absorbed, what the run received.
+
+    *absorbed* is the gap elements' work ∫F·δ̇ dt (dissipated, plus what a closed
+    contact still stores); *received* the initial energy (kinetic, storey and
+    contact strain at the first sample), the input work E_in, the work W_g of
+    the differential ground motion and gravity's work under P-Delta, at most
+    ``½·Σ (P/h)·Δ²`` (the storeys' P-Delta potential, negative, is all that can
+    make their recoverable energy negative).  Every other term of the balance
+    ``E_0 + E_in + W_g = KE + U_s + damping + hysteretic + contacts + links`` is
+    ≥ 0, so in a solution that conserves energy ``absorbed ≤ received`` at every
+    instant.  Read from the solver's final state, so a run and its IDA twin
+    (:func:`simulate_peaks <pounding.simulation.simulate_peaks>`, same steps) agree.
+    """
+    lay = system.layout
+    n = lay.n_floors
+    first, last = raw.state[0], raw.final_state
+    v0 = first[n:2 * n]
+    initial = 0.5 * float(v0 @ (v0 * system.mass)) + float(raw.storey_energy[0, 0]) + float(raw.contact_potential[0])
+    drift = _storey_drift(last[None, :n], system.below)[0]
+    gravity = -0.5 * float(drift @ (drift * system.p_delta_stiffness))
+    received = initial + float(last[lay.input_energy]) + float(last[lay.ground_work]) + gravity
+    absorbed = float(last[lay.work:lay.work + n_gaps].sum())
+    return absorbed, received
+
+
+def energy_inconsistent(absorbed: float, received: float) -> bool:
+    """True if the contacts absorbed more energy than the run received, beyond integration error.
+
+    The margin is :data:`ENERGY_CLOSURE_LIMIT` of the larger of the two: the excess
+    is a lower bound of the run's energy-closure error (every other term of the
+    balance is ≥ 0), so a run that passes the energy audit's limit is never
+    flagged here; converged runs close to ~1e-6, and a contact sequence the
+    solver did not resolve (a chattering contact at loose tolerances) exceeds it
+    many times over (tests/test_stability.py: 45x at atol 1e-4 m unscaled).
+    """
+    return absorbed - received > ENERGY_CLOSURE_LIMIT * max(abs(received), absorbed)
+
+
+def run_status(system: System, raw: RawSolution, n_gaps: int, storey: str) -> tuple[str, str]:
+    """``(status, one-line message)`` of a run that ended (``completed``, ``collapsed``, ``unstable`` or
+    ``energy_inconsistent``; message ``""`` when completed).  *storey*: the label of the storey that
+    collapsed or lost stability (``""`` if none)."""
+    absorbed, received = contact_energy_budget(system, raw, n_gaps)
+    code = STATUS_ENERGY_INCONSISTENT if energy_inconsistent(absorbed, received) else raw.status
+    if code == STATUS_OK:
+        return STATUS_NAMES[code], ""
+    return STATUS_NAMES[code], STATUS_MESSAGES[code].format(t=raw.final_time, storey=storey, dissipated=absorbed,
+                                                            available=received)
+
+
 def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     """The peaks and end-of-run state of one simulation, as plain arrays (what studies keep of a run).
 
     The same values :func:`to_dataset` stores under the same names: storey and
     contact labels, ``peak_drift_ratio`` and ``residual_drift_ratio`` (storey,
     1), ``impact_count`` and ``peak_contact_force`` (contact, N), ``status``
-    (``completed`` or ``collapsed``), ``collapse_time`` (s, NaN if none) and
-    ``collapse_storey`` (label, ``""`` if none).  They do not depend on the
-    output sampling: the solver tracks peaks at every step.
+    (``completed``, ``collapsed``, ``unstable`` or ``energy_inconsistent``: :func:`run_status`) and
+    ``status_message`` (its one line, ``""`` when completed), ``collapse_time`` (s, NaN if none) and
+    ``collapse_storey`` (label, ``""`` if none; also for ``unstable``: the storey that lost its
+    resistance).  They do not depend on the output sampling: the solver tracks peaks at every step.
     """
     labels = _labels(model)
     heights = labels["height"]
@@ -309,6 +368,7 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
     building_names = [b.name for b in model.buildings]
     collapsed = raw.collapse_storey >= 0
+    status, message = run_status(system, raw, ng, floor_names[raw.collapse_storey] if collapsed else "")
     return {
         "storey": floor_names,
         "storey_building": [str(b) for b in labels["building"]],
@@ -318,7 +378,8 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
         "impact_count": (np.bincount(raw.impact_contact, minlength=ng).astype(np.int32) if ng
                          else np.zeros(0, np.int32)),
         "peak_contact_force": raw.peak_contact_force[:ng],
-        "status": "collapsed" if collapsed else "completed",
+        "status": status,
+        "status_message": message,
         "collapse_time": float(raw.final_time) if collapsed else float("nan"),
         "collapse_storey": floor_names[raw.collapse_storey] if collapsed else "",
     }
@@ -564,6 +625,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
+    if peaks["status_message"]:   # not completed: why (a completed run's archive is as before)
+        ds.attrs["status_message"] = peaks["status_message"]
     if model.contacts_held_open:   # the run without pounding (pounding run --no-contacts)
         ds.attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
                                 "(the run without pounding)")

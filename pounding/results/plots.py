@@ -297,8 +297,9 @@ def _storey_hysteresis(plt, ds: xr.Dataset, path: Path) -> None:
                      f"residual {100 * float(ds.residual_drift_ratio.values[i]):+.2f} %", fontsize=8)
         ax.grid(alpha=0.3)
     title = f"storey hysteresis — {run_title(ds)}\n(column shear, without P-Delta and damping; dashed: yield force ±F_y)"
-    if ds.attrs.get("status") == "collapsed":
-        title += f" - COLLAPSED at {ds.attrs['collapse_time']:.2f} s (storey {ds.attrs['collapse_storey']})"
+    if ds.attrs.get("status") in ("collapsed", "unstable"):
+        title += (f" - {ds.attrs['status'].upper()} at {ds.attrs['collapse_time']:.2f} s "
+                  f"(storey {ds.attrs['collapse_storey']})")
     left_out = hysteresis_left_out(ds)
     suptitle(fig, title + (f"\n{left_out}" if left_out else ""), fontsize=8)
     save_figure(fig, path)

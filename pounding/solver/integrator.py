@@ -37,7 +37,9 @@ Design
   located as events, like gap closure, so no step straddles a kink of its
   force (:mod:`pounding.solver.storeys`).  P-Delta is a linear geometric
   stiffness per storey.  A run stops, located, when a storey's drift ratio
-  first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED).
+  first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED), or when a storey
+  with P-Delta loses its lateral resistance, its restoring force plus P-Delta
+  falling to zero as its drift grows (STATUS_UNSTABLE).
 
 State vector layout (:mod:`pounding.solver.layout`): ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]``
 (``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force; ``r``: each
@@ -102,12 +104,14 @@ from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IM
                                       trimmed_outputs, TRACE_ROW_LIMIT)
 from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
-                                    STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT)
-from pounding.solver.storey_events import STOREY_NONE, apply_storey_events, collapse_crossing, locate_storey_events
+                                    STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT, STATUS_UNSTABLE)
+from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, instability_crossing,
+                                           locate_storey_events)
 from pounding.solver.tolerances import floor_tolerance_factors
 
 __all__ = ["System", "RawSolution", "integrate", "ground_kinematics", "ground_state_at", "STATUS_OK",
-           "STATUS_STEP_TOO_SMALL", "STATUS_EVENT_LIMIT", "STATUS_TABLE_LIMIT", "STATUS_COLLAPSED", "STATUS_MESSAGES",
+           "STATUS_STEP_TOO_SMALL", "STATUS_EVENT_LIMIT", "STATUS_TABLE_LIMIT", "STATUS_COLLAPSED", "STATUS_UNSTABLE",
+           "STATUS_MESSAGES",
            "SAFETY", "MIN_FACTOR", "MAX_FACTOR", "SIDE_TERMS", "IMPACT_ROW_LIMIT"]
 
 jit.load_registries_without_scipy()
@@ -258,7 +262,7 @@ class RawSolution:
     storey_shear: np.ndarray         # (nt, N) N, restoring (column) shear of each storey, without P-Delta
     storey_energy: np.ndarray        # (nt, 2) J: recoverable energy of all storeys (with P-Delta), of the yielding ones
     final_state: np.ndarray          # (S,) state at final_time
-    collapse_storey: int             # floor index of the storey that exceeded stop_drift_ratio, −1 if none
+    collapse_storey: int             # floor index of the storey that collapsed or lost stability, −1 if none
     n_steps: int
     n_rejected: int
     status: int
@@ -287,7 +291,7 @@ class Integration(NamedTuple):
     impacts: np.ndarray    #: (ni, IMPACT_COLUMNS) the impact table
     trace: np.ndarray      #: (nr, 4) time, contact, penetration, force of closed contacts
     final_state: np.ndarray
-    collapse_floor: int    #: floor of the storey that exceeded the drift limit, −1 if none
+    collapse_floor: int    #: floor of the storey that exceeded the drift limit or lost stability, −1 if none
     n_steps: int
     n_rejected: int
     status: int
@@ -384,19 +388,28 @@ def _count_events(t, n_applied, start, count, record_step):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _locate_storeys(work, h, lay, below, storey, events, s_first, collapse_floor):
-    """The yielding storeys' first events in a trial step of *h* s and the collapse limit's crossing:
-    ``(first event fraction, *s_first* if earlier; collapse fraction, −1 if none; its floor, else
-    *collapse_floor*)``.  A kernel of its own, so the driver's loop has no branch of its own for the
-    storeys (its branches cost reference counts of the tables it grows, at every step)."""
+def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_floor, stop_status):
+    """The yielding storeys' first events in a trial step of *h* s, and the first stop of the run in it
+    (the collapse limit's crossing, STATUS_COLLAPSED, or a loss of stability, STATUS_UNSTABLE):
+    ``(first event fraction, *s_first* if earlier; stop fraction, −1 if none; its floor and status, else
+    *collapse_floor* and *stop_status*)``.  A kernel of its own, so the driver's loop has no branch of its
+    own for the storeys (its branches cost reference counts of the tables it grows, at every step)."""
+    below = structure.below
     s_first = min(s_first, locate_storey_events(work, h, lay, below, storey, events.storey_s, events.storey_kind))
     collapse_s = -1.0
     if storey.stop_ratio > 0.0:
         collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio, h)
         if collapse_s >= 0.0:
-            s_first = min(s_first, collapse_s)
             collapse_floor = collapse_at
-    return s_first, collapse_s, collapse_floor
+            stop_status = STATUS_COLLAPSED
+    unstable_s, unstable_at = instability_crossing(work, lay, below, storey, structure.storey_stiffness, h)
+    if unstable_s >= 0.0 and (collapse_s < 0.0 or unstable_s < collapse_s):
+        collapse_s = unstable_s
+        collapse_floor = unstable_at
+        stop_status = STATUS_UNSTABLE
+    if collapse_s >= 0.0:
+        s_first = min(s_first, collapse_s)
+    return s_first, collapse_s, collapse_floor, stop_status
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
@@ -478,6 +491,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     h, n_steps, n_rej, status, collapse_floor, i_out = settings.first_step, zero, zero, zero, zero - 1, zero + 1
     tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
     window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
+    stop_status = zero + STATUS_COLLAPSED  # which stop collapse_s / collapse_pending is: collapsed or unstable
     while t < t_end - tiny and i_out <= n_out:
         while (seg + 1) * dt_rec <= t + 1e-9 * dt_rec:
             seg += 1
@@ -509,13 +523,13 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
                                                        events, storey, ground))
             collapse_s = -1.0
             if storey is not None:
-                s_first, collapse_s, collapse_floor = _locate_storeys(work, h_try, lay, below, storey, events, s_first,
-                                                                      collapse_floor)
+                s_first, collapse_s, collapse_floor, stop_status = _locate_storeys(
+                    work, h_try, lay, structure, storey, events, s_first, collapse_floor, stop_status)
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 _keep_events_within(events, h_try, tiny)
                 if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
-                    status = STATUS_COLLAPSED
+                    status = stop_status
                     break
                 impacts = _with_room(impacts, n_imp, nc)
                 n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
@@ -564,8 +578,8 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
         any_events = _with_pending(events)
-        if storey is not None:  # located: this step ends where the drift limit is first exceeded
-            status = STATUS_COLLAPSED if collapse_s >= 0.0 or collapse_pending else status
+        if storey is not None:  # located: this step ends where the drift limit is first exceeded (or stability lost)
+            status = stop_status if collapse_s >= 0.0 or collapse_pending else status
         if status != 0:
             break
         if any_events:
@@ -591,7 +605,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             ag_t = _rates_at(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground)
             record_sample(i2, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
         i_out = n_out
-    if status != STATUS_COLLAPSED:
+    if status != STATUS_COLLAPSED and status != STATUS_UNSTABLE:
         collapse_floor = zero - 1
     return Integration(trimmed_outputs(out, i_out), peaks, impacts[:n_imp], trace[:n_trace], y,
                        collapse_floor, n_steps, n_rej, status, t)

@@ -4,7 +4,9 @@ A bilinear storey's force has kinks where its drift reaches the yield
 surface and where a yielding storey unloads; they are located on the step's
 interpolant like gap closure, so no step straddles one
 (:mod:`pounding.solver.storeys`).  A run stops, located, where a storey's
-drift ratio first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED).
+drift ratio first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED), and where a
+storey with P-Delta loses its lateral resistance (STATUS_UNSTABLE,
+:func:`instability_crossing`).
 """
 
 from __future__ import annotations
@@ -14,11 +16,11 @@ from numba import njit
 from pounding import hysteresis
 from pounding.solver import jit
 from pounding.solver import storeys
-from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing
+from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
 from pounding.solver.kinematics import drift, drift_interpolant
 
 __all__ = ["STOREY_NONE", "STOREY_YIELD_POSITIVE", "STOREY_YIELD_NEGATIVE", "STOREY_UNLOAD", "storey_event",
-           "locate_storey_events", "apply_storey_events", "collapse_crossing"]
+           "locate_storey_events", "apply_storey_events", "collapse_crossing", "instability_crossing"]
 
 # Kinds of storey events (bilinear storeys).
 STOREY_NONE, STOREY_YIELD_POSITIVE, STOREY_YIELD_NEGATIVE, STOREY_UNLOAD = range(4)
@@ -135,6 +137,77 @@ def collapse_crossing(work, n, below, heights, stop_ratio, h):
             if s >= 0.0 and (best < 0.0 or s < best):
                 best = s
                 where = j
+    return best, where
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def instability_crossing(work, lay, below, storey, stiffness, h):
+    """First instant in a step where a storey with P-Delta loses its lateral resistance: (fraction, floor).
+
+    The storey's total resistance ``R = F(Δ, r) + k_pd·Δ`` (restoring force and
+    P-Delta, ``k_pd = −P/h``; *stiffness*: every storey's k, N/m) falls to zero
+    while its drift grows away from zero: ``σR`` crosses from > 0 to ≤ 0 (σ the
+    sign of the drift at the step's start) where ``σΔ > 0`` and ``σΔ̇ > 0``.
+    Beyond it gravity's overturning moment exceeds what the storey can resist:
+    the building cannot stand (a bilinear storey with αk < P/h, past its
+    zero-resistance drift ``(1 − α)F_y / (P/h − αk)``).  F is linear in (Δ, r)
+    for the bilinear and Bouc–Wen storeys (:mod:`pounding.solver.storeys`), so
+    R's Hermite cubic on the step is that combination of the cubics of Δ and r
+    (its rate F(Δ̇, ṙ) + k_pd·Δ̇) and its crossing is found exactly, as the
+    collapse limit's; a model whose force is not linear in its state is not
+    searched until it brings its own rate here.  Only a crossing from
+    the near side counts: a step that starts with ``σR ≤ 0`` (a storey unloaded
+    past zero force, moving back toward its plastic offset) has none.
+
+    A crossing counts only from a resistance above the noise the tolerances
+    leave in it, ``(k + P/h)·atol`` (atol: the storey state's tolerance in m):
+    a storey drifting 1e-23 m with its Bouc–Wen z a tolerance away from AΔ/u_y
+    would otherwise "cross" there.  A bilinear storey is searched only while
+    it yields and beyond its yield drift u_y, two comparisons for most steps:
+    while elastic its tangent ``k − P/h`` is positive (the model's check), and
+    its zero-resistance drift ``(1 − α)F_y / (P/h − αk)`` exceeds u_y whenever
+    ``P/h < k``.  (A Bouc–Wen storey softens from its first drift, and with
+    ``k0 − P/h`` small loses its resistance well below u_y.)  A storey whose
+    post-yield tangent ``αk − P/h`` is ≥ 0 is not searched at all (bilinear,
+    and Bouc–Wen with β ≥ 0, whose z, within ±(A/(β + γ))^(1/n), does not fall
+    while the drift grows: its resistance cannot fall either).
+    """
+    y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
+    n, ih = lay.n_floors, lay.hysteretic
+    kpd, smodel, sprm, sidx = storey.p_delta, storey.model, storey.parameters, storey.state_index
+    best = -1.0
+    where = -1
+    for j in range(n):
+        hi = sidx[j]
+        model = smodel[j]
+        if kpd[j] == 0.0 or hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
+            continue
+        bilinear = model == hysteresis.MODEL_BILINEAR
+        k = stiffness[j]
+        if (bilinear or sprm[j, 3] >= 0.0) and sprm[j, 1] * k + kpd[j] >= 0.0:
+            continue
+        if bilinear and storey.mode[hi] == storeys.ELASTIC:
+            continue
+        reach = sprm[j, 0] if bilinear else 0.0
+        d0, v0, d1, v1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, below[j])
+        # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|v0| + |v1|) (collapse_crossing).
+        if max(abs(d0), abs(d1)) + 0.25 * h * (abs(v0) + abs(v1)) < reach:
+            continue
+        sign = 1.0 if d0 > 0.0 else -1.0
+        q0, q1, dq0, dq1 = y[ih + hi], ynew[ih + hi], k1[ih + hi], k7[ih + hi]
+        r0 = sign * (storeys.restoring_force(model, sprm, j, k, d0, q0) + kpd[j] * d0)
+        if r0 <= (k - kpd[j]) * storey.tolerance[hi] * (1.0 if bilinear else sprm[j, 0]):
+            continue
+        r1 = sign * (storeys.restoring_force(model, sprm, j, k, d1, q1) + kpd[j] * d1)
+        rate0 = sign * (storeys.restoring_force(model, sprm, j, k, v0, dq0) + kpd[j] * v0)
+        rate1 = sign * (storeys.restoring_force(model, sprm, j, k, v1, dq1) + kpd[j] * v1)
+        s = first_crossing(r0, rate0, r1, rate1, h, False, DELTA_ROUNDOFF * (abs(k * d0) + abs(kpd[j] * d0)))
+        if s < 0.0 or (best >= 0.0 and s >= best):
+            continue
+        drift_s = sign * hermite(d0, v0, d1, v1, h, s)
+        if drift_s > 0.0 and drift_s >= reach and sign * hermite(v0, a0, v1, a1, h, s) > 0.0:
+            best = s
+            where = j
     return best, where
 
 

@@ -36,7 +36,10 @@ Levels
 Outcome of a run
     ``completed`` or ``collapsed`` from the run's ``status`` attribute
     (``collapsed`` only when the solver stopped the run at its collapse
-    criterion), ``failed`` when the run raised.  A building is taken as
+    criterion, or where a storey lost its lateral resistance to P-Delta,
+    status ``unstable``: a sidesway collapse), ``failed`` when the run raised
+    or its status is ``energy_inconsistent`` (its contacts dissipated more
+    energy than it received: tighter tolerances give an answer).  A building is taken as
     **collapsed** in a run when the run's status is ``collapsed`` (every
     building: the run stopped, so the later response of its neighbours is
     unknown) or when its largest peak storey drift ratio reaches the collapse

@@ -75,7 +75,7 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     ``status = "error"`` and the message (the run ``failed``).  NaN values
     are stored as None (JSON has no NaN).
     """
-    from pounding.simulation import simulate_peaks
+    from pounding.simulation import refuse_failed_run, simulate_peaks
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
 
@@ -85,9 +85,11 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model, record = _model_and_record(task)
         peaks = simulate_peaks(model, record)   # the peaks of simulate(model), without histories or dataset
+        refuse_failed_run(peaks["status"], peaks["status_message"])   # energy_inconsistent: failed
         result.update({
             "status": "ok",
-            "outcome": peaks["status"],
+            # A storey that lost its lateral resistance (unstable) is a sidesway collapse of the building.
+            "outcome": "collapsed" if peaks["status"] in ("collapsed", "unstable") else peaks["status"],
             "run_status": peaks["status"],
             "collapse_time": _plain(peaks["collapse_time"]),
             "collapse_storey": peaks["collapse_storey"],

@@ -30,7 +30,7 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
         from pounding.model.model import model_from_data, model_from_text
         from pounding.results.checks import run_warnings
         from pounding.results.dataset import record_pga
-        from pounding.simulation import simulate
+        from pounding.simulation import refuse_failed_run, simulate
 
         try:
             if task.get("data") is not None:
@@ -41,6 +41,7 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
         except ModelError as exc:
             raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
         ds = simulate(model)
+        refuse_failed_run(ds.attrs["status"], ds.attrs.get("status_message", ""))   # energy_inconsistent: an error
         result.update({
             "warnings": run_warnings(ds),
             "scale_factor": float(ds.attrs["record_scale"]),
