@@ -253,6 +253,18 @@ def test_an_ida_prints_its_number_of_runs_before_it_starts(case, tmp_path):
     assert status == 2 and "--hunt would make up to 2e+05 runs per record" in err, err
 
 
+
+@pytest.mark.parametrize("command, expected", [
+    (["gap"], "gap 'gap-model': 1 scenarios = 1 record"),
+    (["compare", "--xi", "ye,exact"], "compare 'compare-model': 2 scenarios = 2 xi x 1 record"),
+])
+def test_gap_and_compare_print_their_number_of_runs_before_they_start(case, tmp_path, command, expected):
+    status, out, err = pounding([command[0], str(case / "model.yaml"), *command[1:], "--duration", "0.3",
+                                 "--workers", "1", "--no-progress", "-o", str(tmp_path / "study.nc")],
+                                tmp_path, limit=120)
+    assert status == 0, err
+    assert err.splitlines()[0] == expected, err
+
 # --------------------------------------------------------------------------- #
 # §3 Memory checked before allocating
 # --------------------------------------------------------------------------- #

@@ -72,7 +72,7 @@ def raise_if_all_failed(ds, output) -> None:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
-    from pounding.studies.sweep.execution import run_sweep
+    from pounding.studies.sweep.execution import plan_line, run_sweep
     from pounding.results.checks import axis_warning, print_warnings
     from pounding.studies.sweep.spec import load_sweep
 
@@ -87,8 +87,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     for message in invalid:
         print(f"pounding: warning: {message}; its scenarios will record this error", file=sys.stderr)
     print_warnings(filter(None, (axis_warning(a.name, a.values, a.units) for a in sweep.axes if a.kind == "path")))
-    print(f"sweep '{sweep.name}': {sweep.size} scenarios = "
-          + " x ".join(f"{d.size} {d.name}" for d in sweep.dimensions), file=sys.stderr)
+    print(plan_line(sweep), file=sys.stderr)
     try:
         ds = run_sweep(sweep, output, workers=args.workers, scheduler=args.scheduler,
                        keep_histories=args.keep_histories, overwrite=args.overwrite, keep_parts=args.keep_parts,
