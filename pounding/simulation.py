@@ -490,9 +490,9 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     if isinstance(run, xr.Dataset):
         check_archive(ds, name)
     spec = json.loads(ds.attrs["run_spec"])
-    _archived_tolerances(spec)
     model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
                             path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
+    model = _archived_tolerances(model, spec)
     if model.has_building_records:
         again = simulate(model, _archived_records(model, spec, name))
         now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
@@ -513,13 +513,16 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     return again
 
 
-def _archived_tolerances(spec: dict) -> None:
-    """An archive written before tolerances followed the model's scales (issue 25) reruns with its own:
+def _archived_tolerances(model: Model, spec: dict) -> Model:
+    """*model* as an archive written before tolerances followed the model's scales (issue 25) ran it:
     ``solver.tolerance_scaling`` off where its effective model does not name it."""
-    model = spec.get("model")
-    if isinstance(model, dict):
-        solver = model.setdefault("solver", {})
-        solver.setdefault("tolerance_scaling", False)
+    import yaml
+
+    document = spec.get("model")
+    solver = (yaml.safe_load(document) or {}).get("solver") if isinstance(document, str) else None
+    if isinstance(solver, dict) and "tolerance_scaling" not in solver:
+        return model.with_solver(tolerance_scaling=False)
+    return model
 
 
 def _archived_records(model: Model, spec: dict, name: str) -> list[Record]:

@@ -277,3 +277,25 @@ def test_fuzz_touching_rows_end_and_rigid_contacts_hold(tmp_path, case, building
     # tolerances (7e-5 at atol 1e-10: a tolerance effect of its internal force, docs/numerics.md), so it
     # is held to 1e-2 here
     assert ds.attrs["energy_closure_error"] < (1e-2 if law.startswith("bilinear") else 1e-3)
+
+
+def test_rerun_of_an_archive_from_before_tolerance_scaling_keeps_its_tolerances(tmp_path):
+    # An archive written before issue 25 has no solver.tolerance_scaling in its effective model: its
+    # rerun must integrate with the tolerances it was run with (scaling off), a new one with scaling on.
+    import json
+
+    m_a, k_a, m_b, k_b = 1.0e3, 1.0e4, 1.0e6, 1.0e12
+    contacts = ["{between: [A, B], levels: matching, gap: 0.01, law: stereo-mechanical, restitution: 0.5}"]
+    model = pounding.load_model(_model(tmp_path, [("A", m_a, k_a), ("B", m_b, k_b)], contacts, 1.0))
+    ds = pounding.simulate(model)
+    spec = json.loads(ds.attrs["run_spec"])
+    assert "tolerance_scaling: true" in spec["model"]
+    spec["model"] = spec["model"].replace(", tolerance_scaling: true", "").replace("tolerance_scaling: true", "")
+    old = ds.copy()
+    old.attrs["run_spec"] = json.dumps(spec)
+    again = pounding.rerun(old)
+    assert "tolerance_scaling: false" in json.loads(again.attrs["run_spec"])["model"]
+    unscaled = pounding.simulate(model.with_solver(tolerance_scaling=False))
+    np.testing.assert_array_equal(again["impact_time"].values, unscaled["impact_time"].values)
+    # and the scaling matters here: the scaled run takes other steps
+    assert ds.attrs["solver_steps"] != unscaled.attrs["solver_steps"]
