@@ -85,7 +85,7 @@ def verdict(status, out: str, err: str, archive: Path | None) -> str | None:
         return f"traceback (exit {status})"
     if status == 2:
         errors = [line for line in lines if not line.startswith(("pounding: warning:", "pounding: note:"))
-                  and not line.startswith("sweep '")]
+                  and not line.startswith(("sweep '", "gap '", "compare '"))]
         if len(errors) != 1 or not errors[0].startswith("pounding: error: "):
             return f"exit 2 without exactly one error line: {errors[:3]}"
         return None

@@ -136,11 +136,11 @@ def compare(model: str | os.PathLike, formulas: str | list[str] | None = None,
     run_options
         Passed to :func:`pounding.studies.sweep.execution.run_sweep` (workers, scheduler, client, progress, overwrite...).
     """
-    from pounding.studies.sweep.execution import announce, run_sweep
+    from pounding.studies.sweep.execution import plan_line, run_sweep
 
     sweep = build_sweep(model, formulas, records, duration=duration, reference=reference, contacts=contacts,
                         scale=scale)
-    announce(sweep, "compare", run_options)
+    run_options.setdefault("plan", plan_line(sweep, "compare"))
     if contacts is not None:
         return run_sweep(sweep, output, assemble=_with_pounding_change, **run_options)
     ds = run_sweep(sweep, output, **run_options)

@@ -453,10 +453,10 @@ def gap_study(model: str | os.PathLike, records: str | list[str] | None = None, 
     *run_options* go to :func:`pounding.studies.sweep.execution.run_sweep` and the study engine
     (workers, scheduler, client, progress, overwrite...).
     """
-    from pounding.studies.sweep.execution import announce, run_sweep
+    from pounding.studies.sweep.execution import plan_line, run_sweep
 
     sweep = build_gap_sweep(model, records, scale=scale, duration=duration)
-    announce(sweep, "gap", run_options)
+    run_options.setdefault("plan", plan_line(sweep, "gap"))
     return run_sweep(sweep, output, runner=run_gap_scenario, assemble=assemble_gap_dataset, **run_options)
 
 

@@ -140,7 +140,7 @@ def _held_logs() -> Iterator[list]:
 def run_study(source: TaskSource, output: str | os.PathLike | None = None, *, workers: int | None = None,
               scheduler: str | None = None, client: Any = None, keep_histories: str | os.PathLike | None = None,
               overwrite: bool = False, keep_parts: bool = False, progress: bool = True, retries: int = 2,
-              task_seconds: float = 0.5, log: Callable[[str], None] | None = None):
+              task_seconds: float = 0.5, log: Callable[[str], None] | None = None, plan: str | None = None):
     """Run every scenario of *source* and return the dataset it assembles (written to *output* if given).
 
     Parameters
@@ -173,6 +173,8 @@ def run_study(source: TaskSource, output: str | os.PathLike | None = None, *, wo
         source's own ``task_seconds`` takes precedence.
     log : callable, optional
         Receives one-line notes (default: print to stderr).
+    plan : str, optional
+        The study's number of runs, said once its inputs are checked and before any run starts.
     """
     from pounding.results.archive import check_writable
 
@@ -193,7 +195,7 @@ def run_study(source: TaskSource, output: str | os.PathLike | None = None, *, wo
             raise PoundingError(f"--keep-histories {histories} is not writable; choose another folder")
     source.check()  # before expanding the scenarios
     options = dict(workers=workers, scheduler=scheduler, client=client, overwrite=overwrite, keep_parts=keep_parts,
-                   progress=progress, retries=retries,
+                   progress=progress, retries=retries, plan=plan,
                    task_seconds=task_seconds if source.task_seconds is None else source.task_seconds)
     if target is None:
         return _run_locked(source, None, None, histories, say, **options)
@@ -203,7 +205,7 @@ def run_study(source: TaskSource, output: str | os.PathLike | None = None, *, wo
 
 
 def _run_locked(source: TaskSource, target: Path | None, store: Path | None, histories: Path | None, say, *,
-                workers, scheduler, client, overwrite, keep_parts, progress, retries, task_seconds):
+                workers, scheduler, client, overwrite, keep_parts, progress, retries, task_seconds, plan=None):
     """The body of :func:`run_study`, once the output is checked and locked."""
     from pounding.results.archive import save_run
 
@@ -235,6 +237,8 @@ def _run_locked(source: TaskSource, target: Path | None, store: Path | None, his
         return None
 
     todo = source.first(known)
+    if plan:
+        say(plan)  # the scenarios are valid: the number of runs, before any runs
     done_identities = {p.get("identity") for p in done.values()} - {None}
     stale = len({s.key for s in todo if s.identity in done_identities})
     if stale:

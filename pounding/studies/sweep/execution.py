@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 import re
-import sys
 from typing import Any, Callable
 
 from pounding.studies.engine.execution import run_study
@@ -13,7 +12,7 @@ from pounding.studies.sweep.dataset import build_dataset
 from pounding.studies.sweep.scenario import run_scenario
 from pounding.studies.sweep.spec import Sweep
 
-__all__ = ["run_sweep", "plan_line", "announce", "sweep_tasks", "failures", "failure_report", "sweep_inputs"]
+__all__ = ["run_sweep", "plan_line", "sweep_tasks", "failures", "failure_report", "sweep_inputs"]
 
 
 def failures(ds) -> dict[str, list[str]]:
@@ -95,12 +94,6 @@ def plan_line(sweep: Sweep, study: str = "sweep") -> str:
     ``gap 'pair': 44 scenarios = 44 record`` (issue 25 §2: every study states its work first)."""
     return (f"{study} '{sweep.name}': {sweep.size} scenarios = "
             + " x ".join(f"{d.size} {d.name}" for d in sweep.dimensions))
-
-
-def announce(sweep: Sweep, study: str, run_options: dict[str, Any]) -> None:
-    """Print :func:`plan_line` to stderr (or the study's ``log``) before a gap or compare study runs."""
-    say = run_options.get("log") or (lambda line: print(line, file=sys.stderr))
-    say(plan_line(sweep, study))
 
 
 def sweep_tasks(sweep: Sweep, *, runner: Callable[[dict[str, Any]], dict[str, Any]] = run_scenario,
