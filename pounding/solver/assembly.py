@@ -22,6 +22,7 @@ import numpy as np
 
 from pounding import hysteresis
 from pounding.contact import laws as contact_laws
+from pounding.errors import ModelError
 from pounding.model.model import WALL, Model, column_weights
 from pounding.solver.integrator import System
 
@@ -75,10 +76,20 @@ def storey_arrays(model: Model) -> dict[str, Any]:
 
     ``storey_state`` numbers the yielding storeys (their hysteretic states in the
     solver's state vector), −1 for an elastic storey.
+
+    Raises
+    ------
+    ModelError
+        A storey model the building solver does not integrate
+        (``StoreyHysteresis.in_building_solver``), named in one line.
     """
     models, parameters, heights, p_delta = [], [], [], []
     for building in model.buildings:
-        for law, k, h in zip(building.hysteresis, building.stiffness, building.height):
+        for level, (law, k, h) in enumerate(zip(building.hysteresis, building.stiffness, building.height), start=1):
+            if law is not None and not law.in_building_solver:
+                raise ModelError(f"storey {building.name}:{level}: storey hysteresis '{law.name}' is not integrated "
+                                 f"by the building solver yet; `pounding hysteresis MODEL --storey "
+                                 f"{building.name}:{level}` drives it alone (docs/hysteresis.md)")
             models.append(hysteresis.MODEL_ELASTIC if law is None else law.model_id)
             parameters.append(np.zeros(hysteresis.N_HYSTERESIS_PARAMETERS) if law is None
                               else law.kernel_parameters(k, h))
