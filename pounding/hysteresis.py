@@ -38,7 +38,7 @@ from pounding.registry import add_numbered
 __all__ = ["StoreyHysteresis", "BilinearStorey", "BoucWenStorey", "ImkStorey", "ImkBilinearStorey",
            "ImkPeakOrientedStorey", "ImkPinchingStorey", "ImkDirection", "Deterioration", "Pinching",
            "HYSTERESES", "register", "N_HYSTERESIS_PARAMETERS", "MODEL_ELASTIC", "MODEL_BILINEAR",
-           "MODEL_BOUC_WEN"]
+           "MODEL_BOUC_WEN", "MODEL_IMK_BILINEAR", "MODEL_IMK_PEAK", "MODEL_IMK_PINCHING"]
 
 #: Length of every model's kernel parameter vector.
 N_HYSTERESIS_PARAMETERS = 6
@@ -66,13 +66,10 @@ class StoreyHysteresis(BaseModel):
     #: Checks of tests/test_registry_contract.py that apply to the model (its kind).
     checks: ClassVar[tuple[str, ...]] = ("dissipation_nonnegative",)
     #: True if the model has modes whose switches the solver locates as storey events (yield onset,
-    #: unloading). The integrator's storey-event search handles modes for the bilinear model only
-    #: (pounding.solver.integrator tests ``model == MODEL_BILINEAR``); tests/test_registry_contract.py
+    #: unloading; an IMK storey's branch changes). The integrator's storey-event search handles them for
+    #: the bilinear and IMK models, by id (pounding.solver.storey_events); tests/test_registry_contract.py
     #: holds this attribute to that rule until the search reads it from here.
     has_modes: ClassVar[bool] = False
-    #: False for a model the building solver does not integrate (yet): a run with such a storey is
-    #: refused in one line (pounding.solver.assembly.storey_arrays); `pounding hysteresis` drives it alone.
-    in_building_solver: ClassVar[bool] = True
 
     model: str
     yield_force: Positive | None = Field(None, description="yield force F_y, N")
@@ -270,7 +267,7 @@ class ImkStorey(StoreyHysteresis):
     """
 
     checks: ClassVar[tuple[str, ...]] = ("cyclic_response",)
-    in_building_solver: ClassVar[bool] = False
+    has_modes: ClassVar[bool] = True
     reference: ClassVar[str] = ("Ibarra, Medina & Krawinkler (2005) EESD 34(12); Lignos & Krawinkler (2011) "
                                 "J. Struct. Eng. 137(11)")
     #: The variant's kernel in pounding.studies.imk ("bilinear", "peak-oriented", "pinching").
@@ -376,10 +373,11 @@ class ImkStorey(StoreyHysteresis):
         return out
 
     def kernel_parameters(self, stiffness: float, height: float) -> np.ndarray:
-        """``[u_y, 0, …]``: the building solver does not integrate IMK storeys (:attr:`in_building_solver`)."""
-        out = np.zeros(N_HYSTERESIS_PARAMETERS)
-        out[0] = self.yield_force_for(stiffness, height) / float(stiffness)
-        return out
+        """``[u_y, slope, k_unload, lower limit, upper limit, watch]`` of the storey at rest: elastic (slope k),
+        its limits the yield drifts −u_y⁻ and u_y⁺ (pounding.solver.imk rewrites the row at each event)."""
+        k = float(stiffness)
+        p = self.backbone(k, height)
+        return np.array([p["positive"]["fy"] / k, k, k, -p["negative"]["fy"] / k, p["positive"]["fy"] / k, 0.0])
 
 
 @register
@@ -417,3 +415,9 @@ class ImkPinchingStorey(ImkStorey):
         out = super().backbone(stiffness, height)
         out.update(kappa_f=float(self.pinching.kappa_f), kappa_d=float(self.pinching.kappa_d))
         return out
+
+
+#: Kernel branch ids of the IMK variants (compile-time constants of the kernels).
+MODEL_IMK_BILINEAR = ImkBilinearStorey.model_id
+MODEL_IMK_PEAK = ImkPeakOrientedStorey.model_id
+MODEL_IMK_PINCHING = ImkPinchingStorey.model_id

@@ -132,13 +132,8 @@ def test_link_has_a_compiled_branch(name):
 
 @pytest.mark.parametrize("name", list(hysteresis.HYSTERESES))
 def test_hysteresis_has_a_compiled_branch(name):
-    # The elastic fall-through has no state rate; every model's state moves in some mode. A model the
-    # building solver does not integrate (IMK, for now) is refused by it instead (tests/test_imk.py) and is
-    # driven alone by pounding.studies.cyclic (its check "cyclic_response" below).
+    # The elastic fall-through has no state rate; every model's state moves in some mode.
     model = model_of(name)
-    if not model.in_building_solver:
-        assert "cyclic_response" in model.checks
-        return
     k, h = 1.0e8, 3.0
     table = model.kernel_parameters(k, h)[None, :]
     rates = [storeys.state_rate(model.model_id, table, 0, mode, 0.1, 0.0)
@@ -437,11 +432,12 @@ def test_law_modules_are_in_every_solver_cache_stamp(name):
 
 @pytest.mark.parametrize("name", list(hysteresis.HYSTERESES))
 def test_storey_modes_follow_the_integrators_rule(name):
-    # The integrator's storey-event search gives modes (yield onset, unloading) to the bilinear model only
-    # (integrator.py tests model == MODEL_BILINEAR). A new model with modes fails here until that search
-    # reads StoreyHysteresis.has_modes instead of the id.
+    # The integrator's storey-event search gives modes (yield onset, unloading; IMK branch changes) to the
+    # bilinear and IMK models only, by id (pounding.solver.storey_events). A new model with modes fails here
+    # until that search reads StoreyHysteresis.has_modes instead of the id.
     cls = hysteresis.HYSTERESES[name]
-    assert cls.has_modes == (cls.model_id == hysteresis.MODEL_BILINEAR)
+    assert cls.has_modes == (cls.model_id in (hysteresis.MODEL_BILINEAR, hysteresis.MODEL_IMK_BILINEAR,
+                                              hysteresis.MODEL_IMK_PEAK, hysteresis.MODEL_IMK_PINCHING))
 
 
 def test_the_checks_bite():

@@ -19,9 +19,11 @@ branches.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from pounding.hysteresis import ImkStorey
+from pounding.solver.imk import beta
 
 __all__ = ["ImkMaterial", "Backbone", "ELASTIC", "UNLOAD", "PINCH", "LOCAL", "GLOBAL", "HARDENING",
            "POST_CAPPING", "RESIDUAL"]
@@ -106,23 +108,6 @@ def _slope(df: float, du: float, fallback: float) -> float:
     return df / du if du != 0.0 else fallback
 
 
-def _beta(energy: float, reference: float, spent: float, c: float) -> tuple[float, bool]:
-    """β = (E_i / (E_t − ΣE))^c of Ibarra et al. (2005) eq. 4, clipped to [0, 1], and whether it fails.
-
-    *reference* E_t = 0: the mode is off (β = 0).  The capacity is exhausted
-    (failure) where β > 1 or where the remaining energy E_t − ΣE is not
-    positive (the paper: β outside 0 < β ≤ 1; OpenSees clips a negative β to 0
-    and carries on, docs/hysteresis.md).
-    """
-    if reference <= 0.0:
-        return 0.0, False
-    remaining = reference - spent
-    if remaining <= 0.0:
-        return 1.0, True
-    beta = (max(energy, 0.0) / remaining) ** c
-    return min(beta, 1.0), beta > 1.0
-
-
 class ImkMaterial:
     """An IMK storey's shear (N) as a function of its drift history (m): call :meth:`step` per drift.
 
@@ -190,17 +175,17 @@ class ImkMaterial:
         """Unloading stiffness at a reversal: k_u ← k_u(1 − β_k), the elastic energy of the unloading
         excluded from both E_i and ΣE (OpenSees); returns whether the capacity is exhausted."""
         elastic = 0.5 * f_prev * f_prev / self.k_unload
-        beta, fail = _beta(self.energy - self.energy_last - elastic, self.e_k, self.energy - elastic, self.c_k)
-        self.k_unload *= 1.0 - beta
+        beta_k, fail = beta(self.energy - self.energy_last - elastic, self.e_k, self.energy - elastic, self.c_k)
+        self.k_unload *= 1.0 - beta_k
         return fail
 
     def _excursion_betas(self) -> tuple[float, float, float, bool]:
         """β_s, β_c, β_a of a new excursion (E_i: the work since the last one) and whether any fails."""
         spent = self.energy
         e_i = max(0.0, spent - self.energy_last)
-        beta_s, fail_s = _beta(e_i, self.e_s, spent, self.c_s)
-        beta_c, fail_c = _beta(e_i, self.e_c, spent, self.c_c)
-        beta_a, fail_a = _beta(e_i, self.e_a, spent, self.c_a)
+        beta_s, fail_s = beta(e_i, self.e_s, spent, self.c_s)
+        beta_c, fail_c = beta(e_i, self.e_c, spent, self.c_c)
+        beta_a, fail_a = beta(e_i, self.e_a, spent, self.c_a)
         self.energy_last = spent
         return beta_s, beta_c, beta_a, fail_s or fail_c or fail_a
 
@@ -241,7 +226,7 @@ class ImkMaterial:
         b.ures = (b.fres - b.fcap + b.kpc * b.ucap) / b.kpc
         u0 = sigma * (u_prev - f_prev / self.k_unload)  # zero-force drift, this direction's coordinates
         k_global = b.f_global / (b.u_global - u0)
-        k_local = b.f_local / (b.u_local - u0)
+        k_local = _slope(b.f_local, b.u_local - u0, -math.inf)  # 0/0 in OpenSees: NaN, never chosen
         self.side = sigma
         if self.variant == "pinching":
             u_plastic = b.u_global - b.f_global / self.k_unload
