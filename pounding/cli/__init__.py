@@ -23,7 +23,8 @@ __all__ = ["main", "console_main", "build_parser", "SUBCOMMAND_MODULES"]
 SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sweep",
                       "compare": "pounding.cli.compare", "records": "pounding.cli.records",
                       "export": "pounding.cli.export", "gap": "pounding.cli.gap", "ida": "pounding.cli.ida",
-                      "init": "pounding.cli.init", "hysteresis": "pounding.cli.hysteresis"}
+                      "init": "pounding.cli.init", "hysteresis": "pounding.cli.hysteresis",
+                      "pushover": "pounding.cli.pushover"}
 
 
 # --------------------------------------------------------------------------- #

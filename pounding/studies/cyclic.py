@@ -29,6 +29,7 @@ Protocols (drift amplitudes, each cycle +a, −a, back to 0; legs sampled in
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 
 import numpy as np
@@ -40,6 +41,7 @@ from pounding.solver import storeys
 from pounding.studies.imk import ImkMaterial
 
 __all__ = ["PROTOCOLS", "POINTS_PER_LEG", "named_protocol", "read_protocol", "amplitudes", "storey_response",
+           "StoreySpring",
            "hysteresis_test", "write_csv", "plot_hysteresis"]
 
 PROTOCOLS = ("fema461", "atc24")
@@ -115,9 +117,8 @@ def read_protocol(path: str | Path) -> np.ndarray:
     return np.asarray(out, dtype=float)
 
 
-def storey_response(law: StoreyHysteresis | None, stiffness: float, height: float,
-                    drifts: np.ndarray) -> np.ndarray:
-    """Storey shear (N) after each drift of *drifts* (m), from rest at zero drift.
+class StoreySpring:
+    """One storey's shear as its drift moves, from rest: :meth:`step` moves it, :meth:`trial` only asks.
 
     Parameters
     ----------
@@ -126,30 +127,48 @@ def storey_response(law: StoreyHysteresis | None, stiffness: float, height: floa
     stiffness, height : float
         Elastic storey stiffness (N/m) and storey height (m).
     """
-    drifts = np.asarray(drifts, dtype=float)
-    k = float(stiffness)
-    if law is None:
-        return k * drifts
-    if isinstance(law, ImkStorey):
-        return np.asarray(ImkMaterial(law, k, height).run(drifts))
-    table = law.kernel_parameters(k, height)[None, :]
-    uy = table[0, 0]
-    out = np.empty(drifts.size)
-    r, previous = 0.0, 0.0
-    for i, u in enumerate(drifts):
-        if law.model_id == MODEL_BILINEAR:
-            elastic = u - r
-            if elastic > uy:
-                r = u - uy
-            elif elastic < -uy:
-                r = u + uy
-        elif law.model_id == MODEL_BOUC_WEN:
-            r = _bouc_wen_increment(law.model_id, table, r, u - previous, uy)
-        else:
+
+    def __init__(self, law: StoreyHysteresis | None, stiffness: float, height: float):
+        self.law, self.k = law, float(stiffness)
+        self.material = ImkMaterial(law, self.k, height) if isinstance(law, ImkStorey) else None
+        self.table = None if law is None or self.material is not None else law.kernel_parameters(self.k, height)[None, :]
+        if self.table is not None and law.model_id not in (MODEL_BILINEAR, MODEL_BOUC_WEN):
             raise ModelError(f"storey hysteresis '{law.name}' has no quasi-static driver")
-        out[i] = storeys.restoring_force(law.model_id, table, 0, k, u, r)
-        previous = u
-    return out
+        self.r, self.u = 0.0, 0.0
+
+    @property
+    def failed(self) -> bool:
+        """An IMK storey that has lost its strength (in either direction)."""
+        m = self.material
+        return m is not None and (m.failed or any(m.lost.values()))
+
+    def step(self, u: float) -> float:
+        """Move to drift *u* (m); the shear, N."""
+        if self.table is None:
+            self.u = u
+            return self.material.step(u) if self.material is not None else self.k * u
+        table, uy = self.table, self.table[0, 0]
+        if self.law.model_id == MODEL_BILINEAR:
+            elastic = u - self.r
+            if elastic > uy:
+                self.r = u - uy
+            elif elastic < -uy:
+                self.r = u + uy
+        else:
+            self.r = _bouc_wen_increment(self.law.model_id, table, self.r, u - self.u, uy)
+        self.u = u
+        return storeys.restoring_force(self.law.model_id, table, 0, self.k, u, self.r)
+
+    def trial(self, u: float) -> float:
+        """The shear (N) at drift *u* (m) from here, the spring left as it is."""
+        return copy.deepcopy(self).step(u)
+
+
+def storey_response(law: StoreyHysteresis | None, stiffness: float, height: float,
+                    drifts: np.ndarray) -> np.ndarray:
+    """Storey shear (N) after each drift of *drifts* (m), from rest at zero drift (:class:`StoreySpring`)."""
+    spring = StoreySpring(law, stiffness, height)
+    return np.array([spring.step(float(u)) for u in np.asarray(drifts, dtype=float)])
 
 
 def _bouc_wen_increment(model: int, table: np.ndarray, z: float, du: float, uy: float) -> float:
