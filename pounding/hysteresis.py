@@ -20,7 +20,9 @@ Contract of a model
     F_y (N) from ``yield_force`` or ``yield_drift_ratio`` (exactly one is given).
 ``kernel_parameters(stiffness, height)``
     A float64 vector of length :data:`N_HYSTERESIS_PARAMETERS`:
-    ``[u_y, α, n, β, γ, A]`` (the last four used by Bouc–Wen only).
+    ``[u_y, α, n, β, γ, A]`` (the last four used by Bouc–Wen only); an IMK
+    storey's ``[u_y, slope, k_unload, lower limit, upper limit, watch]`` at rest
+    (:mod:`pounding.solver.imk` rewrites its run's copy at each branch change).
 
 Adding a model is one subclass with its citation and one ``register`` line,
 plus one branch in each kernel of :mod:`pounding.solver.storeys`.
