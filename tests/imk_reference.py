@@ -37,7 +37,9 @@ def _kinks(material: ImkMaterial, ahead: bool = True) -> list[float]:
     points = []
     for sigma, b in material.sides.items():
         rise = b.ucap + (b.fres - b.fcap) / b.kp if b.kp > 0 else np.nan
-        for x in (b.uy, b.ucap, b.ures, b.uu, b.u_local, b.u_global, rise):
+        # The residual drift of the current backbone (ImkMaterial keeps b.ures for the oriented variants only).
+        ures = b.ucap + (b.fres - b.fcap) / b.kpc if b.kpc != 0 else np.nan
+        for x in (b.uy, b.ucap, b.ures, ures, b.uu, b.u_local, b.u_global, rise):
             points.append(sigma * x)
     points.append(material.u_pinch)
     u, f, k = material.u, material.f, material.k_unload

@@ -59,17 +59,14 @@ solver: {{rtol: 1.0e-10, atol: 1.0e-13, atol_velocity: 1.0e-12, output_dt: 0.01}
 
 @pytest.mark.parametrize("name", list(VARIANTS))
 def test_imk_building_matches_an_independent_scipy_integration(tmp_path, name):
-    model = building(tmp_path, name)
+    model = building(tmp_path, name, amplitude=5.0 if name == "imk-bilinear" else 4.0)
     ds = pounding.simulate(model)
     record = record_for(model)
     ref = imk_reference_run(model, record.acceleration, record.time_step, 6.0)
-    # The first storey goes through capping into its residual branch (ImkMaterial's branches 6 and 7);
-    # imk-bilinear's (no branch numbers) goes well past its capping drift (0.042 m) on the post-capping
-    # branch, not to its residual: there the reference's kink list misses a point and it drifts from the
-    # solver by 4e-6 (the solver's event-driven rules equal the drift-driven ones to 1e-9 through the
-    # residual branch, tests/test_imk.py::test_event_driven_kernel_equals_the_drift_driven_material).
+    # The first storey goes through capping into its residual branch (ImkMaterial's branches 6 and 7;
+    # imk-bilinear has no branch numbers: its residual flag counts as 7, past 3x its capping drift).
     if name == "imk-bilinear":
-        assert ref["peak_drift"][0] > 2.0 * 0.042
+        assert 7 in ref["branches"][0] and ref["peak_drift"][0] > 3 * 0.042
     else:
         assert {6, 7} <= ref["branches"][0], ref["branches"]
     assert ds.attrs["status"] == "completed" and ref["collapse"] is None

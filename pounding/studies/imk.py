@@ -339,6 +339,8 @@ class ImkMaterial:
                 b.ucap = 0.0
             elif 0.0 < candidate < b.kp:
                 b.kp = candidate
+            if b.kpc != 0.0:  # kept current for readers; the residual tests below compute it themselves
+                b.ures = (b.fres - b.fcap + b.kpc * b.ucap) / b.kpc
         x = sigma * u
         slope = b.kp if x < b.ucap else b.kpc
         bound = b.fcap + (x - b.ucap) * slope
