@@ -260,6 +260,10 @@ def test_hysteresis_command_writes_archive_csv_and_plot(model_file, tmp_path, ca
     np.testing.assert_array_equal(table, np.column_stack([drift, shear]))
     assert open(csv).readline().strip() == "storey_drift_m,storey_shear_N"
     assert (plots / "hysteresis.png").stat().st_size > 0
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0 and "[hysteresis archive]" in capsys.readouterr().out
+    assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "hysteresis.png").exists()
     law = hysteresis.HYSTERESES["imk-pinching"](model="imk-pinching", **BASE, **VARIANTS["imk-pinching"])
     np.testing.assert_array_equal(shear, cyclic.storey_response(law, K, H, drift))
 

@@ -118,5 +118,8 @@ def test_pushover_command_writes_table_archive_and_plot(model_file, tmp_path, ca
         assert ds.base_shear.attrs["units"] == "N" and ds.roof_displacement.attrs["units"] == "m"
         assert ds.storey_drift.dims == ("building", "storey", "step")
     assert (plots / "pushover.png").stat().st_size > 0
+    assert main(["info", str(out)]) == 0 and "[pushover archive]" in capsys.readouterr().out
+    assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "pushover.png").exists()
     assert main(["pushover", str(model_file), "--building", "C"]) == 2
     assert "no building 'C'" in capsys.readouterr().err

@@ -35,13 +35,14 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from pounding import __version__
 from pounding.errors import ModelError, PoundingError
 from pounding.hysteresis import MODEL_BILINEAR, MODEL_BOUC_WEN, ImkStorey, StoreyHysteresis
 from pounding.solver import storeys
 from pounding.studies.imk import ImkMaterial
 
 __all__ = ["PROTOCOLS", "POINTS_PER_LEG", "named_protocol", "read_protocol", "amplitudes", "storey_response",
-           "StoreySpring",
+           "StoreySpring", "hysteresis_summary",
            "hysteresis_test", "write_csv", "plot_hysteresis"]
 
 PROTOCOLS = ("fema461", "atc24")
@@ -223,7 +224,12 @@ def hysteresis_test(model, storey: str, protocol: str, amplitude: float | None =
         {"storey_drift": ("step", drifts, {"units": "m", "long_name": f"storey drift of {storey}"}),
          "storey_shear": ("step", shear, {"units": "N", "long_name": f"storey shear of {storey}"})},
         coords={"step": ("step", np.arange(drifts.size), {"long_name": "step of the drift history"})},
-        attrs={"kind": "hysteresis", "storey": storey, "hysteresis": "elastic" if law is None else law.describe(),
+        attrs={"kind": "hysteresis", "source": f"pounding {__version__}",
+               "title": f"cyclic test of storey {storey} ({protocol})",
+               "history": f"pounding hysteresis {model if isinstance(model, (str, Path)) else '(a loaded model)'} "
+                          f"--storey {storey} --protocol {protocol}"
+                          + ("" if amplitude is None else f" --amplitude {float(amplitude):g}"),
+               "storey": storey, "hysteresis": "elastic" if law is None else law.describe(),
                "stiffness": k, "height": h, "protocol": str(protocol),
                "amplitude_drift_ratio": float("nan") if amplitude is None else float(amplitude),
                "model_file": str(model) if isinstance(model, (str, Path)) else ""})
@@ -253,7 +259,7 @@ def write_csv(ds: xr.Dataset, path: str | Path) -> Path:
 
 
 def plot_hysteresis(ds: xr.Dataset, folder: str | Path) -> list[Path]:
-    """``hysteresis.png`` in *folder*: storey shear (kN) against drift ratio (%)."""
+    """``hysteresis.png`` in *folder*: storey shear (kN) against drift ratio (%); its path in a list."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -273,3 +279,9 @@ def plot_hysteresis(ds: xr.Dataset, folder: str | Path) -> list[Path]:
     fig.savefig(out, dpi=130)
     plt.close(fig)
     return [out]
+
+
+def hysteresis_summary(ds: xr.Dataset) -> str:
+    """One line for ``pounding info``: the storey, its model, the steps and the peaks."""
+    return (f"  storey {ds.attrs['storey']}: {ds.attrs['hysteresis']}\n  {ds.sizes['step']} steps; peak |drift| "
+            f"{float(abs(ds.storey_drift).max()):.6g} m, peak |shear| {float(abs(ds.storey_shear).max()):.6g} N")

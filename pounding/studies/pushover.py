@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from pounding import __version__
 from pounding.errors import PoundingError
 from pounding.studies.cyclic import StoreySpring
 from pounding.units import STANDARD_GRAVITY
@@ -208,7 +209,11 @@ def pushover(model, *, pattern: str = "first-mode", building: str | None = None,
     }
     return xr.Dataset(data, coords={"building": [b.name for b in chosen], "step": np.arange(width),
                                     "storey": np.arange(1, storeys + 1)},
-                      attrs={"kind": "pushover", "pattern": pattern, "steps": steps,
+                      attrs={"kind": "pushover", "source": f"pounding {__version__}",
+                             "title": f"pushover ({pattern} pattern)",
+                             "history": f"pounding pushover {model if isinstance(model, (str, Path)) else '(a loaded model)'} "
+                                        f"--pattern {pattern}" + (f" --building {building}" if building else ""),
+                             "pattern": pattern, "steps": steps,
                              "model_file": str(model) if isinstance(model, (str, Path)) else ""})
 
 
