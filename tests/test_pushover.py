@@ -121,5 +121,8 @@ def test_pushover_command_writes_table_archive_and_plot(model_file, tmp_path, ca
     assert main(["info", str(out)]) == 0 and "[pushover archive]" in capsys.readouterr().out
     assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
     assert (tmp_path / "again" / "pushover.png").exists()
-    assert main(["pushover", str(model_file), "--building", "C"]) == 2
-    assert "no building 'C'" in capsys.readouterr().err
+    for argv, message in ((["--building", "C"], "no building 'C'"), (["--steps", "0"], "--steps must be at least 1"),
+                          (["--design-cs", "-1"], "--design-cs must be a number > 0")):
+        assert main(["pushover", str(model_file), *argv]) == 2
+        err = capsys.readouterr().err.strip()
+        assert message in err and "\n" not in err

@@ -158,6 +158,11 @@ def pushover(model, *, pattern: str = "first-mode", building: str | None = None,
     with ``kind = "pushover"`` (capacity curves on ``step``, padded with NaN; FEMA P695 quantities per building)."""
     from pounding.model.model import load_model
 
+    if steps < 1:
+        raise PoundingError(f"--steps must be at least 1 (got {steps})")
+    for key, value in (("--period", period), ("--design-cs", design_cs)):
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            raise PoundingError(f"{key} must be a number > 0 (got {value:g})")
     loaded = load_model(model) if isinstance(model, (str, Path)) else model
     names = [b.name for b in loaded.buildings]
     if building is not None and building not in names:
