@@ -35,9 +35,12 @@ Design
   bilinear storey, Bouc–Wen's z) is integrated with the motion and is part
   of the error norm; a bilinear storey's yield onset and unloading are
   located as events, like gap closure, so no step straddles a kink of its
-  force (:mod:`pounding.solver.storeys`).  P-Delta is a linear geometric
-  stiffness per storey.  A run stops, located, when a storey's drift ratio
-  first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED).
+  force (:mod:`pounding.solver.storeys`).  An IMK storey's state is its
+  shear, and every branch change of it is a located event
+  (:mod:`pounding.solver.imk`); one that loses its strength ends the run as a
+  collapse.  P-Delta is a linear geometric stiffness per storey.  A run
+  stops, located, when a storey's drift ratio first exceeds
+  ``stop_drift_ratio`` (STATUS_COLLAPSED).
 
 State vector layout (:mod:`pounding.solver.layout`): ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]``
 (``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force; ``r``: each
@@ -64,7 +67,8 @@ record) and the Python entry point :func:`integrate`; the parts it drives:
 ``dormand_prince``  tableau, stages, the error norm, step-size factor
 ``dense``           Hermite interpolant, its extrema and exact crossings
 ``contact_events``  contact events: locate, apply
-``storey_events``   bilinear storeys' yield and unloading, collapse: locate, apply
+``storey_events``   bilinear storeys' yield and unloading, IMK branch changes, collapse: locate, apply
+``imk``             IMK storeys' discrete state and branch rules at their events
 ``recorder``        output samples, peaks, impact table, trace of closed contacts
 ``status``          how a run ended
 ==================  ===========================================================
