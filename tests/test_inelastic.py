@@ -278,7 +278,7 @@ solver: {stop_drift_ratio: STOP}
      "m.yaml:4: buildings[0].storeys[0].hysteresis.n must be > 0 (got 0)"),
     ("{model: elastoplastic, yield_force: 2.0e5}", "true", "0.1",
      "m.yaml:4: buildings[0].storeys[0].hysteresis.model: unknown hysteresis model 'elastoplastic'; "
-     "choose one of: bilinear, bouc-wen"),
+     "choose one of: bilinear, bouc-wen, imk-bilinear, imk-peak-oriented, imk-pinching"),
     ("{model: bilinear, yield_force: 2.0e5, yield_drift_ratio: 0.01}", "true", "0.1",
      "m.yaml:4: buildings[0].storeys[0].hysteresis: give exactly one of yield_force (N) and yield_drift_ratio "
      "(yield drift / height); both given"),
@@ -289,7 +289,7 @@ solver: {stop_drift_ratio: STOP}
      "m.yaml:4: buildings[0].storeys[0].hysteresis: unknown key 'yeild'"),
     ("{yield_force: 2.0e5}", "true", "0.1",
      "m.yaml:4: buildings[0].storeys[0].hysteresis: missing required key 'model' (storey hysteresis: bilinear, "
-     "bouc-wen)"),
+     "bouc-wen, imk-bilinear, imk-peak-oriented, imk-pinching)"),
     ("{model: bilinear, yield_force: 2.0e5}", "yes", "0.1",
      "m.yaml:6: buildings[0].p_delta must be true or false (got 'yes')"),
     ("{model: bilinear, yield_force: 2.0e5}", "true", "-0.1",

@@ -349,12 +349,29 @@ def check_hysteresis_dissipation(model: hysteresis.StoreyHysteresis) -> None:
         assert f * rate - dv >= -1e-6 * (abs(f * rate) + abs(dv)), (drift, r, mode, rate)
 
 
+def check_cyclic_response(model: hysteresis.StoreyHysteresis) -> None:
+    """Driven alone through FEMA 461 cycles to 6 % drift: the work done on the storey is ≥ 0 at every
+    return to zero drift (no model creates energy over a cycle) and |F| stays within the highest capping
+    force (a deteriorating backbone only shrinks)."""
+    from pounding.studies import cyclic
+
+    k, h = 1.0e8, 3.0
+    drifts = cyclic.named_protocol("fema461", 0.06 * h)
+    shear = cyclic.storey_response(model, k, h, drifts)
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (shear[1:] + shear[:-1]) * np.diff(drifts))])
+    cap = max(model.backbone(k, h)[s]["fy"] * model.backbone(k, h)[s]["fcap_ratio"] for s in ("positive", "negative"))
+    assert np.all(work[drifts == 0.0] >= -1e-9 * cap * h)
+    assert np.abs(shear).max() <= cap * (1.0 + 1e-12)
+    assert np.abs(shear).max() > 0.5 * cap
+
+
 CONTACT_CHECKS = {"implied_mode_force": check_implied_mode_force, "elastic_potential": check_elastic_potential,
                   "never_pulls": check_never_pulls, "dissipation_nonnegative": check_dissipation_nonnegative,
                   "free_restitution": check_free_restitution}
 LINK_CHECKS = {"elastic_potential": check_elastic_potential, "dissipation_nonnegative": check_dissipation_nonnegative}
 HYSTERESIS_CHECKS = {"elastic_potential": check_hysteresis_elastic_potential,
-                     "dissipation_nonnegative": check_hysteresis_dissipation, "bounded_state": check_bounded_state}
+                     "dissipation_nonnegative": check_hysteresis_dissipation, "bounded_state": check_bounded_state,
+                     "cyclic_response": check_cyclic_response}
 
 CASES = ([("contact", n, c) for n, cls in laws.LAWS.items() for c in cls.checks]
          + [("link", n, c) for n, cls in links.LINK_LAWS.items() for c in cls.checks]
@@ -415,11 +432,12 @@ def test_law_modules_are_in_every_solver_cache_stamp(name):
 
 @pytest.mark.parametrize("name", list(hysteresis.HYSTERESES))
 def test_storey_modes_follow_the_integrators_rule(name):
-    # The integrator's storey-event search gives modes (yield onset, unloading) to the bilinear model only
-    # (integrator.py tests model == MODEL_BILINEAR). A new model with modes fails here until that search
-    # reads StoreyHysteresis.has_modes instead of the id.
+    # The integrator's storey-event search gives modes (yield onset, unloading; IMK branch changes) to the
+    # bilinear and IMK models only, by id (pounding.solver.storey_events). A new model with modes fails here
+    # until that search reads StoreyHysteresis.has_modes instead of the id.
     cls = hysteresis.HYSTERESES[name]
-    assert cls.has_modes == (cls.model_id == hysteresis.MODEL_BILINEAR)
+    assert cls.has_modes == (cls.model_id in (hysteresis.MODEL_BILINEAR, hysteresis.MODEL_IMK_BILINEAR,
+                                              hysteresis.MODEL_IMK_PEAK, hysteresis.MODEL_IMK_PINCHING))
 
 
 def test_the_checks_bite():

@@ -24,7 +24,8 @@ SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sw
                       "compare": "pounding.cli.compare", "records": "pounding.cli.records",
                       "export": "pounding.cli.export", "gap": "pounding.cli.gap", "ida": "pounding.cli.ida",
                       "init": "pounding.cli.init", "spectrum": "pounding.cli.spectrum",
-                      "table": "pounding.cli.table"}
+                      "table": "pounding.cli.table", "hysteresis": "pounding.cli.hysteresis",
+                      "pushover": "pounding.cli.pushover"}
 
 
 # --------------------------------------------------------------------------- #

@@ -270,7 +270,8 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
 
 
 def open_archive(path) -> tuple[str, object]:
-    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``sweep``, ``compare`` or ``verify``."""
+    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``sweep``, ``compare``, ``gap``,
+    ``ida``, ``verify``, ``hysteresis`` or ``pushover``."""
     import xarray as xr
 
     from pounding.errors import ArchiveError
@@ -306,6 +307,8 @@ def open_archive(path) -> tuple[str, object]:
                 else "sweep"), ds
     if is_verify:
         return "verify", ds
+    if attrs.get("kind") in ("hysteresis", "pushover"):
+        return str(attrs["kind"]), ds
     raise ArchiveError(f"{source}: a pounding file of an unknown kind (not from run, rerun, sweep, compare or "
                        "verify); a newer pounding may read it")
 
@@ -342,6 +345,14 @@ def _print_info(kind: str, ds) -> None:
         from pounding.studies.ida import ida_table
 
         print(ida_table(ds))
+    elif kind == "hysteresis":
+        from pounding.studies.cyclic import hysteresis_summary
+
+        print(hysteresis_summary(ds))
+    elif kind == "pushover":
+        from pounding.studies.pushover import pushover_table
+
+        print(pushover_table(ds))
     elif kind in ("sweep", "compare"):
         from pounding.cli.sweep import summary_lines
 
@@ -396,6 +407,14 @@ def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
         from pounding.studies.gap import plot_gap
 
         return plot_gap(ds, out)
+    if kind == "hysteresis":
+        from pounding.studies.cyclic import plot_hysteresis
+
+        return plot_hysteresis(ds, out)
+    if kind == "pushover":
+        from pounding.studies.pushover import plot_pushover
+
+        return plot_pushover(ds, out)
     if kind == "ida":
         from pounding.studies.ida import plot_ida
 

@@ -13,7 +13,9 @@ OpenSeesPy and runs it under the same record:
   0, 0, 0)`` for a ``bouc-wen`` one (OpenSees' z is in length units, z_o =
   u_y·z, and in its code ``gamma`` is the constant term and ``beta``
   multiplies sgn(Δε·z): our γ goes to its ``gamma``, our β to its ``beta``;
-  its internal Newton tolerance on z_o is set to 1e-12·u_y);
+  its internal Newton tolerance on z_o is set to 1e-12·u_y); ``IMKBilin``,
+  ``IMKPeakOriented`` or ``IMKPinching`` for an IMK storey (drift ratios × h,
+  OpenSees' Λ = Λ·h; :func:`imk_material`);
 * each Rayleigh-damped building gets its own ``a0, a1`` through a ``region``
   holding its storey elements and their nodes, with ``a1`` on the *initial*
   stiffness (``-rayleigh a0 0 a1 0``: the nodes carry ``a0·M``, the storeys
@@ -90,7 +92,7 @@ from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
 __all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "contact_material",
-           "link_materials", "storey_material", "BILINEAR_NOTE", "DEFAULT_DT"]
+           "link_materials", "storey_material", "imk_material", "IMK_MATERIALS", "LAMBDA_OFF", "BILINEAR_NOTE", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
 DEFAULT_DT = 1.0e-4
@@ -200,13 +202,54 @@ def link_materials(law, element: int) -> list[list]:
                         "(supported: viscous, kelvin, maxwell)")
 
 
+#: OpenSees' Λ (m) written for a mode switched off (Λ = 0 here): OpenSees has no off switch, and with
+#: E_t = 1e20·F_y its β = (E_i / (E_t − ΣE))^c is ~1e-20 (Λ = 0 there gives β ≤ 0, clipped to 0 for c = 1
+#: but NaN for another c).
+LAMBDA_OFF = 1.0e20
+
+#: OpenSees material of each IMK variant (pounding.hysteresis.ImkStorey.variant).
+IMK_MATERIALS = {"bilinear": "IMKBilin", "peak-oriented": "IMKPeakOriented", "pinching": "IMKPinching"}
+
+
+def imk_material(law, stiffness: float, height: float) -> list:
+    """``IMKBilin | IMKPeakOriented | IMKPinching`` arguments (after the tag) of an IMK storey.
+
+    ``Ke, then per direction (positive, then negative, magnitudes) Up Upc Uu Fy FcapFy FresFy``
+    (m, m, m, N, -, -), then ``Λ_s Λ_c [Λ_a] Λ_k c_s c_c [c_a] c_k D+ D−`` with OpenSees' Λ = E_t / F_y+
+    = Λ·h (m; :data:`LAMBDA_OFF` for a mode switched off), then ``κ_f κ_d`` for IMKPinching
+    (the argument order of OpenSees' ``OPS_IMKBilin`` / ``OPS_IMKPeakOriented`` / ``OPS_IMKPinching``).
+    """
+    k = float(stiffness)
+    p = law.backbone(k, height)
+    fy = p["positive"]["fy"]
+
+    def lam(energy: float) -> float:
+        return energy / fy if energy > 0.0 else LAMBDA_OFF
+
+    sides = []
+    for sign in ("positive", "negative"):
+        d = p[sign]
+        sides += [d["up"], d["upc"], d["uu"], d["fy"], d["fcap_ratio"], d["fres_ratio"]]
+    rates = [p["positive"]["d"], p["negative"]["d"]]
+    if law.variant == "bilinear":
+        tail = [lam(p["e_s"]), lam(p["e_c"]), lam(p["e_k"]), p["c_s"], p["c_c"], p["c_k"]] + rates
+    else:
+        tail = [lam(p["e_s"]), lam(p["e_c"]), lam(p["e_a"]), lam(p["e_k"]), p["c_s"], p["c_c"], p["c_a"],
+                p["c_k"]] + rates
+        if law.variant == "pinching":
+            tail += [p["kappa_f"], p["kappa_d"]]
+    return [IMK_MATERIALS[law.variant], k] + [float(x) for x in sides + tail]
+
+
 def storey_material(law, stiffness: float, height: float) -> list:
-    """OpenSees material arguments (after the tag) of a storey: Elastic, Steel01 or BoucWen."""
-    from pounding.hysteresis import BilinearStorey, BoucWenStorey
+    """OpenSees material arguments (after the tag) of a storey: Elastic, Steel01, BoucWen or an IMK material."""
+    from pounding.hysteresis import BilinearStorey, BoucWenStorey, ImkStorey
 
     k = float(stiffness)
     if law is None:
         return ["Elastic", k]
+    if isinstance(law, ImkStorey):
+        return imk_material(law, k, height)
     fy = float(law.yield_force_for(k, height))
     alpha = float(law.post_yield_ratio)
     if isinstance(law, BilinearStorey):
@@ -221,7 +264,7 @@ def storey_material(law, stiffness: float, height: float) -> list:
         return ["BoucWen", alpha, k, float(law.n), float(law.gamma) / scale, float(law.beta) / scale,
                 float(law.A), 0.0, 0.0, 0.0, 1.0e-12 * uy, 100]
     raise PoundingError(f"storey hysteresis '{law.name}' has no OpenSees counterpart in this exporter "
-                        "(supported: bilinear, bouc-wen)")
+                        "(supported: bilinear, bouc-wen, imk-bilinear, imk-peak-oriented, imk-pinching)")
 
 
 def _initial_tangent(law, stiffness: float) -> float:

@@ -360,7 +360,15 @@ def _hysteresis_parameters(value: Any) -> Any:
     out = dict(value)
     for key, item in value.items():
         info = cls.model_fields.get(key)
-        if info is not None and key != "model" and item is not None:
+        if info is not None and key != "model" and isinstance(item, dict):
+            # A nested mapping of an IMK storey (deterioration, pinching, negative): numbers, one level down.
+            out[key] = dict(item)
+            for inner, number in item.items():
+                try:
+                    out[key][inner] = as_number(number)
+                except Problem as failed:
+                    raise problem(failed.predicate, at=(key, inner)) from None
+        elif info is not None and key != "model" and item is not None:
             try:
                 out[key] = as_number(item)
             except Problem as failed:

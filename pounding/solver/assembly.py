@@ -23,6 +23,7 @@ import numpy as np
 from pounding import hysteresis
 from pounding.contact import laws as contact_laws
 from pounding.model.model import WALL, Model, column_weights
+from pounding.solver import imk
 from pounding.solver.integrator import System
 
 __all__ = ["assemble", "building_arrays", "storey_arrays", "element_arrays", "contact_side_terms", "side_mass"]
@@ -74,14 +75,18 @@ def storey_arrays(model: Model) -> dict[str, Any]:
     """Hysteresis kernel id and parameters, height (m) and P-Delta stiffness (N/m) of every storey.
 
     ``storey_state`` numbers the yielding storeys (their hysteretic states in the
-    solver's state vector), −1 for an elastic storey.
+    solver's state vector), −1 for an elastic storey; ``storey_imk`` holds the
+    initial discrete state of each IMK storey among them (:mod:`pounding.solver.imk`).
     """
-    models, parameters, heights, p_delta = [], [], [], []
+    models, parameters, heights, p_delta, discrete = [], [], [], [], []
     for building in model.buildings:
         for law, k, h in zip(building.hysteresis, building.stiffness, building.height):
             models.append(hysteresis.MODEL_ELASTIC if law is None else law.model_id)
             parameters.append(np.zeros(hysteresis.N_HYSTERESIS_PARAMETERS) if law is None
                               else law.kernel_parameters(k, h))
+            if law is not None:
+                discrete.append(imk.initial_state(law, k, h) if isinstance(law, hysteresis.ImkStorey)
+                                else np.zeros(imk.N_STATE))
         heights.append(building.height)
         p_delta.append(building.p_delta_stiffness)
     yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
@@ -92,6 +97,7 @@ def storey_arrays(model: Model) -> dict[str, Any]:
         p_delta_stiffness=np.ascontiguousarray(np.concatenate(p_delta), dtype=float),
         storey_height=np.ascontiguousarray(np.concatenate(heights), dtype=float),
         stop_drift_ratio=float(model.solver.stop_drift_ratio or 0.0),
+        storey_imk=np.array(discrete, dtype=float).reshape(len(discrete), imk.N_STATE),
     )
 
 

@@ -35,11 +35,14 @@ Design
   bilinear storey, Bouc–Wen's z) is integrated with the motion and is part
   of the error norm; a bilinear storey's yield onset and unloading are
   located as events, like gap closure, so no step straddles a kink of its
-  force (:mod:`pounding.solver.storeys`).  P-Delta is a linear geometric
-  stiffness per storey.  A run stops, located, when a storey's drift ratio
-  first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED), or when a storey
-  with P-Delta loses its lateral resistance, its restoring force plus P-Delta
-  falling to zero as its drift grows (STATUS_UNSTABLE).
+  force (:mod:`pounding.solver.storeys`).  An IMK storey's state is its
+  shear, and every branch change of it is a located event
+  (:mod:`pounding.solver.imk`); one that loses its strength ends the run as a
+  collapse.  P-Delta is a linear geometric stiffness per storey.  A run stops,
+  located, when a storey's drift ratio first exceeds ``stop_drift_ratio``
+  (STATUS_COLLAPSED), or when a storey with P-Delta loses its lateral
+  resistance, its restoring force plus P-Delta falling to zero as its drift
+  grows (STATUS_UNSTABLE).
 
 State vector layout (:mod:`pounding.solver.layout`): ``[u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]``
 (``q``: each contact law's internal state, e.g. the bilinear law's hysteretic force; ``r``: each
@@ -66,7 +69,8 @@ record) and the Python entry point :func:`integrate`; the parts it drives:
 ``dormand_prince``  tableau, stages, the error norm, step-size factor
 ``dense``           Hermite interpolant, its extrema and exact crossings
 ``contact_events``  contact events: locate, apply
-``storey_events``   bilinear storeys' yield and unloading, collapse: locate, apply
+``storey_events``   bilinear storeys' yield and unloading, IMK branch changes, collapse: locate, apply
+``imk``             IMK storeys' discrete state and branch rules at their events
 ``recorder``        output samples, peaks, impact table, trace of closed contacts
 ``status``          how a run ended
 ==================  ===========================================================
@@ -86,7 +90,7 @@ import numpy as np
 from numba import njit
 
 from pounding import hysteresis
-from pounding.solver import jit
+from pounding.solver import imk, jit
 from pounding.solver import kernels
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
@@ -105,9 +109,12 @@ from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IM
 from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
                                     STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT, STATUS_UNSTABLE)
-from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, instability_crossing,
-                                           locate_storey_events)
+from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, failed_storey,
+                                           instability_crossing, locate_storey_events)
 from pounding.solver.tolerances import floor_tolerance_factors
+
+#: Storey models whose hysteretic state is their shear (pounding.solver.imk).
+IMK_MODELS = (hysteresis.MODEL_IMK_BILINEAR, hysteresis.MODEL_IMK_PEAK, hysteresis.MODEL_IMK_PINCHING)
 
 __all__ = ["System", "RawSolution", "integrate", "ground_kinematics", "ground_state_at", "STATUS_OK",
            "STATUS_STEP_TOO_SMALL", "STATUS_EVENT_LIMIT", "STATUS_TABLE_LIMIT", "STATUS_COLLAPSED", "STATUS_UNSTABLE",
@@ -147,6 +154,8 @@ class System:
     p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
     storey_height : (N,) m
     stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
+    storey_imk : (nh, imk.N_STATE) float, optional
+        Initial discrete state of each IMK storey (row of its hysteretic state; other rows unused)
     contact_floors : (nc, SIDE_TERMS) int, optional
         Floor terms of each contact ``[left, left, right, right]`` (−1: none, the ground or a wall);
         default from ``contact_left`` / ``contact_right``: ``[left, −1, right, −1]``.
@@ -180,6 +189,7 @@ class System:
     p_delta_stiffness: np.ndarray | None = None
     storey_height: np.ndarray | None = None
     stop_drift_ratio: float = 0.0
+    storey_imk: np.ndarray | None = None
     contact_floors: np.ndarray | None = None
     contact_weights: np.ndarray | None = None
     floor_ground: np.ndarray | None = None
@@ -208,6 +218,8 @@ class System:
         for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)
+        if self.storey_imk is None:
+            object.__setattr__(self, "storey_imk", np.zeros((self.n_hysteretic, imk.N_STATE)))
 
     @property
     def n_floors(self) -> int:
@@ -392,11 +404,15 @@ def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_f
     """The yielding storeys' first events in a trial step of *h* s, and the first stop of the run in it
     (the collapse limit's crossing, STATUS_COLLAPSED, or a loss of stability, STATUS_UNSTABLE):
     ``(first event fraction, *s_first* if earlier; stop fraction, −1 if none; its floor and status, else
-    *collapse_floor* and *stop_status*)``.  A kernel of its own, so the driver's loop has no branch of its
-    own for the storeys (its branches cost reference counts of the tables it grows, at every step)."""
+    *collapse_floor* and *stop_status*)``.  An IMK storey at zero strength (failed at the event that starts
+    the step) is a collapse at the step's start.  A kernel of its own, so the driver's loop has no branch of
+    its own for the storeys (its branches cost reference counts of the tables it grows, at every step)."""
     below = structure.below
     s_first = min(s_first, locate_storey_events(work, h, lay, below, storey, events.storey_s, events.storey_kind))
     collapse_s = -1.0
+    failed = failed_storey(storey)
+    if failed >= 0:  # an IMK storey lost its strength at the last event: its building collapses there
+        return 0.0, 0.0, failed, STATUS_COLLAPSED
     if storey.stop_ratio > 0.0:
         collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio, h)
         if collapse_s >= 0.0:
@@ -630,13 +646,18 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
     state_floor[system.storey_state[floors]] = floors
     bilinear = system.storey_model[state_floor] == hysteresis.MODEL_BILINEAR
     tolerance = np.where(bilinear, atol, atol / np.where(bilinear, 1.0, system.storey_parameters[state_floor, 0]))
+    # An IMK storey's state is its shear: atol times its stiffness (N).
+    shear_state = np.isin(system.storey_model[state_floor], IMK_MODELS)
+    tolerance = np.where(shear_state, atol * system.storey_stiffness[state_floor], tolerance)
+    # Fresh copies: the IMK events rewrite their storeys' kernel rows and states during the run.
     return Storeys(np.ascontiguousarray(system.storey_model, dtype=np.int64),
-                   np.ascontiguousarray(system.storey_parameters, dtype=np.float64),
+                   np.array(system.storey_parameters, dtype=np.float64, copy=True, order="C"),
                    np.ascontiguousarray(system.storey_state, dtype=np.int64),
                    np.ascontiguousarray(system.p_delta_stiffness, dtype=np.float64),
                    np.ascontiguousarray(system.storey_height, dtype=np.float64),
                    np.zeros(floors.size, dtype=np.int64), state_floor, np.ascontiguousarray(tolerance, dtype=np.float64),
-                   float(system.stop_drift_ratio))
+                   float(system.stop_drift_ratio),
+                   np.array(system.storey_imk, dtype=np.float64, copy=True, order="C").reshape(-1, imk.N_STATE))
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,

@@ -127,6 +127,7 @@ class Storeys(NamedTuple):
     floor: np.ndarray        #: (nh,) int, floor of each hysteretic state
     tolerance: np.ndarray    #: (nh,) absolute tolerance of each hysteretic state
     stop_ratio: float        #: drift ratio that ends the run (0: never)
+    imk: np.ndarray          #: (nh, imk.N_STATE) discrete state of each IMK storey (other rows unused)
 
 
 class Grounds(NamedTuple):

@@ -1,4 +1,5 @@
-"""Storey events: a bilinear storey's yield onset and unloading, and the collapse limit (locate; apply).
+"""Storey events: a bilinear storey's yield onset and unloading, an IMK storey's branch changes, and the
+collapse limit (locate; apply).
 
 A bilinear storey's force has kinks where its drift reaches the yield
 surface and where a yielding storey unloads; they are located on the step's
@@ -6,7 +7,10 @@ interpolant like gap closure, so no step straddles one
 (:mod:`pounding.solver.storeys`).  A run stops, located, where a storey's
 drift ratio first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED), and where a
 storey with P-Delta loses its lateral resistance (STATUS_UNSTABLE,
-:func:`instability_crossing`).
+:func:`instability_crossing`).  An IMK storey's events
+are its drift crossing the lower or upper limit of its branch and, on a loading branch, its
+drift turning back (:mod:`pounding.solver.imk`); one that loses its strength ends the run
+as a collapse of its building (:func:`failed_storey`).
 """
 
 from __future__ import annotations
@@ -14,16 +18,18 @@ from __future__ import annotations
 from numba import njit
 
 from pounding import hysteresis
-from pounding.solver import jit
+from pounding.solver import imk, jit
 from pounding.solver import storeys
 from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
 from pounding.solver.kinematics import drift, drift_interpolant
 
-__all__ = ["STOREY_NONE", "STOREY_YIELD_POSITIVE", "STOREY_YIELD_NEGATIVE", "STOREY_UNLOAD", "storey_event",
-           "locate_storey_events", "apply_storey_events", "collapse_crossing", "instability_crossing"]
+__all__ = ["STOREY_NONE", "STOREY_YIELD_POSITIVE", "STOREY_YIELD_NEGATIVE", "STOREY_UNLOAD", "STOREY_IMK_LOWER",
+           "STOREY_IMK_UPPER", "STOREY_IMK_REVERSAL", "storey_event", "imk_event", "locate_storey_events",
+           "apply_storey_events", "collapse_crossing", "failed_storey", "instability_crossing"]
 
-# Kinds of storey events (bilinear storeys).
+# Kinds of storey events (bilinear storeys; IMK storeys: imk.KIND_* + STOREY_IMK_LOWER).
 STOREY_NONE, STOREY_YIELD_POSITIVE, STOREY_YIELD_NEGATIVE, STOREY_UNLOAD = range(4)
+STOREY_IMK_LOWER, STOREY_IMK_UPPER, STOREY_IMK_REVERSAL = 4 + imk.KIND_LOWER, 4 + imk.KIND_UPPER, 4 + imk.KIND_REVERSAL
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
@@ -64,6 +70,39 @@ def storey_event(y, ynew, k1, k7, lay, j, b, hi, model, uy, mode, h):
     return s, STOREY_UNLOAD if s >= 0.0 else STOREY_NONE
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
+def imk_event(y, ynew, k1, k7, lay, j, b, sprm, h):
+    """First branch change of IMK storey *j* inside a step: ``(fraction, STOREY_IMK_*)``, −1 if none.
+
+    The drift crossing its branch's lower limit downward or its upper limit
+    upward (``sprm[j, P_LOWER]``, ``sprm[j, P_UPPER]``, m), and on a loading
+    branch (``sprm[j, P_WATCH]`` = ±1) the drift rate crossing zero against
+    that direction.
+    """
+    n = lay.n_floors
+    d0, r0, d1, r1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, b)
+    lower, upper, watch = sprm[j, imk.P_LOWER], sprm[j, imk.P_UPPER], sprm[j, imk.P_WATCH]
+    reach = max(abs(d0), abs(d1)) + 0.25 * h * (abs(r0) + abs(r1))
+    best = -1.0
+    kind = STOREY_NONE
+    floor = DELTA_ROUNDOFF * (abs(d0) + reach)
+    # The Hermite cubic stays within its ends ± (4/27)·h·(|r0| + |r1|): search only a limit within reach.
+    if upper - max(d0, d1) < 0.25 * h * (abs(r0) + abs(r1)) + floor:
+        s = first_crossing(d0 - upper, r0, d1 - upper, r1, h, True, floor + DELTA_ROUNDOFF * abs(upper))
+        if s >= 0.0:
+            best, kind = s, STOREY_IMK_UPPER
+    if min(d0, d1) - lower < 0.25 * h * (abs(r0) + abs(r1)) + floor:
+        s = first_crossing(d0 - lower, r0, d1 - lower, r1, h, False, floor + DELTA_ROUNDOFF * abs(lower))
+        if s >= 0.0 and (best < 0.0 or s < best):
+            best, kind = s, STOREY_IMK_LOWER
+    if watch != 0.0:
+        rate_floor = DELTA_ROUNDOFF * (abs(y[n + j]) + (abs(y[n + b]) if b >= 0 else 0.0))
+        s = first_crossing(r0, a0, r1, a1, h, watch < 0.0, rate_floor)
+        if s >= 0.0 and (best < 0.0 or s < best):
+            best, kind = s, STOREY_IMK_REVERSAL
+    return best, kind
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def locate_storey_events(work, h, lay, below, storey, sev_s, sev_kind) -> float:
     """Each yielding storey's first switch inside a step (:func:`storey_event`, inlined here) into
@@ -77,7 +116,10 @@ def locate_storey_events(work, h, lay, below, storey, sev_s, sev_kind) -> float:
     first = 2.0
     for hi in range(sfloor.size):
         j = sfloor[hi]
-        s, kind = storey_event(y, ynew, k1, k7, lay, j, below[j], hi, smodel[j], sprm[j, 0], smode[hi], h)
+        if storeys.is_imk(smodel[j]):
+            s, kind = imk_event(y, ynew, k1, k7, lay, j, below[j], sprm, h)
+        else:
+            s, kind = storey_event(y, ynew, k1, k7, lay, j, below[j], hi, smodel[j], sprm[j, 0], smode[hi], h)
         sev_s[hi] = s
         sev_kind[hi] = kind
         if kind != STOREY_NONE and s < first:
@@ -92,7 +134,8 @@ def apply_storey_events(kinds, y, lay, below, storey):
     Yield onset puts the plastic drift on the yield surface (``Δ − Δ_p = ±u_y``
     exactly) and enters the yield mode, unless the drift is not moving
     outward there (a grazing touch of the surface: it stays elastic);
-    unloading returns to the elastic mode.
+    unloading returns to the elastic mode.  An IMK storey moves to its next branch at the
+    located drift, its shear (the state) set to that branch's (:func:`imk.apply_event`).
     """
     sfloor, sprm, smode = storey.floor, storey.parameters, storey.mode
     n = lay.n_floors
@@ -106,6 +149,10 @@ def apply_storey_events(kinds, y, lay, below, storey):
         j = sfloor[hi]
         b = below[j]
         du = drift(y, 0, j, b)
+        if kind >= STOREY_IMK_LOWER:
+            y[ih + hi] = imk.apply_event(storey.imk[hi], sprm[j], kind - STOREY_IMK_LOWER, du, y[ih + hi],
+                                         drift(y, n, j, b))
+            continue
         rate = drift(y, n, j, b)
         uy = sprm[j, 0]
         if kind == STOREY_YIELD_POSITIVE:
@@ -117,6 +164,16 @@ def apply_storey_events(kinds, y, lay, below, storey):
         else:
             smode[hi] = storeys.ELASTIC
     return applied
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def failed_storey(storey):
+    """Floor of the first IMK storey at zero strength (failed at an event), −1 if none."""
+    smodel, sfloor = storey.model, storey.floor
+    for hi in range(sfloor.size):
+        if storeys.is_imk(smodel[sfloor[hi]]) and storey.imk[hi, imk.FAILED] > 0.0:
+            return sfloor[hi]
+    return sfloor.size - sfloor.size - 1
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
