@@ -397,3 +397,21 @@ def test_a_link_between_buildings_on_different_grounds_closes_the_balance(tmp_pa
     ds = pounding.simulate(pounding.load_model(tmp_path / "linked.yaml"))
     assert ds.attrs["energy_closure_error"] < 1e-5
     assert np.abs(ds.energy_ground_work.values).max() > 1e-3 * np.abs(ds.energy_input.values).max()
+
+
+def test_the_run_summary_prints_each_buildings_record_pga(tmp_path):
+    # issue 28 §4: every record's PGA, as recorded and as run, not only the first building's
+    import json
+
+    from pounding.cli.run import summary
+
+    a, b = _records(tmp_path)
+    model = _model(tmp_path, gm_a="ground_motion: {record: a.txt, scale: 2.0}", gm_b="ground_motion: {record: b.txt}")
+    ds = pounding.simulate(model)
+    pga = json.loads(ds.attrs["ground_pga"])
+    # the file's own peak as recorded, times the factor as run (rel 1e-12: a g round trip at most)
+    assert pga["A"]["pga_recorded"] == pytest.approx(np.abs(a).max(), rel=1e-12)
+    assert pga["A"]["pga"] == pytest.approx(2.0 * np.abs(a).max(), rel=1e-12)
+    assert pga["B"]["pga"] == pytest.approx(np.abs(b).max(), rel=1e-12) and pga["B"]["scale"] == 1.0
+    lines = [line for line in summary(ds).splitlines() if line.startswith("record PGA")]
+    assert len(lines) == 2 and "under A (a)" in lines[0] and "(x2)" in lines[0] and "under B (b)" in lines[1]

@@ -85,9 +85,17 @@ def _pga_line(ds) -> str:
     from pounding.results.dataset import record_pga
     from pounding.units import STANDARD_GRAVITY
 
+    def line(label: str, own: float, scaled: float, factor: float) -> str:
+        return (f"{label} {own / STANDARD_GRAVITY:.3g} g ({own:.3g} m/s2) as recorded, "
+                f"{scaled / STANDARD_GRAVITY:.3g} g ({scaled:.3g} m/s2) as run (x{factor:.4g})")
+
+    if "ground_pga" in ds.attrs:   # each building on its own record: one line each
+        import json
+
+        return "\n".join(line(f"record PGA under {name} ({g['record']})", g["pga_recorded"], g["pga"], g["scale"])
+                         for name, g in json.loads(ds.attrs["ground_pga"]).items())
     own, scaled = record_pga(ds)
-    return (f"record PGA {own / STANDARD_GRAVITY:.3g} g ({own:.3g} m/s2) as recorded, "
-            f"{scaled / STANDARD_GRAVITY:.3g} g ({scaled:.3g} m/s2) as run (x{ds.attrs['record_scale']:.4g})")
+    return line("record PGA", own, scaled, ds.attrs["record_scale"])
 
 
 def summary(ds) -> str:

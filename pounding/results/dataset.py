@@ -627,11 +627,25 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     }
     if peaks["status_message"]:   # not completed: why (a completed run's archive is as before)
         ds.attrs["status_message"] = peaks["status_message"]
+    if model.has_building_records:   # each building's own record: its PGA as recorded and as run, m/s²
+        ds.attrs["ground_pga"] = json.dumps({b.name: {"record": str(ground["record"][i]), "scale": float(ground["scale"][i]),
+                                                      "pga_recorded": ground["pga"][i][0], "pga": ground["pga"][i][1]}
+                                             for i, b in enumerate(model.buildings)})
     if model.contacts_held_open:   # the run without pounding (pounding run --no-contacts)
         ds.attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
                                 "(the run without pounding)")
     ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"
     return ds
+
+
+def _record_pga(record: Record) -> tuple[float, float]:
+    """A record's PGA, m/s²: as recorded (the file's own ``pga_g``, else the samples over the factor) and as run."""
+    scale = float(record.scale)
+    pga_g = record.metadata.get("pga_g")
+    if pga_g is not None:
+        return float(pga_g) * STANDARD_GRAVITY, float(pga_g) * STANDARD_GRAVITY * scale
+    scaled = float(np.max(np.abs(record.acceleration))) if record.acceleration.size else 0.0
+    return (scaled / scale if scale else scaled), scaled
 
 
 def _grounds(model: Model, record: Record, system: System, raw: RawSolution, supports) -> dict:
@@ -651,6 +665,7 @@ def _grounds(model: Model, record: Record, system: System, raw: RawSolution, sup
     else:
         _, vel, disp = kinematics.ground_state_at(rows, step, raw.time)
     return {"record": np.array([r.name for r in records], dtype=object),
+            "pga": [_record_pga(r) for r in records],
             "source": np.array([r.source for r in records], dtype=object),
             "scale": np.array([float(r.scale) for r in records]),
             "sha256": [str(r.metadata.get("sha256", "")) for r in records],
