@@ -74,11 +74,18 @@ def record_pga(ds: xr.Dataset) -> tuple[float, float]:
     truncation), the scaled one that times ``record_scale``.  A record given as samples without that
     metadata falls back on the stored ``ground_acceleration`` (sampled at ``output_dt``).
     """
-    scale = float(ds.attrs.get("record_scale", 1.0))
     pga_g = json.loads(ds.attrs.get("record_metadata", "{}")).get("pga_g")
+    return _pga_pair(pga_g, float(ds.attrs.get("record_scale", 1.0)),
+                     lambda: float(np.max(np.abs(ds.ground_acceleration.values))) if "ground_acceleration" in ds
+                     else np.nan)
+
+
+def _pga_pair(pga_g: float | None, scale: float, peak_as_run) -> tuple[float, float]:
+    """``(as recorded, as run)`` PGA, m/s², from the file's own ``pga_g`` and the factor, else from
+    ``peak_as_run()`` (the scaled samples' peak) over the factor."""
     if pga_g is None:
-        scaled = float(np.max(np.abs(ds.ground_acceleration.values))) if "ground_acceleration" in ds else np.nan
-        return scaled / scale, scaled
+        scaled = peak_as_run()
+        return (scaled / scale if scale else scaled), scaled
     unscaled = float(pga_g) * STANDARD_GRAVITY
     return unscaled, unscaled * scale
 
@@ -640,12 +647,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
 
 def _record_pga(record: Record) -> tuple[float, float]:
     """A record's PGA, m/s²: as recorded (the file's own ``pga_g``, else the samples over the factor) and as run."""
-    scale = float(record.scale)
-    pga_g = record.metadata.get("pga_g")
-    if pga_g is not None:
-        return float(pga_g) * STANDARD_GRAVITY, float(pga_g) * STANDARD_GRAVITY * scale
-    scaled = float(np.max(np.abs(record.acceleration))) if record.acceleration.size else 0.0
-    return (scaled / scale if scale else scaled), scaled
+    return _pga_pair(record.metadata.get("pga_g"), float(record.scale),
+                     lambda: float(np.max(np.abs(record.acceleration))) if record.acceleration.size else 0.0)
 
 
 def _grounds(model: Model, record: Record, system: System, raw: RawSolution, supports) -> dict:

@@ -26,7 +26,7 @@ from pounding.solver.status import STATUS_TABLE_LIMIT
 
 __all__ = ["EVENT_NONE", "EVENT_CLOSE", "EVENT_SEPARATE", "EVENT_RELEASE", "EVENT_SWITCH0", "EVENT_SAMPLES",
            "STEPS_PER_CONTACT", "EVENTS_PER_WINDOW_BASE", "EVENTS_PER_WINDOW_PER_CONTACT", "switch_crossing",
-           "locate_contact_events", "locate_releases", "velocity_jump", "switch_contact", "plastic_jump", "resolve_rigid_contacts", "apply_contact_events"]
+           "locate_contact_events", "locate_releases", "velocity_jump", "switch_contact", "plastic_jump", "instant_row", "resolve_rigid_contacts", "apply_contact_events"]
 
 #: Sub-intervals sampled on the interpolant when searching for a contact event.
 EVENT_SAMPLES = 8
@@ -130,9 +130,10 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
         kind = EVENT_NONE
         if kernels.is_permanent(claw[c]):
             continue  # a link has no events
+        if cstate.resting[c]:
+            # at rest: neither parting nor (after a release at rest) re-closing within the band is an event
+            floor = max(floor, cstate.rest_band[c])
         if not closed[c]:
-            if cstate.resting[c]:
-                floor = max(floor, cstate.rest_band[c])  # released at rest: re-closing takes a resolved overlap
             # not closed[c], a run-time bool: one specialisation of first_crossing, not one per literal
             s = first_crossing(d0, r0, d1, r1, h_try, not closed[c], floor)  # upward: closure
             kind = EVENT_CLOSE
@@ -140,8 +141,6 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
             if forces_end[c] < 0.0:
                 n_release += 1  # the constraint force turns tensile inside the step: locate_releases
         else:
-            if cstate.resting[c]:
-                floor = max(floor, cstate.rest_band[c])  # at rest: parting within the solver's resolution is not
             s = first_crossing(d0, r0, d1, r1, h_try, not closed[c], floor)  # downward: separation
             kind = EVENT_SEPARATE
             for which in range(kernels.switch_count(claw[c], cprm[c])):
@@ -219,16 +218,23 @@ def velocity_jump(c, t, y, lay, mass, contacts, impacts, n_imp, dvg):
     y[lay.impulse + c] += impulse
     y[lay.work + c] += impulse * 0.5 * (v0 + v_after)
     y[lay.ground_work] += impulse * dvg
-    impacts[n_imp, IMP_CONTACT] = c
-    impacts[n_imp, IMP_TIME] = t
-    impacts[n_imp, IMP_VELOCITY] = v0
-    impacts[n_imp, IMP_CONSTANT] = np.nan
-    impacts[n_imp, IMP_PEAK_FORCE] = np.nan
-    impacts[n_imp, IMP_END] = t
-    impacts[n_imp, IMP_IMPULSE] = impulse
-    impacts[n_imp, IMP_SEPARATION] = -v_after
-    impacts[n_imp, IMP_WORK] = impulse * 0.5 * (v0 + v_after)
+    instant_row(impacts, n_imp, c, t, v0, impulse, v_after)
     return n_imp + 1
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def instant_row(impacts, row, c, t, v0, impulse, v_after) -> None:
+    """Row *row* of the impact table for an instantaneous impact of contact *c* at *t*: approach *v0*
+    and leaving *v_after* (m/s, δ̇ before and after), impulse (N·s) and its work, opened and closed at once."""
+    impacts[row, IMP_CONTACT] = c
+    impacts[row, IMP_TIME] = t
+    impacts[row, IMP_VELOCITY] = v0
+    impacts[row, IMP_CONSTANT] = np.nan
+    impacts[row, IMP_PEAK_FORCE] = np.nan
+    impacts[row, IMP_END] = t
+    impacts[row, IMP_IMPULSE] = impulse
+    impacts[row, IMP_SEPARATION] = -v_after
+    impacts[row, IMP_WORK] = impulse * 0.5 * (v0 + v_after)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
@@ -341,7 +347,7 @@ def resolve_rigid_contacts(kinds, n_closing, na, t, ag_t, lay, structure, contac
         rate[i] = combo(y, n, cf, cw, c) + dvg[i]
         e = 0.0
         if i < n_closing and rate[i] > kernels.rest_velocity(claw[c], cprm[c]):
-            e = kernels.jump_impulse(claw[c], cprm[c], 1.0) / effective_mass(mass, cf, cw, c) - 1.0
+            e = kernels.restitution(claw[c], cprm[c])
         rigid.target[i] = rate[i] + e * max(rate[i], 0.0)
     delassus(mass, cf, cw, active, na, rigid.delassus)
     solve_lcp(rigid, na)
@@ -362,15 +368,7 @@ def resolve_rigid_contacts(kinds, n_closing, na, t, ag_t, lay, structure, contac
             continue
         kinds[c] = EVENT_NONE
         cstate.resting[c] = False
-        impacts[n_imp, IMP_CONTACT] = c
-        impacts[n_imp, IMP_TIME] = t
-        impacts[n_imp, IMP_VELOCITY] = rate[i]
-        impacts[n_imp, IMP_CONSTANT] = np.nan
-        impacts[n_imp, IMP_PEAK_FORCE] = np.nan
-        impacts[n_imp, IMP_END] = t
-        impacts[n_imp, IMP_IMPULSE] = impulse[i]
-        impacts[n_imp, IMP_SEPARATION] = -after
-        impacts[n_imp, IMP_WORK] = impulse[i] * 0.5 * (rate[i] + after)
+        instant_row(impacts, n_imp, c, t, rate[i], impulse[i], after)
         if rate[i] <= kernels.rest_velocity(claw[c], cprm[c]):
             cstate.closed[c] = True  # tentatively stuck: kept where the constraint force presses it
             cstate.mode[c] = kernels.MODE_STUCK

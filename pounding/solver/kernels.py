@@ -140,10 +140,18 @@ def is_instantaneous(law_id: int) -> bool:
 
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def restitution(law_id: int, prm: np.ndarray) -> float:
+    """Coefficient of restitution e of an instantaneous law (0 for the others)."""
+    if law_id == LAW_STEREO:
+        return prm[0]
+    return 0.0
+
+
+@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
     """Impulse (N·s) of an instantaneous law for approach velocity *v0*: (1+e)·m_eff·v0."""
     if law_id == LAW_STEREO:
-        return (1.0 + prm[0]) * prm[1] * v0
+        return (1.0 + restitution(law_id, prm)) * prm[1] * v0
     return 0.0
 
 
