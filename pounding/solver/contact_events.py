@@ -130,7 +130,7 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
         kind = EVENT_NONE
         if kernels.is_permanent(claw[c]):
             continue  # a link has no events
-        if cstate.resting[c]:
+        if cstate.rest_band[c] > 0.0:
             # at rest: neither parting nor (after a release at rest) re-closing within the band is an event
             floor = max(floor, cstate.rest_band[c])
         if not closed[c]:
@@ -297,11 +297,10 @@ def plastic_jump(c, y, lay, mass, contacts, dvg):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _rigid_set(kinds, contacts, cstate):
-    """Instantaneous contacts to resolve together at this instant into ``cstate.rigid.active``, the
+def _rigid_set(kinds, contacts, cstate, active):
+    """Instantaneous contacts to resolve together at this instant into *active*, the
     closing ones first, then the stuck ones: ``(number closing, number in all)``; 0 in all when
     fewer than two, or none closing (a single closure keeps the rule of :func:`apply_contact_events`)."""
-    active = cstate.rigid.active
     n_closing = 0
     n_all = 0
     for c in range(kinds.size):
@@ -320,25 +319,28 @@ def _rigid_set(kinds, contacts, cstate):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def resolve_rigid_contacts(kinds, n_closing, na, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp,
-                           storey, ground):
-    """Closures of the instantaneous contacts ``cstate.rigid.active[:n_closing]`` together with the stuck
-    ones after them (*na* in all): one impulse each from Newton's restitution as an LCP
-    (:mod:`pounding.solver.simultaneous`).
+def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
+    """Closures of instantaneous contacts (``events.kind``) together with the stuck ones, when there are
+    two or more of them (:func:`_rigid_set`): one impulse each from Newton's restitution as an LCP
+    (:mod:`pounding.solver.simultaneous`).  Returns ``(new impact-row count, closures handled, status)``.
 
     A closure at or below the rest velocity is plastic (e = 0) and becomes stuck where the
     constraint forces after the impulses press it (else it leaves at rest, a plastic impact);
     a stuck contact that takes no impulse and is left separating is released.  Every contact's
     impulse and work ``P·(w + w⁺)/2`` go to its energy-audit states (their sum is the kinetic
-    energy lost), ``P·dvg`` to the ground work.  Clears ``kinds`` of the closures handled;
-    returns the new impact-row count.
+    energy lost), ``P·dvg`` to the ground work.  Clears ``events.kind`` of the closures handled.
     """
     y, scratch, deriv, fbuf, forces = work.y, work.ystage, work.K[1], work.fbuf, work.forces
     mass = structure.mass
     cf, cw, claw, cprm = contacts.floors, contacts.weights, contacts.law, contacts.parameters
-    rigid = cstate.rigid
+    kinds, rigid = events.kind, events.rigid
     active, rate, dvg, impulse = rigid.active, rigid.rate, rigid.dvg, rigid.impulse
     n = mass.size
+    n_closing, na = _rigid_set(kinds, contacts, cstate, active)
+    if na == 0:
+        return n_imp, n_closing - n_closing, n_closing - n_closing
+    if n_imp + n_closing > IMPACT_ROW_LIMIT:
+        return n_imp, n_closing - n_closing, n_closing - n_closing + STATUS_TABLE_LIMIT
     for i in range(na):
         c = active[i]
         dvg[i] = 0.0
@@ -364,10 +366,10 @@ def resolve_rigid_contacts(kinds, n_closing, na, t, ag_t, lay, structure, contac
             if impulse[i] == 0.0 and after < 0.0:  # left separating: released
                 n_imp = switch_contact(c, False, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg[i])
                 cstate.mode[c] = 0
-                cstate.resting[c] = True
+                cstate.rest_band[c] = events.band[c]
             continue
         kinds[c] = EVENT_NONE
-        cstate.resting[c] = False
+        cstate.rest_band[c] = 0.0
         instant_row(impacts, n_imp, c, t, rate[i], impulse[i], after)
         if rate[i] <= kernels.rest_velocity(claw[c], cprm[c]):
             cstate.closed[c] = True  # tentatively stuck: kept where the constraint force presses it
@@ -391,12 +393,12 @@ def resolve_rigid_contacts(kinds, n_closing, na, t, ag_t, lay, structure, contac
         else:
             cstate.closed[c] = False
             cstate.mode[c] = 0
-    return n_imp
+    return n_imp, n_closing, n_closing - n_closing
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
-    """Apply the located events ``kinds[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.
+def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
+    """Apply the located events ``events.kind[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
       ``v0 = δ̇``, the law's onset mode, a new impact row.
@@ -426,16 +428,12 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
     n = mass.size
     nc = cgap.size
     iq = lay.internal
-    n_applied = 0
     cap = np.inf
-    status = 0
-    n_closing, n_rigid = _rigid_set(kinds, contacts, cstate)
-    if n_rigid > 0:
-        if n_imp + n_closing > IMPACT_ROW_LIMIT:
-            return n_imp, n_applied, cap, STATUS_TABLE_LIMIT
-        n_imp = resolve_rigid_contacts(kinds, n_closing, n_rigid, t, ag_t, lay, structure, contacts, cstate, work,
-                                       impacts, n_imp, storey, ground)
-        n_applied += n_closing
+    kinds = events.kind
+    n_imp, n_applied, status = resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work,
+                                                      impacts, n_imp, storey, ground)
+    if status != 0:
+        return n_imp, n_applied, cap, status
     for c in range(nc):
         kind = kinds[c]
         if kind == EVENT_NONE:
@@ -450,7 +448,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
                 status = STATUS_TABLE_LIMIT
                 break
             if kernels.is_instantaneous(claw[c]):
-                cstate.resting[c] = False
+                cstate.rest_band[c] = 0.0
                 stick = False
                 if rate <= kernels.rest_velocity(claw[c], cprm[c]):
                     for i in range(y.size):
@@ -497,7 +495,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
             # kind == EVENT_CLOSE (a run-time True, like the separation's False): one specialisation
             n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
-            cstate.resting[c] = rate <= kernels.rest_velocity(claw[c], cprm[c])
+            cstate.rest_band[c] = events.band[c] if rate <= kernels.rest_velocity(claw[c], cprm[c]) else 0.0
             m_eff = effective_mass(mass, cf, cw, c)
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
@@ -505,7 +503,7 @@ def apply_contact_events(kinds, t, ag_t, lay, structure, contacts, cstate, work,
         elif kind == EVENT_SEPARATE or kind == EVENT_RELEASE:
             n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = 0
-            cstate.resting[c] = kind == EVENT_RELEASE
+            cstate.rest_band[c] = events.band[c] if kind == EVENT_RELEASE else 0.0
         else:
             which = kind - EVENT_SWITCH0
             new_mode = kernels.next_mode(claw[c], cmode[c], which)

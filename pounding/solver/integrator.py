@@ -343,7 +343,7 @@ def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, event
             if ground is not None:
                 fill_grounds(ground, forcing.record_step, seg, t, ground.now)
             n_imp, n_applied, cap, status = apply_contact_events(
-                events.kind, t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay, structure,
+                events, t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay, structure,
                 contacts, cstate, work, table.rows, table.count, storey, ground)
             return n_imp, n_applied + n_storey, cap, status
     return table.count, n_storey, np.inf, zero
@@ -442,40 +442,42 @@ RIGID_BAND_FRACTION = 1e-3
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _new_contact_state(contacts, tol):
-    """Every contact open (a link: closed, engaged from the start and never open), no impact row.
-
-    A resting contact's band is the displacement tolerance of its floors (*tol*: the error norm's
-    per-state tolerances; the smallest over the contact's floor terms): parting by less than the
-    solver resolves is not a separation (docs/numerics.md, "Contacts at rest")."""
+def _new_contact_state(contacts):
+    """Every contact open (a link: closed, engaged from the start and never open), none at rest, no impact row."""
     nc = contacts.gap.size
-    ni = nc - nc
-    for c in range(nc):
-        if kernels.is_instantaneous(contacts.law[c]):
-            ni += 1
-    rigid = RigidWork(np.zeros(ni, dtype=np.int64), np.zeros(ni), np.zeros(ni), np.zeros(ni), np.zeros(ni),
-                      np.zeros(ni), np.zeros(ni, dtype=np.int64), np.zeros((ni, ni)), np.zeros((ni, ni + 1)))
     cstate = ContactState(np.zeros(nc, dtype=np.bool_), np.zeros(nc), np.zeros(nc, dtype=np.int64),
-                          np.empty(nc, dtype=np.int64), np.zeros(nc, dtype=np.bool_), np.empty(nc), rigid)
+                          np.empty(nc, dtype=np.int64), np.zeros(nc))
     for c in range(nc):
         cstate.open_row[c] = -1
         cstate.closed[c] = kernels.is_permanent(contacts.law[c])
-        band = np.inf
-        for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
-            if contacts.weights[k] != 0.0:
-                band = min(band, tol[contacts.floors[k]])
-        if band == np.inf:
-            band = 0.0
-        # a rigid contact's band only needs to clear the interpolant's round-off: 1e-3 of it (≪ 1e-9 m)
-        cstate.rest_band[c] = band * RIGID_BAND_FRACTION if kernels.is_instantaneous(contacts.law[c]) else band
     return cstate
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def _new_events(nc, nh):
-    """No event located, none pending, for *nc* contacts and *nh* yielding storeys."""
+def _new_events(contacts, nh, tol):
+    """No event located, none pending, for the contacts and *nh* yielding storeys; the rigid-impact
+    scratch sized for the contacts of instantaneous laws.
+
+    A contact's rest band is the displacement tolerance of its floors (*tol*: the error norm's per-state
+    tolerances; the smallest over the contact's floor terms): parting by less than the solver resolves
+    is not a separation (docs/numerics.md, "Contacts at rest"); a rigid contact's, 1e-3 of that."""
+    nc = contacts.gap.size
+    ni = nc - nc
+    band = np.zeros(nc)
+    for c in range(nc):
+        if kernels.is_instantaneous(contacts.law[c]):
+            ni += 1
+        smallest = np.inf
+        for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+            if contacts.weights[k] != 0.0:
+                smallest = min(smallest, tol[contacts.floors[k]])
+        if smallest < np.inf:
+            # a rigid contact's band only needs to clear the interpolant's round-off: 1e-3 of it (≪ 1e-9 m)
+            band[c] = smallest * RIGID_BAND_FRACTION if kernels.is_instantaneous(contacts.law[c]) else smallest
+    rigid = RigidWork(np.zeros(ni, dtype=np.int64), np.zeros(ni), np.zeros(ni), np.zeros(ni), np.zeros(ni),
+                      np.zeros(ni), np.zeros(ni, dtype=np.int64), np.zeros((ni, ni)), np.zeros((ni, ni + 1)))
     return Events(np.empty(nc), np.zeros(nc, dtype=np.int64), np.zeros(nc, dtype=np.int64), np.empty(nh),
-                  np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64))
+                  np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64), band, rigid)
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -494,7 +496,7 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
         y[i] = y_initial[i]
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
     fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, settings.floor_factor, storey)
-    cstate, events = _new_contact_state(contacts, tol), _new_events(nc, nh)
+    cstate, events = _new_contact_state(contacts), _new_events(contacts, nh, tol)
     normed = normed_states(tol)
     out = new_outputs(n_out, lay, ground)
     peaks = new_peaks(lay)

@@ -110,9 +110,8 @@ class ContactState(NamedTuple):
     constant: np.ndarray  #: law constant fixed at onset (ξ of Hertz-damp)
     mode: np.ndarray      #: int, mode of a closed contact (pounding.contact.MODE_*)
     open_row: np.ndarray  #: int, row of the contact's open impact in the impact table, −1 if none
-    resting: np.ndarray   #: bool, a compliant contact closed at rest (v0 ≤ the law's rest velocity)
-    rest_band: np.ndarray  #: m, how far a resting contact's faces part before it counts as separated
-    rigid: RigidWork      #: scratch of the simultaneous rigid-impact resolution
+    rest_band: np.ndarray  #: m, 0 unless the contact is at rest; then how far its faces part (or, released
+    #: at rest, overlap again) before that is an event (events.band; docs/numerics.md "Contacts at rest")
 
 
 class Storeys(NamedTuple):
@@ -173,6 +172,9 @@ class Events(NamedTuple):
     storey_s: np.ndarray        #: (nh,) likewise for the yielding storeys
     storey_kind: np.ndarray     #: (nh,) int (storey_events.STOREY_*)
     storey_pending: np.ndarray  #: (nh,) int
+    band: np.ndarray            #: (nc,) m, each contact's rest band (ContactState.rest_band while at rest)
+    rigid: RigidWork            #: scratch of the simultaneous rigid-impact resolution (kept out of the
+    #: contact state, which the right-hand side takes six times a step)
 
 
 class Work(NamedTuple):

@@ -139,7 +139,7 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
             f = kernels.mode_force(claw[c], cprm[c], cconst[c], cmode[c], delta, rate, q)
             if kernels.is_permanent(claw[c]):
                 out[internal + c] = kernels.link_internal_rate(claw[c], cprm[c], rate, q)
-            elif delta > 0.0 or not cstate.resting[c]:
+            elif delta > 0.0 or cstate.rest_band[c] == 0.0:
                 out[internal + c] = kernels.mode_internal_rate(claw[c], cprm[c], cmode[c], delta, rate)
             # a resting contact parted within its band carries no force: its internal state (the bilinear
             # law's force) waits, so it is the loop's value at δ = 0 when the faces meet again
