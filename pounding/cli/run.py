@@ -141,10 +141,11 @@ def summary(ds) -> str:
             lines.append(f"  {name} residual: " + " ".join(f"{100 * v:+.3f}" for v in residual))
         energy = float(ds.energy_hysteretic.values[-1]) if "energy_hysteretic" in ds else 0.0
         lines.append(f"  hysteretic energy dissipated: {energy / 1e3:.4g} kJ")
-    if ds.attrs.get("status") == "collapsed":
-        lines.append(f"COLLAPSED: storey {ds.attrs['collapse_storey']} passed drift ratio "
-                     f"{ds.attrs['stop_drift_ratio']:g} at t = {ds.attrs['collapse_time']:.4f} s; the run ended there")
-    elif ds.attrs.get("status") in ("unstable", "energy_inconsistent"):
+    if "collapse_drift_ratio" in ds and bool(np.isfinite(ds.collapse_drift_ratio.values).any()):
+        limits = {str(b): float(r) for b, r in zip(ds.storey_building.values, ds.collapse_drift_ratio.values)}
+        lines.append("collapse drift ratio (a building collapses, and the run ends, past it): "
+                     + ", ".join(f"{b} {'none' if not np.isfinite(r) else f'{r:g}'}" for b, r in limits.items()))
+    if ds.attrs.get("status") in ("collapsed", "unstable", "energy_inconsistent"):
         status, _, why = str(ds.attrs.get("status_message", ds.attrs["status"])).partition(": ")
         lines.append(f"{status.upper().replace('_', ' ')}: {why}")
     if ds.sizes.get("contact", 0):

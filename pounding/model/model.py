@@ -200,6 +200,11 @@ class Building:
         The building's design factors per code (``design:`` in the YAML:
         ``{asce7_22: {R, Cd, Ie}, ec8: {q, qd}}``), used by the code separation
         rules of ``pounding gap --code``; None: not given.
+    collapse_drift_ratio : float or None
+        The building's own collapse criterion (``collapse: {drift_ratio}`` in
+        the YAML): it collapses, and the run ends, when one of its storeys'
+        |drift ratio| first exceeds this.  None: ``solver.stop_drift_ratio``
+        applies (:meth:`Model.collapse_drift_ratios`).
 
     Arrays are read-only copies.  Equality is identity (arrays do not compare
     as booleans); compare the arrays to test two buildings for equal content.
@@ -213,6 +218,7 @@ class Building:
     hysteresis: tuple = ()
     p_delta: bool = False
     design: Any = None
+    collapse_drift_ratio: float | None = None
 
     def __post_init__(self) -> None:
         arrays = [np.array(getattr(self, key), dtype=float).reshape(-1) for key in ("mass", "stiffness", "height")]
@@ -228,8 +234,11 @@ class Building:
         document = {"name": self.name, "storeys": storeys, "damping": damping, "p_delta": self.p_delta}
         if self.design is not None:
             document["design"] = _design_document(self.design)
+        if self.collapse_drift_ratio is not None:
+            document["collapse"] = {"drift_ratio": self.collapse_drift_ratio}
         entry = _checked(schema.BuildingEntry, document, prefix=f"building {self.name}:")
         object.__setattr__(self, "design", entry.design)
+        object.__setattr__(self, "collapse_drift_ratio", None if entry.collapse is None else entry.collapse.drift_ratio)
         for key, array in zip(("mass", "stiffness", "height"), arrays):
             array.setflags(write=False)
             object.__setattr__(self, key, array)
@@ -823,6 +832,20 @@ class Model:
         self.refuse_building_records("changing the ground motion (record or scale)")
         return self._derived(ground_motion=dataclasses.replace(self.ground_motion, **changes))
 
+    def collapse_drift_ratios(self) -> tuple[float | None, ...]:
+        """Each building's collapse drift ratio, left to right: its own ``collapse: {drift_ratio}``, else
+        ``solver.stop_drift_ratio``; None: no drift limit (an IMK storey at zero strength, or a storey
+        losing its resistance to P-Delta, still ends the run: docs/models.md "Collapse")."""
+        return tuple(b.collapse_drift_ratio if b.collapse_drift_ratio is not None else self.solver.stop_drift_ratio
+                     for b in self.buildings)
+
+    def with_collapse_drift(self, drift_ratio: float) -> Model:
+        """The same model with every building's collapse drift ratio set to *drift_ratio* (what
+        ``pounding ida --collapse-drift`` does for its study: it overrides both the buildings' own
+        ``collapse`` and ``solver.stop_drift_ratio``)."""
+        return self._derived(buildings=tuple(dataclasses.replace(b, collapse_drift_ratio=float(drift_ratio))
+                                             for b in self.buildings))
+
     def with_solver(self, **changes: Any) -> Model:
         """The same model with solver settings changed (rtol, atol, atol_velocity, output_dt)."""
         _check_keys("solver", changes, SolverSettings)
@@ -941,6 +964,8 @@ def _building_document(b: Building) -> dict[str, Any]:
         document["p_delta"] = True
     if b.design is not None:
         document["design"] = _design_document(b.design)
+    if b.collapse_drift_ratio is not None:
+        document["collapse"] = {"drift_ratio": b.collapse_drift_ratio}
     return document
 
 
@@ -976,7 +1001,9 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
             array.setflags(write=False)
             arrays[key] = array
         buildings.append(_trusted(Building, name=b.name, damping=damping, hysteresis=b.column("hysteresis"),
-                                  p_delta=b.p_delta, design=b.design, **arrays))
+                                  p_delta=b.p_delta, design=b.design,
+                                  collapse_drift_ratio=None if b.collapse is None else b.collapse.drift_ratio,
+                                  **arrays))
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters, at_a, at_r)
                  for index, c in enumerate(entry.contacts) for (a, r), (at_a, at_r) in zip(c.pairs, c.points))
     links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)

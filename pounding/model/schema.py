@@ -524,11 +524,21 @@ class DesignEntry(_Schema):
     ec8: Ec8DesignEntry | None = Field(None, description="Eurocode 8 factors {q, qd}")
 
 
+class CollapseEntry(_Schema):
+    """A building's collapse criterion: ``drift_ratio``, the storey drift ratio at which it collapses."""
+
+    WHAT: ClassVar[str] = "a mapping {drift_ratio}, e.g. {drift_ratio: 0.1}"
+
+    drift_ratio: StopDriftRatio = Field(
+        description="the building collapses (the run ends, status collapsed) when one of its storeys' |drift "
+                    "ratio| first exceeds this (default: solver.stop_drift_ratio)")
+
+
 class BuildingEntry(_Schema):
     """One building: ``name``, ``storeys``, ``damping``."""
 
     WHAT: ClassVar[str] = "a mapping {name, storeys, damping}"
-    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": StoreyEntry}
+    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": StoreyEntry, "collapse": CollapseEntry}
 
     name: Name = Field(description="unique building name")
     storeys: Storeys = Field(description="a list of {mass, stiffness, height} from the ground up, "
@@ -541,6 +551,8 @@ class BuildingEntry(_Schema):
     design: DesignEntry | None = Field(
         None, description="design factors per code for pounding gap --code, e.g. {asce7_22: {R: 8, Cd: 5.5, Ie: 1}, "
                           "ec8: {q: 3.9}}")
+    collapse: CollapseEntry | None = Field(
+        None, description="this building's collapse criterion {drift_ratio} (default: solver.stop_drift_ratio)")
 
     def column(self, key: str) -> tuple[Any, ...]:
         """Per-floor values of ``mass``, ``stiffness``, ``height`` or ``hysteresis``, from the ground up."""

@@ -346,16 +346,27 @@ def energy_inconsistent(absorbed: float, received: float) -> bool:
     return absorbed - received > ENERGY_CLOSURE_LIMIT * max(abs(received), absorbed)
 
 
-def run_status(system: System, raw: RawSolution, n_gaps: int, storey: str) -> tuple[str, str]:
+def collapse_reason(raw: RawSolution, system: System) -> str:
+    """Why the storey that ended the run did (words after its label): past its collapse drift ratio, at
+    zero strength, or "" (a loss of stability says its own; nothing collapsed)."""
+    if raw.collapse_cause == "drift_ratio":
+        return f"passed its collapse drift ratio {system.storey_stop_ratio[raw.collapse_storey]:g}"
+    if raw.collapse_cause == "zero_strength":
+        return "reached its ultimate drift (IMK storey at zero strength)"
+    return ""
+
+
+def run_status(system: System, raw: RawSolution, n_gaps: int, storey: str, building: str = "") -> tuple[str, str]:
     """``(status, one-line message)`` of a run that ended (``completed``, ``collapsed``, ``unstable`` or
     ``energy_inconsistent``; message ``""`` when completed).  *storey*: the label of the storey that
-    collapsed or lost stability (``""`` if none)."""
+    collapsed or lost stability (``""`` if none), *building* its building."""
     absorbed, received = contact_energy_budget(system, raw, n_gaps)
     code = STATUS_ENERGY_INCONSISTENT if energy_inconsistent(absorbed, received) else raw.status
     if code == STATUS_OK:
         return STATUS_NAMES[code], ""
     return STATUS_NAMES[code], STATUS_MESSAGES[code].format(t=raw.final_time, storey=storey, dissipated=absorbed,
-                                                            available=received)
+                                                            available=received, building=building,
+                                                            cause=collapse_reason(raw, system))
 
 
 def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
@@ -365,9 +376,11 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     contact labels, ``peak_drift_ratio`` and ``residual_drift_ratio`` (storey,
     1), ``impact_count`` and ``peak_contact_force`` (contact, N), ``status``
     (``completed``, ``collapsed``, ``unstable`` or ``energy_inconsistent``: :func:`run_status`) and
-    ``status_message`` (its one line, ``""`` when completed), ``collapse_time`` (s, NaN if none) and
+    ``status_message`` (its one line, ``""`` when completed), ``collapse_time`` (s, NaN if none),
     ``collapse_storey`` (label, ``""`` if none; also for ``unstable``: the storey that lost its
-    resistance).  They do not depend on the output sampling: the solver tracks peaks at every step.
+    resistance), ``collapse_building`` (its building, ``""`` if none) and ``collapse_cause``
+    (:data:`pounding.solver.status.COLLAPSE_CAUSES`, ``""`` if none): the first building to collapse
+    ends the run, so at most one building collapses in a run.  They do not depend on the output sampling: the solver tracks peaks at every step.
     """
     labels = _labels(model)
     heights = labels["height"]
@@ -375,7 +388,8 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     floor_names = [f"{b}:{lv}" for b, lv in zip(labels["building"], labels["level"])]
     building_names = [b.name for b in model.buildings]
     collapsed = raw.collapse_storey >= 0
-    status, message = run_status(system, raw, ng, floor_names[raw.collapse_storey] if collapsed else "")
+    building = str(labels["building"][raw.collapse_storey]) if collapsed else ""
+    status, message = run_status(system, raw, ng, floor_names[raw.collapse_storey] if collapsed else "", building)
     return {
         "storey": floor_names,
         "storey_building": [str(b) for b in labels["building"]],
@@ -389,6 +403,8 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
         "status_message": message,
         "collapse_time": float(raw.final_time) if collapsed else float("nan"),
         "collapse_storey": floor_names[raw.collapse_storey] if collapsed else "",
+        "collapse_building": building,
+        "collapse_cause": raw.collapse_cause if collapsed else "",
     }
 
 
@@ -508,6 +524,10 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                                   "peak absolute floor displacement relative to the ground"),
         "peak_storey_drift": _var(("storey",), raw.peak_drift, "m", "peak absolute storey drift"),
         "peak_drift_ratio": _var(("storey",), peaks["peak_drift_ratio"], "1", "peak absolute storey drift ratio"),
+        "collapse_drift_ratio": _var(("storey",), np.where(system.storey_stop_ratio > 0, system.storey_stop_ratio,
+                                                           np.nan), "1",
+                                     "collapse drift ratio of the storey's building (the run ends when the storey's "
+                                     "|drift ratio| first exceeds it; NaN: no drift limit)"),
         "peak_contact_force": _var(("contact",), peaks["peak_contact_force"], "N", "peak contact force"),
         "impact_count": _var(("contact",), impact_count, "1", "number of impacts (gap closures)"),
         "impact_time": _var(("impact",), raw.impact_time, "s", "time of gap closure (located event)"),
@@ -625,6 +645,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
         "status": peaks["status"],
         "collapse_time": peaks["collapse_time"],
         "collapse_storey": peaks["collapse_storey"],
+        "collapse_building": peaks["collapse_building"],
+        "collapse_cause": peaks["collapse_cause"],
         "stop_drift_ratio": float(model.solver.stop_drift_ratio or 0.0),
         "hysteresis": json.dumps({b.name: [None if law is None else law.describe() for law in b.hysteresis]
                                   for b in model.buildings if b.is_inelastic}),

@@ -26,7 +26,7 @@ from pounding.model.model import WALL, Model, column_weights
 from pounding.solver import imk
 from pounding.solver.integrator import System
 
-__all__ = ["assemble", "building_arrays", "storey_arrays", "element_arrays", "contact_side_terms", "side_mass"]
+__all__ = ["assemble", "building_arrays", "storey_arrays", "storey_stop_ratios", "element_arrays", "contact_side_terms", "side_mass"]
 
 
 def building_arrays(model: Model) -> dict[str, np.ndarray]:
@@ -71,6 +71,12 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
     )
 
 
+def storey_stop_ratios(model: Model) -> np.ndarray:
+    """(N,) each storey's collapse drift ratio: its building's (:meth:`Model.collapse_drift_ratios`), 0: none."""
+    return np.ascontiguousarray(np.concatenate(
+        [np.full(b.n_floors, float(ratio or 0.0)) for b, ratio in zip(model.buildings, model.collapse_drift_ratios())]))
+
+
 def storey_arrays(model: Model) -> dict[str, Any]:
     """Hysteresis kernel id and parameters, height (m) and P-Delta stiffness (N/m) of every storey.
 
@@ -96,7 +102,7 @@ def storey_arrays(model: Model) -> dict[str, Any]:
         storey_state=np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64),
         p_delta_stiffness=np.ascontiguousarray(np.concatenate(p_delta), dtype=float),
         storey_height=np.ascontiguousarray(np.concatenate(heights), dtype=float),
-        stop_drift_ratio=float(model.solver.stop_drift_ratio or 0.0),
+        storey_stop_ratio=storey_stop_ratios(model),
         storey_imk=np.array(discrete, dtype=float).reshape(len(discrete), imk.N_STATE),
     )
 

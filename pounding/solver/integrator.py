@@ -39,8 +39,8 @@ Design
   shear, and every branch change of it is a located event
   (:mod:`pounding.solver.imk`); one that loses its strength ends the run as a
   collapse.  P-Delta is a linear geometric stiffness per storey.  A run stops,
-  located, when a storey's drift ratio first exceeds ``stop_drift_ratio``
-  (STATUS_COLLAPSED), or when a storey with P-Delta loses its lateral
+  located, when a storey's drift ratio first exceeds its building's collapse
+  drift ratio (``storey_stop_ratio``, STATUS_COLLAPSED), or when a storey with P-Delta loses its lateral
   resistance, its restoring force plus P-Delta falling to zero as its drift
   grows (STATUS_UNSTABLE).
 
@@ -153,7 +153,8 @@ class System:
     storey_state : (N,) int, index of the storey's hysteretic state among the nh yielding storeys, −1 if elastic
     p_delta_stiffness : (N,) N/m, geometric stiffness −P/h of the storey (0 without P-Delta)
     storey_height : (N,) m
-    stop_drift_ratio : float, end the run when a storey's |drift ratio| exceeds it (0: never)
+    storey_stop_ratio : (N,) float, end the run when the storey's |drift ratio| exceeds it (its building's
+        collapse drift ratio; 0: never)
     storey_imk : (nh, imk.N_STATE) float, optional
         Initial discrete state of each IMK storey (row of its hysteretic state; other rows unused)
     contact_floors : (nc, SIDE_TERMS) int, optional
@@ -188,7 +189,7 @@ class System:
     storey_state: np.ndarray | None = None
     p_delta_stiffness: np.ndarray | None = None
     storey_height: np.ndarray | None = None
-    stop_drift_ratio: float = 0.0
+    storey_stop_ratio: np.ndarray | None = None
     storey_imk: np.ndarray | None = None
     contact_floors: np.ndarray | None = None
     contact_weights: np.ndarray | None = None
@@ -211,7 +212,7 @@ class System:
         defaults = {"storey_model": np.zeros(n, dtype=np.int64),
                     "storey_parameters": np.zeros((n, hysteresis.N_HYSTERESIS_PARAMETERS)),
                     "storey_state": np.full(n, -1, dtype=np.int64),
-                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n),
+                    "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n), "storey_stop_ratio": np.zeros(n),
                     "floor_ground": np.zeros(n, dtype=np.int64),
                     "contact_ground_left": np.zeros(self.contact_gap.size, dtype=np.int64),
                     "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64)}
@@ -280,6 +281,7 @@ class RawSolution:
     status: int
     final_time: float
     support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row (None: one ground)
+    collapse_cause: str = ""         # status.COLLAPSE_CAUSES: why collapse_storey collapsed ("" if none)
 
 
 
@@ -413,11 +415,10 @@ def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_f
     failed = failed_storey(storey)
     if failed >= 0:  # an IMK storey lost its strength at the last event: its building collapses there
         return 0.0, 0.0, failed, STATUS_COLLAPSED
-    if storey.stop_ratio > 0.0:
-        collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio, h)
-        if collapse_s >= 0.0:
-            collapse_floor = collapse_at
-            stop_status = STATUS_COLLAPSED
+    collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio, h)
+    if collapse_s >= 0.0:
+        collapse_floor = collapse_at
+        stop_status = STATUS_COLLAPSED
     unstable_s, unstable_at = instability_crossing(work, lay, below, storey, structure.storey_stiffness, h)
     if unstable_s >= 0.0 and (collapse_s < 0.0 or unstable_s < collapse_s):
         collapse_s = unstable_s
@@ -641,7 +642,7 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
     A state's tolerance is atol for a bilinear storey's plastic drift (m) and atol/u_y for
     Bouc–Wen's dimensionless z; its mode (a fresh array: the integrator changes it) starts elastic.
     """
-    if system.n_hysteretic == 0 and not np.any(system.p_delta_stiffness) and system.stop_drift_ratio <= 0.0:
+    if system.n_hysteretic == 0 and not np.any(system.p_delta_stiffness) and not np.any(system.storey_stop_ratio > 0.0):
         return None
     floors = np.flatnonzero(system.storey_state >= 0)
     state_floor = np.empty(floors.size, dtype=np.int64)
@@ -658,7 +659,7 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
                    np.ascontiguousarray(system.p_delta_stiffness, dtype=np.float64),
                    np.ascontiguousarray(system.storey_height, dtype=np.float64),
                    np.zeros(floors.size, dtype=np.int64), state_floor, np.ascontiguousarray(tolerance, dtype=np.float64),
-                   float(system.stop_drift_ratio),
+                   np.ascontiguousarray(system.storey_stop_ratio, dtype=np.float64),
                    np.array(system.storey_imk, dtype=np.float64, copy=True, order="C").reshape(-1, imk.N_STATE))
 
 
@@ -715,8 +716,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                                           float(np.max(np.abs(rows))) if rows.size else 0.0, float(atol))
     settings = Settings(float(time_step), float(duration), float(rtol), float(atol), float(atol_velocity),
                         float(output_dt), float(first_step), factors)
-    raw = _integrate(system.layout, structure, contacts, _storey_arguments(system, float(atol)), ground,
-                     Forcing(ag, float(time_step)), settings, y_initial)
+    storey = _storey_arguments(system, float(atol))
+    raw = _integrate(system.layout, structure, contacts, storey, ground, Forcing(ag, float(time_step)), settings,
+                     y_initial)
     out, impacts, trace = raw.outputs, raw.impacts, raw.trace
     return RawSolution(out.time, out.state, out.acceleration, out.force, out.ground, out.potential,
                        raw.peaks.displacement, raw.peaks.drift, raw.peaks.force,
@@ -726,7 +728,21 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        impacts[:, IMP_WORK], trace[:, 0], trace[:, 1].astype(np.int64), trace[:, 2], trace[:, 3],
                        out.shear, out.storey_energy, raw.final_state.copy(), int(raw.collapse_floor),
                        int(raw.n_steps), int(raw.n_rejected), int(raw.status), float(raw.final_time),
-                       None if ground is None else out.support)
+                       None if ground is None else out.support,
+                       _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)))
+
+
+def _collapse_cause(storey: Storeys | None, status: int, floor: int) -> str:
+    """Why the storey under *floor* ended the run (:data:`pounding.solver.status.COLLAPSE_CAUSES`; "" if it
+    did not): an IMK storey whose discrete state the run left failed reached zero strength, else its
+    drift passed its collapse drift ratio; status ``unstable`` is a loss of resistance to P-Delta."""
+    if floor < 0 or storey is None:
+        return ""
+    if status == STATUS_UNSTABLE:
+        return "unstable"
+    hi = int(storey.state_index[floor])
+    failed = hi >= 0 and storey.model[floor] in IMK_MODELS and storey.imk[hi, imk.FAILED] > 0.0
+    return "zero_strength" if failed else "drift_ratio"
 
 
 def _ground_arguments(system: System, rows: np.ndarray, time_step: float) -> Grounds:

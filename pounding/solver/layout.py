@@ -125,7 +125,7 @@ class Storeys(NamedTuple):
     mode: np.ndarray         #: (nh,) int, bilinear mode of each yielding storey (changed by the solver)
     floor: np.ndarray        #: (nh,) int, floor of each hysteretic state
     tolerance: np.ndarray    #: (nh,) absolute tolerance of each hysteretic state
-    stop_ratio: float        #: drift ratio that ends the run (0: never)
+    stop_ratio: np.ndarray   #: (N,) drift ratio of the storey that ends the run, its building's collapse (0: never)
     imk: np.ndarray          #: (nh, imk.N_STATE) discrete state of each IMK storey (other rows unused)
 
 

@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 __all__ = ["STATUS_OK", "STATUS_STEP_TOO_SMALL", "STATUS_EVENT_LIMIT", "STATUS_TABLE_LIMIT", "STATUS_COLLAPSED",
-           "STATUS_UNSTABLE", "STATUS_ENERGY_INCONSISTENT", "STATUS_NAMES", "STATUS_MESSAGES"]
+           "STATUS_UNSTABLE", "STATUS_ENERGY_INCONSISTENT", "STATUS_NAMES", "STATUS_MESSAGES", "COLLAPSE_CAUSES"]
 
 STATUS_OK = 0
 STATUS_STEP_TOO_SMALL = 1  # also the outcome of a non-finite state: such steps are rejected and shrunk
 STATUS_EVENT_LIMIT = 2     # more contact events inside one record step than EVENTS_PER_WINDOW allows
 STATUS_TABLE_LIMIT = 3     # the impact or trace table would exceed its row cap
-STATUS_COLLAPSED = 4       # a storey's drift ratio exceeded stop_drift_ratio: the run ended there (not an error)
+STATUS_COLLAPSED = 4       # a building collapsed (a storey past its collapse drift ratio, or an IMK storey at zero
+#                            strength): the run ended there (not an error)
 STATUS_UNSTABLE = 5        # a storey's resistance (restoring force + P-Delta) fell to zero as its drift grew: ended there
 STATUS_ENERGY_INCONSISTENT = 6  # set after the run: the contacts dissipated more energy than the run received
+#: Why a building collapsed (the archive's ``collapse_cause``): its storey passed its collapse drift
+#: ratio, an IMK storey reached its ultimate drift (zero strength), or a storey lost its lateral
+#: resistance to P-Delta (status ``unstable``); "" when nothing collapsed.
+COLLAPSE_CAUSES = ("drift_ratio", "zero_strength", "unstable")
 #: The archive's ``status`` attribute of a run that ended with each code (the others raise their message).
 STATUS_NAMES = {
     STATUS_OK: "completed",
@@ -28,7 +33,8 @@ STATUS_MESSAGES = {
                          "(an impact sequence that does not end, e.g. chattering contacts); run stopped"),
     STATUS_TABLE_LIMIT: ("the impact or contact-trace table reached its row cap at t = {t:.6g} s "
                          "(too many impacts or closed-contact samples); run stopped"),
-    STATUS_COLLAPSED: "collapsed: a storey's drift ratio exceeded solver.stop_drift_ratio at t = {t:.6g} s",
+    STATUS_COLLAPSED: "collapsed: building {building} collapsed at t = {t:.6g} s, storey {storey} {cause}; the run "
+                      "ended there",
     STATUS_UNSTABLE: ("unstable: storey {storey} lost its lateral resistance at t = {t:.6g} s (restoring force plus "
                       "P-Delta fell to zero as its drift grew: a sidesway collapse); the run ended there"),
     STATUS_ENERGY_INCONSISTENT: ("energy_inconsistent: the contacts dissipated {dissipated:.4g} J, more than the "

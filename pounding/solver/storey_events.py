@@ -5,7 +5,7 @@ A bilinear storey's force has kinks where its drift reaches the yield
 surface and where a yielding storey unloads; they are located on the step's
 interpolant like gap closure, so no step straddles one
 (:mod:`pounding.solver.storeys`).  A run stops, located, where a storey's
-drift ratio first exceeds ``stop_drift_ratio`` (STATUS_COLLAPSED), and where a
+drift ratio first exceeds its building's collapse drift ratio (STATUS_COLLAPSED), and where a
 storey with P-Delta loses its lateral resistance (STATUS_UNSTABLE,
 :func:`instability_crossing`).  An IMK storey's events
 are its drift crossing the lower or upper limit of its branch and, on a loading branch, its
@@ -178,13 +178,17 @@ def failed_storey(storey):
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def collapse_crossing(work, n, below, heights, stop_ratio, h):
-    """First instant in a step where a storey's |drift| exceeds ``stop_ratio·height``: (fraction, floor)."""
+    """First instant in a step where a storey's |drift| exceeds ``stop_ratio[j]·height[j]``: (fraction, floor).
+
+    *stop_ratio*: (N,) each storey's collapse drift ratio, its building's (0: no limit, not searched)."""
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     best = -1.0
     where = -1
     for j in range(n):
+        if stop_ratio[j] <= 0.0:
+            continue
         d0, r0, d1, r1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, below[j])
-        limit = stop_ratio * heights[j]
+        limit = stop_ratio[j] * heights[j]
         # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|r0| + |r1|) (its basis
         # functions' bounds): search only where the limit is within reach.
         if max(abs(d0), abs(d1)) + 0.25 * h * (abs(r0) + abs(r1)) < limit:
