@@ -208,9 +208,11 @@ def test_the_command_line_reports_a_collapse_and_archives_it(tmp_path, capsys):
     path = write(tmp_path, COLLAPSING)
     assert main(["run", str(path), "-o", str(tmp_path / "c.nc")]) == 0
     out = capsys.readouterr().out
-    assert "COLLAPSED: storey W:" in out and "drift ratio 0.08" in out
+    assert "COLLAPSED: building W collapsed at t = " in out and "storey W:" in out
+    assert "passed its collapse drift ratio 0.08" in out
     again = open_run(tmp_path / "c.nc")
     assert again.attrs["status"] == "collapsed"
+    assert again.attrs["collapse_building"] == "W" and again.attrs["collapse_cause"] == "drift_ratio"
 
 
 # --------------------------------------------------------------------------- #
