@@ -16,6 +16,28 @@ structural analysis", Earthquake Spectra 31(1) 579–599:
   θ = exp(mean ln IM_c), β = standard deviation of ln IM_c with n − 1
   (Baker 2015, eqs. 3–4).
 
+- :func:`fit_censored_intensities`: the same from per-record intensities of
+  which some are right-censored (the record had not reached the limit at that
+  intensity: another building collapsed first and ended the run, or the hunt
+  reached its ceiling), by maximum likelihood,
+  L = Π_observed φ(z_i)/(β x_i) · Π_censored [1 − Φ(z_i)], z = ln(x/θ)/β.
+  Without censored records its maximum is the closed form θ = exp(mean ln x),
+  β = standard deviation of ln x with n (the MLE; Baker's eq. 4 uses n − 1).
+- Stripes with censored runs: a run whose outcome is unknown (the building had
+  not reached the limit when another building's collapse ended the run) is not
+  a Bernoulli trial, so it leaves its stripe's n_j (and z_j); the binomial
+  likelihood of :func:`fit_stripes` is then the likelihood of the observed runs.
+
+Whether the data define a fit at all (:func:`median_observed`,
+:func:`median_observed_stripes`): a two-parameter lognormal needs
+:data:`MIN_DISTINCT_OBSERVATIONS` distinct observations, and its median must be
+inside the data, not extrapolated from its lower tail through the lognormal
+shape: at least half of the records that ran were seen to reach the limit (on
+hunts), or at some stripe at least half of the runs exceeded it.  A censored
+record counts in the denominators and never as reaching the limit: its own
+outcome was hidden, so it may lie on either side of the median.  Otherwise the
+fit is "not determinable", with the counts, never a number.
+
 And :func:`collapse_margin_ratio`, the FEMA P695 (2009) CMR = Ŝ_CT / S_MT.
 """
 
@@ -29,7 +51,12 @@ from scipy.special import log_ndtr, ndtr, ndtri
 
 from pounding.errors import PoundingError
 
-__all__ = ["Fragility", "fit_stripes", "fit_intensities", "collapse_margin_ratio", "probability"]
+__all__ = ["Fragility", "fit_stripes", "fit_intensities", "fit_censored_intensities", "collapse_margin_ratio",
+           "probability", "median_observed", "median_observed_stripes", "MIN_DISTINCT_OBSERVATIONS"]
+
+#: Distinct observed intensities (or stripes with observed runs) a two-parameter fit needs: one gives
+#: no dispersion (β = 0 or undefined).
+MIN_DISTINCT_OBSERVATIONS = 2
 
 
 @dataclass(frozen=True)
@@ -167,6 +194,70 @@ def fit_intensities(intensities: np.ndarray) -> Fragility:
                             f"{values.size}, {int(np.sum(~np.isfinite(values)))} not finite)")
     logs = np.log(values)
     return Fragility(theta=float(np.exp(logs.mean())), beta=float(logs.std(ddof=1)), method="intensities")
+
+
+def fit_censored_intensities(intensities: np.ndarray, censored: np.ndarray, *, tolerance: float = 1e-12) -> Fragility:
+    """Lognormal fragility by maximum likelihood from per-record intensities, some right-censored.
+
+    Parameters
+    ----------
+    intensities : (n,) array
+        Each record's intensity at the limit (``censored`` False), or the highest intensity at which it
+        was seen not to reach it (``censored`` True), > 0, any units (θ comes out in the same).
+    censored : (n,) array of bool
+
+    Maximises Σ_observed [−ln β − z²/2] + Σ_censored ln Φ(−z), z = (ln x − ln θ)/β, over (ln θ, ln β)
+    with scipy's BFGS from the observed records' moments (gradient norm below *tolerance*).  Without
+    censored records the result is the closed form (mean and standard deviation with n of ln x).
+
+    Raises
+    ------
+    PoundingError
+        Fewer than :data:`MIN_DISTINCT_OBSERVATIONS` distinct observed intensities.
+    """
+    from scipy.optimize import minimize
+
+    x = np.asarray(intensities, dtype=float)
+    cens = np.asarray(censored, dtype=bool)
+    if x.shape != cens.shape or not np.all(np.isfinite(x)) or np.any(x <= 0):
+        raise PoundingError("fragility fit: needs finite intensities > 0, one censoring flag each")
+    logs = np.log(x)
+    seen = logs[~cens]
+    if np.unique(seen).size < MIN_DISTINCT_OBSERVATIONS:
+        raise PoundingError(f"fragility fit: needs at least {MIN_DISTINCT_OBSERVATIONS} distinct observed "
+                            f"intensities (got {np.unique(seen).size}; {int(cens.sum())} censored)")
+    mu0, sigma0 = float(seen.mean()), float(seen.std())
+    if not cens.any():
+        return Fragility(theta=float(math.exp(mu0)), beta=sigma0, method="mle-censored")
+    gone = logs[cens]
+
+    def negative(p: np.ndarray) -> float:
+        mu, log_beta = p
+        beta = math.exp(log_beta)
+        z_seen = (seen - mu) / beta
+        value = -(seen.size * -log_beta - 0.5 * float(z_seen @ z_seen)) - float(np.sum(log_ndtr(-(gone - mu) / beta)))
+        return value if math.isfinite(value) else math.inf
+
+    best = minimize(negative, np.array([mu0, math.log(sigma0)]), method="BFGS", options={"gtol": tolerance})
+    if not np.all(np.isfinite(best.x)):   # pragma: no cover - the likelihood is smooth and bounded
+        raise PoundingError("fragility fit: the censored maximum likelihood did not converge")
+    mu, log_beta = best.x
+    return Fragility(theta=float(math.exp(mu)), beta=float(math.exp(log_beta)), method="mle-censored")
+
+
+def median_observed(n_reached: int, n_records: int) -> bool:
+    """Whether a fit's median is inside the data: at least half of *n_records* (every record that ran,
+    censored ones included) were seen to reach the limit.  A censored record may lie on either side of
+    the median (another building's collapse hid its own), so it is never counted as above it."""
+    return n_records > 0 and 2 * n_reached >= n_records
+
+
+def median_observed_stripes(n_exceed: np.ndarray, n_ran: np.ndarray) -> bool:
+    """Whether a stripe fit's median is inside the data: :data:`MIN_DISTINCT_OBSERVATIONS` stripes with
+    runs, and a stripe where at least half of the runs (censored ones included: *n_ran*) exceeded."""
+    z = np.asarray(n_exceed, dtype=float)
+    n = np.asarray(n_ran, dtype=float)
+    return bool(np.sum(n > 0) >= MIN_DISTINCT_OBSERVATIONS and np.any((n > 0) & (2 * z >= n)))
 
 
 def collapse_margin_ratio(median_collapse_intensity: float, mce_intensity: float) -> float:

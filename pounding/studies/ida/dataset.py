@@ -11,7 +11,7 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.studies.common import records_text
 from pounding.studies.ida.plan import SA_DAMPING, IdaPlan, limit_label
-from pounding.studies.ida.runs import building_drifts, run_outcome
+from pounding.studies.ida.runs import building_drifts, collapse_building_of, run_collapses, run_outcome
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["MAX_BETA", "assemble_ida_dataset", "exceeds", "ida_fragility"]
@@ -65,6 +65,8 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
     scale_factor = np.full((nv, nr, nl), np.nan)
     max_drift = np.full((nv, nr, nl, nb), np.nan)
     collapsed = np.zeros((nv, nr, nl, nb), np.int8)
+    censored = np.zeros((nv, nr, nl, nb), np.int8)
+    collapse_building = np.full((nv, nr, nl), "", dtype=object)
     peak_drift = np.full((nv, nr, nl, ns), np.nan)
     residual = np.full((nv, nr, nl, ns), np.nan)
     impacts = np.full((nv, nr, nl, nc), -1, np.int32)
@@ -91,8 +93,8 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         wall[i, r, j] = part.get("solver_wall_time", np.nan)
         scale_factor[i, r, j] = part.get("scale_factor", factor)
         max_drift[i, r, j] = building_drifts(part, plan.buildings)
-        collapsed[i, r, j] = [1 if (outcome == "collapsed" or d >= plan.collapse_drift) else 0
-                              for d in max_drift[i, r, j]]
+        collapsed[i, r, j], censored[i, r, j] = run_collapses(part, plan)
+        collapse_building[i, r, j] = collapse_building_of(part)
         peak_drift[i, r, j] = part["storeys"]["peak_drift_ratio"]
         residual[i, r, j] = [np.nan if x is None else x for x in part["storeys"]["residual_drift_ratio"]]
         impacts[i, r, j] = part["contacts"]["impact_count"]
@@ -125,8 +127,17 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "impact_count": var(run + ("contact",), impacts, "1", "number of impacts (-1: run failed)"),
         "peak_contact_force": var(run + ("contact",), force, "N", "peak contact force"),
         "collapsed": var(run + ("building",), collapsed, "1",
-                         "1 if the building collapsed in the run: run status collapsed, or max drift ratio >= "
-                         "collapse_drift"),
+                         "1 if the building collapsed in the run: its collapse ended the run, or its max drift "
+                         "ratio >= its collapse_drift_ratio"),
+        "censored": var(run + ("building",), censored, "1",
+                        "1 if another building's collapse ended the run before this one collapsed: its outcome "
+                        "at this intensity is unknown (right-censored)"),
+        "collapse_building": (run, collapse_building, {"long_name": "building whose collapse ended the run "
+                                                                     "('' if none)"}),
+        "collapse_drift_ratio": var(("building",), np.array(plan.collapse_drifts or (plan.collapse_drift,) * nb,
+                                                            dtype=float), "1",
+                                    "the building's collapse drift ratio in this study",
+                                    source="; ".join(plan.collapse_sources)),
         "status": (run, status, {"long_name": "completed, collapsed, failed (or not run)"}),
         "error": (run, error, {"long_name": "error message of a failed run"}),
         "collapse_time": var(run, collapse_time, "s", "time at which the solver stopped the run at collapse"),
@@ -214,11 +225,13 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
 
 
 def exceeds(ds, limit: float | None) -> np.ndarray:
-    """(variant, record, level, building): 1 exceed, 0 not, NaN failed/not run; limit None = collapse."""
+    """(variant, record, level, building): 1 exceed, 0 not, NaN failed, not run or censored (another
+    building's collapse ended the run before this one reached the limit); limit None = collapse."""
     ok = np.isin(ds.status.values, ("completed", "collapsed"))[..., None]
     collapsed = ds.collapsed.values.astype(bool)
     hit = collapsed if limit is None else (collapsed | (ds.max_drift_ratio.values >= limit))
-    return np.where(ok, hit.astype(float), np.nan)
+    hidden = ds.censored.values.astype(bool) & ~hit if "censored" in ds else np.zeros_like(hit)
+    return np.where(ok & ~hidden, hit.astype(float), np.nan)
 
 
 def _crossing(levels: np.ndarray, drift: np.ndarray, hit: np.ndarray, limit: float | None) -> float:
@@ -238,20 +251,84 @@ def _crossing(levels: np.ndarray, drift: np.ndarray, hit: np.ndarray, limit: flo
     return float(low_level + (levels[j] - low_level) * (limit - low_drift) / (drift[j] - low_drift))
 
 
+def _survived(levels: np.ndarray, hit: np.ndarray) -> float:
+    """The highest level (g) at which one record was seen not to reach the limit (0 if none): where a
+    record that never reached it is right-censored."""
+    seen = np.isfinite(levels) & (hit == 0)
+    return float(levels[seen].max()) if seen.any() else 0.0
+
+
+def _undeterminable(reached: int, records: int, censored: int, how: str) -> str:
+    return (f"not determinable: {reached} of {records} records reached it, {censored} censored (another "
+            f"building collapsed first); {how}")
+
+
+def _fit_stripes(levels: np.ndarray, hit: np.ndarray, ran: np.ndarray) -> dict[str, Any]:
+    """The stripe fit of one building and limit (*hit*: (record, level) of :func:`exceeds`; *ran*: runs
+    per stripe that ran, censored ones included)."""
+    from pounding.studies.fragility import fit_stripes, median_observed_stripes
+
+    n = np.sum(np.isfinite(hit), axis=0)
+    z = np.nansum(hit, axis=0)
+    fit = fit_stripes(levels, n, z)
+    if not (0 < fit.theta < math.inf and fit.beta < MAX_BETA):
+        raise PoundingError(f"the fraction exceeding hardly changes over the stripes (beta "
+                            f"{fit.beta:.3g}): widen the range of levels")
+    hidden = int(ran.sum() - n.sum())
+    if not median_observed_stripes(z, ran):
+        raise PoundingError(_undeterminable(int(z.sum()), int(ran.sum()), hidden,
+                                            "a stripe fit needs a stripe where at least half the runs (censored "
+                                            "ones included) exceeded, and 2 stripes (docs/ida.md)").replace(
+                                                "records", "runs"))
+    entry = {"theta": fit.theta, "beta": fit.beta, "method": "mle-stripes"}
+    if hidden:
+        entry["note"] = f"{hidden} censored runs left out of their stripes' counts (maximum likelihood on the rest)"
+    return entry
+
+
+def _fit_hunt(levels: np.ndarray, drift: np.ndarray, hit: np.ndarray, limit: float | None) -> dict[str, Any]:
+    """The fit of one building and limit from each record's intensity at it (*levels*, *drift*, *hit*:
+    (record, run)); records that never reached it are right-censored where last seen below it."""
+    from pounding.studies.fragility import (MIN_DISTINCT_OBSERVATIONS, fit_censored_intensities, fit_intensities,
+                                            median_observed)
+
+    ran = np.any(np.isfinite(drift), axis=1)   # records with a run that ran (a failed run has no drift)
+    values = np.array([_crossing(levels[r], drift[r], hit[r], limit) for r in range(hit.shape[0])])[ran]
+    reached = np.isfinite(values)
+    bounds = np.array([_survived(levels[r], hit[r]) for r in range(hit.shape[0])])[ran]
+    hidden = int(np.sum(~reached & np.any(np.isnan(hit) & np.isfinite(drift), axis=1)[ran]))
+    if not median_observed(int(reached.sum()), int(ran.sum())):
+        raise PoundingError(_undeterminable(int(reached.sum()), int(ran.sum()), hidden,
+                                            "the median needs at least half the records to reach it (docs/ida.md)"))
+    if np.unique(values[reached]).size < MIN_DISTINCT_OBSERVATIONS:
+        raise PoundingError(_undeterminable(int(reached.sum()), int(ran.sum()), hidden,
+                                            f"beta needs {MIN_DISTINCT_OBSERVATIONS} distinct intensities at it"))
+    if reached.all():
+        fit = fit_intensities(values)
+        return {"theta": fit.theta, "beta": fit.beta, "method": "intensities"}
+    keep = reached | (bounds > 0)   # a record censored at 0 carries no information
+    fit = fit_censored_intensities(np.where(reached, values, bounds)[keep], ~reached[keep])
+    return {"theta": fit.theta, "beta": fit.beta, "method": "mle-censored",
+            "note": f"{int((~reached).sum())} of {values.size} records censored ({hidden} by another building's "
+                    "collapse, the rest never reached it); maximum likelihood with censoring"}
+
+
 def ida_fragility(ds) -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
     """Fragility per variant, building and limit (drift limits as written, and ``collapse``); θ in g.
 
     Each entry: ``theta`` (g), ``beta``, ``method`` and, when no fit was
-    possible or records were left out, ``note``.  Stripes: MLE on the
-    counts; hunt: from the per-record intensities (see the module docstring).
+    possible or records were censored, ``note``.  Stripes: MLE on the counts
+    of the observed runs; hunt: from the per-record intensities, with the
+    censored records' likelihood when there are any (see the module docstring
+    of :mod:`pounding.studies.fragility`).  A fit whose median is not inside
+    the data is "not determinable" (theta and beta None).
     """
-    from pounding.studies.fragility import fit_intensities, fit_stripes
-
     stripes = ds.attrs["method"] == "stripes"
     limits = [float(x) for x in ds.limit.values]
     out: dict[str, dict[str, dict[str, dict[str, Any]]]] = {}
     for i, variant in enumerate(ds.variant.values):
         out[str(variant)] = {}
+        ran = np.sum(np.isin(ds.status.values[i], ("completed", "collapsed")), axis=0)
         for b, building in enumerate(ds.building.values):
             entries: dict[str, dict[str, Any]] = {}
             for limit in limits + [None]:
@@ -260,24 +337,10 @@ def ida_fragility(ds) -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
                 entry: dict[str, Any] = {"theta": None, "beta": None}
                 try:
                     if stripes:
-                        n = np.sum(np.isfinite(hit), axis=0)
-                        z = np.nansum(hit, axis=0)
-                        fit = fit_stripes(ds.level.values / STANDARD_GRAVITY, n, z)
-                        if not (0 < fit.theta < math.inf and fit.beta < MAX_BETA):
-                            raise PoundingError(f"the fraction exceeding hardly changes over the stripes (beta "
-                                                f"{fit.beta:.3g}): widen the range of levels")
-                        entry.update(theta=fit.theta, beta=fit.beta, method="mle-stripes")
+                        entry.update(_fit_stripes(ds.level.values / STANDARD_GRAVITY, hit, ran))
                     else:
-                        levels = ds.level_value.values[i] / STANDARD_GRAVITY
-                        drift = ds.max_drift_ratio.values[i, :, :, b]
-                        values = np.array([_crossing(levels[r], drift[r], hit[r], limit)
-                                           for r in range(ds.record.size)])
-                        finite = values[np.isfinite(values)]
-                        if finite.size < values.size:
-                            entry["note"] = (f"{values.size - finite.size} of {values.size} records never reached "
-                                             "it (or failed) and are left out")
-                        fit = fit_intensities(finite)
-                        entry.update(theta=fit.theta, beta=fit.beta, method="intensities")
+                        entry.update(_fit_hunt(ds.level_value.values[i] / STANDARD_GRAVITY,
+                                               ds.max_drift_ratio.values[i, :, :, b], hit, limit))
                 except PoundingError as exc:
                     entry["note"] = str(exc).replace("fragility fit: ", "")
                 entries[label] = entry

@@ -4,6 +4,12 @@ Each (variant, record) is a chain of runs; :class:`HuntTasks` hands the study
 engine (:func:`pounding.studies.engine.execution.run_study`) the first run of
 every chain, and the chain's next level as soon as a run finishes, so the
 chains run side by side and a worker is never idle while any chain has work.
+
+A chain hunts each building's collapse in turn (model order), from the runs
+in which that building was observed: a run that another building's collapse
+ended censors it (its outcome there is unknown), and its hunt goes no higher
+than the lowest level where that happened (docs/ida.md "Collapse of each
+building").  One building: the hunt of Vamvatsikos & Cornell, as before.
 """
 
 from __future__ import annotations
@@ -16,7 +22,7 @@ import numpy as np
 from pounding.studies.engine.tasks import Scenario, TaskSource
 from pounding.studies.ida.dataset import assemble_ida_dataset
 from pounding.studies.ida.plan import LEVEL_DECIMALS, Hunt, IdaPlan
-from pounding.studies.ida.runs import collapsed_in, run_ida_scenario
+from pounding.studies.ida.runs import run_collapses, run_ida_scenario
 
 __all__ = ["next_hunt_level", "HuntTasks", "run_hunt"]
 
@@ -82,23 +88,39 @@ class HuntTasks(TaskSource):
         self.results: dict[str, dict[str, Any]] = {}
         self.chain_of: dict[str, tuple[str, int]] = {}
 
-    def _history(self, chain: tuple[str, int]) -> list[tuple[float, bool]] | None:
-        """The chain's (level, collapsed) so far; None once a run of it failed."""
-        out = []
+    def _histories(self, chain: tuple[str, int]) -> tuple[list[list[tuple[float, bool]]], list[float]] | None:
+        """Per building: its (level, collapsed) in the chain's runs that observed it, and the lowest level
+        at which another building's collapse censored it (inf: none); None once a run of it failed."""
+        observed: list[list[tuple[float, bool]]] = [[] for _ in self.plan.buildings]
+        censored_at = [np.inf] * len(self.plan.buildings)
         for level, scenario in self.runs[chain]:
-            collapsed = collapsed_in(self.results.get(scenario.key), self.plan, self.plan.im.building)
-            if collapsed is None:
+            found = run_collapses(self.results.get(scenario.key), self.plan)
+            if found is None:
                 return None
-            out.append((level, collapsed))
-        return out
+            for b, (collapsed, censored) in enumerate(zip(*found)):
+                if censored:
+                    censored_at[b] = min(censored_at[b], level)
+                else:
+                    observed[b].append((level, bool(collapsed)))
+        return observed, censored_at
+
+    def _next_level(self, chain: tuple[str, int]) -> float | None:
+        """The chain's next level: the first building whose hunt (:func:`next_hunt_level` on the runs that
+        observed it) asks for a level below its censoring and not yet run; None when every hunt is done."""
+        found = self._histories(chain)
+        if found is None:
+            return None
+        ran = {level for level, _ in self.runs[chain]}
+        for history, ceiling in zip(*found):
+            level = next_hunt_level(self.plan.hunt, history)
+            if level is not None and level < ceiling and level not in ran:
+                return level
+        return None
 
     def _advance(self, chain: tuple[str, int], known) -> list[Scenario]:
         """The chain's next scenario to run, after replaying the finished ones; [] when the chain is done."""
         while True:
-            past = self._history(chain)
-            if past is None:
-                return []
-            level = next_hunt_level(self.plan.hunt, past)
+            level = self._next_level(chain)
             if level is None:
                 return []
             scenario = self.plan.scenario(chain[0], chain[1], level)

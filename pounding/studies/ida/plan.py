@@ -24,7 +24,8 @@ from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "SA_DAMPING", "LEVEL_DECIMALS",
            "LEVEL_RESOLUTION", "MAX_IDA_RUNS", "IntensityMeasure",
-           "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity"]
+           "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity",
+           "collapse_drifts", "with_collapse_drift"]
 
 #: The two variants of every scenario: the model as given, and with its contacts held open.
 VARIANTS = ("with_contacts", "without_contacts")
@@ -259,13 +260,16 @@ class IdaPlan:
     buildings: list[str]
     variants: tuple[str, ...]
     limits: tuple[float, ...]
-    collapse_drift: float
+    collapse_drift: float              # --collapse-drift, else the largest drift limit (see collapse_drifts)
     levels: np.ndarray | None = None   # g (stripes)
     hunt: Hunt | None = None
     mce: float | None = None           # m/s²
     model_path: str = ""
     model_name: str = ""
     errors: list[str | None] = field(default_factory=list)   # per record: why it cannot run (or None)
+    #: Per building: its collapse drift ratio in this study (:func:`collapse_drifts`) and where it comes from.
+    collapse_drifts: tuple[float, ...] = ()
+    collapse_sources: tuple[str, ...] = ()
     _cache: dict = field(default_factory=dict, repr=False)
 
     def describe_levels(self) -> str:
@@ -381,7 +385,9 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     limits : str or sequence, optional
         Drift-ratio limits (default :data:`DEFAULT_LIMITS`).
     collapse_drift : float, optional
-        Peak storey drift ratio taken as collapse (default: the largest limit).
+        Every building's collapse drift ratio in this study: written into every run's model (so the run
+        ends there) over the buildings' own ``collapse`` and ``solver.stop_drift_ratio``
+        (:func:`collapse_drifts`).
     mce : float, optional
         S_MT, m/s², for the collapse margin ratio.
     scaling : str
@@ -405,6 +411,7 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
         hunt.check()
     drift_limits = limits if isinstance(limits, tuple) else parse_limits(
         None if limits is None else (",".join(map(str, limits)) if not isinstance(limits, str) else limits))
+    override = collapse_drift
     if collapse_drift is None:
         collapse_drift = max(drift_limits)
     if not (math.isfinite(collapse_drift) and collapse_drift > 0):
@@ -438,7 +445,7 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     recs = [str(s.coords["record"]) for s in scenarios]
     documents, stored, norm, errors = [], [], [], []
     for s in scenarios:
-        documents.append(s.data)
+        documents.append(s.data if override is None else with_collapse_drift(s.data, float(override)))
         try:
             if s.error is not None:
                 raise PoundingError(s.error)
@@ -481,7 +488,34 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     return IdaPlan(sweep=sweep, records=recs, documents=documents, im=measure, im_stored=im_stored,
                    normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=names,
                    variants=variants, limits=drift_limits, collapse_drift=float(collapse_drift), levels=levels,
-                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors)
+                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors,
+                   **dict(zip(("collapse_drifts", "collapse_sources"),
+                              collapse_drifts(base, override, max(drift_limits)))))
+
+
+def with_collapse_drift(document: dict, drift_ratio: float) -> dict:
+    """A copy of the model *document* (plain data) with every building's ``collapse: {drift_ratio}`` set."""
+    out = copy.deepcopy(document)
+    for building in out.get("buildings", []):
+        if isinstance(building, dict):
+            building["collapse"] = {"drift_ratio": drift_ratio}
+    return out
+
+
+def collapse_drifts(model, override: float | None, fallback: float) -> tuple[tuple[float, ...], tuple[str, ...]]:
+    """Each building's collapse drift ratio in an IDA and its source, by precedence: ``--collapse-drift``
+    (*override*; the runs end there), the building's ``collapse: {drift_ratio}``, ``solver.stop_drift_ratio``
+    (both end the run there too), else *fallback*, the largest drift limit, applied to the peaks after
+    the run (the run does not end there, so it censors no other building)."""
+    if override is not None:
+        return (float(override),) * len(model.buildings), ("--collapse-drift",) * len(model.buildings)
+    values, sources = [], []
+    for b, ratio in zip(model.buildings, model.collapse_drift_ratios()):
+        values.append(float(fallback if ratio is None else ratio))
+        sources.append("largest drift limit (peaks, after the run)" if ratio is None else
+                       "building collapse.drift_ratio" if b.collapse_drift_ratio is not None else
+                       "solver.stop_drift_ratio")
+    return tuple(values), tuple(sources)
 
 
 def parse_intensity(text: Any, what: str) -> float:

@@ -56,6 +56,26 @@ def _g(value: float | None, digits: int = 3) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.{digits}f}"
 
 
+def _collapse_drifts(ds) -> np.ndarray:
+    """Each building's collapse drift ratio in the study (an archive before them: the one ``collapse_drift``)."""
+    if "collapse_drift_ratio" in ds:
+        return np.asarray(ds.collapse_drift_ratio.values, dtype=float)
+    return np.full(ds.building.size, float(ds.attrs["collapse_drift"]))
+
+
+def _collapse_line(ds) -> str:
+    """How a building collapses in this study: its collapse ending the run, or its drift past its limit."""
+    if "collapse_drift_ratio" not in ds:
+        return f"collapse: run status collapsed, or max storey drift ratio >= {ds.attrs['collapse_drift']:g}"
+    sources = str(ds.collapse_drift_ratio.attrs.get("source", "")).split("; ")
+    each = ", ".join(f"{b} {x:g}" + (f" ({sources[k]})" if k < len(sources) and sources[k] else "")
+                     for k, (b, x) in enumerate(zip(ds.building.values, _collapse_drifts(ds))))
+    censored = int(ds.censored.values.sum()) if "censored" in ds else 0
+    return (f"collapse: a storey past its building's collapse drift ratio ({each}), an IMK storey at zero "
+            f"strength, or a loss of resistance to P-Delta; the first building to collapse ends the run, the "
+            f"others are censored there ({censored} building-runs censored)")
+
+
 def ida_table(ds) -> str:
     """The printed summary: θ (g) and β per building, limit and variant, and the change of θ due to pounding."""
     summary = ida_summary(ds)
@@ -68,7 +88,7 @@ def ida_table(ds) -> str:
              f"IM: {ds.attrs['im_description']}, in g; scaling: "
              + ("FEMA P695 (records normalised, the set's median IM at the level)"
                 if ds.attrs["scaling"] == "fema-p695" else "each record to the level"),
-             f"collapse: run status collapsed, or max storey drift ratio >= {ds.attrs['collapse_drift']:g}",
+             _collapse_line(ds),
              "fragility P(exceed | IM) = Phi(ln(IM/theta)/beta), "
              + ("maximum likelihood on the stripe counts" if ds.attrs["method"] == "stripes"
                 else "from each record's intensity at the limit")]
@@ -98,7 +118,8 @@ def ida_table(ds) -> str:
                      "the limit easier to reach)")
     if "cmr" in summary:
         lines.append(f"collapse margin ratio CMR = theta(collapse) / S_MT, S_MT = {summary['mce']:.3f} g: "
-                     + "; ".join(f"{v}: " + ", ".join(f"{b} {_g(x, 2)}" for b, x in summary["cmr"][v].items())
+                     + "; ".join(f"{v}: " + ", ".join(f"{b} {'not determinable' if x is None else _g(x, 2)}"
+                                                      for b, x in summary["cmr"][v].items())
                                  for v in variants))
     if notes:
         lines.append("not fitted or partly fitted:")
@@ -153,7 +174,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     variants = [str(v) for v in ds.variant.values]
     buildings = [str(b) for b in ds.building.values]
     stripes = ds.attrs["method"] == "stripes"
-    collapse_drift = float(ds.attrs["collapse_drift"])
+    collapse_drifts = _collapse_drifts(ds)
     titles = {"with_contacts": "with contacts (pounding)", "without_contacts": "contacts held open"}
     paths = []
 
@@ -161,8 +182,10 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     fig, axes = plt.subplots(len(buildings), len(variants), figsize=(5.4 * len(variants), 4.2 * len(buildings)),
                              squeeze=False, sharey=True)
     largest = float(np.nanmax(ds.max_drift_ratio.values, initial=0.0))
-    top = 115 * collapse_drift if largest >= 0.5 * collapse_drift else 120 * max(largest, 1e-6)
+    widest = float(np.max(collapse_drifts))
+    top = 115 * widest if largest >= 0.5 * widest else 120 * max(largest, 1e-6)
     for b, building in enumerate(buildings):
+        collapse_drift = float(collapse_drifts[b])
         for i, variant in enumerate(variants):
             ax = axes[b, i]
             collapse_labelled = False
@@ -191,7 +214,8 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
                     keep = np.isfinite(values)
                     ax.plot(100 * values[keep], levels[keep], style, color="k", lw=1.8 if q == 50 else 1.1,
                             label=name)
-            ax.axvline(100 * collapse_drift, color="C3", lw=0.8, ls=":", label="collapse drift")
+            if 100 * collapse_drift <= top:
+                ax.axvline(100 * collapse_drift, color="C3", lw=0.8, ls=":", label="collapse drift")
             ax.set_xlim(0, top * 1.02)
             ax.set_ylim(bottom=0)
             ax.set_xlabel(f"max storey drift ratio of {building} (%)")
@@ -217,6 +241,12 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     x = np.linspace(grid_top / 400, grid_top, 400)
     for b, building in enumerate(buildings):
         ax = axes[0, b]
+        undetermined = [f"{variant}: {ds.fragility_note.values[i, b, -1]}" for i, variant in enumerate(variants)
+                        if str(ds.fragility_note.values[i, b, -1]).startswith("not determinable")]
+        if undetermined:   # marked, not drawn: no collapse curve from fewer observations than the fit needs
+            ax.text(0.02, 0.98, "collapse fragility NOT DETERMINABLE\n" + "\n".join(undetermined), fontsize=6,
+                    va="top", ha="left", transform=ax.transAxes, wrap=True, color="C3",
+                    bbox={"facecolor": "white", "edgecolor": "C3", "alpha": 0.9})
         for k, (label, limit) in enumerate(zip(labels, limits)):
             color = f"C{k}" if limit is not None else "k"
             name = f"{100 * limit:g} %" if limit is not None else "collapse"

@@ -12,7 +12,8 @@ import numpy as np
 
 from pounding.studies.ida.plan import IdaPlan
 
-__all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in"]
+__all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in", "collapse_building_of",
+           "run_collapses"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 IDA_PART = "ida-1"
@@ -93,6 +94,7 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "run_status": peaks["status"],
             "collapse_time": _plain(peaks["collapse_time"]),
             "collapse_storey": peaks["collapse_storey"],
+            "collapse_building": peaks["collapse_building"],
             "storeys": {
                 "storey": list(peaks["storey"]),
                 "building": list(peaks["storey_building"]),
@@ -128,12 +130,46 @@ def building_drifts(part: dict[str, Any], buildings: list[str]) -> np.ndarray:
                      for b in buildings])
 
 
-def collapsed_in(part: dict[str, Any] | None, plan: IdaPlan, building: str) -> bool | None:
-    """Whether *building* collapsed in a run (None if the run failed)."""
-    outcome = run_outcome(part)
-    if outcome == "failed":
+def collapse_building_of(part: dict[str, Any]) -> str:
+    """The building whose collapse ended a run ("" if none; a part stored before parts named it: the
+    building of its ``collapse_storey``)."""
+    if part.get("outcome") != "collapsed":
+        return ""
+    if part.get("collapse_building"):
+        return str(part["collapse_building"])
+    storeys = part["storeys"]
+    label = part.get("collapse_storey", "")
+    return str(storeys["building"][storeys["storey"].index(label)]) if label in storeys["storey"] else ""
+
+
+def run_collapses(part: dict[str, Any] | None, plan: IdaPlan) -> tuple[np.ndarray, np.ndarray] | None:
+    """Per building of ``plan.buildings``: ``(collapsed, censored)`` in one run, None if the run failed.
+
+    A building collapsed when its collapse ended the run (a storey past its collapse drift ratio, an
+    IMK storey at zero strength, or a loss of resistance to P-Delta) or when its largest peak storey
+    drift ratio reached its collapse drift in the study (``plan.collapse_drifts``).  It is censored when
+    another building's collapse ended the run before it collapsed: its outcome at this intensity is
+    unknown (docs/ida.md "Collapse of each building").
+    """
+    if run_outcome(part) == "failed":
         return None
-    if outcome == "collapsed":
-        return True
-    drift = building_drifts(part, [building])[0]
-    return bool(drift >= plan.collapse_drift)
+    names = np.array(plan.buildings, dtype=object)
+    limits = np.array(plan.collapse_drifts or (plan.collapse_drift,) * names.size, dtype=float)
+    stopper = collapse_building_of(part)
+    collapsed = (names == stopper) | (building_drifts(part, plan.buildings) >= limits)
+    stopped = part.get("outcome") == "collapsed"
+    if stopped and not stopper:   # the collapse of a building not named: every building, as parts before
+        collapsed[:] = True
+    return collapsed, stopped & ~collapsed
+
+
+def collapsed_in(part: dict[str, Any] | None, plan: IdaPlan, building: str | None = None) -> bool | None:
+    """Whether *building* collapsed in a run (None: whether any building did, the event a hunt brackets);
+    None if the run failed."""
+    found = run_collapses(part, plan)
+    if found is None:
+        return None
+    collapsed, _ = found
+    if building is None:
+        return bool(collapsed.any())
+    return bool(collapsed[list(plan.buildings).index(building)])
