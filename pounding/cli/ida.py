@@ -91,13 +91,15 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                              "comma-separated list of records (default: the model's record)")
     parser.add_argument("--im", choices=("sa-t1", "pga"), default="sa-t1",
                         help="intensity measure: Sa(T1, 5 %%) of --building (default) or PGA")
-    parser.add_argument("--building", help="the building of Sa(T1) and of the hunt's collapse (default: the first)")
+    parser.add_argument("--building", help="the building of Sa(T1) (default: the first); a hunt brackets every "
+                                           "building's collapse")
     levels = parser.add_mutually_exclusive_group()
     levels.add_argument("--levels", metavar="A:B:STEP",
                         help="fixed stripes in g (or with units, as --mce: 0.1g, 1 m/s2, 100 gal): START:STOP:STEP "
                         "(both ends included) or a list 0.2,0.4,0.8")
     levels.add_argument("--hunt", action="store_true",
-                        help="hunt-and-fill (Vamvatsikos & Cornell): bracket each record's collapse intensity")
+                        help="hunt-and-fill (Vamvatsikos & Cornell): bracket each record's collapse intensity, "
+                             "per building")
     parser.add_argument("--hunt-start", type=float, default=0.1, metavar="G", help="first level of a hunt (g; 0.1)")
     parser.add_argument("--hunt-step", type=float, default=0.1, metavar="G",
                         help="first step of a hunt (g; 0.1); the k-th step adds k x --hunt-increment")
@@ -113,8 +115,9 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--limits", metavar="LIST",
                         help="peak storey drift ratio limits, e.g. 0.005,0.015,0.025 (the default)")
     parser.add_argument("--collapse-drift", type=float, metavar="RATIO",
-                        help="max storey drift ratio taken as collapse, besides a run that the solver stopped "
-                             "at collapse (default: the largest limit)")
+                        help="every building's collapse drift ratio in this study, over the model's collapse: "
+                             "{drift_ratio} and solver.stop_drift_ratio (the runs end there; default: the model's, "
+                             "else the largest limit, applied to the peaks); see docs/ida.md")
     parser.add_argument("--mce", metavar="IM",
                         help="MCE intensity S_MT (g, or with units: 0.9g) for the FEMA P695 collapse margin ratio")
     parser.add_argument("--scaling", choices=("auto", "record", "fema-p695"), default="auto",

@@ -168,8 +168,10 @@ def pushover(model, *, pattern: str = "first-mode", building: str | None = None,
     if building is not None and building not in names:
         raise PoundingError(f"no building '{building}' in the model (buildings: {', '.join(names)})")
     chosen = [b for b in loaded.buildings if building is None or b.name == building]
-    limit = float(loaded.solver.stop_drift_ratio or DEFAULT_DRIFT_LIMIT)
-    curves = [pushover_building(b, pattern, steps=steps, drift_limit_ratio=limit) for b in chosen]
+    # Each building to its own collapse drift ratio (collapse: {drift_ratio}, else solver.stop_drift_ratio).
+    limits = dict(zip(names, loaded.collapse_drift_ratios()))
+    curves = [pushover_building(b, pattern, steps=steps, drift_limit_ratio=float(limits[b.name] or DEFAULT_DRIFT_LIMIT))
+              for b in chosen]
     results = [fema_p695_quantities(b, c, period=period, design_cs=design_cs) for b, c in zip(chosen, curves)]
     width = max(c["base_shear"].size for c in curves)
     storeys = max(b.n_floors for b in chosen)

@@ -27,7 +27,8 @@ Scaling to a level (:class:`IdaPlan`)
 Levels
     Fixed stripes (``--levels``): every record at every level.  Or
     hunt-and-fill (``--hunt``, :func:`next_hunt_level`): per record, levels
-    rise with a growing step until the first collapse, the bracket between
+    rise with a growing step until the first collapse (each building in turn,
+    below the level where another's collapse censors it), the bracket between
     the highest non-collapsing and the lowest collapsing level is bisected
     down to a tolerance, and leftover runs fill the largest gaps below it
     (Vamvatsikos & Cornell 2004, "Applied incremental dynamic analysis",
@@ -39,23 +40,27 @@ Outcome of a run
     criterion, or where a storey lost its lateral resistance to P-Delta,
     status ``unstable``: a sidesway collapse), ``failed`` when the run raised
     or its status is ``energy_inconsistent`` (its contacts dissipated more
-    energy than it received: tighter tolerances give an answer).  A building is taken as
-    **collapsed** in a run when the run's status is ``collapsed`` (every
-    building: the run stopped, so the later response of its neighbours is
-    unknown) or when its largest peak storey drift ratio reaches the collapse
-    drift (``collapse_drift``, by default the largest drift limit).  A
-    collapsed building counts as exceeding every drift limit.
+    energy than it received: tighter tolerances give an answer).  A building is
+    **collapsed** in a run when its collapse ended the run (the run records
+    which building) or when its largest peak storey drift ratio reaches its
+    collapse drift ratio in the study (``--collapse-drift``, else its own
+    ``collapse: {drift_ratio}``, else ``solver.stop_drift_ratio``, else the
+    largest drift limit); every other building of a run that a collapse ended
+    is **censored** there (its later response is unknown).  A collapsed
+    building counts as exceeding every drift limit.
 
 Fragility (:mod:`pounding.studies.fragility`)
     Stripes: lognormal θ, β by maximum likelihood on the counts of records
-    exceeding each limit at each level (Baker 2015), failed runs left out.
-    Hunt: from each record's intensity at the limit (Baker 2015 eqs. 3–4):
+    exceeding each limit at each level (Baker 2015), failed and censored runs
+    left out.  Hunt: from each record's intensity at the limit (Baker 2015
+    eqs. 3–4; with right-censored records, the censored likelihood):
     for collapse, the middle of the final bracket; for a drift limit, the IM
     where the record's IDA curve (max drift ratio against IM, runs in IM
     order) first reaches the limit, by linear interpolation between the two
     runs either side (the middle of them when the upper one collapsed).
     With ``mce``: the collapse margin ratio CMR = Ŝ_CT / S_MT, Ŝ_CT = θ of
-    collapse (FEMA P695 §7.2).
+    collapse (FEMA P695 §7.2).  A fit whose median is not inside the data is
+    "not determinable": no θ, β or CMR (docs/ida.md).
 
 Modules
     ``plan``     inputs (IM, levels, limits, hunt settings) and the plan of every run
