@@ -244,8 +244,10 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
         undetermined = [f"{variant}: {ds.fragility_note.values[i, b, -1]}" for i, variant in enumerate(variants)
                         if str(ds.fragility_note.values[i, b, -1]).startswith("not determinable")]
         if undetermined:   # marked, not drawn: no collapse curve from fewer observations than the fit needs
-            ax.text(0.02, 0.98, "collapse fragility NOT DETERMINABLE\n" + "\n".join(undetermined), fontsize=6,
-                    va="top", ha="left", transform=ax.transAxes, wrap=True, color="C3",
+            from textwrap import fill
+
+            ax.text(0.02, 0.98, "collapse fragility NOT DETERMINABLE\n" + "\n".join(fill(u, 70) for u in undetermined),
+                    fontsize=6, va="top", ha="left", transform=ax.transAxes, color="C3",
                     bbox={"facecolor": "white", "edgecolor": "C3", "alpha": 0.9})
         for k, (label, limit) in enumerate(zip(labels, limits)):
             color = f"C{k}" if limit is not None else "k"
