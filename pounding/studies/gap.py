@@ -234,6 +234,12 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
         ds = simulate(model.with_contacts_open())
+        if ds.attrs.get("status", "completed") != "completed":
+            # A building that collapsed or lost its resistance stops the run: the peaks of a truncated
+            # history are no separation (they would understate it), so the record is an error.
+            raise PoundingError(f"{ds.attrs.get('status_message', ds.attrs['status'])}; no separation is derived "
+                                "from a run that did not reach the record's end (lower --scale, or check the "
+                                "model's strength)")
         found = required_separations(ds)
         names = [b.name for b in model.buildings]
         modes = {b.name: _first_mode(b) for b in model.buildings}
