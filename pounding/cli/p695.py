@@ -41,7 +41,8 @@ def _cmd_p695(args: argparse.Namespace) -> int:
         return 130
     print(json.dumps(p695_summary(ds), indent=2) if args.json else p695_table(ds))
     out = sys.stderr if args.json else sys.stdout
-    print(f"ran {ds.attrs['n_run']} of {ds.attrs['n_runs']} runs (the others were done before)", file=out)
+    reused = ds.attrs["n_runs"] - ds.attrs["n_run"]
+    print(f"ran {ds.attrs['n_run']} runs" + (f" ({reused} more done before)" if reused else ""), file=out)
     if args.output:
         print(f"wrote {args.output} (each building's IDA in {ida_folder(args.output)}/)", file=out)
     if args.plot:
