@@ -18,7 +18,6 @@ import xarray as xr
 from scipy.stats import norm
 
 from pounding.cli import main
-from pounding.errors import PoundingError
 from pounding.studies import p695
 from pounding.studies.p695 import tables
 from pounding.studies.p695.verdict import Quality, beta_rtr, mce_spectrum, parse_quality, total_uncertainty
