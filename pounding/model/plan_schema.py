@@ -20,10 +20,9 @@ from pounding.model import plan, plan_contacts
 from pounding.model.document import Document, Location, plural
 from pounding.model.ground_pair import pair_components
 from pounding.model.schema import (TAGS, WALL, WALL_NAME, BuildingEntry, ContactEntry, ContactGeometry, Damping,
-                                   HysteresisUnion, ModalEntry, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
+                                   HysteresisUnion, ModalEntry, between_indices, list_shape, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
                                    as_number, contact_levels, hysteresis_parameters, located, problem,
                                    record_reference, storey_count, units_name, validate)
-from pounding.errors import did_you_mean
 
 __all__ = ["PlaneEntry", "PlanStoreyEntry", "PlanStoreyShorthand", "PlanEntry", "PlanBuildingEntry",
            "PlanContactEntry", "ComponentEntry", "PlanGroundMotionEntry", "PlanModelEntry", "is_plan_document",
@@ -86,14 +85,8 @@ class PlaneEntry(SchemaEntry):
         return plan.Plane(self.direction, self.at, self.stiffness, self.hysteresis)
 
 
-def _planes_shape(value: Any) -> Any:
-    if isinstance(value, tuple):
-        value = list(value)
-    if not isinstance(value, list):
-        raise problem("must be a list of planes {direction: x | y, at, stiffness}", line="key")
-    if not value:
-        raise problem("list at least one plane along x and one along y", kind="error", line="key")
-    return value
+_planes_shape = list_shape("must be a list of planes {direction: x | y, at, stiffness}",
+                           "list at least one plane along x and one along y")
 
 
 class PlanStoreyEntry(SchemaEntry):
@@ -332,24 +325,8 @@ def _outline_text(building: PlanBuildingEntry) -> str:
 def _plan_between(index: int, value: Any, buildings: list) -> tuple[int, int]:
     """``between`` of a plan contact: two building names or a building and the wall, both plan buildings."""
     at: Location = (index, "between")
-    if isinstance(value, tuple):
-        value = list(value)
-    if not isinstance(value, list) or len(value) != 2:
-        raise problem("must be two building names (or a building and wall), e.g. [A, B]", at=at)
     names = [b.name for b in buildings]
-    indices = []
-    for position, item in enumerate(value):
-        try:
-            name = as_name(item)
-        except Problem as failed:
-            raise problem(failed.predicate, at=at + (position,)) from None
-        if name == WALL_NAME:
-            indices.append(WALL)
-        elif name in names:
-            indices.append(names.index(name))
-        else:
-            raise problem(f"unknown building '{name}'{did_you_mean(name, names + [WALL_NAME])}; buildings are: "
-                          f"{', '.join(names)}", kind="error", at=at + (position,))
+    indices = between_indices(index, value, buildings, "two building names (or a building and wall), e.g. [A, B]")
     if indices[0] == indices[1]:
         raise problem("joins a building (or the wall) to itself", kind="error", at=at)
     if indices[0] == WALL:

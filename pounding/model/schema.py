@@ -59,7 +59,7 @@ from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNIT_CHOICES, canonic
 __all__ = [
     "ModelEntry", "BuildingEntry", "DesignEntry", "Asce722DesignEntry", "Ec8DesignEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
     "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
-    "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
+    "Problem", "problem", "as_number", "between_indices", "list_shape", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME",
 ]
@@ -735,12 +735,16 @@ class LinkEntry(_JoinEntry):
     parameters: Annotated[LinkUnion | None, BeforeValidator(_parameters_of(LINK_LAWS))] = None  # type: ignore[valid-type]
 
 
-def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
+def between_indices(index: int, value: Any, buildings: list, shape: str) -> list[int]:
+    """The two sides of ``contacts[index].between``: building indices, :data:`WALL` for the wall.
+
+    *shape* completes "must be ..." when *value* is not two names.
+    """
     at: Location = (index, "between")
     if isinstance(value, tuple):
         value = list(value)
     if not isinstance(value, list) or len(value) != 2:
-        raise problem("must be two building names, left first, e.g. [A, B]", at=at)
+        raise problem(f"must be {shape}", at=at)
     names = [b.name for b in buildings]
     indices = []
     for position, item in enumerate(value):
@@ -755,7 +759,13 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str =
             raise problem(f"unknown building '{name}'{did_you_mean(name, names + [WALL_NAME])}; buildings are: "
                           f"{', '.join(names)}", kind="error", at=at + (position,))
         indices.append(names.index(name))
-    left, right = indices
+    return indices
+
+
+def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
+    at: Location = (index, "between")
+    names = [b.name for b in buildings]
+    left, right = indices = between_indices(index, value, buildings, "two building names, left first, e.g. [A, B]")
     if WALL in indices:
         return _wall_sides(at, left, right, names)
     a, b = names[left], names[right]
@@ -1055,14 +1065,22 @@ class SolverEntry(SchemaEntry):
         True, description="tighten atol per building to its own static drift scale (docs/numerics.md)")
 
 
-def _buildings_shape(value: Any) -> Any:
-    if isinstance(value, tuple):
-        value = list(value)
-    if not isinstance(value, list):
-        raise problem("must be a list of buildings, left to right", line="key")
-    if not value:
-        raise problem("list at least one building", kind="error", line="key")
-    return value
+def list_shape(must: str, empty: str) -> Callable[[Any], Any]:
+    """A before-validator: a non-empty list (a tuple is taken as one), else ``must ...`` or the *empty* sentence."""
+
+    def check(value: Any) -> Any:
+        if isinstance(value, tuple):
+            value = list(value)
+        if not isinstance(value, list):
+            raise problem(must, line="key")
+        if not value:
+            raise problem(empty, kind="error", line="key")
+        return value
+
+    return check
+
+
+_buildings_shape = list_shape("must be a list of buildings, left to right", "list at least one building")
 
 
 def _links_shape(value: Any) -> Any:
