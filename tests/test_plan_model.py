@@ -216,6 +216,17 @@ def test_wall_faces_and_friction():
     assert "\n" not in message
 
 
+def test_a_building_in_a_moat_with_four_walls():
+    walls = "".join(f"  - {{between: [A, wall], face: {face}, gap: 0.3, levels: [1], law: hertz-damp, kh: 1.0e9, "
+                    f"restitution: 0.6}}\n" for face in ("east", "west", "north", "south"))
+    model = build(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()), walls))
+    assert [(c.face.normal, c.face.first_low) for c in model.contacts] == [("x", True), ("x", False), ("y", True),
+                                                                          ("y", False)]
+    twice = walls + walls.splitlines(keepends=True)[0]
+    assert "already joined by contacts[0]" in error_of(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()),
+                                                                 twice))
+
+
 # --------------------------------------------------------------------------- #
 # Two-component ground motion
 # --------------------------------------------------------------------------- #
@@ -328,3 +339,9 @@ def test_run_refuses_a_plan_model_in_one_line(tmp_path):
     with pytest.raises(ModelError, match="singular"):
         model_from_text(plan_text(building("A", "[[0, 0], [20, 10]]",
                                            one_storey("[{direction: x, at: 0, stiffness: 1.0e7}]"))))
+
+
+def test_an_unknown_key_of_a_plan_contact_suggests_its_own_keys():
+    contact = "  - {between: [A, wall], face: east, gap: 0.1, levels: [1], law: hertz-damp, kh: 1.0e9, fricton: 0.2}\n"
+    message = error_of(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()), contact))
+    assert "unknown key 'fricton' (did you mean 'friction'?)" in message

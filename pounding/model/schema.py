@@ -1155,7 +1155,8 @@ class ModelEntry(SchemaEntry):
                 if section == "links" and (at_a is not None or at_b is not None):
                     raise problem("links join floors; a column point {storey, at} is for contacts only",
                                   kind="error", at=(index, "levels", position))
-                key = (left, right, a, _point_key(at_a), b, _point_key(at_b))   # one point within the resolution
+                # one point within the resolution; a plan model's walls on different faces are different sides
+                key = (left, right, a, _point_key(at_a), b, _point_key(at_b), getattr(contact, "face", None))
                 if key in joined:
                     other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
                     names = (side_text(buildings, left, a, at_a), side_text(buildings, right, b, at_b))
@@ -1327,6 +1328,8 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
     if kind == "extra_forbidden":
         if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
             entry = ContactEntry if issubclass(owner, ContactLaw) else LinkEntry
+            found = _owner(cls, raw[:-2])      # the entry holding the law's parameters (a plan contact's own keys)
+            entry = found if isinstance(found, type) and issubclass(found, entry) else entry
             choices = list(entry.KEYS) + [k for k in owner.model_fields if k != "law"]
         else:
             choices = list(getattr(owner, "ALLOWED", None) or (owner.model_fields if owner else []))
