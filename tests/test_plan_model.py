@@ -12,7 +12,7 @@ import pytest
 
 from pounding.errors import ModelError
 from pounding.model.ground_pair import ground_components, pair_components
-from pounding.model.model import Building, Damping, load_model, model_from_text
+from pounding.model.model import Building, Damping, load_model, model_from_data, model_from_text
 from pounding.model.plan import PlanStorey, Plane, plan_geometric_stiffness, plan_stiffness_matrix
 from pounding.model.plan_contacts import facing
 from pounding.model.plan_model import plan_model_from_text
@@ -335,6 +335,10 @@ def test_run_refuses_a_plan_model_in_one_line(tmp_path):
         load_model(path)
     message = str(caught.value)
     assert "read and checked but not yet integrated" in message and "\n" not in message
+    import yaml
+
+    with pytest.raises(ModelError, match="not yet integrated"):
+        model_from_data(yaml.safe_load(path.read_text()))
     # a bad plan model is reported as such first, not as "not integrated"
     with pytest.raises(ModelError, match="singular"):
         model_from_text(plan_text(building("A", "[[0, 0], [20, 10]]",
