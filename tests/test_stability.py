@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import pounding
 from pounding.errors import ModelError
@@ -382,8 +383,11 @@ def test_contacts_that_dissipate_more_than_the_run_received_are_not_a_completed_
     message = ds.attrs["status_message"]
     assert "\n" not in message and "tighten solver.atol" in message
     assert message.startswith("energy_inconsistent: the contacts dissipated 7.")
-    assert main(["run", str(path), "-o", str(tmp_path / "z.nc")]) == 0
+    # run writes it (nothing computed is lost) and exits 1: a script must not take it as completed.
+    assert main(["run", str(path), "-o", str(tmp_path / "z.nc")]) == 1
     assert "ENERGY INCONSISTENT: the contacts dissipated" in capsys.readouterr().out
+    assert xr.open_dataset(tmp_path / "z.nc").attrs["status"] == "energy_inconsistent"
+    assert main(["rerun", str(tmp_path / "z.nc"), "-o", str(tmp_path / "z2.nc")]) == 1
     # ida and sweeps count it as failed, with the message.
     part = ida.run_ida_scenario(_task(path))
     assert ida.run_outcome(part) == "failed" and "tighten solver.atol" in part["error"]

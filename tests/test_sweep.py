@@ -401,3 +401,27 @@ def test_a_chunk_of_scenarios_is_shipped_whole_and_runs_like_the_list():
         assert parse_input(chunk) is chunk
     runner = lambda task: {"key": task["key"], "size": len(task["data"])}  # noqa: E731
     assert run_chunk(runner, chunk) == run_chunk(runner, tasks) == [{"key": "a", "size": 1}, {"key": "b", "size": 0}]
+
+
+def test_a_scenario_that_collapses_is_marked_with_where_it_ended(tmp_path, capsys):
+    # pair_inelastic reaches ~1 % storey drift under far-field 1a: with collapse at 0.2 % the run
+    # ends early and its peaks are those of a truncated history, which the archive must say.
+    from pounding.cli import main
+
+    spec = tmp_path / "collapse.yaml"
+    spec.write_text(f"name: collapse\nmodel: {ROOT / 'models' / 'pair_inelastic.yaml'}\n"
+                    "set:\n  ground_motion.duration: 6\n"
+                    "axes:\n  solver.stop_drift_ratio: [0.002, 0.10]\n")
+    out = tmp_path / "collapse.nc"
+    assert main(["sweep", str(spec), "-o", str(out), "--workers", "1", "--no-progress"]) == 0
+    assert "1 of the ok scenarios collapsed before the record's end" in capsys.readouterr().out
+    ds = xr.open_dataset(out)
+    assert list(ds.status.values.ravel()) == ["ok", "ok"]
+    assert list(ds.run_status.values.ravel()) == ["collapsed", "completed"]
+    assert ds.end_time.attrs["units"] == "s"
+    ended = ds.end_time.values.ravel()
+    assert 0.0 < ended[0] < 6.0 and ended[1] == pytest.approx(6.0)
+    # the collapsed run stopped where a storey passed 0.2 %: its peak is that crossing, not more
+    peaks = ds.peak_drift_ratio.values.reshape(2, -1).max(axis=1)
+    assert peaks[0] == pytest.approx(0.002, rel=1e-6)   # the located crossing (event tolerance ~1e-9 m)
+    assert peaks[1] > 0.002

@@ -9,7 +9,8 @@ from pathlib import Path
 
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 
-__all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options"]
+__all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options", "outcome_status",
+           "UNTRUSTED_RUN_STATUS"]
 
 SCALE_HELP = ("factor on the record (0.8), or a target as in the YAML: a PGA (0.4g, 3.9m/s2, 390gal), "
               "sa=0.8g@1.0 (Sa at 1.0 s, 5%% damping), sa=0.8g@A (at building A's first period), "
@@ -261,7 +262,18 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
         for png in written:
             print(f"wrote {png}")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
-    return 0
+    return outcome_status(ds)
+
+
+#: Exit status of a run whose archive is written but whose results are not to be trusted
+#: (``energy_inconsistent``); 2 stays the status of a user error, 0 of a completed, collapsed or
+#: unstable run (physical outcomes).
+UNTRUSTED_RUN_STATUS = 1
+
+
+def outcome_status(ds) -> int:
+    """Exit status of ``run``/``rerun`` for the written run *ds*: 1 if it ended ``energy_inconsistent``."""
+    return UNTRUSTED_RUN_STATUS if ds.attrs.get("status") == "energy_inconsistent" else 0
 
 
 def _cmd_rerun(args: argparse.Namespace) -> int:
@@ -275,7 +287,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
         path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
     print(f"wrote {path}")
-    return 0
+    return outcome_status(ds)
 
 
 def open_archive(path) -> tuple[str, object]:

@@ -47,6 +47,12 @@ def summary_lines(ds) -> list[str]:
 
     status = ds.status.values.ravel()
     lines = [f"{status.size} scenarios: {int((status == 'ok').sum())} ok, {int((status != 'ok').sum())} failed"]
+    if "run_status" in ds:
+        ended = ds.run_status.values.ravel()
+        for outcome in ("collapsed", "unstable"):
+            if (ended == outcome).any():
+                lines.append(f"  {int((ended == outcome).sum())} of the ok scenarios {outcome} before the record's "
+                             "end (variable run_status; their peaks stop at end_time)")
     return lines + failure_report(ds)
 
 

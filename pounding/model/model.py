@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from pounding.model import schema
-from pounding.model.document import DataSource, dump_document
+from pounding.model import plan_schema, schema
+from pounding.model.document import DataSource, dump_document, parse_document
 from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
 from pounding.contact.links import LinkLaw
@@ -54,7 +54,12 @@ __all__ = [
     "column_weights",
     "OPEN_GAP",
     "hold_contacts_open",
+    "PLAN_NOT_INTEGRATED",
 ]
+
+#: What a command says of a plan model (a building with ``plan:``): checked, not yet run.
+PLAN_NOT_INTEGRATED = ("plan models (buildings with plan:) are read and checked but not yet integrated by the "
+                       "solver; the model is valid (pounding.model.plan_model.load_plan_model gives its matrices)")
 
 #: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
 #: without pounding of ``pounding run --no-contacts``, ``pounding gap``, ``ida --without-contacts`` and
@@ -1042,7 +1047,11 @@ def model_from_text(text: str, *, name: str = "model", path: str | None = None,
         ``<path>:<line>: <location> <problem>``.
     """
     label = path if path is not None else f"<{name}>"
-    entry, _ = schema.parse(text, label, base_dir=base_dir)
+    doc = parse_document(text, label)
+    if plan_schema.is_plan_document(doc.data):
+        plan_schema.validate_plan(doc, base_dir)
+        raise ModelError(PLAN_NOT_INTEGRATED, file=label)
+    entry = schema.validate(schema.ModelEntry, doc.data, doc, context={"base_dir": base_dir})
     return _build(entry, name=name, text=text, path=path, base_dir=base_dir)
 
 
@@ -1058,6 +1067,9 @@ def model_from_data(data: dict[str, Any], *, name: str = "model", source: str = 
     ModelError
         ``<location> <problem>`` (no file, no line).
     """
+    if plan_schema.is_plan_document(data):
+        _checked(plan_schema.PlanModelEntry, data)
+        raise ModelError(PLAN_NOT_INTEGRATED)
     entry = _checked(schema.ModelEntry, data)
     return _build(entry, name=name, text=source, path=None, base_dir=base_dir)
 

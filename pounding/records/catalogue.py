@@ -118,14 +118,17 @@ def _read(path_text: str, mtime: float) -> tuple[dict[str, Entry], dict[str, str
     path = Path(path_text)
     loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
     text = path.read_text(encoding="utf-8")
+    reader = loader(text)
     try:
-        root = yaml.compose(text, Loader=loader)
-        data = yaml.load(text, Loader=loader)
+        root = reader.get_single_node()  # parsed once: the data is constructed from the same node
+        data = reader.construct_document(root) if root is not None else None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         raise RecordError(f"invalid YAML in the record catalogue ({getattr(exc, 'problem', exc)}); regenerate it "
                           "with python ground_motions/make_synthetic.py", file=str(path),
                           line=None if mark is None else mark.line + 1) from None
+    finally:
+        reader.dispose()
     if not isinstance(data, dict) or not isinstance(data.get("records"), dict):
         raise RecordError("the record catalogue needs a top-level 'records' mapping", file=str(path), line=1)
     lines: dict[str, int] = {}

