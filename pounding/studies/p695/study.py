@@ -82,7 +82,9 @@ def collapse_intensities(ida, building: str) -> np.ndarray:
     """
     b = [str(x) for x in ida.building.values].index(building)
     levels = ida.level_value.values
-    collapsed = ida.collapsed.values[..., b] == 1
+    # A run that another building's collapse ended (censored, issue 27 §3) counts as this building's
+    # collapse here, as it did before censoring existed: S_CT then stays a lower bound (conservative).
+    collapsed = (ida.collapsed.values[..., b] == 1) | (ida.censored.values[..., b] == 1 if "censored" in ida else False)
     failed = ida.status.values == "failed"
     out = np.full(levels.shape[:2], np.nan)
     for i in range(levels.shape[0]):
