@@ -43,6 +43,10 @@ def archive_tables(kind: str, ds) -> dict:
         from pounding.studies.ida.report import ida_tables
 
         return ida_tables(ds)
+    if kind == "p695":
+        from pounding.studies.p695.report import p695_tables
+
+        return p695_tables(ds)
     from pounding.studies.verify import verify_tables
 
     return verify_tables(ds)
