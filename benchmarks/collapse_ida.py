@@ -56,7 +56,7 @@ def one_ida(plan, client, folder: Path) -> tuple[float, int, dict]:
         ds = ida_study(plan, Path(tmp) / "ida.nc", client=client, progress=False)
         elapsed = time.perf_counter() - started
         status = np.asarray(ds.status.values).ravel()
-        status = status[status != ""]
+        status = status[(status != "") & (status != "not run")]   # the hunt's unused slots are no runs
         outcomes = {str(k): int(v) for k, v in zip(*np.unique(status, return_counts=True))}
     return elapsed, int(status.size), outcomes
 
