@@ -28,7 +28,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import pounding
-from inelastic_reference import Row, _drift
+from inelastic_reference import Row, _drift, floor_forces
 from pounding.simulation import record_for
 
 IMK = ("{model: imk-peak-oriented, yield_drift_ratio: 0.004, capping_strength_ratio: 1.15, plastic_drift_ratio: 0.01, "
@@ -158,13 +158,7 @@ def reference(model, ag: np.ndarray, dt: float, duration: float, output_dt: floa
         return storeys[j].force(d) if storeys[j] is not None else row.k[j] * d
 
     def rhs(t, y, a_g):
-        f = row.C @ y[n:]
-        for j in range(n):
-            d, _ = _drift(row, y, j)
-            s = shear(j, d) + row.pdelta[j] * d
-            f[j] += s
-            if row.below[j] >= 0:
-                f[row.below[j]] -= s
+        f = floor_forces(row, y, shear)
         if contact["closed"]:
             delta, rate = y[lf] - y[rf] - gap, y[n + lf] - y[n + rf]
             force = max(0.0, max(delta, 0.0) ** 1.5 * (KH + contact["xi"] * rate))
