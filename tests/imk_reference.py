@@ -22,7 +22,7 @@ import copy
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from inelastic_reference import Row, _drift
+from inelastic_reference import Row, _drift, floor_forces
 from pounding.hysteresis import ImkStorey
 from pounding.studies.imk import ImkMaterial
 
@@ -83,14 +83,7 @@ def imk_reference_run(model, ag: np.ndarray, dt: float, duration: float, *, rtol
         return _trial(materials[j], d) if materials[j] is not None else row.k[j] * d
 
     def rhs(t, y, a_g):
-        f = row.C @ y[n:]
-        for j in range(n):
-            d, _ = _drift(row, y, j)
-            s = shear(j, d) + row.pdelta[j] * d
-            f[j] += s
-            if row.below[j] >= 0:
-                f[row.below[j]] -= s
-        return np.concatenate([y[n:], -f / row.mass - a_g])
+        return np.concatenate([y[n:], -floor_forces(row, y, shear) / row.mass - a_g])
 
     def events_for(y):
         found = []

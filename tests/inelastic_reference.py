@@ -81,6 +81,19 @@ def _drift(row, y, j):
     return y[j] - y[b], y[n + j] - y[n + b]
 
 
+def floor_forces(row, y, shear) -> np.ndarray:
+    """Damping plus every storey's resisting force (``shear(j, drift)`` and P-Delta) on the floors, N."""
+    n = row.n
+    f = row.C @ y[n:2 * n]
+    for j in range(n):
+        d, _ = _drift(row, y, j)
+        s = shear(j, d) + row.pdelta[j] * d
+        f[j] += s
+        if row.below[j] >= 0:
+            f[row.below[j]] -= s
+    return f
+
+
 def reference_run(model, ag: np.ndarray, dt: float, duration: float, *, rtol: float = 1e-11,
                   sample: float = 2e-5) -> dict:
     """Integrate *model* under *ag* (m/s², step *dt*); peaks, impacts and the final state."""

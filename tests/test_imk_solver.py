@@ -105,3 +105,37 @@ def test_opensees_export_of_imk_storeys_agrees_on_peaks(tmp_path, name):
     assert peaks["converged"]
     np.testing.assert_allclose(peaks["peak_drift_ratio"], ds.peak_drift_ratio.values, rtol=0.01)
     assert float(ds.peak_storey_drift[0]) > 3 * 0.012  # past the capping drift (yield 0.012 m + θ_p h 0.03 m)
+
+
+def test_opensees_export_of_the_shipped_collapse_pair_agrees_on_peaks():
+    # models/pair_collapse.yaml (IMK peak-oriented A beside IMK pinching B, P-Delta, Hertz-damp contacts) at 1.6x
+    # record 1a over a 6 s window: B:1 past capping on its post-capping branch, A:1 yielded, 7 impacts, before
+    # any collapse (the record collapses B at 2x). The exported script (IMKPeakOriented / IMKPinching, Newmark at
+    # dt 2.5e-4) against our solver at rtol 1e-9: measured 2.5e-4 on peak drift ratios, 1.3e-5 on peak floor
+    # displacements and 1.0e-4 of the largest peak contact force (1.2e-3, 2.5e-4, 1.5e-3 at dt 1e-3: the
+    # difference is OpenSees' step); the issue's bound is 1 %. The model's own rtol 1e-6 is not tight enough for
+    # this check: on the post-capping branch (negative stiffness, steeper with P-Delta) the response amplifies
+    # small differences, and B:1's peak drift moves by 1 % between rtol 1e-6 and 1e-9 (docs/hysteresis.md).
+    pytest.importorskip("openseespy")
+    from pathlib import Path
+
+    from pounding.export.opensees import run_opensees
+    from pounding.model.model import model_from_text
+
+    text = (Path(__file__).resolve().parents[1] / "models" / "pair_collapse.yaml").read_text()
+    for old, new in (("  scale: 1.0\n", "  scale: 1.6\n"), ("rtol: 1.0e-6", "rtol: 1.0e-9"),
+                     ("atol: 1.0e-8", "atol: 1.0e-11"), ("atol_velocity: 1.0e-7", "atol_velocity: 1.0e-10")):
+        assert old in text
+        text = text.replace(old, new)
+    model = model_from_text(text)
+    ds = pounding.simulate(model, duration=6.0)
+    assert ds.attrs["status"] == "completed"
+    drift = ds.peak_drift_ratio.values
+    assert drift[8] > 0.0022 + 0.016 and drift[0] > 6.7e6 / 3.5e8 / 3.2   # B:1 past capping, A:1 yielded
+    peaks = run_opensees(model, dt=2.5e-4, duration=6.0)
+    assert peaks["converged"]
+    assert peaks["impact_count"] == [int(n) for n in ds.impact_count.values] and sum(peaks["impact_count"]) > 0
+    np.testing.assert_allclose(peaks["peak_drift_ratio"], drift, rtol=0.01)
+    np.testing.assert_allclose(peaks["peak_displacement"], ds.peak_displacement.values, rtol=0.01)
+    force = ds.peak_contact_force.values
+    np.testing.assert_allclose(peaks["peak_contact_force"], force, rtol=0, atol=0.01 * force.max())

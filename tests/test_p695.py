@@ -211,3 +211,20 @@ def test_a_small_p695_study_is_consistent_and_resumes_to_the_same_archive(in_pro
     assert again.attrs["n_run"] == 0
     for name in ds.data_vars:
         np.testing.assert_array_equal(again[name].values, ds[name].values)
+    # info, table (and --csv) and plot read the archive like every other kind (issue 27 §5).
+    assert main(["info", str(out)]) == 0
+    assert "[p695 archive]" in capsys.readouterr().out
+    assert main(["table", str(out), "--csv", str(tmp_path / "t.csv")]) == 0
+    capsys.readouterr()
+    import pandas as pd
+    verdict = pd.read_csv(tmp_path / "t.csv")
+    assert len(verdict) == 2 * 2 and "acmr [-]" in verdict.columns and "s_ct [m s-2]" in verdict.columns
+    got = verdict.set_index(["variant", "building"])["acmr [-]"]
+    for variant in ds.variant.values:
+        for name in ("A", "B"):
+            want = float(ds.acmr.sel(variant=variant, building=name))
+            assert (got[(variant, name)] == pytest.approx(want, rel=1e-15)) or (np.isnan(want) and np.isnan(got[(variant, name)]))
+    records = pd.read_csv(tmp_path / "t.records.csv")
+    assert len(records) == 2 * 2 * 4
+    assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "p695.png").exists()

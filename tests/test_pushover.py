@@ -126,3 +126,40 @@ def test_pushover_command_writes_table_archive_and_plot(model_file, tmp_path, ca
         assert main(["pushover", str(model_file), *argv]) == 2
         err = capsys.readouterr().err.strip()
         assert message in err and "\n" not in err
+
+
+def test_table_reads_pushover_and_hysteresis_archives(model_file, tmp_path, capsys):
+    # `pounding table` (and its --csv) on the archives of `pounding pushover` and `pounding hysteresis`
+    # (issue 27 §5): the per-building quantities, the curves and the storeys; the cyclic test's steps.
+    import pandas as pd
+
+    po, hy = tmp_path / "po.nc", tmp_path / "hy.nc"
+    assert main(["pushover", str(model_file), "-o", str(po)]) == 0
+    assert main(["hysteresis", str(model_file), "--storey", "A:1", "--protocol", "fema461", "--amplitude", "0.03",
+                 "-o", str(hy)]) == 0
+    capsys.readouterr()
+    assert main(["table", str(po)]) == 0
+    text = capsys.readouterr().out
+    assert "[pushover archive]" in text and "buildings:" in text and "curves:" in text and "storeys:" in text
+    assert "v_max [N]" in text and "period_based_ductility [-]" in text and "zero strength" in text
+    assert main(["table", str(po), "--csv", str(tmp_path / "po.csv")]) == 0
+    buildings = pd.read_csv(tmp_path / "po.csv")
+    curves = pd.read_csv(tmp_path / "po.curves.csv")
+    storeys = pd.read_csv(tmp_path / "po.storeys.csv")
+    with xr.open_dataset(po) as ds:
+        np.testing.assert_array_equal(buildings["v_max [N]"], ds.v_max.values)
+        for i, name in enumerate(ds.building.values):
+            taken = np.isfinite(ds.base_shear.values[i])
+            np.testing.assert_array_equal(curves[curves.building == name]["base_shear [N]"], ds.base_shear.values[i][taken])
+            # B has 3 storeys: its padded storeys 4..n are left out, as are the steps it did not take.
+            rows = storeys[storeys.building == name]
+            assert set(rows["storey"]) == set(range(1, (2 if name == "A" else 3) + 1))
+        assert not curves.isna().any().any() and not storeys.isna().any().any()
+    assert main(["table", str(hy)]) == 0
+    text = capsys.readouterr().out
+    assert "[hysteresis archive]" in text and "storey_drift [m]" in text and "storey_shear [N]" in text
+    assert main(["table", str(hy), "--csv", str(tmp_path / "hy.csv")]) == 0
+    steps = pd.read_csv(tmp_path / "hy.csv")
+    with xr.open_dataset(hy) as ds:
+        np.testing.assert_array_equal(steps["storey_shear [N]"], ds.storey_shear.values)
+        np.testing.assert_array_equal(steps["step"], ds.step.values)

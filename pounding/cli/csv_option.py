@@ -21,7 +21,7 @@ def archive_tables(kind: str, ds) -> dict:
     """The tables (``{name: pandas.DataFrame}``, main table first) of an archive of *kind*.
 
     *kind* is what :func:`pounding.cli.run.open_archive` returns: ``run``,
-    ``sweep``, ``compare``, ``gap``, ``ida`` or ``verify``.
+    ``sweep``, ``compare``, ``gap``, ``ida``, ``pushover``, ``hysteresis`` or ``verify``.
     """
     if kind == "run":
         from pounding.results.tables import run_tables
@@ -43,6 +43,18 @@ def archive_tables(kind: str, ds) -> dict:
         from pounding.studies.ida.report import ida_tables
 
         return ida_tables(ds)
+    if kind == "p695":
+        from pounding.studies.p695.report import p695_tables
+
+        return p695_tables(ds)
+    if kind == "pushover":
+        from pounding.studies.pushover import pushover_tables
+
+        return pushover_tables(ds)
+    if kind == "hysteresis":
+        from pounding.studies.cyclic import hysteresis_tables
+
+        return hysteresis_tables(ds)
     from pounding.studies.verify import verify_tables
 
     return verify_tables(ds)

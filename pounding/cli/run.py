@@ -292,7 +292,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
 
 def open_archive(path) -> tuple[str, object]:
     """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``sweep``, ``compare``, ``gap``,
-    ``ida``, ``verify``, ``hysteresis`` or ``pushover``."""
+    ``ida``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
     import xarray as xr
 
     from pounding.errors import ArchiveError
@@ -328,7 +328,7 @@ def open_archive(path) -> tuple[str, object]:
                 else "sweep"), ds
     if is_verify:
         return "verify", ds
-    if attrs.get("kind") in ("hysteresis", "pushover"):
+    if attrs.get("kind") in ("hysteresis", "pushover", "p695"):
         return str(attrs["kind"]), ds
     raise ArchiveError(f"{source}: a pounding file of an unknown kind (not from run, rerun, sweep, compare or "
                        "verify); a newer pounding may read it")
@@ -387,6 +387,10 @@ def _print_info(kind: str, ds) -> None:
         from pounding.studies.pushover import pushover_table
 
         print(pushover_table(ds))
+    elif kind == "p695":
+        from pounding.studies.p695.report import p695_table
+
+        print(p695_table(ds))
     elif kind in ("sweep", "compare"):
         from pounding.cli.sweep import summary_lines
 
@@ -453,6 +457,10 @@ def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
         from pounding.studies.ida import plot_ida
 
         return plot_ida(ds, out)
+    if kind == "p695":
+        from pounding.studies.p695.report import plot_p695
+
+        return plot_p695(ds, out)
     from pounding.studies.verify import plot_verification
 
     out.mkdir(parents=True, exist_ok=True)

@@ -29,9 +29,9 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
         "table", help="print an archive's results as tables, or write them as CSV",
         description="Print the tables of any archive (run: per storey, contact and link; sweep and compare: per "
                     "scenario and storey or contact; gap: per contact, rule and record; ida: fragility and "
-                    "runs; verify: per law), units in the headers, or write them as CSV files with --csv.")
+                    "runs; pushover: per building, step and storey; hysteresis: per step; verify: per law), units in the headers, or write them as CSV files with --csv.")
     parser.add_argument("archive", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare, "
-                        "gap, ida or verify")
+                        "gap, ida, pushover, hysteresis or verify")
     parser.add_argument("--csv", metavar="FILE", help="write the main table to FILE and the others beside it as "
                         "STEM.NAME.csv instead of printing them")
     parser.set_defaults(func=_cmd_table)

@@ -42,7 +42,7 @@ from pounding.solver import storeys
 from pounding.studies.imk import ImkMaterial
 
 __all__ = ["PROTOCOLS", "POINTS_PER_LEG", "named_protocol", "read_protocol", "amplitudes", "storey_response",
-           "StoreySpring", "hysteresis_summary",
+           "StoreySpring", "hysteresis_summary", "hysteresis_tables",
            "hysteresis_test", "write_csv", "plot_hysteresis"]
 
 PROTOCOLS = ("fema461", "atc24")
@@ -256,6 +256,14 @@ def write_csv(ds: xr.Dataset, path: str | Path) -> Path:
     rows = np.column_stack([ds.storey_drift.values, ds.storey_shear.values])
     np.savetxt(path, rows, delimiter=",", header="storey_drift_m,storey_shear_N", comments="", fmt="%.17g")
     return path
+
+
+def hysteresis_tables(ds: xr.Dataset) -> dict:
+    """The table of a hysteresis archive for ``pounding table``: ``steps``, the storey drift (m) and shear (N)
+    per step (the columns of ``--csv``, with the step number)."""
+    from pounding.results.tables import long_table
+
+    return {"steps": long_table(ds, ["storey_drift", "storey_shear"])}
 
 
 def plot_hysteresis(ds: xr.Dataset, folder: str | Path) -> list[Path]:

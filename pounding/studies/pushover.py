@@ -37,7 +37,8 @@ from pounding.errors import PoundingError
 from pounding.studies.cyclic import StoreySpring
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["PATTERNS", "load_pattern", "pushover_building", "pushover", "pushover_table", "plot_pushover"]
+__all__ = ["PATTERNS", "load_pattern", "pushover_building", "pushover", "pushover_table", "pushover_tables",
+           "plot_pushover"]
 
 PATTERNS = ("first-mode", "triangular", "uniform")
 
@@ -235,6 +236,27 @@ def pushover_table(ds: xr.Dataset) -> str:
                      f"{float(row.ultimate_roof_displacement):>8.4f} {float(row.period_based_ductility):>6.2f} "
                      f"{float(row.overstrength):>6.2f} {int(row.control_storey):>6}  {str(row.end.values)}")
     return "\n".join(lines)
+
+
+#: The per-building quantities of a pushover archive, in the order of :func:`pushover_table`.
+BUILDING_QUANTITIES = ["v_max", "weight", "period", "c0", "effective_yield_roof_displacement",
+                       "ultimate_roof_displacement", "period_based_ductility", "overstrength", "control_storey", "end"]
+
+
+def pushover_tables(ds: xr.Dataset) -> dict:
+    """The tables of a pushover archive for ``pounding table``: ``buildings`` (V_max, W, T, C₀, δ_y,eff, δ_u,
+    μ_T, Ω, control storey, end), ``curves`` (base shear and roof displacement per step) and ``storeys``
+    (drift and shear per storey and step); the NaN padding past a building's last step is left out."""
+    from pounding.results.tables import long_table
+
+    def steps_taken(frame, value: str):
+        return frame[frame[value].notna()].reset_index(drop=True)
+
+    curves = long_table(ds, ["base_shear", "roof_displacement", "roof_drift_ratio"])
+    storeys = long_table(ds, ["storey_drift", "storey_shear"])
+    return {"buildings": long_table(ds, [n for n in BUILDING_QUANTITIES if n in ds.variables]),
+            "curves": steps_taken(curves, curves.columns[-3]),
+            "storeys": steps_taken(storeys, storeys.columns[-2])}
 
 
 def plot_pushover(ds: xr.Dataset, folder: str | Path) -> list[Path]:

@@ -38,7 +38,7 @@ VOLATILE_ATTRIBUTES = {"history", "wall_time", "model_path", "run_spec", "elapse
 #: which hashes the package's source files so that a changed code never resumes old parts.
 VOLATILE_VARIABLES = {"wall_time", "solver_wall_time", "scenario_id"}
 
-MODELS = ["pair", "pair_inelastic", "isolated_moat", "pair_bumper", "pair_column", "pair_links",
+MODELS = ["pair", "pair_inelastic", "pair_collapse", "isolated_moat", "pair_bumper", "pair_column", "pair_links",
           "pair_wave_passage", "row_of_three"]
 
 #: Small studies: (name, pounding arguments), each writing ``{out}``.

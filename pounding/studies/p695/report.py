@@ -10,7 +10,7 @@ import numpy as np
 
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["VERDICT_WORDS", "p695_summary", "p695_table", "pounding_effect", "plot_p695"]
+__all__ = ["VERDICT_WORDS", "p695_summary", "p695_table", "p695_tables", "pounding_effect", "plot_p695"]
 
 VERDICT_WORDS = {1: "PASS", 0: "FAIL", -1: "not determinable"}
 _VARIANT = {"with_contacts": "with contacts", "without_contacts": "without contacts"}
@@ -101,6 +101,18 @@ def p695_table(ds) -> str:
                          f"{'PASS' if int(ds.group_passes.sel(variant=variant)) else 'FAIL'}")
     lines += pounding_effect(ds)
     return "\n".join(lines)
+
+
+def p695_tables(ds) -> dict:
+    """Tables of a P695 archive: ``verdict`` (per variant and building: S_CT, CMR, ACMR, pass, note, with
+    the building's T, S_MT, μ_T, SSF, β_TOT and acceptable ACMRs beside) and ``records`` (per variant,
+    building and record: the collapse intensity); units in the headers."""
+    from pounding.results.tables import long_table
+
+    beside = [n for n in ("system", "period", "period_t1", "period_based_ductility", "s_mt", "ssf", "beta_tot",
+                          "acmr_10", "acmr_20") if n in ds.variables]
+    verdict_table = long_table(ds, ["s_ct", "cmr", "acmr", "passes", "note"], extra=beside)
+    return {"verdict": verdict_table, "records": long_table(ds, ["collapse_intensity"])}
 
 
 def plot_p695(ds, directory: str | os.PathLike) -> list[Path]:
