@@ -10,7 +10,7 @@ from pounding.cli.sweep import add_cluster_options, check_study_options
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
-__all__ = ["register_cli"]
+__all__ = ["register_cli", "add_hunt_options"]
 
 
 def _cmd_ida(args: argparse.Namespace) -> int:
@@ -77,6 +77,20 @@ def _cmd_ida(args: argparse.Namespace) -> int:
     return 0
 
 
+def add_hunt_options(parser: argparse.ArgumentParser) -> None:
+    """The hunt-and-fill options (levels in g) of ``pounding ida --hunt`` and ``pounding p695``."""
+    parser.add_argument("--hunt-start", type=float, default=0.1, metavar="G", help="first level of a hunt (g; 0.1)")
+    parser.add_argument("--hunt-step", type=float, default=0.1, metavar="G",
+                        help="first step of a hunt (g; 0.1); the k-th step adds k x --hunt-increment")
+    parser.add_argument("--hunt-increment", type=float, default=0.05, metavar="G", help="step growth (g; 0.05)")
+    parser.add_argument("--tolerance", type=float, default=0.05, metavar="G",
+                        help="width of the final collapse bracket (g; 0.05)")
+    parser.add_argument("--runs-per-record", type=int, default=12, metavar="N",
+                        help="fill each record's IDA curve up to N runs after bracketing (12)")
+    parser.add_argument("--hunt-ceiling", type=float, default=5.0, metavar="G",
+                        help="highest level of a hunt (g; 5): a record that has not collapsed there is censored")
+
+
 def register_cli(subparsers) -> argparse.ArgumentParser:
     """Add ``pounding ida`` to *subparsers*."""
     parser = subparsers.add_parser(
@@ -100,16 +114,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     levels.add_argument("--hunt", action="store_true",
                         help="hunt-and-fill (Vamvatsikos & Cornell): bracket each record's collapse intensity, "
                              "per building")
-    parser.add_argument("--hunt-start", type=float, default=0.1, metavar="G", help="first level of a hunt (g; 0.1)")
-    parser.add_argument("--hunt-step", type=float, default=0.1, metavar="G",
-                        help="first step of a hunt (g; 0.1); the k-th step adds k x --hunt-increment")
-    parser.add_argument("--hunt-increment", type=float, default=0.05, metavar="G", help="step growth (g; 0.05)")
-    parser.add_argument("--tolerance", type=float, default=0.05, metavar="G",
-                        help="width of the final collapse bracket (g; 0.05)")
-    parser.add_argument("--runs-per-record", type=int, default=12, metavar="N",
-                        help="fill each record's IDA curve up to N runs after bracketing (12)")
-    parser.add_argument("--hunt-ceiling", type=float, default=5.0, metavar="G",
-                        help="highest level of a hunt (g; 5): a record that has not collapsed there is censored")
+    add_hunt_options(parser)
     parser.add_argument("--without-contacts", action="store_true",
                         help="run every scenario again with the contacts held open (the effect of pounding)")
     parser.add_argument("--limits", metavar="LIST",

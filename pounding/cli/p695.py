@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 
+from pounding.cli.ida import add_hunt_options
 from pounding.cli.sweep import add_cluster_options, check_study_options
 
 __all__ = ["register_cli", "SDCS", "SYSTEMS"]
@@ -78,14 +79,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                         help="load pattern of the pushover that gives mu_T")
     parser.add_argument("--collapse-drift", type=float, metavar="RATIO",
                         help="max storey drift ratio taken as collapse (as `pounding ida --collapse-drift`)")
-    parser.add_argument("--hunt-start", type=float, default=0.1, metavar="G", help="first level of a hunt (g; 0.1)")
-    parser.add_argument("--hunt-step", type=float, default=0.1, metavar="G", help="first step of a hunt (g; 0.1)")
-    parser.add_argument("--hunt-increment", type=float, default=0.05, metavar="G", help="step growth (g; 0.05)")
-    parser.add_argument("--tolerance", type=float, default=0.05, metavar="G",
-                        help="width of the final collapse bracket (g; 0.05)")
-    parser.add_argument("--runs-per-record", type=int, default=12, metavar="N", help="runs per record (12)")
-    parser.add_argument("--hunt-ceiling", type=float, default=5.0, metavar="G",
-                        help="highest level of a hunt (g; 5): a record not collapsed there is censored")
+    add_hunt_options(parser)
     parser.add_argument("--duration", type=float, help="simulated time of every run, s (default: the model's)")
     parser.add_argument("-o", "--output", metavar="P695.nc",
                         help="write the verdict (NetCDF); resumable: each building's IDA is kept in P695.nc.ida/")
