@@ -62,11 +62,11 @@ def pounding_effect(ds) -> list[str]:
         acmr = [float(ds.acmr.sel(variant=v, building=name)) for v in ("without_contacts", "with_contacts")]
         change = f" (ACMR {acmr[0]:.2f} -> {acmr[1]:.2f})" if all(map(math.isfinite, acmr)) else ""
         if o == 1 and w == 0:
-            lines.append(f"pounding turns {name} from PASS into FAIL{change}")
+            lines.append(f"{name}: pounding turns it from PASS into FAIL{change}")
         elif o == 0 and w == 1:
-            lines.append(f"pounding turns {name} from FAIL into PASS{change}")
+            lines.append(f"{name}: pounding turns it from FAIL into PASS{change}")
         else:
-            lines.append(f"pounding does not change the verdict of {name}: {VERDICT_WORDS[w]}{change}")
+            lines.append(f"{name}: pounding does not change the verdict, {VERDICT_WORDS[w]}{change}")
     return lines
 
 
