@@ -201,3 +201,24 @@ def test_friction_and_hysteretic_planes_are_refused_in_one_line(tmp_path):
     friction = _free_floor("law: hertz-damp, kh: 1.0e9, restitution: 0.6, friction: 0.3", lever=0.0)
     with pytest.raises(PoundingError, match="friction is read but not yet integrated$"):
         simulate_plan(friction)
+
+
+def test_pounding_run_writes_a_labelled_plan_archive(tmp_path, capsys):
+    """`pounding run` on a plan model: floors per direction, rotations, planes, points, units everywhere."""
+    import xarray as xr
+
+    from pounding.cli import main
+
+    model = tmp_path / "e.yaml"
+    model.write_text(ECCENTRIC.replace("REC", _record(tmp_path)))
+    out = tmp_path / "e.nc"
+    assert main(["run", str(model), "-o", str(out)]) == 0
+    assert "peak roof rotation" in capsys.readouterr().out
+    with xr.open_dataset(out) as ds:
+        assert ds.displacement.dims == ("time", "floor", "direction") and list(ds.direction.values) == ["x", "y"]
+        assert ds.rotation.attrs["units"] == "rad" and ds.peak_plane_drift.sizes["plane"] == 4
+        for name, var in ds.data_vars.items():
+            assert var.attrs.get("units") and var.attrs.get("long_name"), name
+        assert ds.attrs["energy_closure"] < 1e-5
+    assert main(["run", str(model), "-o", str(tmp_path / "x.nc"), "--xi", "ye"]) != 0
+    assert "--xi not yet available for plan models" in capsys.readouterr().err
