@@ -30,18 +30,21 @@ from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
-from pounding.model.model import Model, model_from_text
+from pounding.model.model import WALL, Model, model_from_text
 from pounding.model.scales import check_work
 from pounding.records.supports import SupportMotions, common_step, lagged, on_step, support_motions_from
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, run_peaks, to_dataset
 from pounding.solver.assembly import assemble, contact_side_terms
+from pounding.model.plan_model import PlanModel
+from pounding.results.plan_dataset import plan_dataset
+from pounding.solver.plan_assembly import plan_ground_rows, plan_refusal, plan_system, plan_tolerance_factors
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, STATUS_UNSTABLE, integrate
 
 __all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
            "processed_record_for", "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs", "FAILED_STATUSES",
-           "refuse_failed_run"]
+           "refuse_failed_run", "simulate_plan", "plan_ground"]
 
 #: Run statuses that studies (``ida``, sweeps) count as failed: the run ended, but its numbers are
 #: not an answer (``energy_inconsistent``: the contacts dissipated energy the run never received).
@@ -535,3 +538,53 @@ def _archived_records(model: Model, spec: dict, name: str) -> list[Record]:
                                 "since the run was archived; restore the original file")
         records.append(record)
     return records
+
+
+def plan_ground(model: PlanModel, duration: float | None = None) -> tuple[np.ndarray, float, float]:
+    """A plan model's ground rows ``(3, ns)`` (a_gx, a_gy, zeros; m/s²), their step (s) and the end time (s).
+
+    The grid takes the finer of the two components' steps; each component is linear on its
+    own samples (:func:`pounding.model.ground_pair.ground_components`), so with equal steps
+    (a catalogue pair) the rows are exact.  End: *duration*, else the model's, else the
+    longer component's.
+    """
+    records = [r for r in model.ground_motion.records() if r is not None]
+    step = min(r.time_step for r in records)
+    end = duration or model.ground_motion.duration or max(r.time_step * r.acceleration.size for r in records)
+    time = np.arange(int(math.ceil(end / step + 1e-9)) + 1) * step
+    return plan_ground_rows(*model.ground_motion.on_grid(time)), float(step), float(end)
+
+
+def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: float | None = None,
+                  output_dt: float | None = None) -> xr.Dataset:
+    """Simulate a plan model (docs/plan-models.md) under its two-component ground motion.
+
+    Lowered by :func:`pounding.solver.plan_assembly.plan_system` (no plan code in the
+    compiled kernels), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
+    Friction, hysteretic planes and ``stop_drift_ratio`` are refused in one line.
+    """
+    from pounding.solver.integrator import ground_state_at
+
+    refusal = plan_refusal(model)
+    if refusal is not None:
+        raise PoundingError(f"{model.path or model.name}: {refusal}")
+    rows, step, end = plan_ground(model, duration)
+    if any(c.second == WALL and c.law.instantaneous for c in model.contacts) and np.any(rows):
+        raise PoundingError(f"{model.path or model.name}: a rigid (stereo-mechanical) contact with a wall under "
+                            "ground motion is not yet integrated in plan models; use hertz-damp")
+    settings = model.solver
+    psys = plan_system(model)
+    atol = settings.atol
+    factors = plan_tolerance_factors(model, float(np.abs(rows).max()), atol) if settings.tolerance_scaling else \
+        plan_tolerance_factors(model, 0.0, 0.0)
+    started = _time.perf_counter()
+    raw = integrate(psys.system, rows, step, end, rtol=rtol or settings.rtol, atol=atol,
+                    atol_velocity=settings.atol_velocity, output_dt=output_dt or settings.output_dt,
+                    floor_factors=factors)
+    wall = _time.perf_counter() - started
+    if raw.status != STATUS_OK:
+        raise PoundingError(f"{model.path or model.name}: " + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
+    raw = dataclasses.replace(raw, support_acceleration=ground_state_at(rows, step, raw.time)[0])
+    return plan_dataset(model, psys, raw, attrs={"record_step": step, "end_time": end, "wall_time": wall,
+                                                 "angle": model.ground_motion.angle,
+                                                 "created": datetime.now(timezone.utc).isoformat()})

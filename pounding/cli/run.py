@@ -232,6 +232,10 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     from pounding.simulation import model_inputs, simulate
 
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])   # finished by another meanwhile?
+    from pounding.model.plan_model import is_plan_file
+
+    if is_plan_file(args.model):
+        return _run_plan(args, output, started)
     model = load_model(args.model)
     scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
     if args.record is None and (args.units is not None or args.dt is not None):
@@ -263,6 +267,32 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
             print(f"wrote {png}")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return outcome_status(ds)
+
+
+def _run_plan(args: argparse.Namespace, output: Path, started: float) -> int:
+    """``pounding run`` of a plan model (docs/plan-models.md): its own archive and summary."""
+    from pounding.errors import PoundingError
+    from pounding.model.plan_model import load_plan_model
+    from pounding.results.archive import save_run
+    from pounding.results.plan_dataset import plan_summary
+    from pounding.simulation import simulate_plan
+
+    unsupported = [flag for flag, given in (("--record", args.record), ("--scale", args.scale), ("--xi", args.xi),
+                                            ("--units", args.units), ("--dt", args.dt), ("--plot", args.plot),
+                                            ("--no-contacts", args.no_contacts),
+                                            ("--csv", getattr(args, "csv", None))) if given]
+    if unsupported:
+        raise PoundingError(f"{args.model}: {', '.join(unsupported)} not yet available for plan models; "
+                            "give the ground motion and contacts in the model file")
+    model = load_plan_model(args.model)
+    ds = simulate_plan(model, duration=args.duration, rtol=args.rtol, output_dt=args.output_dt)
+    path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
+    print(plan_summary(ds))
+    for warning in model.warnings:
+        print(f"warning: {warning}")
+    print(f"wrote {path}")
+    print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
+    return 0
 
 
 #: Exit status of a run whose archive is written but whose results are not to be trusted

@@ -57,9 +57,9 @@ __all__ = [
     "PLAN_NOT_INTEGRATED",
 ]
 
-#: What a command says of a plan model (a building with ``plan:``): checked, not yet run.
-PLAN_NOT_INTEGRATED = ("plan models (buildings with plan:) are read and checked but not yet integrated by the "
-                       "solver; the model is valid (pounding.model.plan_model.load_plan_model gives its matrices)")
+#: What a command other than ``pounding run`` says of a plan model (a building with ``plan:``): checked, not run.
+PLAN_NOT_INTEGRATED = ("plan models (buildings with plan:) are read and checked but not yet integrated by this "
+                       "command; the model is valid: `pounding run` integrates it (pounding.simulation.simulate_plan)")
 
 #: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
 #: without pounding of ``pounding run --no-contacts``, ``pounding gap``, ``ida --without-contacts`` and

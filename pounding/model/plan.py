@@ -32,7 +32,7 @@ from pounding.units import STANDARD_GRAVITY
 __all__ = ["DOF_PER_FLOOR", "DIRECTIONS", "Plane", "PlanStorey", "outline_centroid", "outline_contains",
            "slab_radius_of_gyration", "point_weights", "drift_weights", "plane_weights", "plan_mass_matrix",
            "plan_stiffness_matrix", "plan_influence", "plan_modes", "rayleigh_coefficients", "coincident_modes",
-           "plan_geometric_stiffness", "storey_stiffness_defect", "plane_drift_ratio_weights", "COINCIDENT_MODES"]
+           "plan_geometric_stiffness", "plan_geometric_terms", "storey_stiffness_defect", "plane_drift_ratio_weights", "COINCIDENT_MODES"]
 
 #: Degrees of freedom of a rigid floor: u_x, u_y, θ.
 DOF_PER_FLOOR = 3
@@ -258,11 +258,25 @@ def plan_geometric_stiffness(storeys: list[PlanStorey]) -> np.ndarray:
     summed over the distributed load (first moments vanish about c̄),
     ``K_G = −(P/h) (a_x a_xᵀ + a_y a_yᵀ + r̄² a_θ a_θᵀ)`` with a_x, a_y the drift
     weights of the point c̄ and a_θ = e_θ,i − e_θ,i−1: per direction P/h, and the
-    torsional term P r̄²/h (docs/plan-models.md).
+    torsional term P r̄²/h (docs/plan-models.md).  The sum of :func:`plan_geometric_terms`.
     """
     n = DOF_PER_FLOOR * len(storeys)
     kg = np.zeros((n, n))
+    for _, stiffness, a in plan_geometric_terms(storeys):
+        kg += stiffness * np.outer(a, a)
+    return kg
+
+
+def plan_geometric_terms(storeys: list[PlanStorey]) -> list[tuple[int, float, np.ndarray]]:
+    """``(storey, k_G, a)`` for the three rank-one P-Delta terms of every storey: ``K_G = Σ k_G a aᵀ``.
+
+    Per storey i (1-based): ``(−P/h, a_x)``, ``(−P/h, a_y)`` and ``(−P r̄²/h, a_θ)``
+    (N/m, N/m, N·m; see :func:`plan_geometric_stiffness`); a solver applies each as a
+    linear spring of stiffness k_G on the drift ``a · q``.
+    """
+    n = DOF_PER_FLOOR * len(storeys)
     centres = [s.centre for s in storeys]
+    terms: list[tuple[int, float, np.ndarray]] = []
     for i in range(len(storeys)):
         above = storeys[i:]
         masses = np.array([s.mass for s in above])
@@ -275,11 +289,11 @@ def plan_geometric_stiffness(storeys: list[PlanStorey]) -> np.ndarray:
         a_theta[DOF_PER_FLOOR * i + 2] = 1.0
         if i > 0:
             a_theta[DOF_PER_FLOOR * (i - 1) + 2] = -1.0
-        a_x = drift_weights(centres, i + 1, centroid, "x")
-        a_y = drift_weights(centres, i + 1, centroid, "y")
-        kg -= (STANDARD_GRAVITY * total / storeys[i].height) * (
-            np.outer(a_x, a_x) + np.outer(a_y, a_y) + spread * np.outer(a_theta, a_theta))
-    return kg
+        weight = -STANDARD_GRAVITY * total / storeys[i].height
+        terms += [(i + 1, weight, drift_weights(centres, i + 1, centroid, "x")),
+                  (i + 1, weight, drift_weights(centres, i + 1, centroid, "y")),
+                  (i + 1, weight * spread, a_theta)]
+    return terms
 
 
 # --------------------------------------------------------------------------- #

@@ -666,7 +666,8 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,
               *, rtol: float, atol: float, atol_velocity: float, output_dt: float,
               scale_tolerances: bool = True, initial_displacement: np.ndarray | None = None,
-              initial_velocity: np.ndarray | None = None) -> RawSolution:
+              initial_velocity: np.ndarray | None = None,
+              floor_factors: np.ndarray | None = None) -> RawSolution:
     """Integrate the row of buildings under a piecewise-linear ground motion.
 
     Parameters
@@ -691,6 +692,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     initial_displacement, initial_velocity : (N,) ndarray, optional
         Initial state relative to the ground (m, m/s); default at rest.  All
         contacts start open.
+    floor_factors : (N,) ndarray, optional
+        Factors (0, 1] on atol and atol_velocity per floor, given by the caller (a plan model's
+        rotations, :mod:`pounding.solver.plan_assembly`); replaces *scale_tolerances*.
     """
     # A fresh writable copy: a read-only array would compile a second specialisation.  One ground:
     # a 1-D array (ground None: the single-record solver); several: one row each (row 0 also as *ag*).
@@ -711,7 +715,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                           system.dense_values)
     contacts = Contacts(floors, weights, system.contact_gap, system.contact_law, system.contact_parameters)
     factors = np.ones(system.n_floors)
-    if scale_tolerances:
+    if floor_factors is not None:
+        factors = np.array(floor_factors, dtype=np.float64, copy=True)
+    elif scale_tolerances:
         factors = floor_tolerance_factors(system.mass, system.storey_stiffness, system.below,
                                           float(np.max(np.abs(rows))) if rows.size else 0.0, float(atol))
     settings = Settings(float(time_step), float(duration), float(rtol), float(atol), float(atol_velocity),

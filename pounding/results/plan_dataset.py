@@ -1,0 +1,165 @@
+"""The archive of a plan-model run: floors per DOF with a ``direction`` dimension, planes, contact points, energy.
+
+A plan run is lowered by :mod:`pounding.solver.plan_assembly` (every DOF a
+solver floor, planes and P-Delta terms as linear links, contact points as gap
+elements); this module labels what the solver returns:
+
+* ``displacement`` / ``velocity`` (time, floor, direction) m, m/s and ``rotation`` /
+  ``rotation_rate`` (time, floor) rad, rad/s: each floor's centre of mass relative to the
+  ground; their full-resolution peaks ``peak_displacement`` (floor, direction) and
+  ``peak_rotation`` (floor);
+* ``plane_drift`` (time, plane) m and ``peak_plane_drift`` (plane, full resolution);
+* ``contact_force`` (time, point) N, ``peak_contact_force`` and ``impact_count`` (point),
+  and the impact table (``impact`` dimension);
+* the energy audit ``energy_*`` (time) J and its closure (attribute ``energy_closure``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from pounding.model.model import WALL
+from pounding.model.plan import DOF_PER_FLOOR
+from pounding.model.plan_model import PlanModel
+from pounding.solver.integrator import RawSolution
+from pounding.solver.kinematics import penetration
+from pounding.solver.plan_assembly import PlanSystem
+
+__all__ = ["plan_dataset", "plan_energy_closure", "plan_summary"]
+
+
+def _var(dims, data, units: str, long_name: str) -> tuple:
+    return dims, np.asarray(data), {"units": units, "long_name": long_name}
+
+
+def _floor_labels(model: PlanModel) -> dict[str, Any]:
+    buildings = [b.name for b in model.buildings for _ in range(b.n_floors)]
+    levels = [i + 1 for b in model.buildings for i in range(b.n_floors)]
+    return {"floor_building": (("floor",), np.array(buildings, dtype=object), {"long_name": "building of the floor"}),
+            "floor_level": (("floor",), np.array(levels, dtype=np.int64),
+                            {"units": "1", "long_name": "floor number from the ground up"})}
+
+
+def _plane_labels(model: PlanModel) -> dict[str, Any]:
+    rows = [(b.name, storey, b.storeys[storey - 1].planes[j])
+            for b in model.buildings for storey, j, _ in b.plane_weights()]
+    return {"plane_building": (("plane",), np.array([r[0] for r in rows], dtype=object),
+                               {"long_name": "building of the plane"}),
+            "plane_storey": (("plane",), np.array([r[1] for r in rows], dtype=np.int64),
+                             {"units": "1", "long_name": "storey of the plane"}),
+            "plane_direction": (("plane",), np.array([r[2].direction for r in rows], dtype=object),
+                                {"long_name": "direction the plane resists"}),
+            "plane_at": (("plane",), np.array([r[2].at for r in rows], dtype=float),
+                         {"units": "m", "long_name": "the plane's line (y along x, x along y)"})}
+
+
+def _point_labels(model: PlanModel, psys: PlanSystem) -> dict[str, Any]:
+    names = [b.name for b in model.buildings]
+    faces = [model.contacts[f] for f in psys.point_face]
+    between = [f"{names[c.first]}:{c.level_first}-"
+               + ("wall" if c.second == WALL else f"{names[c.second]}:{c.level_second}") for c in faces]
+    return {"point_between": (("point",), np.array(between, dtype=object),
+                              {"long_name": "the two floors of the contact point (building:floor)"}),
+            "point_face": (("point",), psys.point_face, {"units": "1", "long_name": "index of the point's face"}),
+            "point_normal": (("point",), np.array([c.face.normal for c in faces], dtype=object),
+                             {"long_name": "normal direction of the point's face"}),
+            "point_x": (("point",), psys.point_location[:, 0], {"units": "m", "long_name": "x of the point at rest"}),
+            "point_y": (("point",), psys.point_location[:, 1], {"units": "m", "long_name": "y of the point at rest"})}
+
+
+def _energies(psys: PlanSystem, raw: RawSolution, delta: np.ndarray) -> dict[str, np.ndarray]:
+    """Energy histories (J): input, kinetic, damping, plane strain, P-Delta, contacts; initial energy first."""
+    system = psys.system
+    lay = system.layout
+    n, npt, npl = lay.n_floors, psys.n_points, psys.n_planes
+    state = raw.state
+    v = state[:, n:2 * n]
+    work = state[:, lay.work:lay.work + lay.n_contacts]
+    stiffness = system.contact_parameters[npt:, 0]
+    link_start = 0.5 * (stiffness * delta[0, npt:] ** 2)
+    return {"energy_input": state[:, lay.input_energy],
+            "energy_kinetic": 0.5 * (v * v) @ system.mass,
+            "energy_damping": state[:, lay.damping_energy],
+            "energy_plane_strain": work[:, npt:npt + npl].sum(axis=1) + link_start[:npl].sum(),
+            "energy_p_delta": work[:, npt + npl:].sum(axis=1) + link_start[npl:].sum(),
+            "energy_contact": work[:, :npt].sum(axis=1)}
+
+
+def plan_energy_closure(ds: xr.Dataset) -> float:
+    """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of a plan archive (dimensionless)."""
+    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact)
+    initial = float(parts[0])
+    supplied = initial + ds.energy_input
+    scale = float(np.abs(supplied).max())
+    return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
+
+
+def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
+                 attrs: dict[str, Any] | None = None) -> xr.Dataset:
+    """The archive of a plan run (module docstring); *attrs* join the dataset's attributes."""
+    system = psys.system
+    n = system.n_floors
+    nf = n // DOF_PER_FLOOR
+    npt, npl = psys.n_points, psys.n_planes
+    u = raw.state[:, :n].reshape(-1, nf, DOF_PER_FLOOR)
+    v = raw.state[:, n:2 * n].reshape(-1, nf, DOF_PER_FLOOR)
+    delta = penetration(raw.state[:, :n], system.contact_floors, system.contact_weights, system.contact_gap,
+                        np.zeros((raw.time.size, system.n_contacts)))
+    peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
+    counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
+    data = {
+        "displacement": _var(("time", "floor", "direction"), u[:, :, :2], "m",
+                             "displacement of the floor's centre of mass relative to the ground"),
+        "rotation": _var(("time", "floor"), u[:, :, 2], "rad", "rotation of the floor, counter-clockwise"),
+        "velocity": _var(("time", "floor", "direction"), v[:, :, :2], "m/s",
+                         "velocity of the floor's centre of mass relative to the ground"),
+        "rotation_rate": _var(("time", "floor"), v[:, :, 2], "rad/s", "rotation rate of the floor"),
+        "peak_displacement": _var(("floor", "direction"), peak_u[:, :2], "m",
+                                  "peak |displacement| of the centre of mass (full resolution)"),
+        "peak_rotation": _var(("floor",), peak_u[:, 2], "rad", "peak |rotation| of the floor (full resolution)"),
+        "plane_drift": _var(("time", "plane"), delta[:, npt:npt + npl], "m", "drift of the plane's line"),
+        "peak_plane_drift": _var(("plane",), raw.peak_contact_force[npt:npt + npl] / psys.plane_stiffness, "m",
+                                 "peak |drift| of the plane (full resolution)"),
+        "plane_stiffness": _var(("plane",), psys.plane_stiffness, "N/m", "elastic stiffness of the plane"),
+        "contact_force": _var(("time", "point"), raw.contact_force[:, :npt], "N",
+                              "normal contact force at the point (compression positive)"),
+        "penetration": _var(("time", "point"), delta[:, :npt], "m", "penetration at the point (overlap positive)"),
+        "peak_contact_force": _var(("point",), raw.peak_contact_force[:npt], "N",
+                                   "peak normal contact force at the point (full resolution)"),
+        "impact_count": _var(("point",), counts, "1", "number of impacts at the point"),
+        "impact_point": _var(("impact",), raw.impact_contact, "1", "contact point of the impact"),
+        "impact_time": _var(("impact",), raw.impact_time, "s", "time of contact onset"),
+        "impact_velocity": _var(("impact",), raw.impact_velocity, "m/s", "approach velocity at the point at onset"),
+        "impact_peak_force": _var(("impact",), raw.impact_peak_force, "N", "peak force of the impact"),
+        "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
+    }
+    for name, values in _energies(psys, raw, delta).items():
+        label = name.removeprefix("energy_").replace("_", " ")
+        data[name] = _var(("time",), values, "J", f"energy: {label}")
+    if raw.support_acceleration is not None:
+        data["ground_acceleration"] = _var(("time", "direction"), raw.support_acceleration[:, :2], "m/s²",
+                                           "ground acceleration along x and y")
+    coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
+              "direction": ("direction", np.array(["x", "y"], dtype=object), {"long_name": "plan direction"}),
+              **_floor_labels(model), **_plane_labels(model), **_point_labels(model, psys)}
+    ds = xr.Dataset(data, coords=coords, attrs={"title": f"pounding plan run: {model.name}", "model": model.name,
+                                                "kind": "plan_run", **(attrs or {})})
+    ds.attrs["energy_closure"] = plan_energy_closure(ds)
+    return ds
+
+
+def plan_summary(ds: xr.Dataset) -> str:
+    """A few lines: peak displacement and roof rotation per building, impacts, energy closure."""
+    lines = [f"{ds.attrs.get('model', '')}: plan run to {float(ds.time[-1]):.3f} s"]
+    for name in dict.fromkeys(ds.floor_building.values):
+        floors = ds.floor_building.values == name
+        peak = ds.peak_displacement.values[floors]
+        roof = ds.peak_rotation.values[floors][-1]
+        lines.append(f"  {name}: peak displacement x {1e3 * peak[:, 0].max():.2f} mm, "
+                     f"y {1e3 * peak[:, 1].max():.2f} mm; peak roof rotation {roof:.3e} rad")
+    lines.append(f"  impacts {int(ds.impact_count.sum())} at {int((ds.impact_count > 0).sum())} of "
+                 f"{ds.sizes.get('point', 0)} points; energy closure {ds.attrs['energy_closure']:.1e}")
+    return "\n".join(lines)

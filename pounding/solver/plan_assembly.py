@@ -1,0 +1,196 @@
+"""A plan model lowered into the solver's arrays: every DOF a solver floor, planes as weighted springs.
+
+The compiled integrator needs no plan-specific code (docs/plan-models.md, "What is
+integrated now"):
+
+* every DOF (u_x, u_y, θ of each floor; :mod:`pounding.model.plan_model`'s
+  numbering) is a solver *floor* of mass m, m or I = m r²; it has no storey
+  spring (stiffness 0, floor below −1);
+* every plane is a permanent linear spring (the Kelvin link with no dashpot) on
+  its drift ``a · q``: its at most four terms (u and θ of the floor above, u and θ
+  of the floor below) are the link's two sides, so K = Σ k a aᵀ exactly, the
+  link's peak |F|/k is the plane's peak |drift| at full resolution and its work
+  ∫F·Δ̇ dt its strain energy;
+* P-Delta adds the three rank-one terms of :func:`pounding.model.plan.plan_geometric_terms`
+  per storey as links of negative stiffness;
+* damping is the building's dense damping matrix (Rayleigh at its own 3-D modes, or
+  modal), the solver's dense damping block;
+* the ground acceleration per DOF comes from three ground rows: a_gx (row 0),
+  a_gy (row 1) and a zero row (2) for the rotations (the several-ground mechanism);
+  every contact and link takes the zero row on both sides, so no differential
+  ground motion enters them: in coordinates relative to one rigid ground the
+  penetration of a point is exactly ``w · q − gap``;
+* every contact point is a gap element whose two sides are the (u_n, θ) terms of
+  its two floors (its penetration weights), the low side on the left.
+
+Not yet integrated (one line each, :func:`plan_refusal`): friction, hysteretic
+planes, ``stop_drift_ratio``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pounding.contact.links import LINK_KELVIN
+from pounding.contact import laws as contact_laws
+from pounding.model.model import WALL
+from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
+from pounding.model.plan_model import PlanModel
+from pounding.solver.assembly import side_mass
+from pounding.solver.integrator import System
+from pounding.solver.kinematics import SIDE_TERMS
+from pounding.solver.tolerances import floor_tolerance_factors
+
+__all__ = ["GROUND_X", "GROUND_Y", "GROUND_NONE", "PlanSystem", "plan_refusal", "plan_system", "plan_ground_rows",
+           "plan_tolerance_factors"]
+
+#: Ground rows of a plan run: a_gx, a_gy and the zero row (rotations; contacts and planes).
+GROUND_X, GROUND_Y, GROUND_NONE = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class PlanSystem:
+    """A plan model's solver arrays and what the results need to label them.
+
+    Attributes
+    ----------
+    system : System
+        Contact points first (gap elements, ``n_points``), then the planes' links
+        (``n_planes``), then the P-Delta links.
+    n_points, n_planes : int
+    plane_stiffness : (n_planes,) N/m
+    point_face : (n_points,) int, index of each point's face in ``PlanModel.contacts``
+    point_location : (n_points, 2) m, the point at rest
+    """
+
+    system: System
+    n_points: int
+    n_planes: int
+    plane_stiffness: np.ndarray
+    point_face: np.ndarray
+    point_location: np.ndarray
+
+
+def plan_refusal(model: PlanModel) -> str | None:
+    """Why *model* cannot be run yet (one line), or None."""
+    if any(c.friction for c in model.contacts):
+        return "friction is read but not yet integrated"
+    for b in model.buildings:
+        for i, s in enumerate(b.storeys):
+            if any(p.hysteresis is not None for p in s.planes):
+                return (f"building {b.name} storey {i + 1}: hysteretic planes are read but not yet integrated "
+                        "(elastic planes only)")
+    if model.solver.stop_drift_ratio:
+        return "solver.stop_drift_ratio is read but not yet integrated for plan models"
+    return None
+
+
+def _floor_terms(offset: int, weights: np.ndarray) -> list[tuple[int, float]]:
+    """A side's ``(DOF, weight)`` terms from one floor's (3,) weights (the DOF after *offset*), nonzero only."""
+    return [(offset + k, float(w)) for k, w in enumerate(weights) if w != 0.0]
+
+
+def _side(terms: list[tuple[int, float]]) -> list[tuple[int, float]]:
+    """Pad a side's terms to SIDE_TERMS/2 with absent terms ``(−1, 0)``."""
+    if len(terms) > SIDE_TERMS // 2:
+        raise ValueError(f"a side has {len(terms)} terms; the solver takes {SIDE_TERMS // 2}")
+    return terms + [(-1, 0.0)] * (SIDE_TERMS // 2 - len(terms))
+
+
+def _drift_sides(offset: int, a: np.ndarray, storey: int) -> tuple[list, list]:
+    """A storey drift ``a · q`` (a over one building's DOF) as two sides: the floor above, the floor below."""
+    top = DOF_PER_FLOOR * (storey - 1)
+    upper = _floor_terms(offset + top, a[top:top + DOF_PER_FLOOR])
+    lower = _floor_terms(offset + top - DOF_PER_FLOOR, a[top - DOF_PER_FLOOR:top]) if storey > 1 else []
+    return _side(upper), _side(lower)
+
+
+def _link_parameters(stiffness: float) -> np.ndarray:
+    out = np.zeros(contact_laws.N_PARAMETERS)
+    out[0] = stiffness
+    return out
+
+
+def plan_system(model: PlanModel) -> PlanSystem:
+    """Lower *model* into a :class:`PlanSystem` (call :func:`plan_refusal` first)."""
+    mass = np.concatenate([np.diag(b.mass_matrix()) for b in model.buildings]).astype(float)
+    n = mass.size
+    offsets = model.dof_offsets
+    floors, weights, gaps, laws, params = [], [], [], [], []
+    point_face, locations = [], []
+    for face_index, contact in enumerate(model.contacts):
+        first = offsets[contact.first] + DOF_PER_FLOOR * (contact.level_first - 1)
+        second = None if contact.second == WALL else offsets[contact.second] + DOF_PER_FLOOR * (contact.level_second - 1)
+        for point in contact.points:
+            one = _side(_floor_terms(first, point.weights[0]))
+            two = _side([] if second is None else _floor_terms(second, point.weights[1]))
+            left, right = (one, two) if contact.face.first_low else (two, one)
+            floors.append([f for f, _ in left + right])
+            weights.append([w for _, w in left + right])
+            gaps.append(contact.gap)
+            laws.append(contact.law.law_id)
+            params.append(contact.law.kernel_parameters(side_mass(left, mass), side_mass(right, mass)))
+            point_face.append(face_index)
+            locations.append(point.location)
+    n_points = len(gaps)
+    plane_stiffness = []
+    links: list[tuple[float, np.ndarray, int, int]] = []
+    for b, offset in zip(model.buildings, offsets):
+        for storey, j, a in b.plane_weights():
+            stiffness = float(b.storeys[storey - 1].planes[j].stiffness)
+            links.append((stiffness, a, offset, storey))
+            plane_stiffness.append(stiffness)
+    for b, offset in zip(model.buildings, offsets):
+        if b.p_delta:
+            links += [(k, a, offset, storey) for storey, k, a in plan_geometric_terms(list(b.storeys))]
+    for stiffness, a, offset, storey in links:
+        upper, lower = _drift_sides(offset, a, storey)
+        floors.append([f for f, _ in upper + lower])
+        weights.append([w for _, w in upper + lower])
+        gaps.append(0.0)
+        laws.append(LINK_KELVIN)
+        params.append(_link_parameters(stiffness))
+    nc = len(gaps)
+    floors_arr = np.array(floors, dtype=np.int64).reshape(nc, SIDE_TERMS)
+    dense = [np.asarray(b.damping_matrix(), dtype=float).ravel() for b in model.buildings]
+    sizes = [b.n_dof for b in model.buildings]
+    floor_ground = np.tile(np.array([GROUND_X, GROUND_Y, GROUND_NONE], dtype=np.int64), n // DOF_PER_FLOOR)
+    system = System(
+        mass=np.ascontiguousarray(mass), storey_stiffness=np.zeros(n), below=np.full(n, -1, dtype=np.int64),
+        rayleigh_mass=np.zeros(n), rayleigh_stiffness=np.zeros(n),
+        dense_start=np.asarray(offsets, dtype=np.int64), dense_size=np.asarray(sizes, dtype=np.int64),
+        dense_offset=np.asarray(np.cumsum([0] + [s * s for s in sizes])[:-1], dtype=np.int64),
+        dense_values=np.ascontiguousarray(np.concatenate(dense) if dense else np.zeros(0)),
+        contact_left=floors_arr[:, 0].copy(), contact_right=floors_arr[:, 2].copy(),
+        contact_gap=np.asarray(gaps, dtype=float), contact_law=np.asarray(laws, dtype=np.int64),
+        contact_parameters=np.ascontiguousarray(np.array(params, dtype=float).reshape(nc, contact_laws.N_PARAMETERS)),
+        contact_floors=np.ascontiguousarray(floors_arr),
+        contact_weights=np.ascontiguousarray(np.array(weights, dtype=float).reshape(nc, SIDE_TERMS)),
+        floor_ground=floor_ground,
+        contact_ground_left=np.full(nc, GROUND_NONE, dtype=np.int64),
+        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64))
+    return PlanSystem(system, n_points, len(plane_stiffness), np.asarray(plane_stiffness, dtype=float),
+                      np.asarray(point_face, dtype=np.int64), np.asarray(locations, dtype=float).reshape(n_points, 2))
+
+
+def plan_ground_rows(a_gx: np.ndarray, a_gy: np.ndarray) -> np.ndarray:
+    """(3, ns) ground rows of a plan run from the global components (m/s²): a_gx, a_gy, zeros."""
+    a_gx = np.asarray(a_gx, dtype=float)
+    return np.ascontiguousarray(np.stack([a_gx, np.asarray(a_gy, dtype=float), np.zeros_like(a_gx)]))
+
+
+def plan_tolerance_factors(model: PlanModel, peak_ground_acceleration: float, atol: float) -> np.ndarray:
+    """(N,) factors on atol per DOF: translations at the building's static scale
+    (:func:`pounding.solver.tolerances.floor_tolerance_factors`, with a storey's total plane
+    stiffness), rotations further over the floor's radius of gyration (atol/r rad, r ≥ 1 m)."""
+    factors = []
+    for b in model.buildings:
+        mass = np.repeat([s.mass for s in b.storeys], DOF_PER_FLOOR)
+        stiffness = np.repeat([sum(float(p.stiffness) for p in s.planes) for s in b.storeys], DOF_PER_FLOOR)
+        below = np.r_[-1, np.arange(b.n_dof - 1)]
+        own = floor_tolerance_factors(mass, stiffness, below, peak_ground_acceleration, atol)
+        own[2::DOF_PER_FLOOR] *= np.minimum(1.0, 1.0 / np.array([s.radius_of_gyration for s in b.storeys]))
+        factors.append(own)
+    return np.concatenate(factors) if factors else np.zeros(0)
