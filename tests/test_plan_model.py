@@ -349,3 +349,12 @@ def test_an_unknown_key_of_a_plan_contact_suggests_its_own_keys():
     contact = "  - {between: [A, wall], face: east, gap: 0.1, levels: [1], law: hertz-damp, kh: 1.0e9, fricton: 0.2}\n"
     message = error_of(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()), contact))
     assert "unknown key 'fricton' (did you mean 'friction'?)" in message
+
+
+def test_a_gap_between_outlines_is_the_decimal_gap_written():
+    """20.05 − 20.0 is 0.05000000000000071 in binary floats; the face's gap is rounded to the picometre."""
+    from pounding.model.plan_contacts import facing
+
+    face = facing(((0.0, 0.0), (20.0, 10.0)), ((20.05, 2.0), (30.0, 8.0)))
+    assert face is not None and face.gap == 0.05 and face.normal == "x"
+    assert abs(face.gap - (20.05 - 20.0)) < 1e-15

@@ -27,7 +27,7 @@ import numpy as np
 
 from pounding.model.plan import Outline, point_weights
 
-__all__ = ["Face", "ContactPoint", "WALL_FACES", "facing", "overlap_at_rest", "face_points", "wall_face",
+__all__ = ["Face", "ContactPoint", "WALL_FACES", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face",
            "penetration_weights", "slip_weights"]
 
 #: A wall's face of a building: (normal direction, True if the building is on the low side).
@@ -100,6 +100,20 @@ def overlap_at_rest(first: Outline, second: Outline) -> bool:
     return _overlap(ax, bx) > 0.0 and _overlap(ay, by) > 0.0
 
 
+#: Decimal places (m) a gap between two outlines is rounded to: the picometre.
+GAP_DECIMALS = 12
+
+
+def edge_distance(low: float, high: float) -> float:
+    """The gap (m) between a face at *low* and the facing one at *high*, rounded to :data:`GAP_DECIMALS`.
+
+    Outline coordinates are decimal metres that binary floats hold inexactly, so their difference carries
+    round-off (20.05 − 20.0 = 0.05000000000000071); rounded to the picometre, reports and archives show the
+    gap the user wrote, 1e4 times below the solver's displacement tolerance.
+    """
+    return round(high - low, GAP_DECIMALS)
+
+
 def facing(first: Outline, second: Outline) -> Face | None:
     """The face between two outlines, or None when they do not face each other (diagonal, or overlapping)."""
     first_ranges, second_ranges = _intervals(first), _intervals(second)
@@ -112,7 +126,7 @@ def facing(first: Outline, second: Outline) -> Face | None:
         first_low = a_n[1] <= b_n[0]
         low, high = (a_n, b_n) if first_low else (b_n, a_n)
         span = (max(a_t[0], b_t[0]), min(a_t[1], b_t[1]))
-        return Face(normal, first_low, high[0] - low[1], low[1], high[0], span)
+        return Face(normal, first_low, edge_distance(low[1], high[0]), low[1], high[0], span)
     return None
 
 
