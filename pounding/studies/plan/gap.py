@@ -148,14 +148,10 @@ def assemble_plan_gap(sweep, results: dict[str, dict[str, Any]], *, elapsed: flo
     from pounding.studies.common import sweep_heading
     from pounding.studies.gap import RULES
 
+    from pounding.studies.plan.runs import study_parts
+
     scenarios = sweep.scenarios()
-    parts = []
-    for s in scenarios:
-        part = results.get(s.key, {"status": "error", "error": "not run"})
-        if part.get("status") == "ok" and part.get("study") != PLAN_GAP_PART:
-            part = {"status": "error", "error": f"{s.label}: a stored result of another kind of study has the "
-                                                "same key; delete the .parts folder and run again"}
-        parts.append(part)
+    parts = study_parts(scenarios, results, PLAN_GAP_PART)
     records = [str(s.coords["record"]) for s in scenarios]
     ok = np.array([p.get("status") == "ok" for p in parts], dtype=bool)
     first = next((p for p in parts if p.get("status") == "ok"), {})

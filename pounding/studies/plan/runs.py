@@ -28,7 +28,7 @@ from pounding.studies.engine.tasks import one_line
 from pounding.studies.sweep.spec import strip_location
 
 __all__ = ["run_plan_scenario", "plan_peaks", "corner_peaks", "assemble_plan_sweep", "CORNERS", "PLAN_PART",
-           "floor_states"]
+           "floor_states", "study_parts"]
 
 #: Version of the plan scenario's part layout.
 PLAN_PART = "plan-1"
@@ -146,6 +146,18 @@ def _spread(shape: tuple, parts: list[dict], index: list[tuple], name: str, labe
     return out
 
 
+def study_parts(scenarios: list, results: dict[str, dict[str, Any]], study: str) -> list[dict[str, Any]]:
+    """Each scenario's result (``not run`` where missing; a stored part of another *study* kind is an error)."""
+    parts = []
+    for s in scenarios:
+        part = results.get(s.key, {"status": "error", "error": "not run"})
+        if part.get("status") == "ok" and part.get("study") != study:
+            part = {"status": "error", "error": f"{s.label}: a stored result of another kind of study has the "
+                                                "same key; delete the .parts folder and run again"}
+        parts.append(part)
+    return parts
+
+
 def assemble_plan_sweep(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
                         ran: int = 0, title: str | None = None):
     """The plan sweep's NetCDF layout: peaks over the sweep's dimensions × floor/direction, corner, plane, point."""
@@ -156,13 +168,7 @@ def assemble_plan_sweep(sweep, results: dict[str, dict[str, Any]], *, elapsed: f
     from pounding.studies.common import sweep_heading
 
     scenarios = sweep.scenarios()
-    parts = []
-    for s in scenarios:
-        part = results.get(s.key, {"status": "error", "error": "not run"})
-        if part.get("status") == "ok" and part.get("study") != PLAN_PART:
-            part = {"status": "error", "error": f"{s.label}: a stored result of another kind of study has the "
-                                                "same key; delete the .parts folder and run again"}
-        parts.append(part)
+    parts = study_parts(scenarios, results, PLAN_PART)
     ok_parts = [p if p.get("status") == "ok" else {} for p in parts]
     index = [s.index for s in scenarios]
     shape = sweep.shape
