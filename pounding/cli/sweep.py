@@ -76,6 +76,15 @@ def raise_if_all_failed(ds, output) -> None:
         raise PoundingError(f"all {ds.status.size} scenarios failed (errors above){where}")
 
 
+def _announce_invalid(sweep, strict: bool) -> None:
+    """Each axis value that makes the model invalid: a warning, or (``--strict``) the first one as the error."""
+    invalid = sweep.invalid_values()
+    if invalid and strict:
+        raise PoundingError(invalid[0])
+    for message in invalid:
+        print(f"pounding: warning: {message}; its scenarios will record this error", file=sys.stderr)
+
+
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
     from pounding.studies.sweep.execution import plan_line, run_sweep
@@ -91,11 +100,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     sweep = load_sweep(args.sweep)
     check_csv(args, [args.sweep])
     output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
-    invalid = sweep.invalid_values()
-    if invalid and args.strict:
-        raise PoundingError(invalid[0])
-    for message in invalid:
-        print(f"pounding: warning: {message}; its scenarios will record this error", file=sys.stderr)
+    _announce_invalid(sweep, args.strict)
     print_warnings(filter(None, (axis_warning(a.name, a.values, a.units) for a in sweep.axes if a.kind == "path")))
     print(plan_line(sweep), file=sys.stderr)
     try:
@@ -131,11 +136,7 @@ def _cmd_plan_sweep(args: argparse.Namespace) -> int:
     refuse_options(args, "sweep", ("--keep-histories", "--csv"))
     sweep = load_plan_sweep(args.sweep)
     output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
-    invalid = sweep.invalid_values()
-    if invalid and args.strict:
-        raise PoundingError(invalid[0])
-    for message in invalid:
-        print(f"pounding: warning: {message}; its scenarios will record this error", file=sys.stderr)
+    _announce_invalid(sweep, args.strict)
     print(plan_line(sweep), file=sys.stderr)
     try:
         ds = run_sweep(sweep, output, runner=run_plan_scenario, assemble=assemble_plan_sweep, workers=args.workers,
