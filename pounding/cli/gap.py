@@ -46,7 +46,11 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
     from pounding.studies.engine.store import parts_dir
 
+    from pounding.model.plan_model import is_plan_file
+
     check_study_options(args)
+    if is_plan_file(args.model):
+        return _cmd_plan_gap(args)
     check_csv(args, [args.model])
     if args.code:
         return _cmd_code_gap(args)
@@ -85,6 +89,34 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     if args.plot:
         for png in plot_gap(ds, args.plot):
             print(f"wrote {png}", file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
+def _cmd_plan_gap(args: argparse.Namespace) -> int:
+    """``pounding gap MODEL.yaml`` on a plan model."""
+    import json
+
+    from pounding.studies.plan.gap import plan_gap_study, plan_gap_summary, plan_gap_table
+
+    from pounding.cli.plan_studies import interrupted, refuse_options
+
+    refuse_options(args, "gap", ("--code", "--plot", "--csv", "--sds", "--sd1", "--ag"))
+    scale = None if args.scale is None else parse_scale_option(args.scale)
+    try:
+        ds = plan_gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
+                            workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
+                            progress=not args.no_progress)
+    except KeyboardInterrupt:
+        return interrupted(args.output)
+    ok = ds.status.values == "ok"
+    for record, message in zip(ds.record.values[~ok], ds.error.values[~ok]):
+        print(f"pounding: record failed ({record}): {message}", file=sys.stderr)
+    if not ok.any():
+        raise PoundingError(f"every record failed ({len(ok)}); nothing to report")
+    print(json.dumps(plan_gap_summary(ds), indent=2) if args.json else plan_gap_table(ds))
+    print_study_warnings(ds)
+    if args.output:
+        print(f"wrote {args.output}", file=sys.stderr if args.json else sys.stdout)
     return 0
 
 

@@ -7,5 +7,6 @@
 ``gap``        the separation that avoids pounding, by simulation and by the code rules
 ``ida``        incremental dynamic analysis: plan, runs, hunt-and-fill (an adaptive source), dataset, report
 ``fragility``  lognormal fragility fits and the collapse margin ratio
+``plan``       sweep, compare and gap on plan models (buildings with ``plan:``)
 ``verify``     the ball-drop test of Ye, Li & Zhu (2009, Table I)
 """

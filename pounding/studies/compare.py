@@ -30,7 +30,7 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "comparison_table", "compare_tables", "differences", "reference_formula", "plot_comparison",
+__all__ = ["compare", "formula_keys", "pounding_variants", "comparison_table", "compare_tables", "differences", "reference_formula", "plot_comparison",
            "pounding_change", "DEFAULT_FORMULAS"]
 
 REFERENCE = "exact"
@@ -38,7 +38,7 @@ REFERENCE = "exact"
 DEFAULT_FORMULAS = "ye,lankarani-nikravesh,exact"
 
 
-def _formulas(text: str | list[str], reference: str) -> list[str]:
+def formula_keys(text: str | list[str], reference: str) -> list[str]:
     from pounding.contact import xi
 
     names = [n.strip() for n in (text.split(",") if isinstance(text, str) else text) if n.strip()]
@@ -60,7 +60,7 @@ def _formulas(text: str | list[str], reference: str) -> list[str]:
     return keys
 
 
-def _pounding_variants(text: str | list[str]) -> list[str]:
+def pounding_variants(text: str | list[str]) -> list[str]:
     """``--contacts`` as the ``pounding`` axis: exactly ``with`` and ``without`` (any order, any case)."""
     from pounding.studies.sweep.spec import POUNDING_VALUES
 
@@ -90,13 +90,13 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = Non
                                 "without pounding under its own contact law and xi; drop --xi")
         if not base.gaps:
             raise PoundingError(f"{os.fspath(model)}: the model has no contacts; there is no pounding to compare")
-        axes = {"pounding": _pounding_variants(contacts)}
+        axes = {"pounding": pounding_variants(contacts)}
     else:
         if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
             raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only "
                                 "to law hertz-damp (--contacts with,without compares any law with and without "
                                 "pounding)")
-        axes = {"xi": _formulas(DEFAULT_FORMULAS if formulas is None else formulas, reference)}
+        axes = {"xi": formula_keys(DEFAULT_FORMULAS if formulas is None else formulas, reference)}
     listed = record_values(records)
     if listed is not None:
         axes["records"] = listed
