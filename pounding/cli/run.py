@@ -269,30 +269,63 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     return outcome_status(ds)
 
 
+def plan_scale_option(text: str) -> float:
+    """``--scale`` of a plan model: a positive factor on both components (a PGA or Sa target is refused in one line)."""
+    from pounding.errors import PoundingError
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0.0 or value == float("inf"):
+        raise PoundingError(f"--scale {text}: a plan model takes a positive factor on both components, e.g. "
+                            "--scale 0.8 (PGA and Sa targets are not defined for a pair)")
+    return value
+
+
 def _run_plan(args: argparse.Namespace, output: Path, started: float) -> int:
-    """``pounding run`` of a plan model (docs/plan-models.md): its own archive and summary."""
+    """``pounding run`` of a plan model (docs/plan-models.md): its own archive, summary, CSV and plots."""
     from pounding.errors import PoundingError
     from pounding.model.plan_model import load_plan_model
     from pounding.results.archive import save_run
     from pounding.results.plan_dataset import plan_summary
     from pounding.simulation import simulate_plan
 
-    unsupported = [flag for flag, given in (("--record", args.record), ("--scale", args.scale), ("--xi", args.xi),
-                                            ("--units", args.units), ("--dt", args.dt), ("--plot", args.plot),
-                                            ("--no-contacts", args.no_contacts),
-                                            ("--csv", getattr(args, "csv", None))) if given]
-    if unsupported:
-        raise PoundingError(f"{args.model}: {', '.join(unsupported)} not yet available for plan models; "
-                            "give the ground motion and contacts in the model file")
+    if args.plot:
+        raise PoundingError(f"{args.model}: --plot is not yet available for plan models; run without it")
+    refused = [flag for flag, given in (("--units", args.units), ("--dt", args.dt)) if given is not None]
+    if refused:
+        raise PoundingError(f"{args.model}: {' and '.join(refused)} describe{'s' if len(refused) == 1 else ''} a "
+                            "record file; a plan model's --record "
+                            "is a catalogue pair, which declares its own (give files as x: and y: components, with "
+                            "units and dt, in the model's ground_motion)")
+    scale = None if args.scale is None else plan_scale_option(args.scale)
     model = load_plan_model(args.model)
-    ds = simulate_plan(model, duration=args.duration, rtol=args.rtol, output_dt=args.output_dt)
+    ds = simulate_plan(model, duration=args.duration, rtol=args.rtol, output_dt=args.output_dt, record=args.record,
+                       scale=scale, xi=args.xi, contacts=not args.no_contacts)
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(plan_summary(ds))
     for warning in model.warnings:
         print(f"warning: {warning}")
     print(f"wrote {path}")
+    write_csv_option(args, "plan", ds, histories=True)
+    if args.plot:
+        _write_plots("plan", ds, args.plot, args, f"; the archive {path} is written")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return 0
+
+
+def _write_plots(kind: str, ds, directory, args: argparse.Namespace, written_note: str = "") -> None:
+    """Draw the figures of an archive of *kind* into *directory* and print each file; one line if they cannot be written."""
+    from pounding.errors import PoundingError
+
+    try:
+        written = _draw(kind, ds, Path(directory), args)
+    except OSError as exc:
+        raise PoundingError(f"--plot {directory}: cannot write the plots ({exc.strerror or exc}){written_note}"
+                            ) from None
+    for png in written:
+        print(f"wrote {png}")
 
 
 #: Exit status of a run whose archive is written but whose results are not to be trusted
