@@ -204,3 +204,104 @@ def test_csv_holds_the_floor_histories_of_the_archive(model_file, tmp_path, caps
         assert np.array_equal(table["B:1 theta [rad]"].values, ds.rotation.values[:, 2])
         planes = pd.read_csv(tmp_path / "h.planes.csv")
         assert np.array_equal(planes["peak_plane_drift [m]"].values, ds.peak_plane_drift.values)
+
+
+# --------------------------------------------------------------------------- plots, info, table, rerun
+
+
+@pytest.fixture(scope="module")
+def archive(model_file, tmp_path_factory):
+    from pounding.cli import main
+
+    out = tmp_path_factory.mktemp("archive") / "corner.nc"
+    assert main(["run", str(model_file), "-o", str(out)]) == 0
+    return out
+
+
+def _check_png(path) -> None:
+    import matplotlib.image as mpimg
+
+    image = mpimg.imread(path)
+    assert image.ndim == 3 and image.shape[0] > 200 and image.shape[1] > 200
+    assert float(image[..., :3].std()) > 0.01   # not a blank canvas
+
+
+def test_run_plot_draws_the_plan_view_and_the_roof_rotation(model_file, tmp_path, capsys):
+    code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "r.nc", "--duration", "3",
+                            "--plot", tmp_path / "figs")
+    assert code == 0
+    for name in ("plan_view.png", "roof_rotation.png"):
+        assert f"wrote {tmp_path / 'figs' / name}" in out
+        _check_png(tmp_path / "figs" / name)
+
+
+def test_plan_view_is_at_the_largest_impact(run):
+    from pounding.results.plan_plots import plan_view_instant, shown_floors
+
+    sample, point = plan_view_instant(run)
+    force = run.contact_force.values
+    assert force[sample, point] == force.max() > 0.0
+    shown = shown_floors(run, point)
+    a, b = (int(np.flatnonzero(run.floor_building.values == n)[-1]) for n in ("A", "B"))
+    between = str(run.point_between.values[point])
+    level = int(between.split(":")[1].split("-")[0])
+    assert shown["A"] == int(np.flatnonzero((run.floor_building.values == "A") & (run.floor_level.values == level))[0])
+    assert shown["B"] == b and a >= shown["A"]
+
+
+def test_plot_redraws_a_plan_archive(archive, tmp_path, capsys):
+    code, out, _ = _run_cli(capsys, "plot", archive, "-o", tmp_path / "again")
+    assert code == 0 and "plan_view.png" in out
+    _check_png(tmp_path / "again" / "plan_view.png")
+    _check_png(tmp_path / "again" / "roof_rotation.png")
+
+
+def test_info_describes_a_plan_archive_with_its_peaks(archive, capsys):
+    code, out, _ = _run_cli(capsys, "info", archive)
+    assert code == 0 and "[plan archive]" in out
+    with xr.open_dataset(archive) as ds:
+        roof = float(ds.peak_rotation.values[ds.floor_building.values == "A"][-1])
+        assert f"peak roof rotation {roof:.3e} rad" in out
+        assert f"{float(ds.peak_contact_force[0]) / 1e3:.4g} kN" in out
+        assert f"impacts {int(ds.impact_count.sum())} at" in out
+    assert "A: 2 floors, [[0, 0], [20, 10]], 4 along x and 4 along y" in out
+    assert "B: 1 floor, [[20.02, 4], [30, 14]], 2 along x and 2 along y" in out
+
+
+def test_table_prints_and_writes_the_peaks(archive, tmp_path, capsys):
+    import pandas as pd
+
+    code, out, _ = _run_cli(capsys, "table", archive)
+    assert code == 0
+    for name in ("floors:", "rotations:", "corners:", "planes:", "points:"):
+        assert name in out
+    code, _, _ = _run_cli(capsys, "table", archive, "--csv", tmp_path / "t.csv")
+    assert code == 0
+    floors = pd.read_csv(tmp_path / "t.csv")
+    corners = pd.read_csv(tmp_path / "t.corners.csv")
+    points = pd.read_csv(tmp_path / "t.points.csv")
+    with xr.open_dataset(archive) as ds:
+        assert np.array_equal(floors["peak_displacement [m]"].values, ds.peak_displacement.values.ravel())
+        assert list(floors["direction"].values[:2]) == ["x", "y"]
+        assert np.array_equal(corners["peak_corner_displacement [m]"].values, ds.peak_corner_displacement.values.ravel())
+        assert np.array_equal(points["impact_count [-]"].values, ds.impact_count.values)
+        assert np.array_equal(points["peak_contact_force [N]"].values, ds.peak_contact_force.values)
+
+
+def test_rerun_reproduces_a_plan_archive(archive, tmp_path, capsys):
+    code, out, _ = _run_cli(capsys, "rerun", archive, "-o", tmp_path / "again.nc")
+    assert code == 0 and f"rerun reproduces {archive}: all" in out and "variables identical" in out
+    with xr.open_dataset(archive) as before, xr.open_dataset(tmp_path / "again.nc") as after:
+        for name in before.data_vars:
+            assert np.array_equal(before[name].values, after[name].values), name
+        assert "rerun of" in after.attrs["history"]
+
+
+def test_rerun_keeps_the_options(model_file, tmp_path, capsys):
+    first = tmp_path / "half.nc"
+    assert _run_cli(capsys, "run", model_file, "-o", first, "--scale", "0.5", "--no-contacts", "--xi", "ye",
+                    "--duration", "2")[0] == 0
+    code, out, _ = _run_cli(capsys, "rerun", first, "-o", tmp_path / "half2.nc")
+    assert code == 0 and "variables identical" in out
+    code, out, _ = _run_cli(capsys, "info", first)
+    assert "--scale 0.5" in out and "--no-contacts" in out and "--xi ye" in out

@@ -35,7 +35,7 @@ from pounding.solver.kinematics import penetration
 from pounding.solver.plan_assembly import PlanSystem
 
 __all__ = ["CORNERS", "plan_dataset", "plan_energy_closure", "plan_summary", "corner_weights", "floor_corners",
-           "hermite_at", "peak_corner"]
+           "hermite_at", "peak_corner", "compare_plan_runs"]
 
 #: The outline's corners, counter-clockwise from the south-west one (the ``corner`` coordinate).
 CORNERS = ("south-west", "south-east", "north-east", "north-west")
@@ -258,3 +258,22 @@ def plan_summary(ds: xr.Dataset) -> str:
     lines.append(f"  impacts {int(ds.impact_count.sum())} at {int((ds.impact_count > 0).sum())} of "
                  f"{ds.sizes.get('point', 0)} points; energy closure {ds.attrs['energy_closure']:.1e}")
     return "\n".join(lines)
+
+
+def compare_plan_runs(before: xr.Dataset, after: xr.Dataset, name: str = "archive") -> str:
+    """One line comparing a rerun *after* with its archive *before*: every variable identical, or those that
+    differ with their largest difference relative to the variable's largest magnitude."""
+    differ = []
+    for var in before.data_vars:
+        old = before[var].values
+        new = after[var].values if var in after.data_vars else None
+        if new is None or old.shape != new.shape:
+            differ.append(f"{var} (shape)")
+        elif not np.array_equal(old, new, equal_nan=old.dtype.kind == "f"):
+            scale = float(np.nanmax(np.abs(old))) if old.size else 0.0
+            gap = float(np.nanmax(np.abs(old - new)))
+            differ.append(f"{var} ({gap / scale if scale else gap:.1e})")
+    if not differ:
+        return f"rerun reproduces {name}: all {len(before.data_vars)} variables identical"
+    return f"rerun differs from {name} in {len(differ)} variable(s): {', '.join(differ[:8])}" + \
+        (" ..." if len(differ) > 8 else "")
