@@ -256,15 +256,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     print(f"wrote {path}")
     write_csv_option(args, "run", ds)
     if args.plot:
-        from pounding.results.plots import plot_run
-
-        try:
-            written = plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation)
-        except OSError as exc:
-            raise PoundingError(f"--plot {args.plot}: cannot write the plots ({exc.strerror or exc}); the archive "
-                                f"{path} is written") from None
-        for png in written:
-            print(f"wrote {png}")
+        _write_plots("run", ds, args.plot, args, f"; the archive {path} is written")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return outcome_status(ds)
 
