@@ -44,7 +44,7 @@ from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS
 __all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
            "processed_record_for", "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
            "estimate_memory", "available_memory", "check_memory", "model_inputs", "FAILED_STATUSES",
-           "refuse_failed_run", "simulate_plan", "plan_ground"]
+           "refuse_failed_run", "simulate_plan", "plan_ground", "plan_with_options", "rerun_plan"]
 
 #: Run statuses that studies (``ida``, sweeps) count as failed: the run ended, but its numbers are
 #: not an answer (``energy_inconsistent``: the contacts dissipated energy the run never received).
@@ -555,16 +555,84 @@ def plan_ground(model: PlanModel, duration: float | None = None) -> tuple[np.nda
     return plan_ground_rows(*model.ground_motion.on_grid(time)), float(step), float(end)
 
 
+def _pair_form(model: PlanModel) -> bool:
+    """True if *model*'s file gives its ground motion as a record pair (``record:``), not as components x and y."""
+    import yaml
+
+    ground = (yaml.safe_load(model.source) or {}).get("ground_motion") if model.source else None
+    return isinstance(ground, dict) and ground.get("record") is not None
+
+
+def plan_with_options(model: PlanModel, *, record: str | None = None, scale: float | None = None,
+                      xi: str | None = None, contacts: bool = True) -> PlanModel:
+    """*model* with what ``pounding run`` overrides on a plan model (one-line errors, the option named).
+
+    Parameters
+    ----------
+    record : str, optional
+        A catalogue pair (``fema-p695:farfield/3``: components a and b) instead of the model's ground motion.
+    scale : float, optional
+        The factor on both components: it replaces the pair's ``scale`` (with components given one by one,
+        ``x`` and ``y``, it multiplies each component's own scale: their ratio is kept).
+    xi : str, optional
+        ξ formula of every hertz-damp contact.
+    contacts : bool
+        False: every contact point held open (gap :data:`pounding.model.model.OPEN_GAP`), the run without
+        pounding.
+    """
+    from pounding.contact import xi as xi_formulas
+    from pounding.contact.laws import HertzDamp
+    from pounding.model.ground_pair import pair_components
+    from pounding.model.model import OPEN_GAP
+    from pounding.model.plan_schema import ComponentEntry
+
+    where = model.path or model.name
+    ground = model.ground_motion
+    if record is not None:
+        pair = pair_components(record)
+        if pair is None:
+            raise PoundingError(f"--record {record}: a plan model needs a catalogue pair such as fema-p695:farfield/3 "
+                                "(components a and b); for single records or files give x: {record: ...} and "
+                                "y: {record: ...} in the model's ground_motion")
+        components = tuple(ComponentEntry(record=c, scale=1.0 if scale is None else scale) for c in pair)
+        ground = dataclasses.replace(ground, components=components, dt=None, units=None)
+    elif scale is not None:
+        pair = _pair_form(model)
+        components = tuple(None if c is None else c.model_copy(update={"scale": scale if pair else scale * c.scale})
+                           for c in ground.components)
+        ground = dataclasses.replace(ground, components=components)
+    contact_list = list(model.contacts)
+    if xi is not None:
+        key = xi_formulas.get(xi).key
+        if not any(isinstance(c.law, HertzDamp) for c in contact_list):
+            raise PoundingError(f"--xi {xi}: {where} has no hertz-damp contacts; the xi formula applies only to "
+                                "law hertz-damp")
+        contact_list = [dataclasses.replace(c, law=type(c.law)(**{**c.law.model_dump(), "xi": key}))
+                        if isinstance(c.law, HertzDamp) else c for c in contact_list]
+    if not contacts:
+        if not contact_list:
+            raise PoundingError(f"--no-contacts: {where} has no contacts; there is no pounding to leave out")
+        contact_list = [dataclasses.replace(c, face=dataclasses.replace(c.face, gap=OPEN_GAP)) for c in contact_list]
+    return dataclasses.replace(model, ground_motion=ground, contacts=tuple(contact_list))
+
+
 def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: float | None = None,
-                  output_dt: float | None = None) -> xr.Dataset:
+                  output_dt: float | None = None, record: str | None = None, scale: float | None = None,
+                  xi: str | None = None, contacts: bool = True) -> xr.Dataset:
     """Simulate a plan model (docs/plan-models.md) under its two-component ground motion.
 
     Lowered by :func:`pounding.solver.plan_assembly.plan_system` (no plan code in the
     compiled kernels), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
     Friction, hysteretic planes and ``stop_drift_ratio`` are refused in one line.
+    *record*, *scale*, *xi* and *contacts* as :func:`plan_with_options`; the archive's
+    attribute ``plan_spec`` (JSON) holds the model text and these options, for
+    :func:`rerun_plan`.
     """
     from pounding.solver.integrator import ground_state_at
 
+    options = dict(record=record, scale=scale, xi=xi, contacts=contacts)
+    source = model
+    model = plan_with_options(model, **options)
     refusal = plan_refusal(model)
     if refusal is not None:
         raise PoundingError(f"{model.path or model.name}: {refusal}")
@@ -585,6 +653,43 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
     if raw.status != STATUS_OK:
         raise PoundingError(f"{model.path or model.name}: " + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     raw = dataclasses.replace(raw, support_acceleration=ground_state_at(rows, step, raw.time)[0])
+    hashes = [None if r is None else r.metadata.get("sha256", "") for r in model.ground_motion.records()]
+    spec = {"model": source.source, "name": source.name, "path": source.path,
+            "base_dir": source.ground_motion.base_dir, **options, "duration": duration, "rtol": rtol,
+            "output_dt": output_dt, "records": [None if c is None else {"record": c.record, "scale": c.scale}
+                                                for c in model.ground_motion.components],
+            "record_sha256": hashes}
+    now = datetime.now(timezone.utc)
+    from pounding import __version__
+
     return plan_dataset(model, psys, raw, attrs={"record_step": step, "end_time": end, "wall_time": wall,
                                                  "angle": model.ground_motion.angle,
-                                                 "created": datetime.now(timezone.utc).isoformat()})
+                                                 "created": now.isoformat(), "source": f"pounding {__version__}",
+                                                 "history": f"{now.strftime('%Y-%m-%dT%H:%M:%SZ')} simulated with "
+                                                            f"pounding {__version__}",
+                                                 "plan_spec": json.dumps(spec)})
+
+
+def rerun_plan(run: xr.Dataset, name: str = "archive") -> xr.Dataset:
+    """Simulate again what a plan archive (:func:`simulate_plan`) recorded: its model text and options.
+
+    Refused in one line if a component's samples no longer hash to the archived SHA-256.
+    """
+    from pounding.model.plan_model import plan_model_from_text
+
+    try:
+        spec = json.loads(run.attrs["plan_spec"])
+        model = plan_model_from_text(spec["model"], name=spec["name"], path=spec["path"], base_dir=spec["base_dir"])
+        options = {k: spec[k] for k in ("record", "scale", "xi", "contacts", "duration", "rtol", "output_dt")}
+    except (KeyError, ValueError, TypeError) as exc:
+        raise PoundingError(f"damaged archive: {name}: its plan_spec attribute is missing or garbled "
+                            f"({type(exc).__name__}); run the model again") from None
+    again_model = plan_with_options(model, **{k: options[k] for k in ("record", "scale", "xi", "contacts")})
+    for component, archived in zip(again_model.ground_motion.records(), spec.get("record_sha256", [])):
+        if component is not None and archived and component.metadata.get("sha256", "") != archived:
+            raise PoundingError(f"{name}: record {component.source} has changed "
+                                "since the run was archived; restore the original file")
+    again = simulate_plan(model, **options)
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    again.attrs["history"] = f"{run.attrs.get('history', '')}\n{now} rerun of {name}".strip()
+    return again

@@ -220,5 +220,5 @@ def test_pounding_run_writes_a_labelled_plan_archive(tmp_path, capsys):
         for name, var in ds.data_vars.items():
             assert var.attrs.get("units") and var.attrs.get("long_name"), name
         assert ds.attrs["energy_closure"] < 1e-5
-    assert main(["run", str(model), "-o", str(tmp_path / "x.nc"), "--xi", "ye"]) != 0
-    assert "--xi not yet available for plan models" in capsys.readouterr().err
+    assert main(["run", str(model), "-o", str(tmp_path / "x.nc"), "--units", "g"]) != 0
+    assert "--units describes a record file" in capsys.readouterr().err

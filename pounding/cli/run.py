@@ -256,43 +256,66 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     print(f"wrote {path}")
     write_csv_option(args, "run", ds)
     if args.plot:
-        from pounding.results.plots import plot_run
-
-        try:
-            written = plot_run(ds, args.plot, drift_limit=args.drift_limit, elevation=args.elevation)
-        except OSError as exc:
-            raise PoundingError(f"--plot {args.plot}: cannot write the plots ({exc.strerror or exc}); the archive "
-                                f"{path} is written") from None
-        for png in written:
-            print(f"wrote {png}")
+        _write_plots("run", ds, args.plot, args, f"; the archive {path} is written")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return outcome_status(ds)
 
 
+def plan_scale_option(text: str) -> float:
+    """``--scale`` of a plan model: a positive factor on both components (a PGA or Sa target is refused in one line)."""
+    from pounding.errors import PoundingError
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0.0 or value == float("inf"):
+        raise PoundingError(f"--scale {text}: a plan model takes a positive factor on both components, e.g. "
+                            "--scale 0.8 (PGA and Sa targets are not defined for a pair)")
+    return value
+
+
 def _run_plan(args: argparse.Namespace, output: Path, started: float) -> int:
-    """``pounding run`` of a plan model (docs/plan-models.md): its own archive and summary."""
+    """``pounding run`` of a plan model (docs/plan-models.md): its own archive, summary, CSV and plots."""
     from pounding.errors import PoundingError
     from pounding.model.plan_model import load_plan_model
     from pounding.results.archive import save_run
     from pounding.results.plan_dataset import plan_summary
     from pounding.simulation import simulate_plan
 
-    unsupported = [flag for flag, given in (("--record", args.record), ("--scale", args.scale), ("--xi", args.xi),
-                                            ("--units", args.units), ("--dt", args.dt), ("--plot", args.plot),
-                                            ("--no-contacts", args.no_contacts),
-                                            ("--csv", getattr(args, "csv", None))) if given]
-    if unsupported:
-        raise PoundingError(f"{args.model}: {', '.join(unsupported)} not yet available for plan models; "
-                            "give the ground motion and contacts in the model file")
+    refused = [flag for flag, given in (("--units", args.units), ("--dt", args.dt)) if given is not None]
+    if refused:
+        raise PoundingError(f"{args.model}: {' and '.join(refused)} describe{'s' if len(refused) == 1 else ''} a "
+                            "record file; a plan model's --record "
+                            "is a catalogue pair, which declares its own (give files as x: and y: components, with "
+                            "units and dt, in the model's ground_motion)")
+    scale = None if args.scale is None else plan_scale_option(args.scale)
     model = load_plan_model(args.model)
-    ds = simulate_plan(model, duration=args.duration, rtol=args.rtol, output_dt=args.output_dt)
+    ds = simulate_plan(model, duration=args.duration, rtol=args.rtol, output_dt=args.output_dt, record=args.record,
+                       scale=scale, xi=args.xi, contacts=not args.no_contacts)
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(plan_summary(ds))
     for warning in model.warnings:
         print(f"warning: {warning}")
     print(f"wrote {path}")
+    write_csv_option(args, "plan", ds, histories=True)
+    if args.plot:
+        _write_plots("plan", ds, args.plot, args, f"; the archive {path} is written")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return 0
+
+
+def _write_plots(kind: str, ds, directory, args: argparse.Namespace, written_note: str = "") -> None:
+    """Draw the figures of an archive of *kind* into *directory* and print each file; one line if they cannot be written."""
+    from pounding.errors import PoundingError
+
+    try:
+        written = _draw(kind, ds, Path(directory), args)
+    except OSError as exc:
+        raise PoundingError(f"--plot {directory}: cannot write the plots ({exc.strerror or exc}){written_note}"
+                            ) from None
+    for png in written:
+        print(f"wrote {png}")
 
 
 #: Exit status of a run whose archive is written but whose results are not to be trusted
@@ -313,6 +336,8 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
     with output_lock(args.output, writer="pounding rerun"):
         check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
+        if _is_plan_archive(args.run):
+            return _rerun_plan(args, open_archive(args.run)[1])
         ds = rerun(args.run)
         path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
@@ -320,8 +345,35 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     return outcome_status(ds)
 
 
+def _is_plan_archive(path) -> bool:
+    """True if *path* reads as a plan-run archive (attribute ``kind``); anything else is left to the planar reader."""
+    import xarray as xr
+
+    if not Path(path).is_file():   # a FIFO would block the open: the planar reader refuses it in one line
+        return False
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as handle:
+            return handle.attrs.get("kind") == "plan_run"
+    except Exception:   # noqa: BLE001 - the planar reader reports what is wrong with the file
+        return False
+
+
+def _rerun_plan(args: argparse.Namespace, before) -> int:
+    """``pounding rerun`` of a plan archive: run it again, write it, and compare its peaks with the archive's."""
+    from pounding.results.archive import save_run
+    from pounding.results.plan_dataset import plan_summary, compare_plan_runs
+    from pounding.simulation import rerun_plan
+
+    ds = rerun_plan(before, str(args.run))
+    path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
+    print(plan_summary(ds))
+    print(compare_plan_runs(before, ds, str(args.run)))
+    print(f"wrote {path}")
+    return 0
+
+
 def open_archive(path) -> tuple[str, object]:
-    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``sweep``, ``compare``, ``gap``,
+    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``plan`` (a plan-model run), ``sweep``, ``compare``, ``gap``,
     ``ida``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
     import xarray as xr
 
@@ -343,11 +395,14 @@ def open_archive(path) -> tuple[str, object]:
     if "run_spec" in attrs:
         return "run", open_run(source)
     is_verify = {"e_pre", "e_post", "model"} <= names and "settings" in attrs
-    if not is_verify and not str(attrs.get("source", "")).startswith("pounding"):
+    is_plan = attrs.get("kind") == "plan_run"
+    if not is_verify and not is_plan and not str(attrs.get("source", "")).startswith("pounding"):
         raise ArchiveError(f"{source}: not a pounding archive (written by pounding run, rerun, sweep, compare or "
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
         ds = load_within_memory(handle, source)
+    if is_plan:
+        return "plan", ds
     if attrs.get("study") in ("gap", "ida") or "sweep_name" in attrs:
         if "status" not in names:   # every study archive has one status per scenario
             raise ArchiveError(f"damaged archive: {source}: variable status missing; run the study again to "
@@ -401,6 +456,12 @@ def _print_info(kind: str, ds) -> None:
     """The summary ``pounding info`` prints for an archive of *kind*."""
     if kind == "run":
         print(summary(ds))
+    elif kind == "plan":
+        from pounding.results.describe import describe_plan
+        from pounding.results.plan_dataset import plan_summary
+
+        print(describe_plan(ds))
+        print(plan_summary(ds))
     elif kind == "gap":
         from pounding.studies.gap import gap_table
 
@@ -459,6 +520,10 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
     """The figures of an archive of *kind* written to the folder *out*; their paths."""
+    if kind == "plan":
+        from pounding.results.plan_plots import plot_plan_run
+
+        return plot_plan_run(ds, out)
     if kind == "run":
         from pounding.results.plots import plot_run
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 
-__all__ = ["record_event", "scale_text", "run_title"]
+__all__ = ["record_event", "scale_text", "run_title", "describe_plan"]
 
 
 def record_event(ds) -> str:
@@ -49,3 +49,36 @@ def run_title(ds) -> str:
     if str(attrs.get("contacts", "")).startswith("held open"):   # pounding run --no-contacts
         text += ", contacts held open"
     return text
+
+
+def describe_plan(ds) -> str:
+    """What a plan-run archive holds, in words: the ground motion and the run's options, then per building its
+    floors, outline and planes, and the contact points per face (the peaks are :func:`plan_summary`'s)."""
+    import numpy as np
+
+    spec = json.loads(ds.attrs.get("plan_spec", "{}") or "{}")
+    components = [f"{axis} {c['record']} x{c['scale']:g}" for axis, c in zip(("a/x", "b/y"), spec.get("records", []))
+                  if c]
+    options = [text for text, on in ((f"--record {spec.get('record')}", spec.get("record")),
+                                     (f"--scale {spec.get('scale')}", spec.get("scale") is not None),
+                                     (f"--xi {spec.get('xi')}", spec.get("xi")),
+                                     ("--no-contacts (every contact held open)", spec.get("contacts") is False))
+               if on]
+    lines = [f"plan model '{ds.attrs.get('model', '')}' under {', '.join(components) or 'its ground motion'}, "
+             f"angle {float(ds.attrs.get('angle', 0.0)):g} deg, {float(ds.time[-1]):.2f} s"
+             + (f" ({'; '.join(options)})" if options else "")]
+    lines.append("buildings (floors, outline m, planes per direction):")
+    for name in dict.fromkeys(ds.floor_building.values):
+        floors = np.flatnonzero(ds.floor_building.values == name)
+        xs, ys = ds.corner_x.values[floors[0]], ds.corner_y.values[floors[0]]
+        mine = ds.plane_building.values == name
+        directions = ds.plane_direction.values[mine]
+        lines.append(f"  {name}: {floors.size} floor{'s' if floors.size > 1 else ''}, [[{xs.min():g}, {ys.min():g}], [{xs.max():g}, {ys.max():g}]], "
+                     f"{int((directions == 'x').sum())} along x and {int((directions == 'y').sum())} along y")
+    if ds.sizes.get("point", 0):
+        lines.append("contact points (floors: location m, normal, impacts, peak normal force):")
+        for p in range(ds.sizes["point"]):
+            lines.append(f"  {ds.point_between.values[p]}: ({float(ds.point_x[p]):g}, {float(ds.point_y[p]):g}), "
+                         f"{ds.point_normal.values[p]}, {int(ds.impact_count[p])} impacts, "
+                         f"{float(ds.peak_contact_force[p]) / 1e3:.4g} kN")
+    return "\n".join(lines)

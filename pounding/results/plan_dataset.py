@@ -9,8 +9,14 @@ elements); this module labels what the solver returns:
   ground; their full-resolution peaks ``peak_displacement`` (floor, direction) and
   ``peak_rotation`` (floor);
 * ``plane_drift`` (time, plane) m and ``peak_plane_drift`` (plane, full resolution);
+* ``corner_displacement`` (time, floor, corner, direction) m of the outline's four corners
+  (small rotations: ``u_x − θ (p_y − y_c)``, ``u_y + θ (p_x − x_c)``),
+  ``corner_displacement_magnitude`` (time, floor, corner) their hypot, and their peaks over the
+  stored samples ``peak_corner_displacement`` (floor, corner, direction) and
+  ``peak_corner_displacement_magnitude`` (floor, corner);
 * ``contact_force`` (time, point) N, ``peak_contact_force`` and ``impact_count`` (point),
-  and the impact table (``impact`` dimension);
+  and the impact table (``impact`` dimension) with the point's location (``impact_x``,
+  ``impact_y``) and the face's tangential slip at the onset (``impact_slip``);
 * the energy audit ``energy_*`` (time) J and its closure (attribute ``energy_closure``).
 """
 
@@ -22,25 +28,72 @@ import numpy as np
 import xarray as xr
 
 from pounding.model.model import WALL
-from pounding.model.plan import DOF_PER_FLOOR
+from pounding.model.plan import DOF_PER_FLOOR, point_weights
 from pounding.model.plan_model import PlanModel
 from pounding.solver.integrator import RawSolution
 from pounding.solver.kinematics import penetration
 from pounding.solver.plan_assembly import PlanSystem
 
-__all__ = ["plan_dataset", "plan_energy_closure", "plan_summary"]
+__all__ = ["CORNERS", "plan_dataset", "plan_energy_closure", "plan_summary", "corner_weights", "floor_corners",
+           "hermite_at", "peak_corner", "compare_plan_runs"]
+
+#: The outline's corners, counter-clockwise from the south-west one (the ``corner`` coordinate).
+CORNERS = ("south-west", "south-east", "north-east", "north-west")
 
 
 def _var(dims, data, units: str, long_name: str) -> tuple:
     return dims, np.asarray(data), {"units": units, "long_name": long_name}
 
 
+def floor_corners(model: PlanModel) -> np.ndarray:
+    """(floors, 4, 2) the outline's corners of every floor at rest (:data:`CORNERS` order), m."""
+    rows = []
+    for b in model.buildings:
+        (x0, y0), (x1, y1) = b.outline
+        rows += [[(x0, y0), (x1, y0), (x1, y1), (x0, y1)]] * b.n_floors
+    return np.asarray(rows, dtype=float).reshape(-1, 4, 2)
+
+
+def corner_weights(centres: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """(floors, 4, 2, 3) weights over each floor's own (u_x, u_y, θ) giving its corners' displacements (x, y), m.
+
+    *centres* (floors, 2) and *corners* (floors, 4, 2) in m; small rotations
+    (:func:`pounding.model.plan.point_weights`).
+    """
+    return np.array([[[point_weights(tuple(c), tuple(p), d) for d in ("x", "y")] for p in floor]
+                     for c, floor in zip(centres, corners)]).reshape(len(centres), 4, 2, DOF_PER_FLOOR)
+
+
+def hermite_at(time: np.ndarray, y: np.ndarray, rate: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Samples *y* (nt, k) with their rates *rate* at times *time* (nt,), s, interpolated at *at* (m,) s.
+
+    Cubic Hermite between the two samples around each time (exact for cubics); times
+    outside the samples take the end values.  Returns (m, k).
+    """
+    at = np.clip(np.asarray(at, dtype=float), time[0], time[-1])
+    if time.size < 2:
+        return np.repeat(y[:1], at.size, axis=0)
+    k = np.clip(np.searchsorted(time, at, side="right") - 1, 0, time.size - 2)
+    h = (time[k + 1] - time[k])[:, None]
+    s = ((at - time[k]) / h[:, 0])[:, None]
+    s2, s3 = s * s, s * s * s
+    return ((2 * s3 - 3 * s2 + 1) * y[k] + (s3 - 2 * s2 + s) * h * rate[k]
+            + (3 * s2 - 2 * s3) * y[k + 1] + (s3 - s2) * h * rate[k + 1])
+
+
 def _floor_labels(model: PlanModel) -> dict[str, Any]:
     buildings = [b.name for b in model.buildings for _ in range(b.n_floors)]
     levels = [i + 1 for b in model.buildings for i in range(b.n_floors)]
+    centres = np.array([c for b in model.buildings for c in b.centres], dtype=float).reshape(-1, 2)
+    corners = floor_corners(model)
     return {"floor_building": (("floor",), np.array(buildings, dtype=object), {"long_name": "building of the floor"}),
             "floor_level": (("floor",), np.array(levels, dtype=np.int64),
-                            {"units": "1", "long_name": "floor number from the ground up"})}
+                            {"units": "1", "long_name": "floor number from the ground up"}),
+            "floor_centre_x": (("floor",), centres[:, 0], {"units": "m", "long_name": "x of the floor's centre of mass"}),
+            "floor_centre_y": (("floor",), centres[:, 1], {"units": "m", "long_name": "y of the floor's centre of mass"}),
+            "corner": (("corner",), np.array(CORNERS, dtype=object), {"long_name": "corner of the floor's outline"}),
+            "corner_x": (("floor", "corner"), corners[:, :, 0], {"units": "m", "long_name": "x of the corner at rest"}),
+            "corner_y": (("floor", "corner"), corners[:, :, 1], {"units": "m", "long_name": "y of the corner at rest"})}
 
 
 def _plane_labels(model: PlanModel) -> dict[str, Any]:
@@ -68,6 +121,20 @@ def _point_labels(model: PlanModel, psys: PlanSystem) -> dict[str, Any]:
                              {"long_name": "normal direction of the point's face"}),
             "point_x": (("point",), psys.point_location[:, 0], {"units": "m", "long_name": "x of the point at rest"}),
             "point_y": (("point",), psys.point_location[:, 1], {"units": "m", "long_name": "y of the point at rest"})}
+
+
+def _impact_slip(model: PlanModel, psys: PlanSystem, raw: RawSolution) -> np.ndarray:
+    """(impacts,) the face's tangential slip (low side minus high side along +tangent, m) at each impact's onset.
+
+    The state at the onset is the cubic Hermite interpolant of the stored samples
+    (displacements with their velocities; :func:`hermite_at`).
+    """
+    n = psys.system.n_floors
+    if raw.impact_contact.size == 0:
+        return np.zeros(0)
+    slip = np.array([model.scatter(c, p.slip) for c in model.contacts for p in c.points]).reshape(-1, n)
+    q = hermite_at(raw.time, raw.state[:, :n], raw.state[:, n:2 * n], raw.impact_time)
+    return np.einsum("ij,ij->i", q, slip[raw.impact_contact])
 
 
 def _energies(psys: PlanSystem, raw: RawSolution, delta: np.ndarray) -> dict[str, np.ndarray]:
@@ -110,6 +177,10 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
                         np.zeros((raw.time.size, system.n_contacts)))
     peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
     counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
+    centres = np.array([c for b in model.buildings for c in b.centres], dtype=float).reshape(nf, 2)
+    corner = np.einsum("tfk,fcdk->tfcd", u, corner_weights(centres, floor_corners(model)))
+    magnitude = np.hypot(corner[..., 0], corner[..., 1])
+    location = psys.point_location[raw.impact_contact] if raw.impact_contact.size else np.zeros((0, 2))
     data = {
         "displacement": _var(("time", "floor", "direction"), u[:, :, :2], "m",
                              "displacement of the floor's centre of mass relative to the ground"),
@@ -120,6 +191,14 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
         "peak_displacement": _var(("floor", "direction"), peak_u[:, :2], "m",
                                   "peak |displacement| of the centre of mass (full resolution)"),
         "peak_rotation": _var(("floor",), peak_u[:, 2], "rad", "peak |rotation| of the floor (full resolution)"),
+        "corner_displacement": _var(("time", "floor", "corner", "direction"), corner, "m",
+                                    "displacement of the outline's corner (small rotations)"),
+        "corner_displacement_magnitude": _var(("time", "floor", "corner"), magnitude, "m",
+                                              "magnitude of the corner's displacement"),
+        "peak_corner_displacement": _var(("floor", "corner", "direction"), np.abs(corner).max(axis=0, initial=0.0),
+                                         "m", "peak |displacement| of the corner (stored samples)"),
+        "peak_corner_displacement_magnitude": _var(("floor", "corner"), magnitude.max(axis=0, initial=0.0), "m",
+                                                   "peak magnitude of the corner's displacement (stored samples)"),
         "plane_drift": _var(("time", "plane"), delta[:, npt:npt + npl], "m", "drift of the plane's line"),
         "peak_plane_drift": _var(("plane",), raw.peak_contact_force[npt:npt + npl] / psys.plane_stiffness, "m",
                                  "peak |drift| of the plane (full resolution)"),
@@ -132,6 +211,10 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
         "impact_count": _var(("point",), counts, "1", "number of impacts at the point"),
         "impact_point": _var(("impact",), raw.impact_contact, "1", "contact point of the impact"),
         "impact_time": _var(("impact",), raw.impact_time, "s", "time of contact onset"),
+        "impact_x": _var(("impact",), location[:, 0], "m", "x of the impact's contact point at rest"),
+        "impact_y": _var(("impact",), location[:, 1], "m", "y of the impact's contact point at rest"),
+        "impact_slip": _var(("impact",), _impact_slip(model, psys, raw), "m",
+                            "tangential slip of the face at the onset (low side minus high side, along +tangent)"),
         "impact_velocity": _var(("impact",), raw.impact_velocity, "m/s", "approach velocity at the point at onset"),
         "impact_peak_force": _var(("impact",), raw.impact_peak_force, "N", "peak force of the impact"),
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
@@ -151,6 +234,14 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
     return ds
 
 
+def peak_corner(ds: xr.Dataset, building: str) -> tuple[int, int, float]:
+    """Building *building*'s largest peak corner displacement magnitude: (floor level, corner index, m)."""
+    floors = np.flatnonzero(ds.floor_building.values == building)
+    peaks = ds.peak_corner_displacement_magnitude.values[floors]
+    row, corner = np.unravel_index(int(np.argmax(peaks)), peaks.shape)
+    return int(ds.floor_level.values[floors[row]]), int(corner), float(peaks[row, corner])
+
+
 def plan_summary(ds: xr.Dataset) -> str:
     """A few lines: peak displacement and roof rotation per building, impacts, energy closure."""
     lines = [f"{ds.attrs.get('model', '')}: plan run to {float(ds.time[-1]):.3f} s"]
@@ -160,6 +251,29 @@ def plan_summary(ds: xr.Dataset) -> str:
         roof = ds.peak_rotation.values[floors][-1]
         lines.append(f"  {name}: peak displacement x {1e3 * peak[:, 0].max():.2f} mm, "
                      f"y {1e3 * peak[:, 1].max():.2f} mm; peak roof rotation {roof:.3e} rad")
+        if "peak_corner_displacement_magnitude" in ds:
+            floor, corner, value = peak_corner(ds, name)
+            lines.append(f"    peak corner displacement {1e3 * value:.2f} mm at floor {floor}, "
+                         f"{ds.corner.values[corner]} corner")
     lines.append(f"  impacts {int(ds.impact_count.sum())} at {int((ds.impact_count > 0).sum())} of "
                  f"{ds.sizes.get('point', 0)} points; energy closure {ds.attrs['energy_closure']:.1e}")
     return "\n".join(lines)
+
+
+def compare_plan_runs(before: xr.Dataset, after: xr.Dataset, name: str = "archive") -> str:
+    """One line comparing a rerun *after* with its archive *before*: every variable identical, or those that
+    differ with their largest difference relative to the variable's largest magnitude."""
+    differ = []
+    for var in before.data_vars:
+        old = before[var].values
+        new = after[var].values if var in after.data_vars else None
+        if new is None or old.shape != new.shape:
+            differ.append(f"{var} (shape)")
+        elif not np.array_equal(old, new, equal_nan=old.dtype.kind == "f"):
+            scale = float(np.nanmax(np.abs(old))) if old.size else 0.0
+            gap = float(np.nanmax(np.abs(old - new)))
+            differ.append(f"{var} ({gap / scale if scale else gap:.1e})")
+    if not differ:
+        return f"rerun reproduces {name}: all {len(before.data_vars)} variables identical"
+    return f"rerun differs from {name} in {len(differ)} variable(s): {', '.join(differ[:8])}" + \
+        (" ..." if len(differ) > 8 else "")

@@ -20,7 +20,7 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["header", "long_table", "run_tables", "sweep_tables", "scenario_dims", "write_csv", "csv_paths",
+__all__ = ["header", "long_table", "run_tables", "plan_tables", "plan_history_table", "sweep_tables", "scenario_dims", "write_csv", "csv_paths",
            "format_tables"]
 
 
@@ -87,6 +87,39 @@ def run_tables(ds) -> dict:
         tables["links"] = long_table(ds, ["peak_link_force", "link_dissipated_energy"],
                                      extra=_present(ds, ["link_law"]))
     return tables
+
+
+def plan_tables(ds) -> dict:
+    """Peak tables of a plan-run archive (:mod:`pounding.results.plan_dataset`): ``floors`` (peak
+    displacement of the centre of mass per floor and direction), ``rotations`` (peak rotation per floor),
+    ``corners`` (peak corner displacement per floor, corner and direction, with its magnitude), ``planes``
+    (peak drift per plane) and ``points`` (impacts and peak normal force per contact point)."""
+    floor = ["floor_building", "floor_level"]
+    tables = {"floors": long_table(ds, ["peak_displacement"], extra=floor),
+              "rotations": long_table(ds, ["peak_rotation"], extra=floor),
+              "corners": long_table(ds, ["peak_corner_displacement"],
+                                    extra=floor + ["corner_x", "corner_y", "peak_corner_displacement_magnitude"]),
+              "planes": long_table(ds, ["peak_plane_drift"], extra=["plane_building", "plane_storey",
+                                                                    "plane_direction", "plane_at", "plane_stiffness"])}
+    if ds.sizes.get("point", 0):
+        tables["points"] = long_table(ds, ["impact_count", "peak_contact_force"],
+                                      extra=["point_between", "point_normal", "point_x", "point_y"])
+    return tables
+
+
+def plan_history_table(ds):
+    """A plan run's floor histories as one wide table: ``time [s]``, then per floor ``B:L x [m]``,
+    ``B:L y [m]`` and ``B:L theta [rad]`` (building B, floor L; the centre of mass's displacement and
+    the floor's rotation)."""
+    import pandas as pd
+
+    columns: dict[str, np.ndarray] = {header(ds, "time"): ds.time.values}
+    u, theta = ds.displacement.values, ds.rotation.values
+    for f, (name, level) in enumerate(zip(ds.floor_building.values, ds.floor_level.values)):
+        columns[f"{name}:{level} x [{ds.displacement.attrs['units']}]"] = u[:, f, 0]
+        columns[f"{name}:{level} y [{ds.displacement.attrs['units']}]"] = u[:, f, 1]
+        columns[f"{name}:{level} theta [{ds.rotation.attrs['units']}]"] = theta[:, f]
+    return pd.DataFrame(columns)
 
 
 def scenario_dims(ds) -> tuple[str, ...]:

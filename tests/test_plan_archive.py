@@ -1,0 +1,307 @@
+"""Plan-model archives (issue 26 §2): corner displacements, the impact table, the summary, the CLI on plan archives."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from pounding.model.plan_model import plan_model_from_text
+from pounding.results.plan_dataset import CORNERS, corner_weights, hermite_at, plan_summary
+from pounding.simulation import simulate_plan
+
+MODEL = """name: corner
+buildings:
+  - name: A
+    plan: {outline: [[0, 0], [20, 10]]}
+    storeys:
+      count: 2
+      mass: 3.0e5
+      height: 3.2
+      centre_of_mass: [8, 4]
+      planes: [{direction: x, at: 0, stiffness: 6.0e7}, {direction: x, at: 10, stiffness: 3.0e7},
+               {direction: y, at: 0, stiffness: 8.0e7}, {direction: y, at: 20, stiffness: 3.0e7}]
+    damping: {ratio: 0.05, modes: [1, 3]}
+  - name: B
+    plan: {outline: [[20.02, 4], [30, 14]]}
+    storeys: [{mass: 2.0e5, height: 3.2, planes: [{direction: x, at: 4, stiffness: 4.0e7},
+              {direction: x, at: 14, stiffness: 4.0e7}, {direction: y, at: 20.02, stiffness: 5.0e7},
+              {direction: y, at: 30, stiffness: 5.0e7}]}]
+    damping: {ratio: 0.05, modes: [1, 2]}
+contacts:
+  - {between: [A, B], levels: [[1, 1]], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
+  - {between: [A, wall], face: south, gap: 0.03, levels: [1, 2], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
+ground_motion: {record: fema-p695:farfield/1, angle: 30, duration: 6}
+solver: {output_dt: 0.005}
+"""
+
+
+@pytest.fixture(scope="module")
+def run():
+    return simulate_plan(plan_model_from_text(MODEL, name="corner"))
+
+
+def test_corner_of_a_pure_translation_is_the_centre_of_mass_displacement():
+    centres = np.array([[8.0, 4.0]])
+    corners = np.array([[[0.0, 0.0], [20.0, 0.0], [20.0, 10.0], [0.0, 10.0]]])
+    w = corner_weights(centres, corners)
+    q = np.array([0.012, -0.007, 0.0])
+    assert np.allclose(w[0] @ q, np.tile([0.012, -0.007], (4, 1)), rtol=0, atol=1e-15)
+
+
+def test_corner_of_a_pure_rotation_is_theta_times_the_lever_arm():
+    """θ ẑ × r: (−θ r_y, θ r_x), magnitude θ |r|."""
+    centres = np.array([[8.0, 4.0]])
+    corners = np.array([[[0.0, 0.0], [20.0, 0.0], [20.0, 10.0], [0.0, 10.0]]])
+    theta = 2.0e-3
+    got = corner_weights(centres, corners)[0] @ np.array([0.0, 0.0, theta])
+    r = corners[0] - centres[0]
+    assert np.allclose(got[:, 0], -theta * r[:, 1], rtol=1e-14) and np.allclose(got[:, 1], theta * r[:, 0], rtol=1e-14)
+    assert np.allclose(np.hypot(got[:, 0], got[:, 1]), theta * np.hypot(r[:, 0], r[:, 1]), rtol=1e-14)
+    assert list(CORNERS) == ["south-west", "south-east", "north-east", "north-west"]
+
+
+def test_hermite_at_is_exact_for_a_cubic():
+    t = np.linspace(0.0, 1.0, 6)
+    y, dy = (t ** 3 - 2 * t)[:, None], (3 * t ** 2 - 2)[:, None]
+    at = np.array([0.0, 0.13, 0.5, 0.999, 1.0])
+    assert np.allclose(hermite_at(t, y, dy, at)[:, 0], at ** 3 - 2 * at, rtol=0, atol=1e-14)
+
+
+def test_archive_corners_follow_the_floor_kinematics(run):
+    ds = run
+    u, theta = ds.displacement.values, ds.rotation.values
+    rx = ds.corner_x.values - ds.floor_centre_x.values[:, None]
+    ry = ds.corner_y.values - ds.floor_centre_y.values[:, None]
+    expected_x = u[:, :, None, 0] - theta[:, :, None] * ry
+    expected_y = u[:, :, None, 1] + theta[:, :, None] * rx
+    corner = ds.corner_displacement.values
+    assert np.allclose(corner[..., 0], expected_x, rtol=1e-12, atol=1e-15)
+    assert np.allclose(corner[..., 1], expected_y, rtol=1e-12, atol=1e-15)
+    assert np.array_equal(ds.corner_displacement_magnitude.values, np.hypot(corner[..., 0], corner[..., 1]))
+    assert np.array_equal(ds.peak_corner_displacement.values, np.abs(corner).max(axis=0))
+    assert np.array_equal(ds.peak_corner_displacement_magnitude.values,
+                          ds.corner_displacement_magnitude.values.max(axis=0))
+    assert ds.corner_displacement.dims == ("time", "floor", "corner", "direction")
+    for name, var in ds.data_vars.items():
+        assert var.attrs.get("units") and var.attrs.get("long_name"), name
+    # B's outline, not A's, for B's floor
+    b = int(np.flatnonzero(ds.floor_building.values == "B")[0])
+    assert list(ds.corner_x.values[b]) == [20.02, 30.0, 30.0, 20.02]
+
+
+def test_impact_table_has_the_point_location_and_the_slip(run):
+    ds = run
+    assert ds.sizes["impact"] > 0 and ds.contact_force.dims == ("time", "point")
+    points = ds.impact_point.values
+    assert np.array_equal(ds.impact_x.values, ds.point_x.values[points])
+    assert np.array_equal(ds.impact_y.values, ds.point_y.values[points])
+    # a wall on A's south face: the slip is A's x-motion along its south edge (y = 0) at the onset
+    floors = {("A", 1): 0, ("A", 2): 1}
+    checked = 0
+    for k in np.flatnonzero(np.char.find(ds.point_between.values[points].astype(str), "wall") >= 0):
+        level = int(str(ds.point_between.values[points[k]]).split(":")[1].split("-")[0])
+        f = floors[("A", level)]
+        t = float(ds.impact_time[k])
+        ux = np.interp(t, ds.time.values, ds.displacement.values[:, f, 0])
+        th = np.interp(t, ds.time.values, ds.rotation.values[:, f])
+        along = ux - th * (0.0 - float(ds.floor_centre_y[f]))
+        # the south wall is the low side: slip = wall (0) − building's x-motion along its face (the archive takes
+        # the onset's state from the Hermite cubic of the samples, this check the straight line: 1 % apart)
+        assert abs(float(ds.impact_slip[k]) - (-along)) < 1e-2 * abs(along) + 1e-6
+        checked += 1
+    assert checked > 0
+
+
+def test_summary_names_the_peak_roof_rotation_and_the_peak_corner(run):
+    text = plan_summary(run)
+    ds = run
+    a = ds.floor_building.values == "A"
+    peaks = ds.peak_corner_displacement_magnitude.values[a]
+    row, corner = np.unravel_index(np.argmax(peaks), peaks.shape)
+    assert f"peak roof rotation {ds.peak_rotation.values[a][-1]:.3e} rad" in text
+    assert f"peak corner displacement {1e3 * peaks[row, corner]:.2f} mm at floor {row + 1}, {CORNERS[corner]} corner" \
+        in text
+
+
+# --------------------------------------------------------------------------- pounding run options
+
+
+@pytest.fixture(scope="module")
+def model_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("plan") / "corner.yaml"
+    path.write_text(MODEL)
+    return path
+
+
+def _run_cli(capsys, *argv) -> tuple[int, str, str]:
+    from pounding.cli import main
+
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_scale_is_a_factor_on_both_components(model_file, tmp_path, capsys, run):
+    """Linear response without contact: half the record, half the response (contacts held open)."""
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "open.nc", "--no-contacts")
+    assert code == 0
+    code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "half.nc", "--no-contacts", "--scale", "0.5")
+    assert code == 0 and "impacts 0 at 0 of 6 points" in out
+    with xr.open_dataset(tmp_path / "open.nc") as full, xr.open_dataset(tmp_path / "half.nc") as half:
+        scale = float(np.abs(full.displacement).max())
+        assert np.allclose(half.displacement.values, 0.5 * full.displacement.values, rtol=0, atol=1e-6 * scale)
+        assert np.allclose(half.ground_acceleration.values, 0.5 * full.ground_acceleration.values, rtol=1e-12)
+        assert int(full.impact_count.sum()) == 0 and np.all(full.contact_force.values == 0.0)
+        # the model's own run pounds: holding the contacts open changes the answer
+        assert int(run.impact_count.sum()) > 0
+        assert not np.allclose(full.peak_displacement.values, run.peak_displacement.values, rtol=1e-3)
+
+
+def test_record_takes_a_catalogue_pair(model_file, tmp_path, capsys):
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "p3.nc", "--record", "fema-p695:farfield/3",
+                          "--duration", "2")
+    assert code == 0
+    with xr.open_dataset(tmp_path / "p3.nc") as ds:
+        spec = __import__("json").loads(ds.attrs["plan_spec"])
+        assert [c["record"] for c in spec["records"]] == ["fema-p695:farfield/3a", "fema-p695:farfield/3b"]
+
+
+def test_xi_is_applied_to_every_hertz_damp_point(model_file):
+    from pounding.simulation import plan_with_options
+    from pounding.model.plan_model import load_plan_model
+
+    model = plan_with_options(load_plan_model(model_file), xi="ye")
+    assert {c.law.xi for c in model.contacts} == {"ye"}
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--scale", "0.4g"], "--scale 0.4g: a plan model takes a positive factor"),
+    (["--scale", "-1"], "--scale -1: a plan model takes a positive factor"),
+    (["--record", "fema-p695:farfield/3a"], "--record fema-p695:farfield/3a: a plan model needs a catalogue pair"),
+    (["--units", "g"], "--units describes a record file"),
+    (["--dt", "0.01"], "--dt describes a record file"),
+])
+def test_options_that_do_not_apply_are_one_line_errors(model_file, tmp_path, capsys, argv, words):
+    code, out, err = _run_cli(capsys, "run", model_file, "-o", tmp_path / "x.nc", *argv)
+    assert code == 2 and words in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_csv_holds_the_floor_histories_of_the_archive(model_file, tmp_path, capsys):
+    import pandas as pd
+
+    out = tmp_path / "r.nc"
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", out, "--csv", tmp_path / "h.csv", "--duration", "2")
+    assert code == 0
+    table = pd.read_csv(tmp_path / "h.csv")
+    with xr.open_dataset(out) as ds:
+        assert list(table.columns) == ["time [s]"] + [f"{b}:{lv} {c}" for b, lv in
+                                                       zip(ds.floor_building.values, ds.floor_level.values)
+                                                       for c in ("x [m]", "y [m]", "theta [rad]")]
+        assert np.array_equal(table["time [s]"].values, ds.time.values)
+        assert np.array_equal(table["A:2 y [m]"].values, ds.displacement.values[:, 1, 1])
+        assert np.array_equal(table["B:1 theta [rad]"].values, ds.rotation.values[:, 2])
+        planes = pd.read_csv(tmp_path / "h.planes.csv")
+        assert np.array_equal(planes["peak_plane_drift [m]"].values, ds.peak_plane_drift.values)
+
+
+# --------------------------------------------------------------------------- plots, info, table, rerun
+
+
+@pytest.fixture(scope="module")
+def archive(model_file, tmp_path_factory):
+    from pounding.cli import main
+
+    out = tmp_path_factory.mktemp("archive") / "corner.nc"
+    assert main(["run", str(model_file), "-o", str(out)]) == 0
+    return out
+
+
+def _check_png(path) -> None:
+    import matplotlib.image as mpimg
+
+    image = mpimg.imread(path)
+    assert image.ndim == 3 and image.shape[0] > 200 and image.shape[1] > 200
+    assert float(image[..., :3].std()) > 0.01   # not a blank canvas
+
+
+def test_run_plot_draws_the_plan_view_and_the_roof_rotation(model_file, tmp_path, capsys):
+    code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "r.nc", "--duration", "3",
+                            "--plot", tmp_path / "figs")
+    assert code == 0
+    for name in ("plan_view.png", "roof_rotation.png"):
+        assert f"wrote {tmp_path / 'figs' / name}" in out
+        _check_png(tmp_path / "figs" / name)
+
+
+def test_plan_view_is_at_the_largest_impact(run):
+    from pounding.results.plan_plots import plan_view_instant, shown_floors
+
+    sample, point = plan_view_instant(run)
+    force = run.contact_force.values
+    assert force[sample, point] == force.max() > 0.0
+    shown = shown_floors(run, point)
+    a, b = (int(np.flatnonzero(run.floor_building.values == n)[-1]) for n in ("A", "B"))
+    between = str(run.point_between.values[point])
+    level = int(between.split(":")[1].split("-")[0])
+    assert shown["A"] == int(np.flatnonzero((run.floor_building.values == "A") & (run.floor_level.values == level))[0])
+    assert shown["B"] == b and a >= shown["A"]
+
+
+def test_plot_redraws_a_plan_archive(archive, tmp_path, capsys):
+    code, out, _ = _run_cli(capsys, "plot", archive, "-o", tmp_path / "again")
+    assert code == 0 and "plan_view.png" in out
+    _check_png(tmp_path / "again" / "plan_view.png")
+    _check_png(tmp_path / "again" / "roof_rotation.png")
+
+
+def test_info_describes_a_plan_archive_with_its_peaks(archive, capsys):
+    code, out, _ = _run_cli(capsys, "info", archive)
+    assert code == 0 and "[plan archive]" in out
+    with xr.open_dataset(archive) as ds:
+        roof = float(ds.peak_rotation.values[ds.floor_building.values == "A"][-1])
+        assert f"peak roof rotation {roof:.3e} rad" in out
+        assert f"{float(ds.peak_contact_force[0]) / 1e3:.4g} kN" in out
+        assert f"impacts {int(ds.impact_count.sum())} at" in out
+    assert "A: 2 floors, [[0, 0], [20, 10]], 4 along x and 4 along y" in out
+    assert "B: 1 floor, [[20.02, 4], [30, 14]], 2 along x and 2 along y" in out
+
+
+def test_table_prints_and_writes_the_peaks(archive, tmp_path, capsys):
+    import pandas as pd
+
+    code, out, _ = _run_cli(capsys, "table", archive)
+    assert code == 0
+    for name in ("floors:", "rotations:", "corners:", "planes:", "points:"):
+        assert name in out
+    code, _, _ = _run_cli(capsys, "table", archive, "--csv", tmp_path / "t.csv")
+    assert code == 0
+    floors = pd.read_csv(tmp_path / "t.csv")
+    corners = pd.read_csv(tmp_path / "t.corners.csv")
+    points = pd.read_csv(tmp_path / "t.points.csv")
+    with xr.open_dataset(archive) as ds:
+        assert np.array_equal(floors["peak_displacement [m]"].values, ds.peak_displacement.values.ravel())
+        assert list(floors["direction"].values[:2]) == ["x", "y"]
+        assert np.array_equal(corners["peak_corner_displacement [m]"].values, ds.peak_corner_displacement.values.ravel())
+        assert np.array_equal(points["impact_count [-]"].values, ds.impact_count.values)
+        assert np.array_equal(points["peak_contact_force [N]"].values, ds.peak_contact_force.values)
+
+
+def test_rerun_reproduces_a_plan_archive(archive, tmp_path, capsys):
+    code, out, _ = _run_cli(capsys, "rerun", archive, "-o", tmp_path / "again.nc")
+    assert code == 0 and f"rerun reproduces {archive}: all" in out and "variables identical" in out
+    with xr.open_dataset(archive) as before, xr.open_dataset(tmp_path / "again.nc") as after:
+        for name in before.data_vars:
+            assert np.array_equal(before[name].values, after[name].values), name
+        assert "rerun of" in after.attrs["history"]
+
+
+def test_rerun_keeps_the_options(model_file, tmp_path, capsys):
+    first = tmp_path / "half.nc"
+    assert _run_cli(capsys, "run", model_file, "-o", first, "--scale", "0.5", "--no-contacts", "--xi", "ye",
+                    "--duration", "2")[0] == 0
+    code, out, _ = _run_cli(capsys, "rerun", first, "-o", tmp_path / "half2.nc")
+    assert code == 0 and "variables identical" in out
+    code, out, _ = _run_cli(capsys, "info", first)
+    assert "--scale 0.5" in out and "--no-contacts" in out and "--xi ye" in out
