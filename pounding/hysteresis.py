@@ -33,7 +33,7 @@ plus one branch in each kernel of :mod:`pounding.solver.storeys`.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -109,10 +109,13 @@ class StoreyHysteresis(BaseModel):
         out[1] = self.post_yield_ratio
         return out
 
+    def described_fields(self) -> dict[str, Any]:
+        """The keys and values :meth:`describe` shows: those given, without ``model``."""
+        return {k: v for k, v in self.model_dump(exclude_none=True).items() if k != "model"}
+
     def describe(self) -> str:
-        """One-line description for summaries."""
-        fields = ", ".join(f"{k}={v}" for k, v in self.model_dump(exclude_none=True).items() if k != "model")
-        return f"{self.name}({fields})"
+        """One-line description for summaries and archives."""
+        return f"{self.name}({', '.join(f'{k}={v}' for k, v in self.described_fields().items())})"
 
 
 HYSTERESES: dict[str, type[StoreyHysteresis]] = {}
@@ -306,6 +309,16 @@ class ImkStorey(StoreyHysteresis):
     deterioration_rate: NonNegative = Field(1.0, description="D+: rate of cyclic deterioration in the positive "
                                             "direction (OpenSees D_pos)")
     negative: ImkDirection | None = Field(None, description="backbone keys that differ in the negative direction")
+
+    def described_fields(self) -> dict[str, Any]:
+        """As the base class, with every deterioration exponent the model runs with (``c_a``, left out, is 1.0
+        where ``lambda_a`` applies)."""
+        fields = super().described_fields()
+        if self.accelerated_reloading and self.deterioration.c_a is None:
+            given = fields["deterioration"]
+            fields["deterioration"] = {key: value for key, value in given.items() if key != "c_k"}
+            fields["deterioration"].update(c_a=1.0, c_k=given["c_k"])
+        return fields
 
     @model_validator(mode="before")
     @classmethod
