@@ -91,7 +91,8 @@ from pounding import __version__
 from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
-__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "contact_material",
+__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "run_script", "allow_tension",
+           "tension_allowed", "inert", "contact_material",
            "link_materials", "storey_material", "imk_material", "IMK_MATERIALS", "LAMBDA_OFF", "BILINEAR_NOTE", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
@@ -105,19 +106,23 @@ def allow_tension(model):
     term produces just before separation; a model compared with it must not
     either.
     """
+    laws: dict[int, object] = {}
+    gaps = tuple(dataclasses.replace(g, law=tension_allowed(g.law, laws)) for g in model.gaps)
+    return dataclasses.replace(model, gaps=gaps)
+
+
+def tension_allowed(law, cache: dict[int, object]):
+    """*law* with ``tension: allow`` if it is a hertz-damp or kelvin law that clamps, else *law* itself.
+
+    *cache* (id of a law -> its switched copy) keeps contacts that shared one law sharing one copy.
+    """
     from pounding.contact.laws import HertzDamp, Kelvin
 
-    laws: dict[int, object] = {}
-
-    def switched(law):
-        if not isinstance(law, (HertzDamp, Kelvin)) or law.tension == "allow":
-            return law
-        if id(law) not in laws:
-            laws[id(law)] = type(law)(**{**law.model_dump(), "tension": "allow"})
-        return laws[id(law)]
-
-    gaps = tuple(dataclasses.replace(g, law=switched(g.law)) for g in model.gaps)
-    return dataclasses.replace(model, gaps=gaps)
+    if not isinstance(law, (HertzDamp, Kelvin)) or law.tension == "allow":
+        return law
+    if id(law) not in cache:
+        cache[id(law)] = type(law)(**{**law.model_dump(), "tension": "allow"})
+    return cache[id(law)]
 
 
 def _prepare(model, record=None, xi=None, duration=None):
@@ -407,18 +412,18 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         notes.append(f"solver.stop_drift_ratio {model.solver.stop_drift_ratio:g}: the OpenSees script does not "
                      "stop at a collapse, it runs to the end (compare completed runs only)")
 
-    summary = "\n".join("#   " + _inert(line) for line in model.summary_lines())
-    note_text = "\n".join("# NOTE: " + _inert(n) for n in notes)
+    summary = "\n".join("#   " + inert(line) for line in model.summary_lines())
+    note_text = "\n".join("# NOTE: " + inert(n) for n in notes)
     return _TEMPLATE.format(
-        version=__version__, name=_inert(model.name), name_literal=repr(str(model.name)), summary=summary,
-        notes=note_text, record_name=_inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
+        version=__version__, name=inert(model.name), name_literal=repr(str(model.name)), summary=summary,
+        notes=note_text, record_name=inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
         duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
         floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
         dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta), links=rows(links),
     ), notes
 
 
-def _inert(text: object) -> str:
+def inert(text: object) -> str:
     """*text* made safe inside a docstring or a comment of the generated script.
 
     Names come from the user's YAML; written raw, a name holding a triple
@@ -699,6 +704,15 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
         If OpenSeesPy is not installed, the model cannot be exported or the
         script fails.
     """
+    source, _notes = opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)
+    return run_script(source, model.name)
+
+
+def run_script(source: str, name: str) -> dict:
+    """Run an exported OpenSeesPy script (*source*) in a child Python process; return the peaks it writes.
+
+    *name* (the model's) labels a failure.
+    """
     import importlib.util
     import json
     import subprocess
@@ -706,7 +720,6 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
 
     if importlib.util.find_spec("openseespy") is None:  # pragma: no cover - depends on the environment
         raise PoundingError("OpenSeesPy is not available; pip install openseespy")
-    source, _notes = opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)
     with tempfile.TemporaryDirectory(prefix="pounding-opensees-") as folder:
         script = Path(folder) / "model_opensees.py"  # not the model's name: it may hold '/' or '..'
         peaks_file = Path(folder) / "peaks.json"
@@ -715,5 +728,5 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
                               text=True, cwd=folder)
         if not peaks_file.exists():
             last = (done.stderr.strip().splitlines() or ["no output"])[-1]
-            raise PoundingError(f"the OpenSees script for {model.name} failed (exit {done.returncode}): {last}")
+            raise PoundingError(f"the OpenSees script for {name} failed (exit {done.returncode}): {last}")
         return json.loads(peaks_file.read_text(encoding="utf-8"))
