@@ -92,7 +92,7 @@ from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
 __all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "run_script", "allow_tension",
-           "tension_allowed", "inert", "contact_material",
+           "tension_allowed", "inert", "SCRIPT_PARTS", "contact_material",
            "link_materials", "storey_material", "imk_material", "IMK_MATERIALS", "LAMBDA_OFF", "BILINEAR_NOTE", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
@@ -419,7 +419,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         notes=note_text, record_name=inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
         duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
         floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
-        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta), links=rows(links),
+        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta), links=rows(links), **SCRIPT_PARTS,
     ), notes
 
 
@@ -447,6 +447,67 @@ def inert(text: object) -> str:
     return "".join(out)
 
 
+#: Parts of the generated scripts shared by the planar and the plan export (inserted by ``str.format``).
+SCRIPT_READ_ROWS = '''def _read_rows(path, width):
+    """Rows of an OpenSees ``-binary`` recorder: *width* native doubles, then a newline byte."""
+    with open(path, "rb") as handle:
+        raw = handle.read()
+    size = 8 * width + 1
+    for start in range(0, len(raw) - size + 1, size):
+        row = array("d")
+        row.frombytes(raw[start:start + 8 * width])
+        yield row'''
+
+SCRIPT_IMPORTS = '''import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from array import array
+
+import openseespy.opensees as ops
+'''
+
+SCRIPT_STEPPING = '''        n_steps = int(round(duration / dt))
+        started = time.perf_counter()
+        status = ops.analyze(n_steps, dt)
+        cut_steps = 0
+        while status != 0 and ops.getTime() < n_steps * dt - 0.5 * dt:
+            # Newton failed: retake that step in 10 sub-steps with line search, then go on.
+            cut_steps += 1
+            ops.algorithm("NewtonLineSearch")
+            status = ops.analyze(10, dt / 10.0)
+            ops.algorithm("Newton")
+            if status != 0:
+                break
+            status = ops.analyze(int(round((n_steps * dt - ops.getTime()) / dt)), dt)
+        wall = time.perf_counter() - started'''
+
+SCRIPT_MAIN = '''def main(argv=None):
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dt", type=float, default=DT, help="time step, s (default %(default)g)")
+    parser.add_argument("--duration", type=float, default=DURATION, help="simulated time, s")
+    parser.add_argument("-o", "--output", help="also write the peaks to this JSON file")
+    args = parser.parse_args(argv)
+    peaks = analyse(args.dt, args.duration)
+    text = json.dumps(peaks, indent=1)
+    print(text)
+    if args.output:
+        with open(args.output, "w") as handle:
+            handle.write(text + "\\n")
+    return 0 if peaks["converged"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())'''
+
+#: The shared parts by their template field names.
+SCRIPT_PARTS = {"imports": SCRIPT_IMPORTS, "read_rows": SCRIPT_READ_ROWS, "stepping": SCRIPT_STEPPING, "main": SCRIPT_MAIN}
+
+
 _TEMPLATE = '''#!/usr/bin/env python3
 """OpenSeesPy model '{name}' exported by pounding {version}.
 
@@ -459,16 +520,7 @@ Record: {record_name} x {record_scale}, {n_samples} samples at {record_dt} s (m/
 simulated for {duration} s.
 """
 {notes}
-import json
-import os
-import shutil
-import sys
-import tempfile
-import time
-from array import array
-
-import openseespy.opensees as ops
-
+{imports}
 MODEL_NAME = {name_literal}
 UNBALANCE_TOLERANCE = {unbalance}  # N
 DT = {dt}
@@ -549,15 +601,7 @@ def build(log_file=None):
     ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
 
 
-def _read_rows(path, width):
-    """Rows of an OpenSees ``-binary`` recorder: *width* native doubles, then a newline byte."""
-    with open(path, "rb") as handle:
-        raw = handle.read()
-    size = 8 * width + 1
-    for start in range(0, len(raw) - size + 1, size):
-        row = array("d")
-        row.frombytes(raw[start:start + 8 * width])
-        yield row
+{read_rows}
 
 
 def analyse(dt=DT, duration=DURATION, workdir=None):
@@ -595,20 +639,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
         ops.integrator("Newmark", 0.5, 0.25)
         ops.analysis("Transient")
 
-        n_steps = int(round(duration / dt))
-        started = time.perf_counter()
-        status = ops.analyze(n_steps, dt)
-        cut_steps = 0
-        while status != 0 and ops.getTime() < n_steps * dt - 0.5 * dt:
-            # Newton failed: retake that step in 10 sub-steps with line search, then go on.
-            cut_steps += 1
-            ops.algorithm("NewtonLineSearch")
-            status = ops.analyze(10, dt / 10.0)
-            ops.algorithm("Newton")
-            if status != 0:
-                break
-            status = ops.analyze(int(round((n_steps * dt - ops.getTime()) / dt)), dt)
-        wall = time.perf_counter() - started
+{stepping}
         end = ops.getTime()
         ops.wipe()  # flushes and closes the recorders
 
@@ -661,25 +692,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             shutil.rmtree(workdir, ignore_errors=True)
 
 
-def main(argv=None):
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dt", type=float, default=DT, help="time step, s (default %(default)g)")
-    parser.add_argument("--duration", type=float, default=DURATION, help="simulated time, s")
-    parser.add_argument("-o", "--output", help="also write the peaks to this JSON file")
-    args = parser.parse_args(argv)
-    peaks = analyse(args.dt, args.duration)
-    text = json.dumps(peaks, indent=1)
-    print(text)
-    if args.output:
-        with open(args.output, "w") as handle:
-            handle.write(text + "\\n")
-    return 0 if peaks["converged"] else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+{main}
 '''
 
 

@@ -57,7 +57,7 @@ import numpy as np
 
 from pounding import __version__
 from pounding.errors import PoundingError
-from pounding.export.opensees import DEFAULT_DT, contact_material, inert, run_script, tension_allowed
+from pounding.export.opensees import DEFAULT_DT, contact_material, inert, run_script, SCRIPT_PARTS, tension_allowed
 from pounding.model.model import WALL
 from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
 from pounding.model.plan_model import PlanModel
@@ -255,7 +255,7 @@ def plan_opensees_script(model: PlanModel, *, dt: float = DEFAULT_DT, xi: str | 
         record_x=_samples(rows[0, :n_samples]), record_y=_samples(rows[1, :n_samples]),
         masters=_rows(nodes.masters), slaves=_rows(nodes.slave_rows), fixed=_rows((tag, x, y) for (x, y), tag in sorted(nodes.fixed.items(), key=lambda kv: kv[1])),
         planes=_rows(planes), p_delta=_rows(p_delta), rayleigh=_rows(rayleigh), contacts=_rows(contacts),
-        corners=_rows(corners))
+        corners=_rows(corners), **SCRIPT_PARTS)
     return text, notes
 
 
@@ -293,16 +293,7 @@ Ground: two components a_gx, a_gy (angle {angle} deg applied), {n_samples} sampl
 simulated for {duration} s.
 """
 {notes}
-import json
-import os
-import shutil
-import sys
-import tempfile
-import time
-from array import array
-
-import openseespy.opensees as ops
-
+{imports}
 MODEL_NAME = {name_literal}
 UNBALANCE_TOLERANCE = {unbalance}  # N
 DT = {dt}
@@ -390,15 +381,7 @@ def build(log_file=None):
     ops.pattern("UniformExcitation", 2, 2, "-accel", 2)
 
 
-def _read_rows(path, width):
-    """Rows of an OpenSees ``-binary`` recorder: *width* native doubles, then a newline byte."""
-    with open(path, "rb") as handle:
-        raw = handle.read()
-    size = 8 * width + 1
-    for start in range(0, len(raw) - size + 1, size):
-        row = array("d")
-        row.frombytes(raw[start:start + 8 * width])
-        yield row
+{read_rows}
 
 
 def _envelope(path):
@@ -433,20 +416,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
         ops.integrator("Newmark", 0.5, 0.25)
         ops.analysis("Transient")
 
-        n_steps = int(round(duration / dt))
-        started = time.perf_counter()
-        status = ops.analyze(n_steps, dt)
-        cut_steps = 0
-        while status != 0 and ops.getTime() < n_steps * dt - 0.5 * dt:
-            # Newton failed: retake that step in 10 sub-steps with line search, then go on.
-            cut_steps += 1
-            ops.algorithm("NewtonLineSearch")
-            status = ops.analyze(10, dt / 10.0)
-            ops.algorithm("Newton")
-            if status != 0:
-                break
-            status = ops.analyze(int(round((n_steps * dt - ops.getTime()) / dt)), dt)
-        wall = time.perf_counter() - started
+{stepping}
         end = ops.getTime()
         ops.wipe()  # flushes and closes the recorders
 
@@ -489,23 +459,5 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             shutil.rmtree(workdir, ignore_errors=True)
 
 
-def main(argv=None):
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dt", type=float, default=DT, help="time step, s (default %(default)g)")
-    parser.add_argument("--duration", type=float, default=DURATION, help="simulated time, s")
-    parser.add_argument("-o", "--output", help="also write the peaks to this JSON file")
-    args = parser.parse_args(argv)
-    peaks = analyse(args.dt, args.duration)
-    text = json.dumps(peaks, indent=1)
-    print(text)
-    if args.output:
-        with open(args.output, "w") as handle:
-            handle.write(text + "\\n")
-    return 0 if peaks["converged"] else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+{main}
 '''
