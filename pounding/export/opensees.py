@@ -91,7 +91,8 @@ from pounding import __version__
 from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
-__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "allow_tension", "contact_material",
+__all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "run_script", "allow_tension",
+           "tension_allowed", "inert", "SCRIPT_PARTS", "contact_material",
            "link_materials", "storey_material", "imk_material", "IMK_MATERIALS", "LAMBDA_OFF", "BILINEAR_NOTE", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
@@ -105,19 +106,23 @@ def allow_tension(model):
     term produces just before separation; a model compared with it must not
     either.
     """
+    laws: dict[int, object] = {}
+    gaps = tuple(dataclasses.replace(g, law=tension_allowed(g.law, laws)) for g in model.gaps)
+    return dataclasses.replace(model, gaps=gaps)
+
+
+def tension_allowed(law, cache: dict[int, object]):
+    """*law* with ``tension: allow`` if it is a hertz-damp or kelvin law that clamps, else *law* itself.
+
+    *cache* (id of a law -> its switched copy) keeps contacts that shared one law sharing one copy.
+    """
     from pounding.contact.laws import HertzDamp, Kelvin
 
-    laws: dict[int, object] = {}
-
-    def switched(law):
-        if not isinstance(law, (HertzDamp, Kelvin)) or law.tension == "allow":
-            return law
-        if id(law) not in laws:
-            laws[id(law)] = type(law)(**{**law.model_dump(), "tension": "allow"})
-        return laws[id(law)]
-
-    gaps = tuple(dataclasses.replace(g, law=switched(g.law)) for g in model.gaps)
-    return dataclasses.replace(model, gaps=gaps)
+    if not isinstance(law, (HertzDamp, Kelvin)) or law.tension == "allow":
+        return law
+    if id(law) not in cache:
+        cache[id(law)] = type(law)(**{**law.model_dump(), "tension": "allow"})
+    return cache[id(law)]
 
 
 def _prepare(model, record=None, xi=None, duration=None):
@@ -407,18 +412,18 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
         notes.append(f"solver.stop_drift_ratio {model.solver.stop_drift_ratio:g}: the OpenSees script does not "
                      "stop at a collapse, it runs to the end (compare completed runs only)")
 
-    summary = "\n".join("#   " + _inert(line) for line in model.summary_lines())
-    note_text = "\n".join("# NOTE: " + _inert(n) for n in notes)
+    summary = "\n".join("#   " + inert(line) for line in model.summary_lines())
+    note_text = "\n".join("# NOTE: " + inert(n) for n in notes)
     return _TEMPLATE.format(
-        version=__version__, name=_inert(model.name), name_literal=repr(str(model.name)), summary=summary,
-        notes=note_text, record_name=_inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
+        version=__version__, name=inert(model.name), name_literal=repr(str(model.name)), summary=summary,
+        notes=note_text, record_name=inert(motion.name), record_name_literal=repr(str(motion.name)), record_scale=_fmt(motion.scale), record_dt=_fmt(motion.time_step),
         duration=_fmt(end_time), dt=_fmt(dt), unbalance=_fmt(1e-12 * max(s[3] for s in storeys)), n_samples=samples.size, record=record_text,
         floors=rows(floors), grounds=repr(grounds), storeys=rows(storeys), buildings=rows(buildings),
-        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta), links=rows(links),
+        dashpots=rows(dashpots), contacts=rows(contacts), p_delta=rows(p_delta), links=rows(links), **SCRIPT_PARTS,
     ), notes
 
 
-def _inert(text: object) -> str:
+def inert(text: object) -> str:
     """*text* made safe inside a docstring or a comment of the generated script.
 
     Names come from the user's YAML; written raw, a name holding a triple
@@ -442,6 +447,67 @@ def _inert(text: object) -> str:
     return "".join(out)
 
 
+#: Parts of the generated scripts shared by the planar and the plan export (inserted by ``str.format``).
+SCRIPT_READ_ROWS = '''def _read_rows(path, width):
+    """Rows of an OpenSees ``-binary`` recorder: *width* native doubles, then a newline byte."""
+    with open(path, "rb") as handle:
+        raw = handle.read()
+    size = 8 * width + 1
+    for start in range(0, len(raw) - size + 1, size):
+        row = array("d")
+        row.frombytes(raw[start:start + 8 * width])
+        yield row'''
+
+SCRIPT_IMPORTS = '''import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from array import array
+
+import openseespy.opensees as ops
+'''
+
+SCRIPT_STEPPING = '''        n_steps = int(round(duration / dt))
+        started = time.perf_counter()
+        status = ops.analyze(n_steps, dt)
+        cut_steps = 0
+        while status != 0 and ops.getTime() < n_steps * dt - 0.5 * dt:
+            # Newton failed: retake that step in 10 sub-steps with line search, then go on.
+            cut_steps += 1
+            ops.algorithm("NewtonLineSearch")
+            status = ops.analyze(10, dt / 10.0)
+            ops.algorithm("Newton")
+            if status != 0:
+                break
+            status = ops.analyze(int(round((n_steps * dt - ops.getTime()) / dt)), dt)
+        wall = time.perf_counter() - started'''
+
+SCRIPT_MAIN = '''def main(argv=None):
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dt", type=float, default=DT, help="time step, s (default %(default)g)")
+    parser.add_argument("--duration", type=float, default=DURATION, help="simulated time, s")
+    parser.add_argument("-o", "--output", help="also write the peaks to this JSON file")
+    args = parser.parse_args(argv)
+    peaks = analyse(args.dt, args.duration)
+    text = json.dumps(peaks, indent=1)
+    print(text)
+    if args.output:
+        with open(args.output, "w") as handle:
+            handle.write(text + "\\n")
+    return 0 if peaks["converged"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())'''
+
+#: The shared parts by their template field names.
+SCRIPT_PARTS = {"imports": SCRIPT_IMPORTS, "read_rows": SCRIPT_READ_ROWS, "stepping": SCRIPT_STEPPING, "main": SCRIPT_MAIN}
+
+
 _TEMPLATE = '''#!/usr/bin/env python3
 """OpenSeesPy model '{name}' exported by pounding {version}.
 
@@ -454,16 +520,7 @@ Record: {record_name} x {record_scale}, {n_samples} samples at {record_dt} s (m/
 simulated for {duration} s.
 """
 {notes}
-import json
-import os
-import shutil
-import sys
-import tempfile
-import time
-from array import array
-
-import openseespy.opensees as ops
-
+{imports}
 MODEL_NAME = {name_literal}
 UNBALANCE_TOLERANCE = {unbalance}  # N
 DT = {dt}
@@ -544,15 +601,7 @@ def build(log_file=None):
     ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
 
 
-def _read_rows(path, width):
-    """Rows of an OpenSees ``-binary`` recorder: *width* native doubles, then a newline byte."""
-    with open(path, "rb") as handle:
-        raw = handle.read()
-    size = 8 * width + 1
-    for start in range(0, len(raw) - size + 1, size):
-        row = array("d")
-        row.frombytes(raw[start:start + 8 * width])
-        yield row
+{read_rows}
 
 
 def analyse(dt=DT, duration=DURATION, workdir=None):
@@ -590,20 +639,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
         ops.integrator("Newmark", 0.5, 0.25)
         ops.analysis("Transient")
 
-        n_steps = int(round(duration / dt))
-        started = time.perf_counter()
-        status = ops.analyze(n_steps, dt)
-        cut_steps = 0
-        while status != 0 and ops.getTime() < n_steps * dt - 0.5 * dt:
-            # Newton failed: retake that step in 10 sub-steps with line search, then go on.
-            cut_steps += 1
-            ops.algorithm("NewtonLineSearch")
-            status = ops.analyze(10, dt / 10.0)
-            ops.algorithm("Newton")
-            if status != 0:
-                break
-            status = ops.analyze(int(round((n_steps * dt - ops.getTime()) / dt)), dt)
-        wall = time.perf_counter() - started
+{stepping}
         end = ops.getTime()
         ops.wipe()  # flushes and closes the recorders
 
@@ -656,25 +692,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             shutil.rmtree(workdir, ignore_errors=True)
 
 
-def main(argv=None):
-    import argparse
-
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dt", type=float, default=DT, help="time step, s (default %(default)g)")
-    parser.add_argument("--duration", type=float, default=DURATION, help="simulated time, s")
-    parser.add_argument("-o", "--output", help="also write the peaks to this JSON file")
-    args = parser.parse_args(argv)
-    peaks = analyse(args.dt, args.duration)
-    text = json.dumps(peaks, indent=1)
-    print(text)
-    if args.output:
-        with open(args.output, "w") as handle:
-            handle.write(text + "\\n")
-    return 0 if peaks["converged"] else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+{main}
 '''
 
 
@@ -699,6 +717,15 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
         If OpenSeesPy is not installed, the model cannot be exported or the
         script fails.
     """
+    source, _notes = opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)
+    return run_script(source, model.name)
+
+
+def run_script(source: str, name: str) -> dict:
+    """Run an exported OpenSeesPy script (*source*) in a child Python process; return the peaks it writes.
+
+    *name* (the model's) labels a failure.
+    """
     import importlib.util
     import json
     import subprocess
@@ -706,7 +733,6 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
 
     if importlib.util.find_spec("openseespy") is None:  # pragma: no cover - depends on the environment
         raise PoundingError("OpenSeesPy is not available; pip install openseespy")
-    source, _notes = opensees_script_and_notes(model, record, dt=dt, xi=xi, duration=duration)
     with tempfile.TemporaryDirectory(prefix="pounding-opensees-") as folder:
         script = Path(folder) / "model_opensees.py"  # not the model's name: it may hold '/' or '..'
         peaks_file = Path(folder) / "peaks.json"
@@ -715,5 +741,5 @@ def run_opensees(model, record=None, *, dt: float = DEFAULT_DT, xi: str | None =
                               text=True, cwd=folder)
         if not peaks_file.exists():
             last = (done.stderr.strip().splitlines() or ["no output"])[-1]
-            raise PoundingError(f"the OpenSees script for {model.name} failed (exit {done.returncode}): {last}")
+            raise PoundingError(f"the OpenSees script for {name} failed (exit {done.returncode}): {last}")
         return json.loads(peaks_file.read_text(encoding="utf-8"))
