@@ -561,7 +561,8 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
 
     Lowered by :func:`pounding.solver.plan_assembly.plan_system` (no plan code in the
     compiled kernels), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
-    Friction, hysteretic planes and ``stop_drift_ratio`` are refused in one line.
+    Friction is refused in one line.  A plane past its building's collapse drift ratio (or an IMK
+    plane at zero strength) ends the run: status ``collapsed`` (attributes :func:`_plan_status`).
     """
     from pounding.solver.integrator import ground_state_at
 
@@ -582,9 +583,29 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
                     atol_velocity=settings.atol_velocity, output_dt=output_dt or settings.output_dt,
                     floor_factors=factors)
     wall = _time.perf_counter() - started
-    if raw.status != STATUS_OK:
+    if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
         raise PoundingError(f"{model.path or model.name}: " + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     raw = dataclasses.replace(raw, support_acceleration=ground_state_at(rows, step, raw.time)[0])
     return plan_dataset(model, psys, raw, attrs={"record_step": step, "end_time": end, "wall_time": wall,
                                                  "angle": model.ground_motion.angle,
-                                                 "created": datetime.now(timezone.utc).isoformat()})
+                                                 "created": datetime.now(timezone.utc).isoformat(),
+                                                 **_plan_status(model, psys, raw)})
+
+
+def _plan_status(model: PlanModel, psys: Any, raw: Any) -> dict[str, Any]:
+    """A plan run's ``status`` and, if a plane ended it, ``status_message``, ``collapse_time`` (s),
+    ``collapse_building``, ``collapse_storey`` (``building:storey``), ``collapse_plane`` (its index in the
+    archive's ``plane`` dimension) and ``collapse_cause`` (``drift_ratio`` or ``zero_strength``)."""
+    if raw.status == STATUS_OK or raw.collapse_storey < 0:
+        return {"status": "completed"}
+    p = int(raw.collapse_storey)
+    building, storey, plane = [(b.name, i + 1, plane) for b in model.buildings
+                               for i, s in enumerate(b.storeys) for plane in s.planes][p]
+    where = f"plane {p} ({plane.direction} at {plane.at:g} m)"
+    cause = (f"{where} reached its ultimate drift (IMK plane at zero strength)" if raw.collapse_cause == "zero_strength"
+             else f"{where} passed its collapse drift ratio {psys.system.storey_stop_ratio[p]:g}")
+    message = STATUS_MESSAGES[STATUS_COLLAPSED].format(t=raw.final_time, building=building,
+                                                       storey=f"{building}:{storey}", cause=cause)
+    return {"status": "collapsed", "status_message": message, "collapse_time": float(raw.final_time),
+            "collapse_building": building, "collapse_storey": f"{building}:{storey}", "collapse_plane": p,
+            "collapse_cause": raw.collapse_cause}

@@ -664,8 +664,8 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
     tolerance = np.where(shear_state, atol * stiffness[state_floor], tolerance)
     terms = None
     if system.storey_floors is not None:
-        floors, weights = kernel_terms(system.storey_floors, system.storey_weights)
-        terms = StoreyTerms(floors, weights, np.ascontiguousarray(system.storey_row_stiffness, dtype=np.float64))
+        terms = StoreyTerms(*kernel_terms(system.storey_floors, system.storey_weights),
+                            np.ascontiguousarray(system.storey_row_stiffness, dtype=np.float64))
     # Fresh copies: the IMK events rewrite their storeys' kernel rows and states during the run.
     return Storeys(np.ascontiguousarray(system.storey_model, dtype=np.int64),
                    np.array(system.storey_parameters, dtype=np.float64, copy=True, order="C"),

@@ -136,7 +136,7 @@ class Storeys(NamedTuple):
     model: np.ndarray        #: (R,) int, hysteresis kernel branch of the storey under each floor (0: elastic)
     parameters: np.ndarray   #: (R, N_HYSTERESIS_PARAMETERS) kernel vectors
     state_index: np.ndarray  #: (R,) int, the storey's hysteretic state among the nh, −1 if elastic
-    p_delta: np.ndarray      #: (R,) N/m, geometric stiffness −P/h
+    p_delta: np.ndarray      #: (N,) N/m, geometric stiffness −P/h of the storey under each floor (plan: zeros)
     height: np.ndarray       #: (R,) m
     mode: np.ndarray         #: (nh,) int, bilinear mode of each yielding storey (changed by the solver)
     floor: np.ndarray        #: (nh,) int, floor (row) of each hysteretic state

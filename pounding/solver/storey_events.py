@@ -239,9 +239,11 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
     best = -1.0
     where = -1
     for j in range(kpd.size):
+        if kpd[j] == 0.0:  # (a plan model's rows have none: its P-Delta terms are links)
+            continue
         hi = sidx[j]
         model = smodel[j]
-        if kpd[j] == 0.0 or hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
+        if hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
             continue
         bilinear = model == hysteresis.MODEL_BILINEAR
         k = storey_stiffness(stiffness, storey.terms, j)
