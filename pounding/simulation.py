@@ -559,8 +559,8 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
                   output_dt: float | None = None) -> xr.Dataset:
     """Simulate a plan model (docs/plan-models.md) under its two-component ground motion.
 
-    Lowered by :func:`pounding.solver.plan_assembly.plan_system` (no plan code in the
-    compiled kernels), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
+    Lowered by :func:`pounding.solver.plan_assembly.plan_system` (the compiled kernels' storey
+    rows take the planes' weighted drifts), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
     Friction is refused in one line.  A plane past its building's collapse drift ratio (or an IMK
     plane at zero strength) ends the run: status ``collapsed`` (attributes :func:`_plan_status`).
     """

@@ -1,6 +1,7 @@
 """A plan model lowered into the solver's arrays: every DOF a solver floor, planes as weighted springs.
 
-The compiled integrator needs no plan-specific code (docs/plan-models.md, "What is
+The compiled integrator needs no plan-specific code beyond storey rows whose drift is a
+weighted sum (:class:`pounding.solver.layout.StoreyTerms`; docs/plan-models.md, "What is
 integrated now"):
 
 * every DOF (u_x, u_y, θ of each floor; :mod:`pounding.model.plan_model`'s
