@@ -234,10 +234,7 @@ def storey_drift(y, offset, terms, below, j) -> float:
     """Drift (offset 0, m) or drift rate (offset N, m/s) of storey row *j* of state *y*."""
     if terms is None:
         return drift(y, offset, j, below[j])
-    f, w = terms.floors, terms.weights
-    k = SIDE_TERMS * j
-    return (w[k] * y[offset + f[k]] + w[k + 1] * y[offset + f[k + 1]] + w[k + 2] * y[offset + f[k + 2]]
-            + w[k + 3] * y[offset + f[k + 3]])
+    return combo(y, offset, terms.floors, terms.weights, j)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
@@ -245,36 +242,21 @@ def storey_interpolant(y, ynew, k1, k7, n, terms, below, j):
     """:func:`drift_interpolant` of storey row *j*: drift and drift rate at both ends of a step, their rates."""
     if terms is None:
         return drift_interpolant(y, ynew, k1, k7, n, j, below[j])
-    f, w = terms.floors, terms.weights
-    d0 = 0.0
-    r0 = 0.0
-    d1 = 0.0
-    r1 = 0.0
-    a0 = 0.0
-    a1 = 0.0
-    for k in range(SIDE_TERMS * j, SIDE_TERMS * j + SIDE_TERMS):
-        d0 += w[k] * y[f[k]]
-        r0 += w[k] * y[n + f[k]]
-        d1 += w[k] * ynew[f[k]]
-        r1 += w[k] * ynew[n + f[k]]
-        a0 += w[k] * k1[n + f[k]]
-        a1 += w[k] * k7[n + f[k]]
+    d0, r0, d1, r1, a0, a1, _ = step_kinematics(y, ynew, k1, k7, n, terms.floors, terms.weights, j, None)
     return d0, r0, d1, r1, a0, a1
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
 def storey_push(fbuf, terms, below, j, force) -> None:
     """Add storey row *j*'s shear *force* (N) to the floor forces: +F on the floor above, −F on the one
-    below; a plane's ``w·F`` on each of its terms (virtual work)."""
+    below; a plane's ``w·F`` on each of its terms (virtual work, :func:`push`)."""
     if terms is None:
         fbuf[j] += force
         b = below[j]
         if b >= 0:
             fbuf[b] -= force
         return
-    f, w = terms.floors, terms.weights
-    for k in range(SIDE_TERMS * j, SIDE_TERMS * j + SIDE_TERMS):
-        fbuf[f[k]] += w[k] * force
+    push(fbuf, terms.floors, terms.weights, j, force)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
