@@ -621,9 +621,10 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
                   xi: str | None = None, contacts: bool = True) -> xr.Dataset:
     """Simulate a plan model (docs/plan-models.md) under its two-component ground motion.
 
-    Lowered by :func:`pounding.solver.plan_assembly.plan_system` (no plan code in the
-    compiled kernels), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
-    Friction, hysteretic planes and ``stop_drift_ratio`` are refused in one line.
+    Lowered by :func:`pounding.solver.plan_assembly.plan_system` (the compiled kernels' storey
+    rows take the planes' weighted drifts), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
+    Friction is refused in one line.  A plane past its building's collapse drift ratio (or an IMK
+    plane at zero strength) ends the run: status ``collapsed`` (attributes :func:`_plan_status`).
     *record*, *scale*, *xi* and *contacts* as :func:`plan_with_options`; the archive's
     attribute ``plan_spec`` (JSON) holds the model text and these options, for
     :func:`rerun_plan`.
@@ -650,7 +651,7 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
                     atol_velocity=settings.atol_velocity, output_dt=output_dt or settings.output_dt,
                     floor_factors=factors)
     wall = _time.perf_counter() - started
-    if raw.status != STATUS_OK:
+    if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
         raise PoundingError(f"{model.path or model.name}: " + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     raw = dataclasses.replace(raw, support_acceleration=ground_state_at(rows, step, raw.time)[0])
     hashes = [None if r is None else r.metadata.get("sha256", "") for r in model.ground_motion.records()]
@@ -667,7 +668,8 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
                                                  "created": now.isoformat(), "source": f"pounding {__version__}",
                                                  "history": f"{now.strftime('%Y-%m-%dT%H:%M:%SZ')} simulated with "
                                                             f"pounding {__version__}",
-                                                 "plan_spec": json.dumps(spec)})
+                                                 "plan_spec": json.dumps(spec),
+                                                 **_plan_status(model, psys, raw)})
 
 
 def rerun_plan(run: xr.Dataset, name: str = "archive") -> xr.Dataset:
@@ -693,3 +695,22 @@ def rerun_plan(run: xr.Dataset, name: str = "archive") -> xr.Dataset:
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     again.attrs["history"] = f"{run.attrs.get('history', '')}\n{now} rerun of {name}".strip()
     return again
+
+
+def _plan_status(model: PlanModel, psys: Any, raw: Any) -> dict[str, Any]:
+    """A plan run's ``status`` and, if a plane ended it, ``status_message``, ``collapse_time`` (s),
+    ``collapse_building``, ``collapse_storey`` (``building:storey``), ``collapse_plane`` (its index in the
+    archive's ``plane`` dimension) and ``collapse_cause`` (``drift_ratio`` or ``zero_strength``)."""
+    if raw.status == STATUS_OK or raw.collapse_storey < 0:
+        return {"status": "completed"}
+    p = int(raw.collapse_storey)
+    building, storey, plane = [(b.name, i + 1, plane) for b in model.buildings
+                               for i, s in enumerate(b.storeys) for plane in s.planes][p]
+    where = f"plane {p} ({plane.direction} at {plane.at:g} m)"
+    cause = (f"{where} reached its ultimate drift (IMK plane at zero strength)" if raw.collapse_cause == "zero_strength"
+             else f"{where} passed its collapse drift ratio {psys.system.storey_stop_ratio[p]:g}")
+    message = STATUS_MESSAGES[STATUS_COLLAPSED].format(t=raw.final_time, building=building,
+                                                       storey=f"{building}:{storey}", cause=cause)
+    return {"status": "collapsed", "status_message": message, "collapse_time": float(raw.final_time),
+            "collapse_building": building, "collapse_storey": f"{building}:{storey}", "collapse_plane": p,
+            "collapse_cause": raw.collapse_cause}

@@ -191,13 +191,7 @@ buildings:
     assert np.allclose(turned.peak_displacement.values, swapped.peak_displacement.values, rtol=1e-8)
 
 
-def test_friction_and_hysteretic_planes_are_refused_in_one_line(tmp_path):
-    text = ECCENTRIC.replace("REC", _record(tmp_path)).replace(
-        "stiffness: 1.0e7}", "stiffness: 1.0e7, hysteresis: {model: bilinear, yield_drift_ratio: 0.01, post_yield_ratio: 0.1}}", 1)
-    with pytest.raises(PoundingError) as caught:
-        simulate_plan(plan_model_from_text(text, name="e"))
-    assert "hysteretic planes are read but not yet integrated" in str(caught.value)
-    assert "\n" not in str(caught.value)
+def test_friction_is_refused_in_one_line():
     friction = _free_floor("law: hertz-damp, kh: 1.0e9, restitution: 0.6, friction: 0.3", lever=0.0)
     with pytest.raises(PoundingError, match="friction is read but not yet integrated$"):
         simulate_plan(friction)

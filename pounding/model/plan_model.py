@@ -45,6 +45,9 @@ class PlanBuilding:
         From the ground up.
     damping : Damping
     p_delta : bool
+    collapse_drift_ratio : float or None
+        Its own ``collapse: {drift_ratio}``: the run ends when one of its planes' |drift ratio| exceeds it
+        (None: ``solver.stop_drift_ratio``, :meth:`PlanModel.collapse_drift_ratios`).
     """
 
     name: str
@@ -52,6 +55,7 @@ class PlanBuilding:
     storeys: tuple[plan.PlanStorey, ...]
     damping: Damping
     p_delta: bool = False
+    collapse_drift_ratio: float | None = None
 
     @property
     def n_floors(self) -> int:
@@ -236,6 +240,12 @@ class PlanModel:
         """Every contact point with its model-wide penetration weights: ``δ = w · q − gap``."""
         return [(c, p, self.scatter(c, p.weights)) for c in self.contacts for p in c.points]
 
+    def collapse_drift_ratios(self) -> tuple[float | None, ...]:
+        """Each building's collapse drift ratio: its own ``collapse: {drift_ratio}``, else
+        ``solver.stop_drift_ratio`` (None: never)."""
+        return tuple(b.collapse_drift_ratio if b.collapse_drift_ratio is not None else self.solver.stop_drift_ratio
+                     for b in self.buildings)
+
     @property
     def warnings(self) -> tuple[str, ...]:
         """The buildings' warnings."""
@@ -255,7 +265,8 @@ def _ground_motion(entry: PlanGroundMotionEntry, base_dir: str | None) -> PlanGr
 def build_plan_model(entry: PlanModelEntry, *, name: str, text: str = "", path: str | None = None,
                      base_dir: str | None = None) -> PlanModel:
     """The objects of a checked plan model."""
-    buildings = tuple(PlanBuilding(b.name, b.plan.outline, tuple(b.plan_storeys()), _damping(b.damping), b.p_delta)
+    buildings = tuple(PlanBuilding(b.name, b.plan.outline, tuple(b.plan_storeys()), _damping(b.damping), b.p_delta,
+                                   None if b.collapse is None else b.collapse.drift_ratio)
                       for b in entry.buildings)
     contacts = []
     for index, c in enumerate(entry.contacts):

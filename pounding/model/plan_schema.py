@@ -19,7 +19,7 @@ from pydantic import BaseModel, BeforeValidator, Discriminator, Field, PrivateAt
 from pounding.model import plan, plan_contacts
 from pounding.model.document import Document, Location, plural
 from pounding.model.ground_pair import pair_components
-from pounding.model.schema import (TAGS, WALL, WALL_NAME, BuildingEntry, ContactEntry, ContactGeometry, Damping,
+from pounding.model.schema import (TAGS, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
                                    HysteresisUnion, ModalEntry, between_indices, list_shape, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
                                    as_number, contact_levels, hysteresis_parameters, located, problem,
                                    record_reference, storey_count, units_name, validate)
@@ -149,7 +149,8 @@ class PlanBuildingEntry(SchemaEntry):
     """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``."""
 
     WHAT: ClassVar[str] = "a mapping {name, plan, storeys, damping}"
-    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": PlanStoreyEntry, "plan": PlanEntry}
+    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": PlanStoreyEntry, "plan": PlanEntry,
+                                                      "collapse": CollapseEntry}
 
     name: Annotated[str, BeforeValidator(located(as_name))] = Field(description="unique building name")
     plan: PlanEntry = Field(description="{outline: [[x0, y0], [x1, y1]]}")
@@ -159,6 +160,9 @@ class PlanBuildingEntry(SchemaEntry):
     p_delta: Annotated[bool, BeforeValidator(located(as_bool))] = Field(
         False, description="leaning-column P-Delta from the floor weights, true or false")
     ground_motion: Annotated[Any, BeforeValidator(_no_own_record)] = None
+    collapse: CollapseEntry | None = Field(
+        None, description="this building's collapse criterion {drift_ratio}: any of its planes' |drift ratio| "
+                          "(default: solver.stop_drift_ratio)")
 
     @property
     def n_floors(self) -> int:

@@ -8,7 +8,8 @@ elements); this module labels what the solver returns:
   ``rotation_rate`` (time, floor) rad, rad/s: each floor's centre of mass relative to the
   ground; their full-resolution peaks ``peak_displacement`` (floor, direction) and
   ``peak_rotation`` (floor);
-* ``plane_drift`` (time, plane) m and ``peak_plane_drift`` (plane, full resolution);
+* ``plane_drift`` (time, plane) m and ``peak_plane_drift`` (plane, full resolution); ``plane_shear``
+  (time, plane) N, a yielding plane's by its hysteresis (its state from the solver's storey rows);
 * ``corner_displacement`` (time, floor, corner, direction) m of the outline's four corners
   (small rotations: ``u_x − θ (p_y − y_c)``, ``u_y + θ (p_x − x_c)``),
   ``corner_displacement_magnitude`` (time, floor, corner) their hypot, and their peaks over the
@@ -33,6 +34,7 @@ from pounding.model.plan_model import PlanModel
 from pounding.solver.integrator import RawSolution
 from pounding.solver.kinematics import penetration
 from pounding.solver.plan_assembly import PlanSystem
+from pounding.solver.storeys import restoring_force
 
 __all__ = ["CORNERS", "plan_dataset", "plan_energy_closure", "plan_summary", "corner_weights", "floor_corners",
            "hermite_at", "peak_corner", "compare_plan_runs"]
@@ -147,17 +149,43 @@ def _energies(psys: PlanSystem, raw: RawSolution, delta: np.ndarray) -> dict[str
     work = state[:, lay.work:lay.work + lay.n_contacts]
     stiffness = system.contact_parameters[npt:, 0]
     link_start = 0.5 * (stiffness * delta[0, npt:] ** 2)
+    # A yielding plane: its link's work (kΔ) is replaced by its own: recoverable energy and the rest dissipated.
+    yielding = _yielding_planes(psys)
+    plane_work = work[:, npt:npt + npl].sum(axis=1) - work[:, npt + yielding].sum(axis=1)
+    hysteretic = state[:, lay.storey_work:lay.ground_work].sum(axis=1) - raw.storey_energy[:, 1]
     return {"energy_input": state[:, lay.input_energy],
             "energy_kinetic": 0.5 * (v * v) @ system.mass,
             "energy_damping": state[:, lay.damping_energy],
-            "energy_plane_strain": work[:, npt:npt + npl].sum(axis=1) + link_start[:npl].sum(),
+            "energy_plane_strain": plane_work + link_start[:npl].sum() + raw.storey_energy[:, 1],
             "energy_p_delta": work[:, npt + npl:].sum(axis=1) + link_start[npl:].sum(),
-            "energy_contact": work[:, :npt].sum(axis=1)}
+            "energy_contact": work[:, :npt].sum(axis=1),
+            "energy_hysteretic": hysteretic}
+
+
+def _yielding_planes(psys: PlanSystem) -> np.ndarray:
+    """Indices of the yielding planes, in the order of their hysteretic states (none without storey rows)."""
+    system = psys.system
+    if system.storey_floors is None:
+        return np.zeros(0, dtype=np.int64)
+    planes = np.flatnonzero(system.storey_state >= 0)
+    return planes[np.argsort(system.storey_state[planes])]
+
+
+def _plane_shear(psys: PlanSystem, raw: RawSolution, drift: np.ndarray) -> np.ndarray:
+    """(nt, plane) shear of every plane, N: kΔ, a yielding plane's by its hysteresis at its state."""
+    system = psys.system
+    shear = drift * psys.plane_stiffness
+    first = system.layout.hysteretic
+    for index, p in enumerate(_yielding_planes(psys)):
+        shear[:, p] = restoring_force.py_func(int(system.storey_model[p]), system.storey_parameters, int(p),
+                                              float(psys.plane_stiffness[p]), drift[:, p], raw.state[:, first + index])
+    return shear
 
 
 def plan_energy_closure(ds: xr.Dataset) -> float:
     """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of a plan archive (dimensionless)."""
-    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact)
+    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
+             + ds.get("energy_hysteretic", 0.0))
     initial = float(parts[0])
     supplied = initial + ds.energy_input
     scale = float(np.abs(supplied).max())
@@ -203,6 +231,8 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
         "peak_plane_drift": _var(("plane",), raw.peak_contact_force[npt:npt + npl] / psys.plane_stiffness, "m",
                                  "peak |drift| of the plane (full resolution)"),
         "plane_stiffness": _var(("plane",), psys.plane_stiffness, "N/m", "elastic stiffness of the plane"),
+        "plane_shear": _var(("time", "plane"), _plane_shear(psys, raw, delta[:, npt:npt + npl]), "N",
+                            "shear of the plane (restoring force, without P-Delta)"),
         "contact_force": _var(("time", "point"), raw.contact_force[:, :npt], "N",
                               "normal contact force at the point (compression positive)"),
         "penetration": _var(("time", "point"), delta[:, :npt], "m", "penetration at the point (overlap positive)"),

@@ -26,7 +26,7 @@ from pounding.model.model import WALL, Model, column_weights
 from pounding.solver import imk
 from pounding.solver.integrator import System
 
-__all__ = ["assemble", "building_arrays", "storey_arrays", "storey_stop_ratios", "element_arrays", "contact_side_terms", "side_mass"]
+__all__ = ["assemble", "building_arrays", "storey_arrays", "hysteresis_arrays", "storey_stop_ratios", "element_arrays", "contact_side_terms", "side_mass"]
 
 
 def building_arrays(model: Model) -> dict[str, np.ndarray]:
@@ -84,25 +84,37 @@ def storey_arrays(model: Model) -> dict[str, Any]:
     solver's state vector), −1 for an elastic storey; ``storey_imk`` holds the
     initial discrete state of each IMK storey among them (:mod:`pounding.solver.imk`).
     """
-    models, parameters, heights, p_delta, discrete = [], [], [], [], []
+    heights, p_delta, laws = [], [], []
     for building in model.buildings:
-        for law, k, h in zip(building.hysteresis, building.stiffness, building.height):
-            models.append(hysteresis.MODEL_ELASTIC if law is None else law.model_id)
-            parameters.append(np.zeros(hysteresis.N_HYSTERESIS_PARAMETERS) if law is None
-                              else law.kernel_parameters(k, h))
-            if law is not None:
-                discrete.append(imk.initial_state(law, k, h) if isinstance(law, hysteresis.ImkStorey)
-                                else np.zeros(imk.N_STATE))
+        laws += list(zip(building.hysteresis, building.stiffness, building.height))
         heights.append(building.height)
         p_delta.append(building.p_delta_stiffness)
-    yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
     return dict(
-        storey_model=np.asarray(models, dtype=np.int64),
-        storey_parameters=np.ascontiguousarray(np.array(parameters, dtype=float)),
-        storey_state=np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64),
+        **hysteresis_arrays(laws),
         p_delta_stiffness=np.ascontiguousarray(np.concatenate(p_delta), dtype=float),
         storey_height=np.ascontiguousarray(np.concatenate(heights), dtype=float),
         storey_stop_ratio=storey_stop_ratios(model),
+    )
+
+
+def hysteresis_arrays(laws: list[tuple[Any, float, float]]) -> dict[str, np.ndarray]:
+    """``storey_model``, ``storey_parameters``, ``storey_state`` and ``storey_imk`` of storey rows given as
+    ``(hysteresis or None, stiffness N/m, height m)``: the kernel id and vector of each row, the yielding
+    rows numbered in order (−1: elastic), and each IMK row's initial discrete state (zeros for the others)."""
+    models, parameters, discrete = [], [], []
+    for law, k, h in laws:
+        models.append(hysteresis.MODEL_ELASTIC if law is None else law.model_id)
+        parameters.append(np.zeros(hysteresis.N_HYSTERESIS_PARAMETERS) if law is None
+                          else law.kernel_parameters(k, h))
+        if law is not None:
+            discrete.append(imk.initial_state(law, k, h) if isinstance(law, hysteresis.ImkStorey)
+                            else np.zeros(imk.N_STATE))
+    yielding = np.asarray(models, dtype=np.int64) != hysteresis.MODEL_ELASTIC
+    return dict(
+        storey_model=np.asarray(models, dtype=np.int64),
+        storey_parameters=np.ascontiguousarray(np.array(parameters, dtype=float)
+                                               .reshape(len(models), hysteresis.N_HYSTERESIS_PARAMETERS)),
+        storey_state=np.where(yielding, np.cumsum(yielding) - 1, -1).astype(np.int64),
         storey_imk=np.array(discrete, dtype=float).reshape(len(discrete), imk.N_STATE),
     )
 

@@ -100,7 +100,7 @@ from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, erro
 from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
                                         kernel_terms)
 from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, Forcing, Grounds, Layout, Settings, Storeys,
-                                    Structure, Work, state_layout)
+                                    StoreyTerms, Structure, Work, state_layout)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_COLUMNS,
                                       IMPACT_ROW_LIMIT, Outputs, Peaks, close_open_impacts, grown, new_outputs,
@@ -168,6 +168,11 @@ class System:
     contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
         side of each gap element: their differential displacement enters the penetration
         (``pounding.solver.assembly.assemble``; a wall takes the row of the building it faces)
+    storey_floors, storey_weights : (R, SIDE_TERMS) int and float, optional
+        A plan model's storey rows, its planes (``pounding.solver.plan_assembly``): row p's drift is
+        ``Σ_k w_k·u[floor_k]`` (floor −1: none).  Then the storey fields above are per plane (R), not per
+        floor, and ``storey_row_stiffness`` (R,) N/m holds each plane's elastic stiffness.  None: the
+        storey under floor j, drift ``u[j] − u[below[j]]``.
     """
 
     mass: np.ndarray
@@ -196,6 +201,9 @@ class System:
     floor_ground: np.ndarray | None = None
     contact_ground_left: np.ndarray | None = None
     contact_ground_right: np.ndarray | None = None
+    storey_floors: np.ndarray | None = None
+    storey_weights: np.ndarray | None = None
+    storey_row_stiffness: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         nc = int(self.contact_gap.size)
@@ -415,7 +423,8 @@ def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_f
     failed = failed_storey(storey)
     if failed >= 0:  # an IMK storey lost its strength at the last event: its building collapses there
         return 0.0, 0.0, failed, STATUS_COLLAPSED
-    collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio, h)
+    collapse_s, collapse_at = collapse_crossing(work, lay.n_floors, below, storey.height, storey.stop_ratio,
+                                                storey.terms, h)
     if collapse_s >= 0.0:
         collapse_floor = collapse_at
         stop_status = STATUS_COLLAPSED
@@ -651,7 +660,12 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
     tolerance = np.where(bilinear, atol, atol / np.where(bilinear, 1.0, system.storey_parameters[state_floor, 0]))
     # An IMK storey's state is its shear: atol times its stiffness (N).
     shear_state = np.isin(system.storey_model[state_floor], IMK_MODELS)
-    tolerance = np.where(shear_state, atol * system.storey_stiffness[state_floor], tolerance)
+    stiffness = system.storey_stiffness if system.storey_floors is None else system.storey_row_stiffness
+    tolerance = np.where(shear_state, atol * stiffness[state_floor], tolerance)
+    terms = None
+    if system.storey_floors is not None:
+        terms = StoreyTerms(*kernel_terms(system.storey_floors, system.storey_weights),
+                            np.ascontiguousarray(system.storey_row_stiffness, dtype=np.float64))
     # Fresh copies: the IMK events rewrite their storeys' kernel rows and states during the run.
     return Storeys(np.ascontiguousarray(system.storey_model, dtype=np.int64),
                    np.array(system.storey_parameters, dtype=np.float64, copy=True, order="C"),
@@ -660,7 +674,8 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
                    np.ascontiguousarray(system.storey_height, dtype=np.float64),
                    np.zeros(floors.size, dtype=np.int64), state_floor, np.ascontiguousarray(tolerance, dtype=np.float64),
                    np.ascontiguousarray(system.storey_stop_ratio, dtype=np.float64),
-                   np.array(system.storey_imk, dtype=np.float64, copy=True, order="C").reshape(-1, imk.N_STATE))
+                   np.array(system.storey_imk, dtype=np.float64, copy=True, order="C").reshape(-1, imk.N_STATE),
+                   terms)
 
 
 def integrate(system: System, ground_acceleration: np.ndarray, time_step: float, duration: float,

@@ -34,7 +34,8 @@ from pounding.solver import jit
 __all__ = ["SIDE_TERMS", "combo", "push", "compliance", "effective_mass", "ground_weight", "kick", "ground_at",
            "fill_grounds", "ground_offset", "contact_sums", "contact_delta", "step_kinematics",
            "step_kinematics_inline", "drift",
-           "drift_interpolant", "ground_kinematics", "ground_state_at", "kernel_terms", "penetration"]
+           "drift_interpolant", "storey_drift", "storey_interpolant", "storey_push", "storey_rate_scale",
+           "storey_stiffness", "ground_kinematics", "ground_state_at", "kernel_terms", "penetration"]
 
 #: Terms per contact: two per side.
 SIDE_TERMS = 4
@@ -220,6 +221,63 @@ def drift_interpolant(y, ynew, k1, k7, n, j, b):
         return (y[j] - y[b], y[n + j] - y[n + b], ynew[j] - ynew[b], ynew[n + j] - ynew[n + b],
                 k1[n + j] - k1[n + b], k7[n + j] - k7[n + b])
     return y[j], y[n + j], ynew[j], ynew[n + j], k1[n + j], k7[n + j]
+
+
+# Storey rows: the storeys of shear buildings (*terms* None: drift u[j] − u[below[j]]) or a plan model's
+# planes (*terms* a layout.StoreyTerms: a weighted sum of up to SIDE_TERMS floor DOF).  Called, not
+# inlined, so that each is compiled per type of *terms*: numba prunes the other branch, and the shear
+# buildings' arithmetic is :func:`drift`'s, bit for bit.
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def storey_drift(y, offset, terms, below, j) -> float:
+    """Drift (offset 0, m) or drift rate (offset N, m/s) of storey row *j* of state *y*."""
+    if terms is None:
+        return drift(y, offset, j, below[j])
+    return combo(y, offset, terms.floors, terms.weights, j)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def storey_interpolant(y, ynew, k1, k7, n, terms, below, j):
+    """:func:`drift_interpolant` of storey row *j*: drift and drift rate at both ends of a step, their rates."""
+    if terms is None:
+        return drift_interpolant(y, ynew, k1, k7, n, j, below[j])
+    d0, r0, d1, r1, a0, a1, _ = step_kinematics(y, ynew, k1, k7, n, terms.floors, terms.weights, j, None)
+    return d0, r0, d1, r1, a0, a1
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def storey_push(fbuf, terms, below, j, force) -> None:
+    """Add storey row *j*'s shear *force* (N) to the floor forces: +F on the floor above, −F on the one
+    below; a plane's ``w·F`` on each of its terms (virtual work, :func:`push`)."""
+    if terms is None:
+        fbuf[j] += force
+        b = below[j]
+        if b >= 0:
+            fbuf[b] -= force
+        return
+    push(fbuf, terms.floors, terms.weights, j, force)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def storey_rate_scale(y, n, terms, below, j) -> float:
+    """Σ |w·v| over storey row *j*'s terms (m/s): the round-off scale of its drift rate."""
+    if terms is None:
+        b = below[j]
+        return abs(y[n + j]) + (abs(y[n + b]) if b >= 0 else 0.0)
+    f, w = terms.floors, terms.weights
+    total = 0.0
+    for k in range(SIDE_TERMS * j, SIDE_TERMS * j + SIDE_TERMS):
+        total += abs(w[k] * y[n + f[k]])
+    return total
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def storey_stiffness(kst, terms, j) -> float:
+    """Elastic stiffness of storey row *j*, N/m: ``kst[j]`` (the floors' storey springs) or the plane's."""
+    if terms is None:
+        return kst[j]
+    return terms.stiffness[j]
 
 
 # --------------------------------------------------------------------------- #

@@ -20,6 +20,8 @@ costs nothing at a call):
 * :class:`Contacts` — every gap element's floor terms, gap, law and parameters;
 * :class:`ContactState` — what changes at contact events (closed, onset constant, mode);
 * :class:`Storeys` — yielding storeys, P-Delta and the collapse limit (None when there are none);
+* :class:`StoreyTerms` — the drifts of a plan model's planes as weighted sums of floor DOF (``Storeys.terms``;
+  None for a row of shear buildings, whose storey drift is ``u[j] − u[below[j]]``);
 * :class:`Grounds` — the support motions with several grounds (None with one common ground);
 * :class:`Settings` — record step, duration, tolerances and output step;
 * :class:`Forcing` — the ground acceleration of ground row 0 and its sample interval;
@@ -33,7 +35,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "RigidWork", "Storeys", "Grounds", "Settings",
+__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "RigidWork", "Storeys", "StoreyTerms", "Grounds", "Settings",
            "Forcing", "Events", "Work"]
 
 
@@ -114,19 +116,34 @@ class ContactState(NamedTuple):
     #: at rest, overlap again) before that is an event (events.band; docs/numerics.md "Contacts at rest")
 
 
-class Storeys(NamedTuple):
-    """Yielding storeys, P-Delta and the collapse limit (the solver's *storey* argument)."""
+class StoreyTerms(NamedTuple):
+    """A plan model's storey elements, its planes (R rows): row p's drift is ``Σ_k weights[4p + k]·u[floors[4p + k]]``
+    (the plane's weight vector a: u and θ of the floors above and below, docs/plan-models.md) and its
+    shear F enters the floors as ``weights·F`` (virtual work).  Absent terms: floor 0, weight 0."""
 
-    model: np.ndarray        #: (N,) int, hysteresis kernel branch of the storey under each floor (0: elastic)
-    parameters: np.ndarray   #: (N, N_HYSTERESIS_PARAMETERS) kernel vectors
-    state_index: np.ndarray  #: (N,) int, the storey's hysteretic state among the nh, −1 if elastic
-    p_delta: np.ndarray      #: (N,) N/m, geometric stiffness −P/h
-    height: np.ndarray       #: (N,) m
+    floors: np.ndarray     #: (R·SIDE_TERMS,) int
+    weights: np.ndarray    #: (R·SIDE_TERMS,) float
+    stiffness: np.ndarray  #: (R,) N/m, the plane's elastic stiffness (its Kelvin link carries k·Δ)
+
+
+class Storeys(NamedTuple):
+    """Yielding storeys, P-Delta and the collapse limit (the solver's *storey* argument).
+
+    Its rows are the storeys under the N floors of a row of shear buildings (``terms`` None), or the R
+    planes of a plan model (``terms`` a :class:`StoreyTerms`: a row's drift is a weighted sum of floor DOF;
+    :mod:`pounding.solver.kinematics` ``storey_*``)."""
+
+    model: np.ndarray        #: (R,) int, hysteresis kernel branch of the storey under each floor (0: elastic)
+    parameters: np.ndarray   #: (R, N_HYSTERESIS_PARAMETERS) kernel vectors
+    state_index: np.ndarray  #: (R,) int, the storey's hysteretic state among the nh, −1 if elastic
+    p_delta: np.ndarray      #: (N,) N/m, geometric stiffness −P/h of the storey under each floor (plan: zeros)
+    height: np.ndarray       #: (R,) m
     mode: np.ndarray         #: (nh,) int, bilinear mode of each yielding storey (changed by the solver)
-    floor: np.ndarray        #: (nh,) int, floor of each hysteretic state
+    floor: np.ndarray        #: (nh,) int, floor (row) of each hysteretic state
     tolerance: np.ndarray    #: (nh,) absolute tolerance of each hysteretic state
-    stop_ratio: np.ndarray   #: (N,) drift ratio of the storey that ends the run, its building's collapse (0: never)
+    stop_ratio: np.ndarray   #: (R,) drift ratio of the storey that ends the run, its building's collapse (0: never)
     imk: np.ndarray          #: (nh, imk.N_STATE) discrete state of each IMK storey (other rows unused)
+    terms: StoreyTerms | None  #: a plan model's plane drifts; None: storey j's drift is u[j] − u[below[j]]
 
 
 class Grounds(NamedTuple):

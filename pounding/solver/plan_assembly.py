@@ -1,6 +1,7 @@
 """A plan model lowered into the solver's arrays: every DOF a solver floor, planes as weighted springs.
 
-The compiled integrator needs no plan-specific code (docs/plan-models.md, "What is
+The compiled integrator needs no plan-specific code beyond storey rows whose drift is a
+weighted sum (:class:`pounding.solver.layout.StoreyTerms`; docs/plan-models.md, "What is
 integrated now"):
 
 * every DOF (u_x, u_y, θ of each floor; :mod:`pounding.model.plan_model`'s
@@ -21,10 +22,15 @@ integrated now"):
   ground motion enters them: in coordinates relative to one rigid ground the
   penetration of a point is exactly ``w · q − gap``;
 * every contact point is a gap element whose two sides are the (u_n, θ) terms of
-  its two floors (its penetration weights), the low side on the left.
+  its two floors (its penetration weights), the low side on the left;
+* with a hysteretic plane or a collapse drift ratio (``solver.stop_drift_ratio``, a
+  building's ``collapse``), the planes are also the solver's storey rows
+  (:func:`plane_storey_arrays`): a row's drift is its weighted sum ``a · q``
+  (:class:`pounding.solver.layout.StoreyTerms`), a yielding plane adds ``F − kΔ`` to
+  its link's ``kΔ`` through the same weights (its state, events, work and error-norm
+  entry those of a yielding storey), and every plane's drift ratio is watched.
 
-Not yet integrated (one line each, :func:`plan_refusal`): friction, hysteretic
-planes, ``stop_drift_ratio``.
+Not yet integrated (one line, :func:`plan_refusal`): friction.
 """
 
 from __future__ import annotations
@@ -38,13 +44,13 @@ from pounding.contact import laws as contact_laws
 from pounding.model.model import WALL
 from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
 from pounding.model.plan_model import PlanModel
-from pounding.solver.assembly import side_mass
+from pounding.solver.assembly import hysteresis_arrays, side_mass
 from pounding.solver.integrator import System
 from pounding.solver.kinematics import SIDE_TERMS
 from pounding.solver.tolerances import floor_tolerance_factors
 
-__all__ = ["GROUND_X", "GROUND_Y", "GROUND_NONE", "PlanSystem", "plan_refusal", "plan_system", "plan_ground_rows",
-           "plan_tolerance_factors"]
+__all__ = ["GROUND_X", "GROUND_Y", "GROUND_NONE", "PlanSystem", "plan_refusal", "plan_system", "plane_storey_arrays",
+           "plan_ground_rows", "plan_tolerance_factors"]
 
 #: Ground rows of a plan run: a_gx, a_gy and the zero row (rotations; contacts and planes).
 GROUND_X, GROUND_Y, GROUND_NONE = 0, 1, 2
@@ -77,13 +83,6 @@ def plan_refusal(model: PlanModel) -> str | None:
     """Why *model* cannot be run yet (one line), or None."""
     if any(c.friction for c in model.contacts):
         return "friction is read but not yet integrated"
-    for b in model.buildings:
-        for i, s in enumerate(b.storeys):
-            if any(p.hysteresis is not None for p in s.planes):
-                return (f"building {b.name} storey {i + 1}: hysteretic planes are read but not yet integrated "
-                        "(elastic planes only)")
-    if model.solver.stop_drift_ratio:
-        return "solver.stop_drift_ratio is read but not yet integrated for plan models"
     return None
 
 
@@ -145,6 +144,7 @@ def plan_system(model: PlanModel) -> PlanSystem:
     for b, offset in zip(model.buildings, offsets):
         if b.p_delta:
             links += [(k, a, offset, storey) for storey, k, a in plan_geometric_terms(list(b.storeys))]
+    rows = plane_storey_arrays(model, [(offset, storey, a) for _, a, offset, storey in links[:len(plane_stiffness)]])
     for stiffness, a, offset, storey in links:
         upper, lower = _drift_sides(offset, a, storey)
         floors.append([f for f, _ in upper + lower])
@@ -170,9 +170,39 @@ def plan_system(model: PlanModel) -> PlanSystem:
         contact_weights=np.ascontiguousarray(np.array(weights, dtype=float).reshape(nc, SIDE_TERMS)),
         floor_ground=floor_ground,
         contact_ground_left=np.full(nc, GROUND_NONE, dtype=np.int64),
-        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64))
+        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64), **rows)
     return PlanSystem(system, n_points, len(plane_stiffness), np.asarray(plane_stiffness, dtype=float),
                       np.asarray(point_face, dtype=np.int64), np.asarray(locations, dtype=float).reshape(n_points, 2))
+
+
+def plane_storey_arrays(model: PlanModel, drifts: list[tuple[int, int, np.ndarray]]) -> dict[str, np.ndarray]:
+    """The :class:`System` storey fields of *model*'s planes as storey rows, or {} when no plane yields and
+    no building has a collapse drift ratio (the planes are then their links alone).
+
+    *drifts*: ``(DOF offset of the building, storey, a)`` per plane in the archive's plane order.  Row p
+    is plane p: its hysteresis kernel and parameters (at the plane's stiffness and storey height),
+    state index (−1: elastic), height, its building's collapse drift ratio (0: none), drift terms
+    (:func:`_drift_sides`, the floor above then the floor below) and stiffness; ``p_delta_stiffness``
+    stays per solver floor and zero (the plan model's P-Delta terms are links).
+    """
+    planes = [(b, ratio, s.height, p) for b, ratio in zip(model.buildings, model.collapse_drift_ratios())
+              for s in b.storeys for p in s.planes]
+    if not any(p.hysteresis is not None or ratio for _, ratio, _, p in planes):
+        return {}
+    floors, weights = [], []
+    for offset, storey, a in drifts:
+        upper, lower = _drift_sides(offset, a, storey)
+        floors.append([f for f, _ in upper + lower])
+        weights.append([w for _, w in upper + lower])
+    count = len(planes)
+    return dict(
+        **hysteresis_arrays([(p.hysteresis, p.stiffness, height) for _, _, height, p in planes]),
+        p_delta_stiffness=np.zeros(model.n_dof),  # per solver floor; the plan's P-Delta terms are links
+        storey_height=np.array([h for _, _, h, _ in planes], dtype=float),
+        storey_stop_ratio=np.array([float(ratio or 0.0) for _, ratio, _, _ in planes]),
+        storey_floors=np.array(floors, dtype=np.int64).reshape(count, SIDE_TERMS),
+        storey_weights=np.array(weights, dtype=float).reshape(count, SIDE_TERMS),
+        storey_row_stiffness=np.array([float(p.stiffness) for _, _, _, p in planes]))
 
 
 def plan_ground_rows(a_gx: np.ndarray, a_gy: np.ndarray) -> np.ndarray:

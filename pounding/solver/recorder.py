@@ -22,12 +22,12 @@ from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver import storeys
 from pounding.solver.dense import extremum_in_step, hermite
-from pounding.solver.kinematics import contact_delta, drift, step_kinematics
+from pounding.solver.kinematics import contact_delta, drift, step_kinematics, storey_drift
 from pounding.solver.status import STATUS_TABLE_LIMIT
 
 __all__ = ["FORCE_SAMPLES", "IMPACT_COLUMNS", "IMPACT_ROW_LIMIT", "TRACE_ROW_LIMIT", "Outputs", "Peaks", "grown",
            "new_outputs", "new_peaks", "closed_contact_samples", "peak_magnitude", "contact_energy",
-           "storey_outputs", "record_sample", "record_floor_peaks", "trace_rows", "record_contacts", "close_open_impacts",
+           "storey_outputs", "plane_outputs", "record_sample", "record_floor_peaks", "trace_rows", "record_contacts", "close_open_impacts",
            "trimmed_outputs",
            "IMP_CONTACT", "IMP_TIME", "IMP_VELOCITY", "IMP_CONSTANT", "IMP_PEAK_FORCE", "IMP_END", "IMP_IMPULSE",
            "IMP_SEPARATION", "IMP_WORK"]
@@ -198,16 +198,32 @@ def storey_outputs(y, lay, structure, storey, out, row):
     yielding ones.  *storey* is None for linear elastic storeys without P-Delta.
     """
     below, kst, shear, energy = structure.below, structure.storey_stiffness, out.shear, out.storey_energy
+    if storey is not None:
+        plane_outputs(y, lay, structure, storey, storey.terms, out, row)
+        return
+    total = 0.0
+    for j in range(lay.n_floors):
+        du = drift(y, 0, j, below[j])
+        shear[row, j] = kst[j] * du
+        total += 0.5 * kst[j] * du * du
+    energy[row, 0] = total
+    energy[row, 1] = 0.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def plane_outputs(y, lay, structure, storey, terms, out, row):
+    """:func:`storey_outputs` with a *storey* record.  Its rows are the storeys (*terms* None), or a plan
+    model's planes (*terms*: :class:`~pounding.solver.layout.StoreyTerms`); then ``shear[row]`` (one column
+    per floor, no storey springs) is 0 and ``energy[row]`` the recoverable energy of the yielding planes
+    in both columns (the elastic ones' is their Kelvin links', and a yielding plane's link carries its
+    ``½kΔ²``: the plan archive takes the planes' energies from their works, pounding.results.plan_dataset)."""
+    below, kst, shear, energy = structure.below, structure.storey_stiffness, out.shear, out.storey_energy
+    smodel, sprm, sidx, kpd = storey.model, storey.parameters, storey.state_index, storey.p_delta
     total = 0.0
     yielding = 0.0
-    for j in range(lay.n_floors):
-        b = below[j]
-        du = drift(y, 0, j, b)
-        if storey is None:
-            shear[row, j] = kst[j] * du
-            total += 0.5 * kst[j] * du * du
-        else:
-            smodel, sprm, sidx, kpd = storey.model, storey.parameters, storey.state_index, storey.p_delta
+    if terms is None:
+        for j in range(lay.n_floors):
+            du = drift(y, 0, j, below[j])
             hi = sidx[j]
             r = y[lay.hysteretic + hi] if hi >= 0 else 0.0
             shear[row, j] = storeys.restoring_force(smodel[j], sprm, j, kst[j], du, r)
@@ -215,6 +231,15 @@ def storey_outputs(y, lay, structure, storey, out, row):
             total += recoverable + 0.5 * kpd[j] * du * du
             if hi >= 0:
                 yielding += recoverable
+    else:
+        for j in range(lay.n_floors):
+            shear[row, j] = 0.0
+        for hi in range(storey.floor.size):
+            j = storey.floor[hi]
+            du = storey_drift(y, 0, terms, below, j)
+            yielding += storeys.recoverable_energy(smodel[j], sprm, j, terms.stiffness[j], du,
+                                                   y[lay.hysteretic + hi])
+        total = yielding
     energy[row, 0] = total
     energy[row, 1] = yielding
 

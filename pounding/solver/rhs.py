@@ -16,7 +16,8 @@ from numba import njit
 from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver import storeys
-from pounding.solver.kinematics import SIDE_TERMS, compliance, contact_sums, drift, ground_offset, ground_weight, push
+from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, drift, ground_offset, ground_weight, push,
+                                        storey_drift, storey_push, storey_stiffness)
 
 __all__ = ["stuck_constraints", "rhs", "rhs_inline", "storey_forces"]
 
@@ -192,29 +193,27 @@ def storey_forces(y, lay, below, kst, storey, out, fbuf):
 
     Writes the rates of the hysteretic states and of the storeys' work
     ∫F dΔ into *out*.  The caller has already applied ``kΔ`` and P-Delta to
-    every storey.
+    every storey (a plan model's plane: its Kelvin link carries ``kΔ``; the departure enters its
+    floors with the plane's weights, :func:`pounding.solver.kinematics.storey_push`).
     The storey kernels take the parameter table and a row (no row views:
     each would be reference-counted, in the solver's innermost loop).
     """
-    smodel, sprm, smode, sfloor = storey.model, storey.parameters, storey.mode, storey.floor
+    smodel, sprm, smode, sfloor, terms = storey.model, storey.parameters, storey.mode, storey.floor, storey.terms
     nh = sfloor.size
     n = lay.n_floors
     ih = lay.hysteretic  # first hysteretic state
     iw = lay.storey_work  # first storey work
     for hi in range(nh):
         j = sfloor[hi]
-        b = below[j]
-        du = drift(y, 0, j, b)
-        dv = drift(y, n, j, b)
+        du = storey_drift(y, 0, terms, below, j)
+        dv = storey_drift(y, n, terms, below, j)
         r = y[ih + hi]
         model = smodel[j]
-        restoring = storeys.restoring_force(model, sprm, j, kst[j], du, r)
+        k = storey_stiffness(kst, terms, j)
+        restoring = storeys.restoring_force(model, sprm, j, k, du, r)
         out[ih + hi] = storeys.state_rate(model, sprm, j, smode[hi], dv, r)
         out[iw + hi] = restoring * dv
-        departure = restoring - kst[j] * du
-        fbuf[j] += departure
-        if b >= 0:
-            fbuf[b] -= departure
+        storey_push(fbuf, terms, below, j, restoring - k * du)
 
 
 jit.stamp_solver_kernels(globals())

@@ -21,7 +21,7 @@ from pounding import hysteresis
 from pounding.solver import imk, jit
 from pounding.solver import storeys
 from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
-from pounding.solver.kinematics import drift, drift_interpolant
+from pounding.solver.kinematics import storey_drift, storey_interpolant, storey_rate_scale, storey_stiffness
 
 __all__ = ["STOREY_NONE", "STOREY_YIELD_POSITIVE", "STOREY_YIELD_NEGATIVE", "STOREY_UNLOAD", "STOREY_IMK_LOWER",
            "STOREY_IMK_UPPER", "STOREY_IMK_REVERSAL", "storey_event", "imk_event", "locate_storey_events",
@@ -33,19 +33,19 @@ STOREY_IMK_LOWER, STOREY_IMK_UPPER, STOREY_IMK_REVERSAL = 4 + imk.KIND_LOWER, 4 
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
-def storey_event(y, ynew, k1, k7, lay, j, b, hi, model, uy, mode, h):
+def storey_event(y, ynew, k1, k7, lay, j, terms, below, hi, model, uy, mode, h):
     """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
 
     Elastic mode: ``Δ − Δ_p`` reaching ``+u_y`` or ``−u_y`` (Δ_p is constant, so
     this is a crossing of the drift's Hermite cubic, found exactly by
     :func:`first_crossing`).  Yielding: the drift rate crossing 0 against
     the yield direction (the cubic of Δ̇ from Δ̇ and Δ̈ at the ends).  *uy*: its
-    yield drift, m.
+    yield drift, m.  *terms*, *below*: the storey rows' drifts (:func:`pounding.solver.kinematics.storey_drift`).
     """
     if model != hysteresis.MODEL_BILINEAR:
         return -1.0, STOREY_NONE
     n = lay.n_floors
-    d0, r0, d1, r1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, b)
+    d0, r0, d1, r1, a0, a1 = storey_interpolant(y, ynew, k1, k7, n, terms, below, j)
     ih = lay.hysteretic
     if mode == storeys.ELASTIC:
         plastic = y[ih + hi]
@@ -65,13 +65,13 @@ def storey_event(y, ynew, k1, k7, lay, j, b, hi, model, uy, mode, h):
             s = s2
             kind = STOREY_YIELD_NEGATIVE
         return s, kind if s >= 0.0 else STOREY_NONE
-    floor = DELTA_ROUNDOFF * (abs(y[n + j]) + (abs(y[n + b]) if b >= 0 else 0.0))
+    floor = DELTA_ROUNDOFF * storey_rate_scale(y, n, terms, below, j)
     s = first_crossing(r0, a0, r1, a1, h, mode < 0, floor)
     return s, STOREY_UNLOAD if s >= 0.0 else STOREY_NONE
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
-def imk_event(y, ynew, k1, k7, lay, j, b, sprm, h):
+def imk_event(y, ynew, k1, k7, lay, j, terms, below, sprm, h):
     """First branch change of IMK storey *j* inside a step: ``(fraction, STOREY_IMK_*)``, −1 if none.
 
     The drift crossing its branch's lower limit downward or its upper limit
@@ -80,7 +80,7 @@ def imk_event(y, ynew, k1, k7, lay, j, b, sprm, h):
     that direction.
     """
     n = lay.n_floors
-    d0, r0, d1, r1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, b)
+    d0, r0, d1, r1, a0, a1 = storey_interpolant(y, ynew, k1, k7, n, terms, below, j)
     lower, upper, watch = sprm[j, imk.P_LOWER], sprm[j, imk.P_UPPER], sprm[j, imk.P_WATCH]
     reach = max(abs(d0), abs(d1)) + 0.25 * h * (abs(r0) + abs(r1))
     best = -1.0
@@ -96,7 +96,7 @@ def imk_event(y, ynew, k1, k7, lay, j, b, sprm, h):
         if s >= 0.0 and (best < 0.0 or s < best):
             best, kind = s, STOREY_IMK_LOWER
     if watch != 0.0:
-        rate_floor = DELTA_ROUNDOFF * (abs(y[n + j]) + (abs(y[n + b]) if b >= 0 else 0.0))
+        rate_floor = DELTA_ROUNDOFF * storey_rate_scale(y, n, terms, below, j)
         s = first_crossing(r0, a0, r1, a1, h, watch < 0.0, rate_floor)
         if s >= 0.0 and (best < 0.0 or s < best):
             best, kind = s, STOREY_IMK_REVERSAL
@@ -112,14 +112,14 @@ def locate_storey_events(work, h, lay, below, storey, sev_s, sev_kind) -> float:
     its four state arrays each time, which measured ~6 % of an inelastic run.
     """
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
-    smodel, sprm, smode, sfloor = storey.model, storey.parameters, storey.mode, storey.floor
+    smodel, sprm, smode, sfloor, terms = storey.model, storey.parameters, storey.mode, storey.floor, storey.terms
     first = 2.0
     for hi in range(sfloor.size):
         j = sfloor[hi]
         if storeys.is_imk(smodel[j]):
-            s, kind = imk_event(y, ynew, k1, k7, lay, j, below[j], sprm, h)
+            s, kind = imk_event(y, ynew, k1, k7, lay, j, terms, below, sprm, h)
         else:
-            s, kind = storey_event(y, ynew, k1, k7, lay, j, below[j], hi, smodel[j], sprm[j, 0], smode[hi], h)
+            s, kind = storey_event(y, ynew, k1, k7, lay, j, terms, below, hi, smodel[j], sprm[j, 0], smode[hi], h)
         sev_s[hi] = s
         sev_kind[hi] = kind
         if kind != STOREY_NONE and s < first:
@@ -137,7 +137,7 @@ def apply_storey_events(kinds, y, lay, below, storey):
     unloading returns to the elastic mode.  An IMK storey moves to its next branch at the
     located drift, its shear (the state) set to that branch's (:func:`imk.apply_event`).
     """
-    sfloor, sprm, smode = storey.floor, storey.parameters, storey.mode
+    sfloor, sprm, smode, terms = storey.floor, storey.parameters, storey.mode, storey.terms
     n = lay.n_floors
     ih = lay.hysteretic
     applied = 0
@@ -147,13 +147,12 @@ def apply_storey_events(kinds, y, lay, below, storey):
             continue
         applied += 1
         j = sfloor[hi]
-        b = below[j]
-        du = drift(y, 0, j, b)
+        du = storey_drift(y, 0, terms, below, j)
         if kind >= STOREY_IMK_LOWER:
             y[ih + hi] = imk.apply_event(storey.imk[hi], sprm[j], kind - STOREY_IMK_LOWER, du, y[ih + hi],
-                                         drift(y, n, j, b))
+                                         storey_drift(y, n, terms, below, j))
             continue
-        rate = drift(y, n, j, b)
+        rate = storey_drift(y, n, terms, below, j)
         uy = sprm[j, 0]
         if kind == STOREY_YIELD_POSITIVE:
             y[ih + hi] = du - uy
@@ -177,17 +176,18 @@ def failed_storey(storey):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def collapse_crossing(work, n, below, heights, stop_ratio, h):
-    """First instant in a step where a storey's |drift| exceeds ``stop_ratio[j]·height[j]``: (fraction, floor).
+def collapse_crossing(work, n, below, heights, stop_ratio, terms, h):
+    """First instant in a step where a storey's |drift| exceeds ``stop_ratio[j]·height[j]``: (fraction, row).
 
-    *stop_ratio*: (N,) each storey's collapse drift ratio, its building's (0: no limit, not searched)."""
+    *stop_ratio*: (R,) each storey row's collapse drift ratio, its building's (0: no limit, not searched);
+    the rows are the storeys under the N floors, or a plan model's planes (*terms*, :class:`StoreyTerms`)."""
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     best = -1.0
     where = -1
-    for j in range(n):
+    for j in range(stop_ratio.size):
         if stop_ratio[j] <= 0.0:
             continue
-        d0, r0, d1, r1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, below[j])
+        d0, r0, d1, r1, a0, a1 = storey_interpolant(y, ynew, k1, k7, n, terms, below, j)
         limit = stop_ratio[j] * heights[j]
         # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|r0| + |r1|) (its basis
         # functions' bounds): search only where the limit is within reach.
@@ -238,19 +238,21 @@ def instability_crossing(work, lay, below, storey, stiffness, h):
     kpd, smodel, sprm, sidx = storey.p_delta, storey.model, storey.parameters, storey.state_index
     best = -1.0
     where = -1
-    for j in range(n):
+    for j in range(kpd.size):
+        if kpd[j] == 0.0:  # (a plan model's rows have none: its P-Delta terms are links)
+            continue
         hi = sidx[j]
         model = smodel[j]
-        if kpd[j] == 0.0 or hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
+        if hi < 0 or (model != hysteresis.MODEL_BILINEAR and model != hysteresis.MODEL_BOUC_WEN):
             continue
         bilinear = model == hysteresis.MODEL_BILINEAR
-        k = stiffness[j]
+        k = storey_stiffness(stiffness, storey.terms, j)
         if (bilinear or sprm[j, 3] >= 0.0) and sprm[j, 1] * k + kpd[j] >= 0.0:
             continue
         if bilinear and storey.mode[hi] == storeys.ELASTIC:
             continue
         reach = sprm[j, 0] if bilinear else 0.0
-        d0, v0, d1, v1, a0, a1 = drift_interpolant(y, ynew, k1, k7, n, j, below[j])
+        d0, v0, d1, v1, a0, a1 = storey_interpolant(y, ynew, k1, k7, n, storey.terms, below, j)
         # The Hermite cubic stays within max(|d0|, |d1|) + (4/27)·h·(|v0| + |v1|) (collapse_crossing).
         if max(abs(d0), abs(d1)) + 0.25 * h * (abs(v0) + abs(v1)) < reach:
             continue

@@ -39,7 +39,7 @@ VOLATILE_ATTRIBUTES = {"history", "wall_time", "model_path", "run_spec", "elapse
 VOLATILE_VARIABLES = {"wall_time", "solver_wall_time", "scenario_id"}
 
 MODELS = ["pair", "pair_inelastic", "pair_collapse", "isolated_moat", "pair_bumper", "pair_column", "pair_links",
-          "pair_wave_passage", "row_of_three", "corner_pair"]
+          "pair_wave_passage", "row_of_three", "corner_pair", "isolated_moat_plan"]
 
 #: Small studies: (name, pounding arguments), each writing ``{out}``.
 STUDIES = [
