@@ -18,7 +18,7 @@ import time as _time
 import dataclasses
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -36,10 +36,10 @@ from pounding.records.supports import SupportMotions, common_step, lagged, on_st
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, run_peaks, to_dataset
 from pounding.solver.assembly import assemble, contact_side_terms
-from pounding.model.plan_model import PlanModel
-from pounding.results.plan_dataset import plan_dataset
-from pounding.solver.plan_assembly import plan_ground_rows, plan_refusal, plan_system, plan_tolerance_factors
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, STATUS_UNSTABLE, integrate
+
+if TYPE_CHECKING:  # plan modules load only when a plan model runs (~60 ms a planar run does not pay)
+    from pounding.model.plan_model import PlanModel
 
 __all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
            "processed_record_for", "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
@@ -552,6 +552,8 @@ def plan_ground(model: PlanModel, duration: float | None = None) -> tuple[np.nda
     step = min(r.time_step for r in records)
     end = duration or model.ground_motion.duration or max(r.time_step * r.acceleration.size for r in records)
     time = np.arange(int(math.ceil(end / step + 1e-9)) + 1) * step
+    from pounding.solver.plan_assembly import plan_ground_rows
+
     return plan_ground_rows(*model.ground_motion.on_grid(time)), float(step), float(end)
 
 
@@ -634,6 +636,9 @@ def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: floa
     options = dict(record=record, scale=scale, xi=xi, contacts=contacts)
     source = model
     model = plan_with_options(model, **options)
+    from pounding.results.plan_dataset import plan_dataset
+    from pounding.solver.plan_assembly import plan_refusal, plan_system, plan_tolerance_factors
+
     refusal = plan_refusal(model)
     if refusal is not None:
         raise PoundingError(f"{model.path or model.name}: {refusal}")

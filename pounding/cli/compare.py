@@ -14,7 +14,7 @@ __all__ = ["register_cli"]
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from pounding.model.plan_model import is_plan_file
+    from pounding.model.model import is_plan_file
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)

@@ -14,7 +14,7 @@ __all__ = ["register_cli"]
 def _cmd_export_opensees(args: argparse.Namespace) -> int:
     from pounding.export.opensees import DEFAULT_DT, opensees_script_and_notes
     from pounding.model.model import load_model
-    from pounding.model.plan_model import is_plan_file
+    from pounding.model.model import is_plan_file
     from pounding.results.archive import check_not_input
     from pounding.simulation import model_inputs, record_path
 

@@ -46,7 +46,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
     from pounding.studies.engine.store import parts_dir
 
-    from pounding.model.plan_model import is_plan_file
+    from pounding.model.model import is_plan_file
 
     check_study_options(args)
     if is_plan_file(args.model):

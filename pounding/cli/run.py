@@ -232,7 +232,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     from pounding.simulation import model_inputs, simulate
 
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])   # finished by another meanwhile?
-    from pounding.model.plan_model import is_plan_file
+    from pounding.model.model import is_plan_file
 
     if is_plan_file(args.model):
         return _run_plan(args, output, started)

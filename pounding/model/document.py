@@ -33,7 +33,7 @@ from pounding.errors import ModelError
 from pounding.units import NUMBER_TEXT
 
 __all__ = ["Document", "Location", "format_location", "parse_document", "dump_document", "MAX_DEPTH",
-           "EXPANSION_FACTOR", "MAX_MERGE_DEPTH", "plural"]
+           "EXPANSION_FACTOR", "MAX_MERGE_DEPTH", "plural", "is_plan_document"]
 
 Location = tuple[str | int, ...]
 
@@ -406,3 +406,9 @@ def parse_document(text: str, label: str) -> Document:
         raise ModelError(f"the top level must be a mapping with keys buildings, contacts, ground_motion, "
                          f"solver (got {kind})", file=label, line=doc.line(()))
     return doc
+
+
+def is_plan_document(data: Any) -> bool:
+    """True if *data* (a model document) has a building with a ``plan`` key (docs/plan-models.md)."""
+    buildings = data.get("buildings") if isinstance(data, dict) else None
+    return isinstance(buildings, list) and any(isinstance(b, dict) and "plan" in b for b in buildings)

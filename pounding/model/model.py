@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from pounding.model import plan_schema, schema
-from pounding.model.document import DataSource, dump_document, parse_document
+from pounding.model import schema
+from pounding.model.document import DataSource, dump_document, is_plan_document, parse_document
 from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
 from pounding.contact.links import LinkLaw
@@ -50,6 +50,7 @@ __all__ = [
     "model_from_text",
     "model_from_data",
     "read_yaml_text",
+    "is_plan_file",
     "WALL",
     "column_weights",
     "OPEN_GAP",
@@ -1048,7 +1049,9 @@ def model_from_text(text: str, *, name: str = "model", path: str | None = None,
     """
     label = path if path is not None else f"<{name}>"
     doc = parse_document(text, label)
-    if plan_schema.is_plan_document(doc.data):
+    if is_plan_document(doc.data):
+        from pounding.model import plan_schema  # loaded for plan models only (~50 ms of pydantic classes)
+
         plan_schema.validate_plan(doc, base_dir)
         raise ModelError(PLAN_NOT_INTEGRATED, file=label)
     entry = schema.validate(schema.ModelEntry, doc.data, doc, context={"base_dir": base_dir})
@@ -1067,7 +1070,9 @@ def model_from_data(data: dict[str, Any], *, name: str = "model", source: str = 
     ModelError
         ``<location> <problem>`` (no file, no line).
     """
-    if plan_schema.is_plan_document(data):
+    if is_plan_document(data):
+        from pounding.model import plan_schema
+
         _checked(plan_schema.PlanModelEntry, data)
         raise ModelError(PLAN_NOT_INTEGRATED)
     entry = _checked(schema.ModelEntry, data)
@@ -1125,3 +1130,11 @@ def _similar_file(file: Path) -> str:
         return ""
     candidates = [str(parent / n) if str(parent) != "." or str(file).startswith(".") else n for n in names]
     return did_you_mean(str(file), candidates)
+
+
+def is_plan_file(path: str | os.PathLike) -> bool:
+    """True if the model file at *path* is a plan model (a building with ``plan:``); parse errors raise one line.
+
+    Here rather than in :mod:`pounding.model.plan_model` so that asking costs a planar run no plan module."""
+    label = os.fspath(path)
+    return is_plan_document(parse_document(read_yaml_text(label, kind="model"), label).data)

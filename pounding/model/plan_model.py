@@ -24,8 +24,8 @@ import numpy as np
 from pounding.model import plan, plan_contacts
 from pounding.model.document import parse_document
 from pounding.model.ground_pair import ground_components
-from pounding.model.model import WALL, Damping, SolverSettings, read_yaml_text
-from pounding.model.plan_schema import PlanGroundMotionEntry, PlanModelEntry, is_plan_document, validate_plan
+from pounding.model.model import WALL, Damping, SolverSettings, is_plan_file, read_yaml_text
+from pounding.model.plan_schema import PlanGroundMotionEntry, PlanModelEntry, validate_plan
 from pounding.model.schema import ModalEntry
 
 __all__ = ["PlanBuilding", "PlanContact", "PlanGroundMotion", "PlanModel", "plan_model_from_text", "load_plan_model",
@@ -293,9 +293,3 @@ def load_plan_model(path: str | os.PathLike) -> PlanModel:
     label = os.fspath(path)
     return plan_model_from_text(read_yaml_text(label, kind="model"), name=Path(label).stem, path=label,
                                 base_dir=os.path.dirname(os.path.abspath(label)))
-
-
-def is_plan_file(path: str | os.PathLike) -> bool:
-    """True if the model file at *path* is a plan model (a building with ``plan:``); parse errors raise one line."""
-    label = os.fspath(path)
-    return is_plan_document(parse_document(read_yaml_text(label, kind="model"), label).data)

@@ -1,7 +1,7 @@
 """Schema of plan models: buildings with ``plan:``, contacts found from the plan, two-component shaking.
 
 A model is a *plan model* when any building has a ``plan:`` key
-(:func:`is_plan_document`); it is then validated by :class:`PlanModelEntry`
+(:func:`pounding.model.document.is_plan_document`); it is then validated by :class:`PlanModelEntry`
 instead of :class:`pounding.model.schema.ModelEntry`, with the same one-line
 located messages (:func:`pounding.model.schema.translate`).  A planar model
 never reaches this module.  The keys are described in docs/plan-models.md.
@@ -25,19 +25,13 @@ from pounding.model.schema import (TAGS, WALL, WALL_NAME, BuildingEntry, Collaps
                                    record_reference, storey_count, units_name, validate)
 
 __all__ = ["PlaneEntry", "PlanStoreyEntry", "PlanStoreyShorthand", "PlanEntry", "PlanBuildingEntry",
-           "PlanContactEntry", "ComponentEntry", "PlanGroundMotionEntry", "PlanModelEntry", "is_plan_document",
+           "PlanContactEntry", "ComponentEntry", "PlanGroundMotionEntry", "PlanModelEntry",
            "validate_plan", "GAP_TOLERANCE"]
 
 #: An explicit ``gap`` may differ from the plan's by at most this, m.
 GAP_TOLERANCE = 1e-6
 
 Number = Annotated[float, BeforeValidator(located(as_number))]
-
-
-def is_plan_document(data: Any) -> bool:
-    """True if *data* (a model document) has a building with a ``plan`` key."""
-    buildings = data.get("buildings") if isinstance(data, dict) else None
-    return isinstance(buildings, list) and any(isinstance(b, dict) and "plan" in b for b in buildings)
 
 
 def _point(value: Any) -> tuple[float, float]:

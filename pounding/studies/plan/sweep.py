@@ -197,7 +197,7 @@ class PlanSweep(Sweep):
 
 def is_plan_sweep_file(path: str | os.PathLike) -> bool:
     """True if the sweep file at *path* names a plan model (False when it cannot tell: the planar reader reports)."""
-    from pounding.model.plan_model import is_plan_file
+    from pounding.model.model import is_plan_file
 
     try:
         data = yaml.safe_load(Path(path).read_text())
