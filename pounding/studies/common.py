@@ -13,7 +13,7 @@ from typing import Any
 
 from pounding.errors import PoundingError
 
-__all__ = ["record_list", "record_values", "study_sweep", "check_duration", "finite_or_none", "records_text",
+__all__ = ["study_parts", "record_list", "record_values", "study_sweep", "check_duration", "finite_or_none", "records_text",
            "scale_spec_text", "sweep_heading"]
 
 
@@ -125,3 +125,14 @@ def sweep_heading(sweep) -> str:
     intensity = "scale swept" if swept else scale_spec_text(ground.get("scale"))
     return f"model '{sweep.model_name}' under {records_text(records)}, {intensity}"
 
+
+def study_parts(scenarios: list, results: dict[str, dict[str, Any]], study: str) -> list[dict[str, Any]]:
+    """Each scenario's result (``not run`` where missing; a stored part of another *study* kind is an error)."""
+    parts = []
+    for s in scenarios:
+        part = results.get(s.key, {"status": "error", "error": "not run"})
+        if part.get("status") == "ok" and part.get("study") != study:
+            part = {"status": "error", "error": f"{s.label}: a stored result of another kind of study has the "
+                                                "same key; delete the .parts folder and run again"}
+        parts.append(part)
+    return parts

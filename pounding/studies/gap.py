@@ -323,18 +323,12 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     import xarray as xr
 
     from pounding import __version__
-    from pounding.studies.common import sweep_heading
+    from pounding.studies.common import study_parts, sweep_heading
     from pounding.results.checks import study_warnings
     from pounding.results.dataset import PGA_LONG_NAME
 
     scenarios = sweep.scenarios()
-    parts = []
-    for s in scenarios:
-        part = results.get(s.key, {"status": "error", "error": "not run"})
-        if part.get("status") == "ok" and part.get("study") != GAP_PART:
-            part = {"status": "error", "error": f"{s.label}: a stored result of another kind of study has the "
-                                                "same key; delete the .parts folder and run again"}
-        parts.append(part)
+    parts = study_parts(scenarios, results, GAP_PART)
     records = [str(s.coords["record"]) for s in scenarios]
     first = next((p for p in parts if p.get("status") == "ok"), None)
     contacts = first["contact"] if first else []

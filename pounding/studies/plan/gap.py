@@ -140,15 +140,13 @@ def _over_records(values: np.ndarray, ok: np.ndarray) -> dict[str, np.ndarray]:
 
 def assemble_plan_gap(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"), ran: int = 0):
     """The plan gap study's NetCDF layout: ``record`` × ``point`` (and ``face``, ``rule``)."""
-    import json
-
     import xarray as xr
 
     from pounding import __version__
     from pounding.studies.common import sweep_heading
     from pounding.studies.gap import RULES
 
-    from pounding.studies.plan.runs import study_parts
+    from pounding.studies.common import study_parts
 
     scenarios = sweep.scenarios()
     parts = study_parts(scenarios, results, PLAN_GAP_PART)
@@ -250,9 +248,6 @@ def assemble_plan_gap(sweep, results: dict[str, dict[str, Any]], *, elapsed: flo
             "Conventions": "CF-1.8",
         },
     )
-    warnings = sorted({w for p in parts if p.get("status") == "ok" for w in p.get("warnings", [])})
-    if warnings:
-        ds.attrs["warnings"] = json.dumps(warnings)
     return ds
 
 

@@ -23,12 +23,13 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import ModelError
+from pounding.studies.common import study_parts
 from pounding.studies.engine.keys import PARTS_FORMAT
 from pounding.studies.engine.tasks import one_line
 from pounding.studies.sweep.spec import strip_location
 
 __all__ = ["run_plan_scenario", "plan_peaks", "corner_peaks", "assemble_plan_sweep", "CORNERS", "PLAN_PART",
-           "floor_states", "study_parts"]
+           "floor_states"]
 
 #: Version of the plan scenario's part layout.
 PLAN_PART = "plan-1"
@@ -144,18 +145,6 @@ def _spread(shape: tuple, parts: list[dict], index: list[tuple], name: str, labe
         for label, value in zip(part.get(name, []), part.get(key, [])):
             out[where + (at[label],)] = value
     return out
-
-
-def study_parts(scenarios: list, results: dict[str, dict[str, Any]], study: str) -> list[dict[str, Any]]:
-    """Each scenario's result (``not run`` where missing; a stored part of another *study* kind is an error)."""
-    parts = []
-    for s in scenarios:
-        part = results.get(s.key, {"status": "error", "error": "not run"})
-        if part.get("status") == "ok" and part.get("study") != study:
-            part = {"status": "error", "error": f"{s.label}: a stored result of another kind of study has the "
-                                                "same key; delete the .parts folder and run again"}
-        parts.append(part)
-    return parts
 
 
 def assemble_plan_sweep(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
@@ -280,7 +269,4 @@ def assemble_plan_sweep(sweep, results: dict[str, dict[str, Any]], *, elapsed: f
         "n_run": int(ran),
         "elapsed_time": float(elapsed),
     }
-    warnings = sorted({w for p in ok_parts for w in p.get("warnings", [])})
-    if warnings:
-        attrs["warnings"] = json.dumps(warnings)
     return xr.Dataset(data, coords=coords, attrs=attrs)
