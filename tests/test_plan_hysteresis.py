@@ -10,20 +10,7 @@ from pounding.model.model import model_from_text
 from pounding.model.plan_model import plan_model_from_text
 from pounding.simulation import simulate, simulate_plan
 
-SOLVER = "solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.01}\n"
-
-
-def _record(tmp_path) -> str:
-    """A decaying two-tone record, 3 s at 0.01 s, in g."""
-    t = np.arange(301) * 0.01
-    path = tmp_path / "rec.txt"
-    np.savetxt(path, 0.35 * np.sin(2 * np.pi * 1.3 * t) * np.exp(-0.4 * t) + 0.2 * np.sin(2 * np.pi * 3.1 * t),
-               fmt="%.6f", header="units: g; dt = 0.01 s")
-    return str(path)
-
-
-def _bilinear(ratio: float, alpha: float) -> str:
-    return f"hysteresis: {{model: bilinear, yield_drift_ratio: {ratio}, post_yield_ratio: {alpha}}}"
+from plan_cases import SOLVER, bilinear as _bilinear, plan_pair as _plan_pair, two_tone_record as _record
 
 
 ECCENTRIC = """name: e
@@ -137,20 +124,6 @@ def _planar_pair(record: str, hyst: str) -> str:
             "contacts:\n  - {between: [A, B], levels: matching, gap: 0.004, law: hertz-damp, kh: 1.0e10, "
             "restitution: 0.65}\n"
             f"ground_motion: {{record: {record}, scale: 2.0, duration: 3.0}}\n" + SOLVER)
-
-
-def _plan_pair(record: str, hyst: str) -> str:
-    def building(name, outline, x0, x1, n, kx, ky, mass, modes, own):
-        planes = (f"{{direction: x, at: 0, stiffness: {kx / 2}{own}}}, {{direction: x, at: 10, stiffness: {kx / 2}{own}}}, "
-                  f"{{direction: y, at: {x0}, stiffness: {ky}}}, {{direction: y, at: {x1}, stiffness: {ky}}}")
-        storey = f"{{mass: {mass}, height: 3.2, planes: [{planes}]}}"
-        return (f"  - name: {name}\n    plan: {{outline: {outline}}}\n    storeys: [{', '.join([storey] * n)}]\n"
-                f"    damping: {{ratio: 0.05, modes: {modes}}}\n")
-    return ("name: q\nbuildings:\n"
-            + building("A", "[[0, 0], [20, 10]]", 0, 20, 3, 3.5e8, 4.4e9, 2.5e5, "[1, 3]", f", {hyst}")
-            + building("B", "[[20.004, 0], [40.004, 10]]", 20.004, 40.004, 2, 4.5e8, 5.6e9, 2.0e5, "[1, 2]", "")
-            + "contacts:\n  - {between: [A, B], levels: matching, law: hertz-damp, kh: 5.0e9, restitution: 0.65}\n"
-            f"ground_motion: {{x: {{record: {record}, scale: 2.0}}, duration: 3.0}}\n" + SOLVER)
 
 
 @pytest.mark.parametrize("hyst", [_bilinear(0.002, 0.05),

@@ -18,6 +18,12 @@ elements); this module labels what the solver returns:
 * ``contact_force`` (time, point) N, ``peak_contact_force`` and ``impact_count`` (point),
   and the impact table (``impact`` dimension) with the point's location (``impact_x``,
   ``impact_y``) and the face's tangential slip at the onset (``impact_slip``);
+* with Coulomb friction on a face (``friction:``), per friction face (``face`` dimension):
+  ``friction_normal`` and ``friction_force`` (time, face) N — the face's normal force and the
+  friction on its low side along +tangent (the high side takes the opposite) —, ``friction_state``
+  (0 open, ±1 slipping along ±tangent, 2 sticking), ``face_slip`` (time, face) m, the tangential slip
+  of the low side's face relative to the high side's, and ``energy_friction`` (time) J, the energy
+  the friction dissipated;
 * the energy audit ``energy_*`` (time) J and its closure (attribute ``energy_closure``).
 """
 
@@ -162,6 +168,43 @@ def _energies(psys: PlanSystem, raw: RawSolution, delta: np.ndarray) -> dict[str
             "energy_hysteretic": hysteretic}
 
 
+def _friction_variables(psys: PlanSystem, raw: RawSolution) -> dict[str, tuple]:
+    """The friction faces' histories (module docstring), {} without friction."""
+    system = psys.system
+    if raw.friction_history is None:
+        return {}
+    nf, lay = system.n_faces, system.layout
+    history = raw.friction_history
+    slip = penetration(raw.state[:, :system.n_floors], system.friction_floors, system.friction_weights,
+                       np.zeros(nf), np.zeros((raw.time.size, nf)))
+    dissipated = raw.state[:, lay.friction_work:lay.friction_work + nf].sum(axis=1)
+    return {"friction_normal": _var(("time", "face"), history[:, :nf], "N", "normal force on the friction face"),
+            "friction_force": _var(("time", "face"), -history[:, nf:2 * nf], "N",
+                                   "friction on the face's low side along +tangent (the high side: the opposite)"),
+            "friction_state": _var(("time", "face"), history[:, 2 * nf:].astype(np.int64), "1",
+                                   "face: 0 open, +1/-1 slipping along +/-tangent, 2 sticking"),
+            "face_slip": _var(("time", "face"), slip, "m",
+                              "tangential slip of the low side's face relative to the high side's, along +tangent"),
+            "energy_friction": _var(("time",), dissipated, "J", "energy: friction (dissipated)")}
+
+
+def _face_labels(model: PlanModel, psys: PlanSystem) -> dict[str, Any]:
+    """Coordinates of the friction faces (``face`` dimension), {} without friction."""
+    if psys.system.n_faces == 0:
+        return {}
+    names = [b.name for b in model.buildings]
+    faces = [(i, c) for i, c in enumerate(model.contacts) if c.friction]
+    between = [f"{names[c.first]}:{c.level_first}-" + ("wall" if c.second == WALL else f"{names[c.second]}:{c.level_second}")
+               for _, c in faces]
+    return {"face_index": (("face",), np.array([i for i, _ in faces], dtype=np.int64),
+                           {"units": "1", "long_name": "index of the face (as point_face)"}),
+            "face_between": (("face",), np.array(between, dtype=object), {"long_name": "the two floors of the face"}),
+            "face_tangent": (("face",), np.array([c.face.tangent for _, c in faces], dtype=object),
+                             {"long_name": "tangential direction of the face"}),
+            "face_friction_coefficient": (("face",), np.array([float(c.friction) for _, c in faces]),
+                                          {"units": "1", "long_name": "Coulomb friction coefficient"})}
+
+
 def _yielding_planes(psys: PlanSystem) -> np.ndarray:
     """Indices of the yielding planes, in the order of their hysteretic states (none without storey rows)."""
     system = psys.system
@@ -185,7 +228,7 @@ def _plane_shear(psys: PlanSystem, raw: RawSolution, drift: np.ndarray) -> np.nd
 def plan_energy_closure(ds: xr.Dataset) -> float:
     """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of a plan archive (dimensionless)."""
     parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
-             + ds.get("energy_hysteretic", 0.0))
+             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0))
     initial = float(parts[0])
     supplied = initial + ds.energy_input
     scale = float(np.abs(supplied).max())
@@ -249,6 +292,7 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
         "impact_peak_force": _var(("impact",), raw.impact_peak_force, "N", "peak force of the impact"),
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
     }
+    data.update(_friction_variables(psys, raw))
     for name, values in _energies(psys, raw, delta).items():
         label = name.removeprefix("energy_").replace("_", " ")
         data[name] = _var(("time",), values, "J", f"energy: {label}")
@@ -257,7 +301,8 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
                                            "ground acceleration along x and y")
     coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
               "direction": ("direction", np.array(["x", "y"], dtype=object), {"long_name": "plan direction"}),
-              **_floor_labels(model), **_plane_labels(model), **_point_labels(model, psys)}
+              **_floor_labels(model), **_plane_labels(model), **_point_labels(model, psys),
+              **_face_labels(model, psys)}
     ds = xr.Dataset(data, coords=coords, attrs={"title": f"pounding plan run: {model.name}", "model": model.name,
                                                 "kind": "plan_run", **(attrs or {})})
     ds.attrs["energy_closure"] = plan_energy_closure(ds)

@@ -160,7 +160,7 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground):
+def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground, friction):
     """Release of every stuck contact whose constraint force is tensile at the end of a trial step from
     *t* of *h* s (``work.forces_end``): bisected on the interpolant, into ``events.s`` and
     ``events.kind`` (EVENT_RELEASE); returns the earliest fraction (2.0 if none).  Kept out of
@@ -185,7 +185,7 @@ def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, 
                 if ground is not None:
                     fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground.now)
                 rhs(ystage, ground_at(ag, dt_rec, seg, t + mid * h_try), lay, structure, contacts, cstate, k2,
-                    fbuf, forces, storey, ground)
+                    fbuf, forces, storey, ground, friction)
                 if forces[c] < 0.0:
                     hi = mid
                 else:
@@ -319,7 +319,8 @@ def _rigid_set(kinds, contacts, cstate, active):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
+def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground,
+                           friction):
     """Closures of instantaneous contacts (``events.kind``) together with the stuck ones, when there are
     two or more of them (:func:`_rigid_set`): one impulse each from Newton's restitution as an LCP
     (:mod:`pounding.solver.simultaneous`).  Returns ``(new impact-row count, closures handled, status)``.
@@ -377,7 +378,7 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
         n_imp += 1
     for i in range(y.size):
         scratch[i] = y[i]
-    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground)
+    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground, friction)
     for i in range(n_closing):
         c = active[i]
         row = first_row + i
@@ -397,7 +398,8 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground):
+def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground,
+                         friction):
     """Apply the located events ``events.kind[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -431,7 +433,7 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
     cap = np.inf
     kinds = events.kind
     n_imp, n_applied, status = resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work,
-                                                      impacts, n_imp, storey, ground)
+                                                      impacts, n_imp, storey, ground, friction)
     if status != 0:
         return n_imp, n_applied, cap, status
     for c in range(nc):
@@ -456,7 +458,7 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
                     plastic_jump(c, scratch, lay, mass, contacts, dvg)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
-                    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground)
+                    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground, friction)
                     # touching without approach (v0 ≤ 0, e.g. at gap 0) sticks at zero force too
                     stick = forces[c] > 0.0 or (rate <= 0.0 and forces[c] >= 0.0)
                     closed[c] = False

@@ -50,7 +50,7 @@ EXCLUDED = -1.0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground):
+def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground, friction):
     """Stages 2–7 of a Dormand–Prince step of size *h* from ``work.y`` at *t* (stage 1, ``K[0]``, given).
 
     Fills ``K[1..6]`` and the 5th-order solution ``work.ynew`` (stage 7 is its rate: first same as
@@ -88,7 +88,7 @@ def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey
         if ground is not None:
             fill_grounds(ground, dt_rec, seg, at, ground.now)
         rhs_inline(target, ground_at(ag, dt_rec, seg, at), lay, structure, contacts, cstate, K[stage], fbuf, forces,
-                   storey, ground)
+                   storey, ground, friction)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)

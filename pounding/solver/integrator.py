@@ -95,11 +95,13 @@ from pounding.solver import kernels
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
 from pounding.solver.dense import interpolate
+from pounding.solver.friction_events import (add_friction_pending, apply_friction_events, keep_friction_within,
+                                             locate_friction_events, record_friction, set_friction_pending)
 from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, normed_states,
                                             stages, step_factor)
 from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
                                         kernel_terms)
-from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, Forcing, Grounds, Layout, Settings, Storeys,
+from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, Forcing, Friction, Grounds, Layout, Settings, Storeys,
                                     StoreyTerms, Structure, Work, state_layout)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_COLUMNS,
@@ -173,6 +175,11 @@ class System:
         ``Σ_k w_k·u[floor_k]`` (floor −1: none).  Then the storey fields above are per plane (R), not per
         floor, and ``storey_row_stiffness`` (R,) N/m holds each plane's elastic stiffness.  None: the
         storey under floor j, drift ``u[j] − u[below[j]]``.
+    friction_floors, friction_weights : (nf, SIDE_TERMS) int and float, optional
+        A plan model's Coulomb friction faces: face f's slip rate is ``Σ_k w_k·v[floor_k]``
+        (:class:`pounding.solver.layout.Friction`); None: no friction (the solver's friction code is pruned).
+    friction_coefficient : (nf,) μ of each face
+    friction_first_point, friction_point_count : (nf,) int, the face's contact points (consecutive contacts)
     """
 
     mass: np.ndarray
@@ -204,6 +211,11 @@ class System:
     storey_floors: np.ndarray | None = None
     storey_weights: np.ndarray | None = None
     storey_row_stiffness: np.ndarray | None = None
+    friction_floors: np.ndarray | None = None
+    friction_weights: np.ndarray | None = None
+    friction_coefficient: np.ndarray | None = None
+    friction_first_point: np.ndarray | None = None
+    friction_point_count: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         nc = int(self.contact_gap.size)
@@ -244,9 +256,14 @@ class System:
         return int((self.storey_state >= 0).sum())
 
     @property
+    def n_faces(self) -> int:
+        """Number of friction faces (0 without friction)."""
+        return 0 if self.friction_coefficient is None else int(self.friction_coefficient.size)
+
+    @property
     def layout(self) -> Layout:
         """Offsets of the state vector (:func:`pounding.solver.layout.state_layout`)."""
-        return state_layout(self.n_floors, self.n_contacts, self.n_hysteretic)
+        return state_layout(self.n_floors, self.n_contacts, self.n_hysteretic, self.n_faces)
 
     @property
     def n_states(self) -> int:
@@ -290,6 +307,7 @@ class RawSolution:
     final_time: float
     support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row (None: one ground)
     collapse_cause: str = ""         # status.COLLAPSE_CAUSES: why collapse_storey collapsed ("" if none)
+    friction_history: np.ndarray | None = None  # (nt, 3·nf): each face's N (N), λ (N), mode code (None: no friction)
 
 
 
@@ -321,13 +339,13 @@ class Integration(NamedTuple):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground) -> float:
+def _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction) -> float:
     """The state's rates *rates* at time *t* (record step *seg*), with the ground states ``ground.now``;
     returns the ground acceleration of row 0 there (m/s²).  Contact forces go to ``work.forces``."""
     ag_t = ground_at(forcing.acceleration, forcing.record_step, seg, t)
     if ground is not None:
         fill_grounds(ground, forcing.record_step, seg, t, ground.now)
-    rhs(y, ag_t, lay, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground)
+    rhs(y, ag_t, lay, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
     return ag_t
 
 
@@ -340,39 +358,49 @@ def _with_room(impacts, n_imp, nc):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, events, table, storey, ground):
-    """Apply the storey events ``events.storey_kind`` and the contact events ``events.kind`` at *t*, in
-    place: ``(n_imp, n_applied, first_step_cap, status)`` (:func:`contact_events.apply_contact_events`;
+def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, events, table, storey, ground, friction):
+    """Apply the storey events ``events.storey_kind``, the contact events ``events.kind`` and then the
+    friction faces' (which follow their points' closures and separations) at *t*, in place:
+    ``(n_imp, n_applied, first_step_cap, status)`` (:func:`contact_events.apply_contact_events`;
     *table* with room for a row per contact, :func:`_with_room`)."""
     zero = lay.n_floors - lay.n_floors
-    n_storey = zero
+    n_applied = zero
     if storey is not None:
-        n_storey = apply_storey_events(events.storey_kind, work.y, lay, structure.below, storey)
+        n_applied = apply_storey_events(events.storey_kind, work.y, lay, structure.below, storey)
+    n_imp, cap, status = table.count, np.inf, zero
     for c in range(lay.n_contacts):
         if events.kind[c] != EVENT_NONE:  # the contact events' applier is called only when there is one
             if ground is not None:
                 fill_grounds(ground, forcing.record_step, seg, t, ground.now)
-            n_imp, n_applied, cap, status = apply_contact_events(
+            n_imp, n_contact, cap, status = apply_contact_events(
                 events, t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay, structure,
-                contacts, cstate, work, table.rows, table.count, storey, ground)
-            return n_imp, n_applied + n_storey, cap, status
-    return table.count, n_storey, np.inf, zero
+                contacts, cstate, work, table.rows, table.count, storey, ground, friction)
+            n_applied += n_contact
+            break
+    if friction is not None and status == 0:
+        if ground is not None:
+            fill_grounds(ground, forcing.record_step, seg, t, ground.now)
+        n_applied += apply_friction_events(t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay,
+                                           structure, contacts, cstate, work, storey, ground, friction)
+    return n_imp, n_applied, cap, status
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _set_pending(events, s_first) -> None:
+def _set_pending(events, s_first, friction) -> None:
     """Mark the events at or before fraction *s_first* as those the retaken step ends at (all others
-    cleared; *s_first* < 0 clears every one)."""
+    cleared; *s_first* < 0 clears every one); the friction faces' too."""
     for c in range(events.kind.size):
         ok = s_first >= 0.0 and events.kind[c] != EVENT_NONE and events.s[c] <= s_first
         events.pending[c] = events.kind[c] if ok else EVENT_NONE
     for hi in range(events.storey_kind.size):
         ok = s_first >= 0.0 and events.storey_kind[hi] != STOREY_NONE and events.storey_s[hi] <= s_first
         events.storey_pending[hi] = events.storey_kind[hi] if ok else STOREY_NONE
+    if friction is not None:
+        set_friction_pending(friction, s_first)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _keep_events_within(events, h, tiny) -> None:
+def _keep_events_within(events, h, tiny, friction) -> None:
     """Drop the located events later than *tiny* seconds into a step of *h* s (those at its start stay)."""
     for c in range(events.kind.size):
         if events.kind[c] != EVENT_NONE and events.s[c] * h > tiny:
@@ -380,10 +408,12 @@ def _keep_events_within(events, h, tiny) -> None:
     for hi in range(events.storey_kind.size):
         if events.storey_kind[hi] != STOREY_NONE and events.storey_s[hi] * h > tiny:
             events.storey_kind[hi] = STOREY_NONE
+    if friction is not None:
+        keep_friction_within(friction, h, tiny)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def _with_pending(events) -> bool:
+def _with_pending(events, friction) -> bool:
     """Add the pending events (those the retaken step was shortened to) to the located ones; any left?"""
     found = False
     for c in range(events.kind.size):
@@ -396,6 +426,8 @@ def _with_pending(events) -> bool:
             events.storey_kind[hi] = events.storey_pending[hi]
         if events.storey_kind[hi] != STOREY_NONE:
             found = True
+    if friction is not None:
+        found = add_friction_pending(friction) or found
     return found
 
 
@@ -491,8 +523,9 @@ def _new_events(contacts, nh, tol):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_initial):
-    """The run (module docstring); *storey*, *ground* None: their blocks are pruned at compile time."""
+def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial):
+    """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile
+    time."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
     dt_rec, t_end, output_dt = forcing.record_step, settings.end_time, settings.output_step
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
@@ -513,9 +546,11 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     t, seg = 0.0, zero
-    ag_t = _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground)
+    ag_t = _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
     # No contact force in the first sample (work.forces_end is still all 0; a link's first force is not kept).
     record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces_end, storey, ground, out)
+    if friction is not None:
+        record_friction(zero, friction)
     h, n_steps, n_rej, status, collapse_floor, i_out = settings.first_step, zero, zero, zero, zero - 1, zero + 1
     tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
     window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
@@ -530,53 +565,57 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             h_try = room
         h_before_events = h_try  # the error-controlled size a located event shortens
         rejected, n_retake, collapse_pending = False, zero, False
-        _set_pending(events, -1.0)
+        _set_pending(events, -1.0, friction)
         while True:  # attempt -> locate -> retake, or apply events at the step's start and attempt again
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
-            stages(work, h_try, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground)
+            stages(work, h_try, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground, friction)
             err, finite = error_norm(work, h_try, tol, normed, rtol)
             if not finite or err > 1.0:
                 n_rej += 1
                 rejected = True
                 h_try *= step_factor(err, finite, False)
                 h_before_events, n_retake, collapse_pending = h_try, zero, False
-                _set_pending(events, -1.0)
+                _set_pending(events, -1.0, friction)
                 continue
             s_first, n_release = locate_contact_events(work, h_try, t, seg, forcing, lay, contacts, cstate, events,
                                                        ground)
+            if friction is not None:  # before locate_releases: friction.force still holds the step's end
+                s_first = min(s_first, locate_friction_events(work, h_try, t, seg, forcing, lay, structure, contacts,
+                                                              cstate, storey, ground, friction))
             if n_release > 0:
                 s_first = min(s_first, locate_releases(work, h_try, t, seg, forcing, lay, structure, contacts, cstate,
-                                                       events, storey, ground))
+                                                       events, storey, ground, friction))
             collapse_s = -1.0
             if storey is not None:
                 s_first, collapse_s, collapse_floor, stop_status = _locate_storeys(
                     work, h_try, lay, structure, storey, events, s_first, collapse_floor, stop_status)
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
-                _keep_events_within(events, h_try, tiny)
+                _keep_events_within(events, h_try, tiny, friction)
                 if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
                     status = stop_status
                     break
                 impacts = _with_room(impacts, n_imp, nc)
                 n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
-                                                              events, ImpactTable(impacts, n_imp), storey, ground)
+                                                              events, ImpactTable(impacts, n_imp), storey, ground,
+                                                              friction)
                 window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
                 if window_events > event_cap:
                     status = STATUS_EVENT_LIMIT
                 if status != 0:
                     break
-                _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground)
+                _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
                 n_retake, collapse_pending = zero, False
-                _set_pending(events, -1.0)
+                _set_pending(events, -1.0, friction)
                 continue
             if s_first < 1.0 - EVENT_END_TOLERANCE and n_retake < MAX_RETAKES:
                 # Retake the step to end at the first event; the retaken step is searched again.
-                _set_pending(events, s_first)
+                _set_pending(events, s_first, friction)
                 collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
                 h_try = s_first * h_try
                 n_retake += 1
@@ -598,14 +637,17 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
             t_o = min(i_out * output_dt, t_new)
             s = (t_o - t) / h_used
             interpolate(work, h_used, s, ystage)
-            ag_o = _rates_at(t_o, seg, ystage, k2, forcing, lay, structure, contacts, cstate, work, storey, ground)
+            ag_o = _rates_at(t_o, seg, ystage, k2, forcing, lay, structure, contacts, cstate, work, storey, ground,
+                             friction)
             record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, forces, storey, ground, out)
+            if friction is not None:
+                record_friction(i_out, friction)
             i_out += 1
         t = t_new  # accept
         _accept(work)
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
-        any_events = _with_pending(events)
+        any_events = _with_pending(events, friction)
         if storey is not None:  # located: this step ends where the drift limit is first exceeded (or stability lost)
             status = stop_status if collapse_s >= 0.0 or collapse_pending else status
         if status != 0:
@@ -613,12 +655,13 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
         if any_events:
             impacts = _with_room(impacts, n_imp, nc)
             n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
-                                                          events, ImpactTable(impacts, n_imp), storey, ground)
+                                                          events, ImpactTable(impacts, n_imp), storey, ground,
+                                                              friction)
         if any_events and n_applied > 0:
             window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
-            _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground)
+            _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -630,8 +673,10 @@ def _integrate(lay, structure, contacts, storey, ground, forcing, settings, y_in
     if status == 0 and i_out < n_out:
         # t_end reached within round-off before the last output sample: fill it.
         for i2 in range(i_out, n_out):
-            ag_t = _rates_at(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground)
+            ag_t = _rates_at(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
             record_sample(i2, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
+            if friction is not None:
+                record_friction(i2, friction)
         i_out = n_out
     if status != STATUS_COLLAPSED and status != STATUS_UNSTABLE:
         collapse_floor = zero - 1
@@ -738,8 +783,9 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     settings = Settings(float(time_step), float(duration), float(rtol), float(atol), float(atol_velocity),
                         float(output_dt), float(first_step), factors)
     storey = _storey_arguments(system, float(atol))
-    raw = _integrate(system.layout, structure, contacts, storey, ground, Forcing(ag, float(time_step)), settings,
-                     y_initial)
+    friction = _friction_argument(system, float(duration), float(output_dt))
+    raw = _integrate(system.layout, structure, contacts, storey, ground, friction, Forcing(ag, float(time_step)),
+                     settings, y_initial)
     out, impacts, trace = raw.outputs, raw.impacts, raw.trace
     return RawSolution(out.time, out.state, out.acceleration, out.force, out.ground, out.potential,
                        raw.peaks.displacement, raw.peaks.drift, raw.peaks.force,
@@ -750,7 +796,24 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        out.shear, out.storey_energy, raw.final_state.copy(), int(raw.collapse_floor),
                        int(raw.n_steps), int(raw.n_rejected), int(raw.status), float(raw.final_time),
                        None if ground is None else out.support,
-                       _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)))
+                       _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)),
+                       None if friction is None else friction.history[:out.time.size].copy())
+
+
+def _friction_argument(system: System, duration: float, output_dt: float) -> Friction | None:
+    """The compiled integrator's *friction* argument: None without friction faces, else a
+    :class:`~pounding.solver.layout.Friction` with every face open and a history of the run's
+    output samples (the integrator's count: ``floor(duration/output_dt + 1e-9) + 1``)."""
+    nf = system.n_faces
+    if nf == 0:
+        return None
+    floors, weights = kernel_terms(system.friction_floors, system.friction_weights)
+    n_out = int(math.floor(duration / output_dt + 1e-9)) + 1
+    return Friction(floors, weights, np.ascontiguousarray(system.friction_coefficient, dtype=np.float64),
+                    np.ascontiguousarray(system.friction_first_point, dtype=np.int64),
+                    np.ascontiguousarray(system.friction_point_count, dtype=np.int64),
+                    np.zeros(nf, dtype=np.int64), np.ones(nf), np.zeros(nf), np.zeros(nf), np.full(nf, -1.0),
+                    np.zeros(nf, dtype=np.int64), np.zeros(nf, dtype=np.int64), np.zeros((n_out, 3 * nf)))
 
 
 def _collapse_cause(storey: Storeys | None, status: int, floor: int) -> str:

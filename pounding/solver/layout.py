@@ -2,12 +2,13 @@
 
 The state vector of a run is, in this order (docs/numerics.md)::
 
-    [u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, r (nh), W (nh), W_g]
+    [u (N), v (N), impulse (nc), work (nc), q (nc), E_input, E_damping, D (nf), r (nh), W (nh), W_g]
 
 ``u``, ``v``: floor displacements (m) and velocities (m/s) relative to each
 floor's ground; per contact its impulse ∫F dt (N·s), its work ∫F·δ̇ dt (J)
 and its law's internal state ``q``; the input and the Rayleigh-damped energy
-(J); per yielding storey its hysteretic state ``r`` and its work ∫F dΔ (J);
+(J); per friction face the energy its friction dissipated ∫λ·v_t dt (J; none without
+friction, nf = 0); per yielding storey its hysteretic state ``r`` and its work ∫F dΔ (J);
 the work of the contact forces on the differential ground motion (J).
 :func:`state_layout` builds the offsets once (:class:`Layout`); the solver
 and :mod:`pounding.results.dataset` both read them from there.
@@ -22,6 +23,7 @@ costs nothing at a call):
 * :class:`Storeys` — yielding storeys, P-Delta and the collapse limit (None when there are none);
 * :class:`StoreyTerms` — the drifts of a plan model's planes as weighted sums of floor DOF (``Storeys.terms``;
   None for a row of shear buildings, whose storey drift is ``u[j] − u[below[j]]``);
+* :class:`Friction` — Coulomb friction faces of a plan model (None without friction);
 * :class:`Grounds` — the support motions with several grounds (None with one common ground);
 * :class:`Settings` — record step, duration, tolerances and output step;
 * :class:`Forcing` — the ground acceleration of ground row 0 and its sample interval;
@@ -35,7 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "RigidWork", "Storeys", "StoreyTerms", "Grounds", "Settings",
+__all__ = ["Layout", "state_layout", "Structure", "Contacts", "ContactState", "RigidWork", "Storeys", "StoreyTerms", "Friction", "Grounds", "Settings",
            "Forcing", "Events", "Work"]
 
 
@@ -51,19 +53,24 @@ class Layout(NamedTuple):
     internal: int        #: first contact internal state, 2N + 2nc
     input_energy: int    #: E_input, 2N + 3nc
     damping_energy: int  #: E_damping, 2N + 3nc + 1
-    hysteretic: int      #: first storey hysteretic state, 2N + 3nc + 2
-    storey_work: int     #: first storey work, 2N + 3nc + 2 + nh
+    hysteretic: int      #: first storey hysteretic state, 2N + 3nc + 2 + nf
+    storey_work: int     #: first storey work, 2N + 3nc + 2 + nf + nh
     ground_work: int     #: W_g, the last state
     size: int            #: length of the state vector
+    n_faces: int = 0     #: nf, friction faces
+    friction_work: int = -1  #: first friction face's dissipated energy, 2N + 3nc + 2
 
 
-def state_layout(n_floors: int, n_contacts: int, n_hysteretic: int) -> Layout:
-    """The :class:`Layout` of *n_floors* floors, *n_contacts* contacts and *n_hysteretic* yielding storeys."""
-    n, nc, nh = int(n_floors), int(n_contacts), int(n_hysteretic)
-    hysteretic = 2 * n + 3 * nc + 2
+def state_layout(n_floors: int, n_contacts: int, n_hysteretic: int, n_faces: int = 0) -> Layout:
+    """The :class:`Layout` of *n_floors* floors, *n_contacts* contacts, *n_hysteretic* yielding storeys
+    and *n_faces* friction faces (their states sit before the storeys': without friction every offset
+    is the one of a run without faces)."""
+    n, nc, nh, nf = int(n_floors), int(n_contacts), int(n_hysteretic), int(n_faces)
+    friction_work = 2 * n + 3 * nc + 2
+    hysteretic = friction_work + nf
     size = hysteretic + 2 * nh + 1
     return Layout(n, nc, nh, n, 2 * n, 2 * n + nc, 2 * n + 2 * nc, 2 * n + 3 * nc, 2 * n + 3 * nc + 1, hysteretic,
-                  hysteretic + nh, size - 1, size)
+                  hysteretic + nh, size - 1, size, nf, friction_work)
 
 
 class Structure(NamedTuple):
@@ -144,6 +151,30 @@ class Storeys(NamedTuple):
     stop_ratio: np.ndarray   #: (R,) drift ratio of the storey that ends the run, its building's collapse (0: never)
     imk: np.ndarray          #: (nh, imk.N_STATE) discrete state of each IMK storey (other rows unused)
     terms: StoreyTerms | None  #: a plan model's plane drifts; None: storey j's drift is u[j] − u[below[j]]
+
+
+class Friction(NamedTuple):
+    """Coulomb friction faces of a plan model (the solver's *friction* argument; nf faces).
+
+    A face's tangential slip rate is ``v_t = Σ_k weights[4f + k]·v[floors[4f + k]]`` (the low side's
+    material point on its face minus the high side's, along +tangent); its friction λ (N, positive
+    resisting +v_t) enters the floors as ``weights·λ`` (virtual work), like a contact force.  Its normal
+    force N is the sum of its points' forces (contacts ``first_point … first_point + point_count − 1``).
+    """
+
+    floors: np.ndarray       #: (nf·SIDE_TERMS,) int, slip terms (an absent term: floor 0, weight 0)
+    weights: np.ndarray      #: (nf·SIDE_TERMS,) float
+    coefficient: np.ndarray  #: (nf,) μ
+    first_point: np.ndarray  #: (nf,) int, the face's first contact point
+    point_count: np.ndarray  #: (nf,) int, its number of points
+    mode: np.ndarray         #: (nf,) int, FRICTION_OFF / SLIP / STICK (changed at events)
+    direction: np.ndarray    #: (nf,) ±1.0, the slip direction while slipping
+    force: np.ndarray        #: (nf,) N, λ of the last right-hand side (scratch)
+    normal: np.ndarray       #: (nf,) N, N of the last right-hand side (scratch)
+    event_s: np.ndarray      #: (nf,) fraction of the trial step of each face's next event (−1: none)
+    event_kind: np.ndarray   #: (nf,) int, its kind (pounding.solver.friction FRICTION_EVENT_*)
+    pending: np.ndarray      #: (nf,) int, events the retaken step was shortened to end at
+    history: np.ndarray      #: (n_out, 3·nf) N, λ and the mode code at each output sample
 
 
 class Grounds(NamedTuple):

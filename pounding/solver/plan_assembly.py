@@ -30,7 +30,13 @@ integrated now"):
   its link's ``kΔ`` through the same weights (its state, events, work and error-norm
   entry those of a yielding storey), and every plane's drift ratio is watched.
 
-Not yet integrated (one line, :func:`plan_refusal`): friction.
+* a face with ``friction: μ`` is a friction face (:class:`pounding.solver.layout.Friction`): its
+  slip terms are the face's slip weights (each side's u_t and θ, the low side on the left), its
+  points the face's consecutive contacts.
+
+Refused in one line (:func:`plan_refusal`): friction in a model with an instantaneous contact law
+(stereo-mechanical) anywhere, whose stuck contacts are constraints of their own not solved jointly
+with the sticking faces.
 """
 
 from __future__ import annotations
@@ -81,8 +87,10 @@ class PlanSystem:
 
 def plan_refusal(model: PlanModel) -> str | None:
     """Why *model* cannot be run yet (one line), or None."""
-    if any(c.friction for c in model.contacts):
-        return "friction is read but not yet integrated"
+    if any(c.friction for c in model.contacts) and any(c.law.instantaneous for c in model.contacts):
+        return ("friction with an instantaneous contact law (stereo-mechanical) elsewhere in the model is not "
+                "supported: its stuck contacts are not solved together with the sticking faces; use a compliant "
+                "law such as hertz-damp on every contact")
     return None
 
 
@@ -144,6 +152,7 @@ def plan_system(model: PlanModel) -> PlanSystem:
     for b, offset in zip(model.buildings, offsets):
         if b.p_delta:
             links += [(k, a, offset, storey) for storey, k, a in plan_geometric_terms(list(b.storeys))]
+    friction = _friction_arrays(model, offsets, point_face)
     rows = plane_storey_arrays(model, [(offset, storey, a) for _, a, offset, storey in links[:len(plane_stiffness)]])
     for stiffness, a, offset, storey in links:
         upper, lower = _drift_sides(offset, a, storey)
@@ -170,9 +179,39 @@ def plan_system(model: PlanModel) -> PlanSystem:
         contact_weights=np.ascontiguousarray(np.array(weights, dtype=float).reshape(nc, SIDE_TERMS)),
         floor_ground=floor_ground,
         contact_ground_left=np.full(nc, GROUND_NONE, dtype=np.int64),
-        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64), **rows)
+        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64), **rows, **friction)
     return PlanSystem(system, n_points, len(plane_stiffness), np.asarray(plane_stiffness, dtype=float),
                       np.asarray(point_face, dtype=np.int64), np.asarray(locations, dtype=float).reshape(n_points, 2))
+
+
+def _friction_arrays(model: PlanModel, offsets: list[int], point_face: list[int]) -> dict[str, np.ndarray]:
+    """The :class:`System` friction fields of *model*'s faces with ``friction`` (μ > 0), or {} without.
+
+    A face's slip terms are its points' (shared) slip weights, the low side first as its contacts'
+    sides; *point_face* the face of every contact point, in the solver's contact order.
+    """
+    floors, weights, coefficient, first, count = [], [], [], [], []
+    for face_index, contact in enumerate(model.contacts):
+        if not contact.friction:
+            continue
+        own = offsets[contact.first] + DOF_PER_FLOOR * (contact.level_first - 1)
+        other = None if contact.second == WALL else offsets[contact.second] + DOF_PER_FLOOR * (contact.level_second - 1)
+        slip = contact.points[0].slip
+        one = _side(_floor_terms(own, slip[0]))
+        two = _side([] if other is None else _floor_terms(other, slip[1]))
+        left, right = (one, two) if contact.face.first_low else (two, one)
+        floors.append([f for f, _ in left + right])
+        weights.append([w for _, w in left + right])
+        coefficient.append(float(contact.friction))
+        first.append(point_face.index(face_index))
+        count.append(point_face.count(face_index))
+    if not coefficient:
+        return {}
+    nf = len(coefficient)
+    return dict(friction_floors=np.array(floors, dtype=np.int64).reshape(nf, SIDE_TERMS),
+                friction_weights=np.array(weights, dtype=float).reshape(nf, SIDE_TERMS),
+                friction_coefficient=np.array(coefficient, dtype=float),
+                friction_first_point=np.array(first, dtype=np.int64), friction_point_count=np.array(count, dtype=np.int64))
 
 
 def plane_storey_arrays(model: PlanModel, drifts: list[tuple[int, int, np.ndarray]]) -> dict[str, np.ndarray]:

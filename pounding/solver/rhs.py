@@ -16,6 +16,7 @@ from numba import njit
 from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver import storeys
+from pounding.solver.friction_forces import friction_forces
 from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, drift, ground_offset, ground_weight, push,
                                         storey_drift, storey_push, storey_stiffness)
 
@@ -61,7 +62,7 @@ def stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
-def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground):
+def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground, friction):
     """Time derivative of the state; contact forces are written to *forces*.
 
     With several grounds (*ground* not None) each floor takes its own ground's
@@ -74,7 +75,8 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
     the two floors moving together, found by Gauss–Seidel sweeps (exact in one
     sweep when no two stuck contacts share a floor); it may come out tensile,
     which the solver locates as the release event.  *lay*: the state's
-    :class:`~pounding.solver.layout.Layout`.
+    :class:`~pounding.solver.layout.Layout`.  *friction* (None without friction faces, pruned):
+    the faces' Coulomb friction after every contact force (:mod:`pounding.solver.friction_forces`).
     """
     mass, kst, below, a0, a1, dstart, dsize, doff, dvals = structure
     cf, cw, cgap, claw, cprm = contacts
@@ -150,6 +152,8 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
                 fbuf[cf[k]] += cw[k] * f
     if n_stuck > 0:
         stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground)
+    if friction is not None:
+        friction_forces(y, ag_t, mass, friction, forces, fbuf, out, lay.friction_work, ground)
     e_in_rate = 0.0
     if ground is None:
         for c in range(nc):
