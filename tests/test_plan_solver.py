@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pounding.errors import PoundingError
 from pounding.model.model import model_from_text
 from pounding.model.plan_model import plan_model_from_text
 from pounding.simulation import simulate, simulate_plan
@@ -189,12 +188,6 @@ buildings:
     mirrored = swapped.displacement.values * np.array([-1.0, 1.0])
     assert np.allclose(turned.displacement.values, mirrored, rtol=0, atol=1e-8 * scale)
     assert np.allclose(turned.peak_displacement.values, swapped.peak_displacement.values, rtol=1e-8)
-
-
-def test_friction_is_refused_in_one_line():
-    friction = _free_floor("law: hertz-damp, kh: 1.0e9, restitution: 0.6, friction: 0.3", lever=0.0)
-    with pytest.raises(PoundingError, match="friction is read but not yet integrated$"):
-        simulate_plan(friction)
 
 
 def test_pounding_run_writes_a_labelled_plan_archive(tmp_path, capsys):

@@ -330,9 +330,21 @@ def plan_summary(ds: xr.Dataset) -> str:
             floor, corner, value = peak_corner(ds, name)
             lines.append(f"    peak corner displacement {1e3 * value:.2f} mm at floor {floor}, "
                          f"{ds.corner.values[corner]} corner")
+    if "energy_friction" in ds:
+        lines.append(_friction_line(ds))
     lines.append(f"  impacts {int(ds.impact_count.sum())} at {int((ds.impact_count > 0).sum())} of "
                  f"{ds.sizes.get('point', 0)} points; energy closure {ds.attrs['energy_closure']:.1e}")
     return "\n".join(lines)
+
+
+def _friction_line(ds: xr.Dataset) -> str:
+    """One summary line: the friction faces' largest force and slip, their stuck samples, the energy dissipated."""
+    force = float(np.abs(ds.friction_force).max())
+    slip = float(np.abs(ds.face_slip).max())
+    stuck = int((ds.friction_state == 2).any("face").sum())
+    return (f"  friction on {ds.sizes['face']} face(s): peak force {force / 1e3:.1f} kN, peak slip "
+            f"{1e3 * slip:.2f} mm, sticking at {stuck} of {ds.sizes['time']} samples, "
+            f"dissipated {float(ds.energy_friction[-1]) / 1e3:.1f} kJ")
 
 
 def compare_plan_runs(before: xr.Dataset, after: xr.Dataset, name: str = "archive") -> str:
