@@ -40,8 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pounding.errors import PoundingError
-from pounding.studies.ida.plan import (VARIANTS, Hunt, IdaPlan, IntensityMeasure, check_ida_inputs, check_run_count,
-                                       collapse_drifts, resolve_scaling, with_collapse_drift)
+from pounding.studies.ida.plan import Hunt, IdaPlan, check_ida_inputs, finish_ida_plan, ida_measure, with_collapse_drift
 from pounding.studies.ida.runs import IDA_PART, run_ida_scenario
 
 __all__ = ["ORIENTATIONS", "BUILDING_PEAKS", "build_pair_ida_plan", "oriented_document",
@@ -103,13 +102,7 @@ def build_pair_ida_plan(model: str | os.PathLike, records: str | list[str] | Non
                                                             duration)
     base = load_plan_model(model)   # the model's own errors, with its file name
     label = os.fspath(model)
-    names = [b.name for b in base.buildings]
-    if building is None:
-        building = names[0]
-    elif building not in names:
-        raise PoundingError(f"--building {building!r}: the model has buildings {', '.join(names)}")
-    period = float(base.buildings[names.index(building)].periods[0]) if im == "sa-t1" else float("nan")
-    measure = IntensityMeasure(im, building, period, pair=True)
+    measure = ida_measure(base, im, building, pair=True)
     if without_contacts and not base.contacts:
         raise PoundingError(f"{label}: --without-contacts needs a model with contacts")
     pairs = pair_values(records) if records is not None else [_model_pair(base, label)]
@@ -140,17 +133,10 @@ def build_pair_ida_plan(model: str | os.PathLike, records: str | list[str] | Non
             stored.append(value)
             norm.append(value_nm)
             errors.append(error)
-    im_stored = np.array(stored)
-    scaling, normalisation, unit = resolve_scaling(scaling, im_stored, np.array(norm), errors)
-    variants = VARIANTS if without_contacts else VARIANTS[:1]
-    check_run_count(len(labels), len(variants), levels, hunt)
-    return IdaPlan(sweep=sweep, records=labels, documents=documents, im=measure, im_stored=im_stored,
-                   normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=names,
-                   variants=variants, limits=drift_limits, collapse_drift=collapse_drift, levels=levels,
-                   hunt=hunt, mce=mce, model_path=os.path.abspath(label), model_name=base.name, errors=errors,
-                   pairs=tuple(components),
-                   **dict(zip(("collapse_drifts", "collapse_sources"),
-                              collapse_drifts(base, override, max(drift_limits)))))
+    return finish_ida_plan(base, sweep, labels, documents, measure, stored, norm, errors, scaling=scaling,
+                           without_contacts=without_contacts, limits=drift_limits, collapse_drift=collapse_drift,
+                           override=override, levels=levels, hunt=hunt, mce=mce, path=os.path.abspath(label),
+                           pairs=tuple(components))
 
 
 def _building_peaks(peaks: dict[str, Any], buildings: list[str]) -> dict[str, list[float]]:

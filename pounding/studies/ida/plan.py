@@ -25,7 +25,8 @@ from pounding.units import STANDARD_GRAVITY
 __all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "SA_DAMPING", "LEVEL_DECIMALS",
            "LEVEL_RESOLUTION", "MAX_IDA_RUNS", "IntensityMeasure",
            "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity",
-           "collapse_drifts", "with_collapse_drift", "check_ida_inputs", "resolve_scaling", "check_run_count"]
+           "collapse_drifts", "with_collapse_drift", "check_ida_inputs", "resolve_scaling", "check_run_count",
+           "ida_measure", "finish_ida_plan"]
 
 #: The two variants of every scenario: the model as given, and with its contacts held open.
 VARIANTS = ("with_contacts", "without_contacts")
@@ -445,6 +446,18 @@ def check_run_count(records: int, variants: int, levels: np.ndarray | None, hunt
                             f"{MAX_IDA_RUNS} allowed: use fewer records, levels or --runs-per-record")
 
 
+def ida_measure(model, im: str, building: str | None, *, pair: bool = False) -> IntensityMeasure:
+    """The IDA's IM on *model* (planar or plan): T1 the first period of *building* (default: the first
+    building; an unknown name is refused in one line)."""
+    names = [b.name for b in model.buildings]
+    if building is None:
+        building = names[0]
+    elif building not in names:
+        raise PoundingError(f"--building {building!r}: the model has buildings {', '.join(names)}")
+    period = float(model.buildings[names.index(building)].periods[0]) if im == "sa-t1" else float("nan")
+    return IntensityMeasure(im, building, period, pair=pair)
+
+
 def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = None, *, im: str = "sa-t1",
                    building: str | None = None, levels: Any = None, hunt: Hunt | None = None,
                    without_contacts: bool = False, limits: Any = None, collapse_drift: float | None = None,
@@ -490,13 +503,7 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
 
     base = load_model(model)   # the model's own errors, with its file name
     base.refuse_building_records("pounding ida (it scales one record)")
-    names = [b.name for b in base.buildings]
-    if building is None:
-        building = names[0]
-    elif building not in names:
-        raise PoundingError(f"--building {building!r}: the model has buildings {', '.join(names)}")
-    period = float(base.buildings[names.index(building)].periods[0]) if im == "sa-t1" else float("nan")
-    measure = IntensityMeasure(im, building, period)
+    measure = ida_measure(base, im, building)
     if without_contacts and not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: --without-contacts needs a model with contacts")
 
@@ -531,16 +538,29 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
             stored.append(float("nan"))
             norm.append(float("nan"))
             errors.append(f"{sweep.label}: record {s.coords['record']}: {' '.join(str(exc).split())}")
+    return finish_ida_plan(base, sweep, recs, documents, measure, stored, norm, errors, scaling=scaling,
+                           without_contacts=without_contacts, limits=drift_limits, collapse_drift=collapse_drift,
+                           override=override, levels=levels, hunt=hunt, mce=mce, path=path)
+
+
+def finish_ida_plan(base, sweep, records: list[str], documents: list[dict], measure: IntensityMeasure,
+                    stored: list[float], norm: list[float], errors: list[str | None], *, scaling: str,
+                    without_contacts: bool, limits: tuple[float, ...], collapse_drift: float,
+                    override: float | None, levels: np.ndarray | None, hunt: Hunt | None, mce: float | None,
+                    path: str, pairs: tuple[tuple[str, str], ...] = ()) -> IdaPlan:
+    """The :class:`IdaPlan` of checked inputs and every record's IM as stored (*stored*, m/s²), FEMA P695 NM
+    (*norm*, NaN if none) and error: the scaling resolved (:func:`resolve_scaling`), the run count checked,
+    each building's collapse drift ratio (*override*: ``--collapse-drift``)."""
     im_stored = np.array(stored)
     scaling, normalisation, unit = resolve_scaling(scaling, im_stored, np.array(norm), errors)
     variants = VARIANTS if without_contacts else VARIANTS[:1]
-    check_run_count(len(recs), len(variants), levels, hunt)
-    return IdaPlan(sweep=sweep, records=recs, documents=documents, im=measure, im_stored=im_stored,
-                   normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=names,
-                   variants=variants, limits=drift_limits, collapse_drift=float(collapse_drift), levels=levels,
-                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors,
-                   **dict(zip(("collapse_drifts", "collapse_sources"),
-                              collapse_drifts(base, override, max(drift_limits)))))
+    check_run_count(len(records), len(variants), levels, hunt)
+    return IdaPlan(sweep=sweep, records=records, documents=documents, im=measure, im_stored=im_stored,
+                   normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=[b.name for b in
+                                                                                               base.buildings],
+                   variants=variants, limits=limits, collapse_drift=float(collapse_drift), levels=levels,
+                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors, pairs=pairs,
+                   **dict(zip(("collapse_drifts", "collapse_sources"), collapse_drifts(base, override, max(limits)))))
 
 
 def with_collapse_drift(document: dict, drift_ratio: float) -> dict:
