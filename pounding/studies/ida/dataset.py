@@ -57,8 +57,12 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
     first = next((p for p in parts.values() if run_outcome(p) != "failed"), None)
     storeys = first["storeys"]["storey"] if first else []
     storey_building = first["storeys"]["building"] if first else []
-    contacts = first["contacts"]["contact"] if first else []
+    # Contacts by label over every run (a plan model's runs without contacts have none: 0 impacts there).
+    contacts = list(dict.fromkeys(c for p in parts.values() if run_outcome(p) != "failed"
+                                  for c in p["contacts"]["contact"]))
+    contact_index = {c: k for k, c in enumerate(contacts)}
     ns, nc = len(storeys), len(contacts)
+    extra = {name: np.full((nv, nr, nl, nb), np.nan) for name in (first or {}).get("building_peaks", {})}
 
     level_value = np.full((nv, nr, nl), np.nan)
     intensity = np.full((nv, nr, nl), np.nan)
@@ -97,8 +101,13 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         collapse_building[i, r, j] = collapse_building_of(part)
         peak_drift[i, r, j] = part["storeys"]["peak_drift_ratio"]
         residual[i, r, j] = [np.nan if x is None else x for x in part["storeys"]["residual_drift_ratio"]]
-        impacts[i, r, j] = part["contacts"]["impact_count"]
-        force[i, r, j] = part["contacts"]["peak_contact_force"]
+        at = [contact_index[c] for c in part["contacts"]["contact"]]
+        if len(at) < nc:
+            impacts[i, r, j], force[i, r, j] = 0, 0.0
+        impacts[i, r, j, at] = part["contacts"]["impact_count"]
+        force[i, r, j, at] = part["contacts"]["peak_contact_force"]
+        for name, values in part.get("building_peaks", {}).items():
+            extra[name][i, r, j] = values
         collapse_time[i, r, j] = np.nan if part.get("collapse_time") is None else part["collapse_time"]
         collapse_storey[i, r, j] = part.get("collapse_storey", "")
     status[status == ""] = "not run"
@@ -148,6 +157,11 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "normalisation_factor": var(("record",), plan.normalisation, "1",
                                     "FEMA P695 normalisation factor NM (1 with per-record scaling)"),
     }
+    if extra:
+        from pounding.studies.ida.pairs import BUILDING_PEAKS
+
+        for name, values in extra.items():
+            data_vars[name] = var(run + ("building",), values, *BUILDING_PEAKS[name])
     if not stripes:
         data_vars["level_value"] = var(run, level_value, "m s-2", "the level of each run (the record's own "
                                        "IM with per-record scaling; the set's median with FEMA P695 scaling)")
@@ -216,6 +230,10 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
                             {"units": "1", "long_name": "lognormal fragility dispersion (beta)"})
     ds["fragility_note"] = (("variant", "building", "fragility_limit"), notes,
                             {"long_name": "why a fragility could not be fitted, or how"})
+    if plan.pairs:
+        from pounding.studies.ida.pairs import pair_layout
+
+        ds = pair_layout(ds, plan)
     return ds
 
 

@@ -22,7 +22,8 @@ import numpy as np
 from pounding.studies.engine.tasks import Scenario, TaskSource
 from pounding.studies.ida.dataset import assemble_ida_dataset
 from pounding.studies.ida.plan import LEVEL_DECIMALS, Hunt, IdaPlan
-from pounding.studies.ida.runs import run_collapses, run_ida_scenario
+from pounding.studies.ida.pairs import ida_runner
+from pounding.studies.ida.runs import run_collapses
 
 __all__ = ["next_hunt_level", "HuntTasks", "run_hunt"]
 
@@ -81,7 +82,7 @@ class HuntTasks(TaskSource):
 
         self.plan = plan
         self.name, self.label, self.model_name = plan.sweep.name, plan.sweep.label, plan.model_name
-        self.runner = run_ida_scenario
+        self.runner = ida_runner(plan)
         self.inputs = sweep_inputs(plan.sweep)
         self.chains = [(v, r) for v in plan.variants for r in range(len(plan.records))]
         self.runs: dict[tuple[str, int], list[tuple[float, Scenario]]] = {c: [] for c in self.chains}

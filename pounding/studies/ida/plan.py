@@ -25,7 +25,8 @@ from pounding.units import STANDARD_GRAVITY
 __all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "SA_DAMPING", "LEVEL_DECIMALS",
            "LEVEL_RESOLUTION", "MAX_IDA_RUNS", "IntensityMeasure",
            "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity",
-           "collapse_drifts", "with_collapse_drift"]
+           "collapse_drifts", "with_collapse_drift", "check_ida_inputs", "resolve_scaling", "check_run_count",
+           "ida_measure", "finish_ida_plan"]
 
 #: The two variants of every scenario: the model as given, and with its contacts held open.
 VARIANTS = ("with_contacts", "without_contacts")
@@ -65,11 +66,15 @@ class IntensityMeasure:
         whose collapse a hunt brackets.
     period : float
         T1, s (NaN for ``pga``).
+    pair : bool
+        True for the record pairs of a plan model: a pair's IM is the geometric mean of its two components' IMs
+        (:meth:`of_pair`).
     """
 
     name: str
     building: str
     period: float = float("nan")
+    pair: bool = False
 
     def of(self, record) -> float:
         """The IM of a :class:`pounding.records.record.Record`, m/s²."""
@@ -79,10 +84,16 @@ class IntensityMeasure:
 
         return spectral_acceleration(record, period=self.period, damping=SA_DAMPING)
 
+    def of_pair(self, first, second) -> float:
+        """The IM of a record pair, m/s²: the geometric mean √(IM_a · IM_b) of its two components'
+        (for ``sa-t1`` the pair's geometric-mean spectrum at T1, as FEMA P695 §A.8 normalises pairs)."""
+        return math.sqrt(self.of(first) * self.of(second))
+
     def describe(self) -> str:
+        mean = ", geometric mean of the pair" if self.pair else ""
         if self.name == "pga":
-            return "PGA"
-        return f"Sa(T1 = {self.period:.3f} s of building {self.building}, 5 %)"
+            return f"PGA{mean}"
+        return f"Sa(T1 = {self.period:.3f} s of building {self.building}, 5 %{mean})"
 
 
 @dataclass(frozen=True)
@@ -270,6 +281,9 @@ class IdaPlan:
     #: Per building: its collapse drift ratio in this study (:func:`collapse_drifts`) and where it comes from.
     collapse_drifts: tuple[float, ...] = ()
     collapse_sources: tuple[str, ...] = ()
+    #: Plan models only: per record (a pair in one orientation) its two components, the one along the model's
+    #: ``angle`` first (ground_motion x) and the one 90° further (y); empty for a planar IDA.
+    pairs: tuple[tuple[str, str], ...] = ()
     _cache: dict = field(default_factory=dict, repr=False)
 
     def describe_levels(self) -> str:
@@ -316,7 +330,9 @@ class IdaPlan:
         identity = scenario_key(text if error is None else f"{text}\n# invalid: {error}", base_dir)
         fingerprint = self._cache.get(("record", record))
         if fingerprint is None:  # hashes the record file, or asks the package version: once per record
-            fingerprint = self._cache[("record", record)] = record_fingerprint(self.records[record], base_dir)
+            specs = self.pairs[record] if self.pairs else (self.records[record],)
+            fingerprint = self._cache[("record", record)] = "|".join(record_fingerprint(spec, base_dir)
+                                                                    for spec in specs)
         key = content_key(identity, fingerprint, code_fingerprint())
         scenario = Scenario((VARIANTS.index(variant), record), coords, text, base_dir, key, error, document, identity)
         self._cache[cache_key] = scenario
@@ -329,7 +345,9 @@ class IdaPlan:
         scenario key hashes it), but built from one dump per variant and record with the factor
         written in: a dump takes milliseconds, which over the thousands of runs of an IDA was
         seconds of serial work on the client before the first run.  The documents share everything but their
-        ``ground_motion`` mapping; nothing changes a scenario's data after it is made.
+        ``ground_motion`` mapping; nothing changes a scenario's data after it is made.  A plan model's
+        pair is written as components ``x`` and ``y``, each with the factor as its ``scale``; without contacts
+        it has no ``contacts`` (its outlines fix every gap, so they cannot be held open by a gap).
         """
         from pounding.model.model import hold_contacts_open
 
@@ -337,15 +355,18 @@ class IdaPlan:
         if template is None:
             base = copy.deepcopy(self.documents[record])
             if variant == "without_contacts":
-                hold_contacts_open(base)
-            base["ground_motion"]["scale"] = _SCALE_PLACEHOLDER
+                if self.pairs:
+                    base["contacts"] = []
+                else:
+                    hold_contacts_open(base)
+            base["ground_motion"] = _scaled_ground(base["ground_motion"], _SCALE_PLACEHOLDER, bool(self.pairs))
             pieces = dump_document(base).split(_yaml_scalar(_SCALE_PLACEHOLDER))
             template = (base, pieces)
             self._cache[("template", variant, record)] = template
         base, pieces = template
         document = dict(base)
-        document["ground_motion"] = dict(base["ground_motion"], scale=factor)
-        if len(pieces) != 2:  # the placeholder is not one scalar of the text: dump the whole document
+        document["ground_motion"] = _scaled_ground(base["ground_motion"], factor, bool(self.pairs))
+        if len(pieces) != (3 if self.pairs else 2):   # the placeholder is not where the scale goes: dump it all
             return document, dump_document(document)
         return document, _yaml_scalar(factor).join(pieces)
 
@@ -358,6 +379,83 @@ class IdaPlan:
         """Every (variant, record, level) of the fixed stripes, variant slowest."""
         return [self.scenario(v, r, float(level)) for v in self.variants for r in range(len(self.records))
                 for level in self.levels]
+
+
+def _scaled_ground(ground: dict, factor: float, pair: bool) -> dict:
+    """A copy of a ``ground_motion`` mapping with its record scaled by *factor*: ``scale``, or with *pair*
+    the ``scale`` of both components ``x`` and ``y`` (a plan model's pair, both scaled alike)."""
+    if not pair:
+        return dict(ground, scale=factor)
+    return dict(ground, x=dict(ground["x"], scale=factor), y=dict(ground["y"], scale=factor))
+
+
+def check_ida_inputs(im: str, scaling: str, levels: Any, hunt: Hunt | None, limits: Any,
+                     collapse_drift: float | None, mce: float | None,
+                     duration: float | None) -> tuple[np.ndarray | None, tuple[float, ...], float]:
+    """Check an IDA's options (one line each; :func:`build_ida_plan` has them):
+    ``(levels in g or None, drift limits, collapse drift ratio)``."""
+    from pounding.studies.common import check_duration
+
+    if im not in IM_NAMES:
+        raise PoundingError(f"--im {im!r}: choose one of {', '.join(IM_NAMES)}")
+    if scaling not in SCALINGS:
+        raise PoundingError(f"--scaling {scaling!r}: choose one of {', '.join(SCALINGS)}")
+    if (levels is None) == (hunt is None):
+        raise PoundingError("give either --levels START:STOP:STEP (fixed stripes) or --hunt (hunt-and-fill)")
+    if levels is not None and not isinstance(levels, np.ndarray):
+        levels = parse_levels(levels) if isinstance(levels, str) else np.array(sorted(float(x) for x in levels))
+    if hunt is not None:
+        hunt.check()
+    drift_limits = limits if isinstance(limits, tuple) else parse_limits(
+        None if limits is None else (",".join(map(str, limits)) if not isinstance(limits, str) else limits))
+    if collapse_drift is None:
+        collapse_drift = max(drift_limits)
+    if not (math.isfinite(collapse_drift) and collapse_drift > 0):
+        raise PoundingError(f"--collapse-drift must be > 0 (got {collapse_drift:g})")
+    if mce is not None and not (math.isfinite(mce) and mce > 0):
+        raise PoundingError(f"--mce must be > 0 (got {mce:g})")
+    check_duration(duration)
+    return levels, drift_limits, float(collapse_drift)
+
+
+def resolve_scaling(scaling: str, im_stored: np.ndarray, normalisation: np.ndarray,
+                    errors: list[str | None]) -> tuple[str, np.ndarray, np.ndarray]:
+    """``(scaling, normalisation, unit factor)`` of every record (module docstring of :mod:`pounding.studies.ida`):
+    *scaling* ``auto`` resolved, NM_i (1 with per-record scaling), the factor taking record i to level 1 m/s²."""
+    if all(e is not None for e in errors):
+        raise PoundingError(f"no record can be read: {errors[0]}")
+    readable = np.array([e is None for e in errors])
+    fema = bool(np.all(np.isfinite(normalisation[readable])))
+    if scaling == "auto":
+        scaling = "fema-p695" if fema else "record"
+    if scaling == "fema-p695":
+        if not fema:
+            raise PoundingError("--scaling fema-p695 needs FEMA P695 records (fema-p695:farfield, "
+                                "fema-p695:nearfield); use --scaling record")
+        median = float(np.median(normalisation[readable] * im_stored[readable]))
+        return scaling, normalisation, normalisation / median
+    return scaling, np.ones_like(im_stored), 1.0 / im_stored
+
+
+def check_run_count(records: int, variants: int, levels: np.ndarray | None, hunt: Hunt | None) -> None:
+    """Refuse an IDA of more than :data:`MAX_IDA_RUNS` runs, with the count."""
+    runs = records * variants * (hunt.max_runs() if hunt is not None else len(levels))
+    if runs > MAX_IDA_RUNS:
+        raise PoundingError(f"this IDA would make up to {runs:.3g} runs ({records} records x {variants} "
+                            f"variant(s) x {runs / records / variants:.3g} per record); at most "
+                            f"{MAX_IDA_RUNS} allowed: use fewer records, levels or --runs-per-record")
+
+
+def ida_measure(model, im: str, building: str | None, *, pair: bool = False) -> IntensityMeasure:
+    """The IDA's IM on *model* (planar or plan): T1 the first period of *building* (default: the first
+    building; an unknown name is refused in one line)."""
+    names = [b.name for b in model.buildings]
+    if building is None:
+        building = names[0]
+    elif building not in names:
+        raise PoundingError(f"--building {building!r}: the model has buildings {', '.join(names)}")
+    period = float(model.buildings[names.index(building)].periods[0]) if im == "sa-t1" else float("nan")
+    return IntensityMeasure(im, building, period, pair=pair)
 
 
 def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = None, *, im: str = "sa-t1",
@@ -397,38 +495,15 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     """
     from pounding.model.model import load_model, model_from_data
     from pounding.simulation import record_for
-    from pounding.studies.common import check_duration, record_values, study_sweep
+    from pounding.studies.common import record_values, study_sweep
 
-    if im not in IM_NAMES:
-        raise PoundingError(f"--im {im!r}: choose one of {', '.join(IM_NAMES)}")
-    if scaling not in SCALINGS:
-        raise PoundingError(f"--scaling {scaling!r}: choose one of {', '.join(SCALINGS)}")
-    if (levels is None) == (hunt is None):
-        raise PoundingError("give either --levels START:STOP:STEP (fixed stripes) or --hunt (hunt-and-fill)")
-    if levels is not None and not isinstance(levels, np.ndarray):
-        levels = parse_levels(levels) if isinstance(levels, str) else np.array(sorted(float(x) for x in levels))
-    if hunt is not None:
-        hunt.check()
-    drift_limits = limits if isinstance(limits, tuple) else parse_limits(
-        None if limits is None else (",".join(map(str, limits)) if not isinstance(limits, str) else limits))
     override = collapse_drift
-    if collapse_drift is None:
-        collapse_drift = max(drift_limits)
-    if not (math.isfinite(collapse_drift) and collapse_drift > 0):
-        raise PoundingError(f"--collapse-drift must be > 0 (got {collapse_drift:g})")
-    if mce is not None and not (math.isfinite(mce) and mce > 0):
-        raise PoundingError(f"--mce must be > 0 (got {mce:g})")
-    check_duration(duration)
+    levels, drift_limits, collapse_drift = check_ida_inputs(im, scaling, levels, hunt, limits, collapse_drift, mce,
+                                                            duration)
 
     base = load_model(model)   # the model's own errors, with its file name
     base.refuse_building_records("pounding ida (it scales one record)")
-    names = [b.name for b in base.buildings]
-    if building is None:
-        building = names[0]
-    elif building not in names:
-        raise PoundingError(f"--building {building!r}: the model has buildings {', '.join(names)}")
-    period = float(base.buildings[names.index(building)].periods[0]) if im == "sa-t1" else float("nan")
-    measure = IntensityMeasure(im, building, period)
+    measure = ida_measure(base, im, building)
     if without_contacts and not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: --without-contacts needs a model with contacts")
 
@@ -463,34 +538,29 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
             stored.append(float("nan"))
             norm.append(float("nan"))
             errors.append(f"{sweep.label}: record {s.coords['record']}: {' '.join(str(exc).split())}")
-    if all(e is not None for e in errors):
-        raise PoundingError(f"no record can be read: {errors[0]}")
-    im_stored, normalisation = np.array(stored), np.array(norm)
-    readable = np.array([e is None for e in errors])
-    fema = bool(np.all(np.isfinite(normalisation[readable])))
-    if scaling == "auto":
-        scaling = "fema-p695" if fema else "record"
-    if scaling == "fema-p695":
-        if not fema:
-            raise PoundingError("--scaling fema-p695 needs FEMA P695 records (fema-p695:farfield, "
-                                "fema-p695:nearfield); use --scaling record")
-        median = float(np.median(normalisation[readable] * im_stored[readable]))
-        unit = normalisation / median
-    else:
-        normalisation = np.ones_like(im_stored)
-        unit = 1.0 / im_stored
+    return finish_ida_plan(base, sweep, recs, documents, measure, stored, norm, errors, scaling=scaling,
+                           without_contacts=without_contacts, limits=drift_limits, collapse_drift=collapse_drift,
+                           override=override, levels=levels, hunt=hunt, mce=mce, path=path)
+
+
+def finish_ida_plan(base, sweep, records: list[str], documents: list[dict], measure: IntensityMeasure,
+                    stored: list[float], norm: list[float], errors: list[str | None], *, scaling: str,
+                    without_contacts: bool, limits: tuple[float, ...], collapse_drift: float,
+                    override: float | None, levels: np.ndarray | None, hunt: Hunt | None, mce: float | None,
+                    path: str, pairs: tuple[tuple[str, str], ...] = ()) -> IdaPlan:
+    """The :class:`IdaPlan` of checked inputs and every record's IM as stored (*stored*, m/s²), FEMA P695 NM
+    (*norm*, NaN if none) and error: the scaling resolved (:func:`resolve_scaling`), the run count checked,
+    each building's collapse drift ratio (*override*: ``--collapse-drift``)."""
+    im_stored = np.array(stored)
+    scaling, normalisation, unit = resolve_scaling(scaling, im_stored, np.array(norm), errors)
     variants = VARIANTS if without_contacts else VARIANTS[:1]
-    runs = len(recs) * len(variants) * (hunt.max_runs() if hunt is not None else len(levels))
-    if runs > MAX_IDA_RUNS:
-        raise PoundingError(f"this IDA would make up to {runs:.3g} runs ({len(recs)} records x {len(variants)} "
-                            f"variant(s) x {runs / len(recs) / len(variants):.3g} per record); at most "
-                            f"{MAX_IDA_RUNS} allowed: use fewer records, levels or --runs-per-record")
-    return IdaPlan(sweep=sweep, records=recs, documents=documents, im=measure, im_stored=im_stored,
-                   normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=names,
-                   variants=variants, limits=drift_limits, collapse_drift=float(collapse_drift), levels=levels,
-                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors,
-                   **dict(zip(("collapse_drifts", "collapse_sources"),
-                              collapse_drifts(base, override, max(drift_limits)))))
+    check_run_count(len(records), len(variants), levels, hunt)
+    return IdaPlan(sweep=sweep, records=records, documents=documents, im=measure, im_stored=im_stored,
+                   normalisation=normalisation, unit_factor=unit, scaling=scaling, buildings=[b.name for b in
+                                                                                               base.buildings],
+                   variants=variants, limits=limits, collapse_drift=float(collapse_drift), levels=levels,
+                   hunt=hunt, mce=mce, model_path=path, model_name=base.name, errors=errors, pairs=pairs,
+                   **dict(zip(("collapse_drifts", "collapse_sources"), collapse_drifts(base, override, max(limits)))))
 
 
 def with_collapse_drift(document: dict, drift_ratio: float) -> dict:

@@ -16,6 +16,11 @@ from pounding.units import STANDARD_GRAVITY
 __all__ = ["ida_summary", "ida_table", "ida_tables", "plot_ida"]
 
 
+
+def _drift_of(ds) -> str:
+    """What drifts in the IDA's buildings: ``storey``, or ``plane`` in a plan model's IDA (docs/ida.md)."""
+    return "plane" if ds.attrs.get("model_kind") == "plan" else "storey"
+
 def ida_summary(ds) -> dict[str, Any]:
     """The study as one JSON-ready document: ``{"im", "fragility", "cmr"}`` (θ and IMs in g)."""
     from pounding.studies.common import finite_or_none
@@ -71,7 +76,8 @@ def _collapse_line(ds) -> str:
     each = ", ".join(f"{b} {x:g}" + (f" ({sources[k]})" if k < len(sources) and sources[k] else "")
                      for k, (b, x) in enumerate(zip(ds.building.values, _collapse_drifts(ds))))
     censored = int(ds.censored.values.sum()) if "censored" in ds else 0
-    return (f"collapse: a storey past its building's collapse drift ratio ({each}), an IMK storey at zero "
+    drifts = _drift_of(ds)
+    return (f"collapse: a {drifts} past its building's collapse drift ratio ({each}), an IMK {drifts} at zero "
             f"strength, or a loss of resistance to P-Delta; the first building to collapse ends the run, the "
             f"others are censored there ({censored} building-runs censored)")
 
@@ -218,7 +224,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
                 ax.axvline(100 * collapse_drift, color="C3", lw=0.8, ls=":", label="collapse drift")
             ax.set_xlim(0, top * 1.02)
             ax.set_ylim(bottom=0)
-            ax.set_xlabel(f"max storey drift ratio of {building} (%)")
+            ax.set_xlabel(f"max {_drift_of(ds)} drift ratio of {building} (%)")
             ax.set_ylabel(f"{_im_label(ds)} level (g)")
             ax.set_title(f"building {building}, {titles.get(variant, variant)}", fontsize=10)
             ax.grid(alpha=0.3)
@@ -273,7 +279,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
         ax.set_ylim(-0.02, 1.02)
         ax.set_xlabel(f"{_im_label(ds)} (g)")
         ax.set_ylabel("P(exceed | IM)")
-        ax.set_title(f"building {building}: max storey drift ratio > limit, or collapse"
+        ax.set_title(f"building {building}: max {_drift_of(ds)} drift ratio > limit, or collapse"
                      + ("\npoints: fraction of records at each stripe (filled: with contacts, open: without)"
                         if stripes else "\nsolid: with contacts; dashed: contacts held open"), fontsize=9)
         ax.grid(alpha=0.3)

