@@ -104,7 +104,8 @@ from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, F
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_COLUMNS,
                                       IMPACT_ROW_LIMIT, Outputs, Peaks, close_open_impacts, grown, new_outputs,
-                                      new_peaks, record_contacts, record_floor_peaks, record_plane_peaks, record_sample, trace_rows,
+                                      new_peaks, record_contacts, record_floor_peaks, record_plane_peaks,
+                                      record_sample, trace_rows,
                                       trimmed_outputs, TRACE_ROW_LIMIT)
 from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,

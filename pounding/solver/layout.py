@@ -78,7 +78,7 @@ class Structure(NamedTuple):
     dense_size: np.ndarray          #: (B,) int, its size (0: Rayleigh)
     dense_offset: np.ndarray        #: (B,) int, its first value in *dense_values*
     dense_values: np.ndarray        #: flat dense damping blocks, N·s/m
-    dense_band: np.ndarray          #: (B,) int, half-bandwidth of each block (entries beyond it are zero; m − 1: full)
+    dense_band: np.ndarray          #: (B,) int, half-bandwidth of each block (entries beyond: zero; m − 1: full)
     dense_stiffness: np.ndarray     #: flat dense stiffness blocks, N/m, laid out as *dense_values* (empty: none)
     plane_floors: np.ndarray        #: (R·SIDE_TERMS,) int, a plan model's plane drifts' floor terms (empty: none)
     plane_weights: np.ndarray       #: (R·SIDE_TERMS,) their weights (drift ``Σ_k w_k·u[f_k]``, its peak recorded)

@@ -5,8 +5,8 @@
 Storey springs and Rayleigh damping act through the tridiagonal structure
 (O(n) per evaluation); only modal damping, on request, adds a dense block per
 building, and a plan model's buildings their banded damping and stiffness
-blocks (its planes and P-Delta terms, :mod:`pounding.solver.plan_assembly`).  The energy audit's rates (input and damped power, each contact's
-force and power, each yielding storey's power, the ground work) are written
+blocks (its planes and P-Delta terms, :mod:`pounding.solver.plan_assembly`).
+The energy audit's rates (input and damped power, each contact's force and power, each yielding storey's power, the ground work) are written
 with the motion's (:mod:`pounding.solver.layout`).
 """
 
@@ -79,7 +79,8 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
     """
     mass, kst, below, a0, a1 = (structure.mass, structure.storey_stiffness, structure.below, structure.rayleigh_mass,
                                 structure.rayleigh_stiffness)
-    dstart, dsize, doff, dvals = structure.dense_start, structure.dense_size, structure.dense_offset, structure.dense_values
+    dstart, dsize, doff = structure.dense_start, structure.dense_size, structure.dense_offset
+    dvals = structure.dense_values
     dband, dstiff = structure.dense_band, structure.dense_stiffness
     cf, cw, cgap, claw, cprm = contacts
     closed, cconst, cmode = cstate.closed, cstate.constant, cstate.mode
@@ -209,8 +210,8 @@ def storey_forces(y, lay, below, kst, storey, out, fbuf):
 
     Writes the rates of the hysteretic states and of the storeys' work
     ∫F dΔ into *out*.  The caller has already applied ``kΔ`` and P-Delta to
-    every storey (a plan model's plane: its building's dense stiffness block carries ``kΔ``; the departure enters its
-    floors with the plane's weights, :func:`pounding.solver.kinematics.storey_push`).
+    every storey (a plan model's plane: its building's dense stiffness block carries ``kΔ``; the
+    departure enters its floors with the plane's weights, :func:`pounding.solver.kinematics.storey_push`).
     The storey kernels take the parameter table and a row (no row views:
     each would be reference-counted, in the solver's innermost loop).
     """
