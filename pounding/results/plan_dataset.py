@@ -1,8 +1,8 @@
 """The archive of a plan-model run: floors per DOF with a ``direction`` dimension, planes, contact points, energy.
 
 A plan run is lowered by :mod:`pounding.solver.plan_assembly` (every DOF a
-solver floor, planes and P-Delta terms as linear links, contact points as gap
-elements); this module labels what the solver returns:
+solver floor, planes and P-Delta terms in each building's stiffness block, contact
+points as gap elements); this module labels what the solver returns:
 
 * ``displacement`` / ``velocity`` (time, floor, direction) m, m/s and ``rotation`` /
   ``rotation_rate`` (time, floor) rad, rad/s: each floor's centre of mass relative to the
@@ -145,25 +145,28 @@ def _impact_slip(model: PlanModel, psys: PlanSystem, raw: RawSolution) -> np.nda
     return np.einsum("ij,ij->i", q, slip[raw.impact_contact])
 
 
-def _energies(psys: PlanSystem, raw: RawSolution, delta: np.ndarray) -> dict[str, np.ndarray]:
-    """Energy histories (J): input, kinetic, damping, plane strain, P-Delta, contacts; initial energy first."""
+def _energies(psys: PlanSystem, raw: RawSolution, drift: np.ndarray) -> dict[str, np.ndarray]:
+    """Energy histories (J): input, kinetic, damping, plane strain, P-Delta, contacts; initial energy first.
+
+    The planes' strain energy is ``Σ ½ k Δ²`` of the elastic ones at the stored states (*drift*: (nt, plane),
+    m) plus the yielding ones' recoverable energy, the P-Delta potential ``Σ ½ k_G (a · q)²``.
+    """
     system = psys.system
     lay = system.layout
-    n, npt, npl = lay.n_floors, psys.n_points, psys.n_planes
+    n, npt = lay.n_floors, psys.n_points
     state = raw.state
     v = state[:, n:2 * n]
     work = state[:, lay.work:lay.work + lay.n_contacts]
-    stiffness = system.contact_parameters[npt:, 0]
-    link_start = 0.5 * (stiffness * delta[0, npt:] ** 2)
-    # A yielding plane: its link's work (kΔ) is replaced by its own: recoverable energy and the rest dissipated.
-    yielding = _yielding_planes(psys)
-    plane_work = work[:, npt:npt + npl].sum(axis=1) - work[:, npt + yielding].sum(axis=1)
+    elastic = np.ones(psys.n_planes, dtype=bool)
+    elastic[_yielding_planes(psys)] = False  # a yielding plane's energy: recoverable here, the rest dissipated
+    strain = 0.5 * (drift[:, elastic] ** 2) @ psys.plane_stiffness[elastic]
+    geometric = 0.5 * ((state[:, :n] @ psys.p_delta_weights.T) ** 2) @ psys.p_delta_stiffness
     hysteretic = state[:, lay.storey_work:lay.ground_work].sum(axis=1) - raw.storey_energy[:, 1]
     return {"energy_input": state[:, lay.input_energy],
             "energy_kinetic": 0.5 * (v * v) @ system.mass,
             "energy_damping": state[:, lay.damping_energy],
-            "energy_plane_strain": plane_work + link_start[:npl].sum() + raw.storey_energy[:, 1],
-            "energy_p_delta": work[:, npt + npl:].sum(axis=1) + link_start[npl:].sum(),
+            "energy_plane_strain": strain + raw.storey_energy[:, 1],
+            "energy_p_delta": geometric,
             "energy_contact": work[:, :npt].sum(axis=1),
             "energy_hysteretic": hysteretic}
 
@@ -241,11 +244,12 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
     system = psys.system
     n = system.n_floors
     nf = n // DOF_PER_FLOOR
-    npt, npl = psys.n_points, psys.n_planes
+    npt = psys.n_points
     u = raw.state[:, :n].reshape(-1, nf, DOF_PER_FLOOR)
     v = raw.state[:, n:2 * n].reshape(-1, nf, DOF_PER_FLOOR)
     delta = penetration(raw.state[:, :n], system.contact_floors, system.contact_weights, system.contact_gap,
                         np.zeros((raw.time.size, system.n_contacts)))
+    drift = raw.state[:, :n] @ psys.plane_weights.T
     peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
     counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
     centres = np.array([c for b in model.buildings for c in b.centres], dtype=float).reshape(nf, 2)
@@ -270,11 +274,10 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
                                          "m", "peak |displacement| of the corner (stored samples)"),
         "peak_corner_displacement_magnitude": _var(("floor", "corner"), magnitude.max(axis=0, initial=0.0), "m",
                                                    "peak magnitude of the corner's displacement (stored samples)"),
-        "plane_drift": _var(("time", "plane"), delta[:, npt:npt + npl], "m", "drift of the plane's line"),
-        "peak_plane_drift": _var(("plane",), raw.peak_contact_force[npt:npt + npl] / psys.plane_stiffness, "m",
-                                 "peak |drift| of the plane (full resolution)"),
+        "plane_drift": _var(("time", "plane"), drift, "m", "drift of the plane's line"),
+        "peak_plane_drift": _var(("plane",), raw.peak_plane_drift, "m", "peak |drift| of the plane (full resolution)"),
         "plane_stiffness": _var(("plane",), psys.plane_stiffness, "N/m", "elastic stiffness of the plane"),
-        "plane_shear": _var(("time", "plane"), _plane_shear(psys, raw, delta[:, npt:npt + npl]), "N",
+        "plane_shear": _var(("time", "plane"), _plane_shear(psys, raw, drift), "N",
                             "shear of the plane (restoring force, without P-Delta)"),
         "contact_force": _var(("time", "point"), raw.contact_force[:, :npt], "N",
                               "normal contact force at the point (compression positive)"),
@@ -293,7 +296,7 @@ def plan_dataset(model: PlanModel, psys: PlanSystem, raw: RawSolution, *,
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
     }
     data.update(_friction_variables(psys, raw))
-    for name, values in _energies(psys, raw, delta).items():
+    for name, values in _energies(psys, raw, drift).items():
         label = name.removeprefix("energy_").replace("_", " ")
         data[name] = _var(("time",), values, "J", f"energy: {label}")
     if raw.support_acceleration is not None:

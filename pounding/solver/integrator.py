@@ -106,7 +106,8 @@ from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, F
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_COLUMNS,
                                       IMPACT_ROW_LIMIT, Outputs, Peaks, close_open_impacts, grown, new_outputs,
-                                      new_peaks, record_contacts, record_floor_peaks, record_sample, trace_rows,
+                                      new_peaks, record_contacts, record_floor_peaks, record_plane_peaks,
+                                      record_sample, trace_rows,
                                       trimmed_outputs, TRACE_ROW_LIMIT)
 from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
@@ -145,6 +146,15 @@ class System:
     rayleigh_mass, rayleigh_stiffness : (N,) Rayleigh a0 (1/s) and a1 (s) of the floor's building
     dense_start, dense_size, dense_offset : (B,) int, modal damping blocks (size 0 for Rayleigh)
     dense_values : flat float array of the dense damping blocks, N·s/m
+    dense_band : (B,) int, optional
+        Half-bandwidth of each block: its entries farther than this from the diagonal are zero and
+        skipped; default ``dense_size − 1`` (full).
+    dense_stiffness : flat float array, optional
+        Dense stiffness blocks laid out as *dense_values*, N/m (a plan model's planes and P-Delta
+        terms, K = Σ k a aᵀ); default empty: none.
+    plane_floors, plane_weights : (R, SIDE_TERMS) int and float, optional
+        A plan model's plane drifts ``Σ_k w_k·u[floor_k]`` (floor −1: none), whose full-resolution
+        peaks the run records (``RawSolution.peak_plane_drift``); default none.
     contact_left, contact_right : (nc,) int, floor index of each gap element's left and right side
         (−1: a fixed wall; for a point of a column, the floor above it)
     contact_gap : (nc,) m
@@ -216,6 +226,10 @@ class System:
     friction_coefficient: np.ndarray | None = None
     friction_first_point: np.ndarray | None = None
     friction_point_count: np.ndarray | None = None
+    dense_band: np.ndarray | None = None
+    dense_stiffness: np.ndarray | None = None
+    plane_floors: np.ndarray | None = None
+    plane_weights: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         nc = int(self.contact_gap.size)
@@ -235,7 +249,10 @@ class System:
                     "p_delta_stiffness": np.zeros(n), "storey_height": np.ones(n), "storey_stop_ratio": np.zeros(n),
                     "floor_ground": np.zeros(n, dtype=np.int64),
                     "contact_ground_left": np.zeros(self.contact_gap.size, dtype=np.int64),
-                    "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64)}
+                    "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64),
+                    "dense_band": np.asarray(self.dense_size, dtype=np.int64) - 1, "dense_stiffness": np.zeros(0),
+                    "plane_floors": np.zeros((0, SIDE_TERMS), dtype=np.int64),
+                    "plane_weights": np.zeros((0, SIDE_TERMS))}
         for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)
@@ -308,6 +325,7 @@ class RawSolution:
     support_acceleration: np.ndarray | None = None  # (nt, G) m/s², every ground row (None: one ground)
     collapse_cause: str = ""         # status.COLLAPSE_CAUSES: why collapse_storey collapsed ("" if none)
     friction_history: np.ndarray | None = None  # (nt, 3·nf): each face's N (N), λ (N), mode code (None: no friction)
+    peak_plane_drift: np.ndarray | None = None  # (R,) m, |drift| of a plan model's planes (System.plane_floors)
 
 
 
@@ -542,7 +560,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     cstate, events = _new_contact_state(contacts), _new_events(contacts, nh, tol)
     normed = normed_states(tol)
     out = new_outputs(n_out, lay, ground)
-    peaks = new_peaks(lay)
+    peaks = new_peaks(lay, structure.plane_weights.size // SIDE_TERMS)
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     t, seg = 0.0, zero
@@ -626,6 +644,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
         record_floor_peaks(work, h_used, n, below, peaks)
+        record_plane_peaks(work, h_used, n, structure.plane_floors, structure.plane_weights, peaks)
         rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
         if rows > trace.shape[0]:
             trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
@@ -770,9 +789,11 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         y_initial[system.n_floors:] = initial_velocity
     # Absent terms (the ground, a wall: floor −1) go to the kernels as floor 0 with weight 0.
     floors, weights = kernel_terms(system.contact_floors, system.contact_weights)
+    plane_floors, plane_weights = kernel_terms(system.plane_floors, system.plane_weights)
     structure = Structure(system.mass, system.storey_stiffness, system.below, system.rayleigh_mass,
                           system.rayleigh_stiffness, system.dense_start, system.dense_size, system.dense_offset,
-                          system.dense_values)
+                          system.dense_values, np.asarray(system.dense_band, dtype=np.int64),
+                          np.ascontiguousarray(system.dense_stiffness, dtype=np.float64), plane_floors, plane_weights)
     contacts = Contacts(floors, weights, system.contact_gap, system.contact_law, system.contact_parameters)
     factors = np.ones(system.n_floors)
     if floor_factors is not None:
@@ -797,7 +818,8 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        int(raw.n_steps), int(raw.n_rejected), int(raw.status), float(raw.final_time),
                        None if ground is None else out.support,
                        _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)),
-                       None if friction is None else friction.history[:out.time.size].copy())
+                       friction_history=None if friction is None else friction.history[:out.time.size].copy(),
+                       peak_plane_drift=raw.peaks.plane)
 
 
 def _friction_argument(system: System, duration: float, output_dt: float) -> Friction | None:

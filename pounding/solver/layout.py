@@ -17,7 +17,7 @@ The other records are the compiled solver's arguments, numba named tuples of
 arrays (numba passes a named tuple's members as flat arguments, so a record
 costs nothing at a call):
 
-* :class:`Structure` — floors, storey springs and damping;
+* :class:`Structure` — floors, storey springs, damping, a plan model's stiffness blocks and plane drifts;
 * :class:`Contacts` — every gap element's floor terms, gap, law and parameters;
 * :class:`ContactState` — what changes at contact events (closed, onset constant, mode);
 * :class:`Storeys` — yielding storeys, P-Delta and the collapse limit (None when there are none);
@@ -85,6 +85,10 @@ class Structure(NamedTuple):
     dense_size: np.ndarray          #: (B,) int, its size (0: Rayleigh)
     dense_offset: np.ndarray        #: (B,) int, its first value in *dense_values*
     dense_values: np.ndarray        #: flat dense damping blocks, N·s/m
+    dense_band: np.ndarray          #: (B,) int, half-bandwidth of each block (entries beyond: zero; m − 1: full)
+    dense_stiffness: np.ndarray     #: flat dense stiffness blocks, N/m, laid out as *dense_values* (empty: none)
+    plane_floors: np.ndarray        #: (R·SIDE_TERMS,) int, a plan model's plane drifts' floor terms (empty: none)
+    plane_weights: np.ndarray       #: (R·SIDE_TERMS,) their weights (drift ``Σ_k w_k·u[f_k]``, its peak recorded)
 
 
 class Contacts(NamedTuple):
@@ -130,7 +134,7 @@ class StoreyTerms(NamedTuple):
 
     floors: np.ndarray     #: (R·SIDE_TERMS,) int
     weights: np.ndarray    #: (R·SIDE_TERMS,) float
-    stiffness: np.ndarray  #: (R,) N/m, the plane's elastic stiffness (its Kelvin link carries k·Δ)
+    stiffness: np.ndarray  #: (R,) N/m, the plane's elastic stiffness (the dense stiffness block carries k·Δ)
 
 
 class Storeys(NamedTuple):

@@ -1,4 +1,4 @@
-"""A plan model lowered into the solver's arrays: every DOF a solver floor, planes as weighted springs.
+"""A plan model lowered into the solver's arrays: every DOF a solver floor, planes in a banded stiffness block.
 
 The compiled integrator needs no plan-specific code beyond storey rows whose drift is a
 weighted sum (:class:`pounding.solver.layout.StoreyTerms`; docs/plan-models.md, "What is
@@ -7,18 +7,22 @@ integrated now"):
 * every DOF (u_x, u_y, θ of each floor; :mod:`pounding.model.plan_model`'s
   numbering) is a solver *floor* of mass m, m or I = m r²; it has no storey
   spring (stiffness 0, floor below −1);
-* every plane is a permanent linear spring (the Kelvin link with no dashpot) on
-  its drift ``a · q``: its at most four terms (u and θ of the floor above, u and θ
-  of the floor below) are the link's two sides, so K = Σ k a aᵀ exactly, the
-  link's peak |F|/k is the plane's peak |drift| at full resolution and its work
-  ∫F·Δ̇ dt its strain energy;
-* P-Delta adds the three rank-one terms of :func:`pounding.model.plan.plan_geometric_terms`
-  per storey as links of negative stiffness;
+* the planes are each building's stiffness matrix K = Σ k a aᵀ (virtual work on every
+  plane's drift ``a · q``; :meth:`pounding.model.plan_model.PlanBuilding.stiffness_matrix`),
+  with P-Delta its geometric stiffness (the three rank-one terms of
+  :func:`pounding.model.plan.plan_geometric_terms` per storey) folded in: the solver's
+  dense stiffness block, applied as ``K·u`` beside the damping block in the right-hand
+  side.  K couples a floor only to the floors above and below, so the block is banded
+  (half-bandwidth 5 DOF) and the right-hand side skips the zeros.  Every plane's drift
+  ``a · q`` is also a *plane row* (``System.plane_floors``) whose peak |drift| the
+  solver records at full resolution; the archive takes the planes' strain energy
+  ``½ k (a · q)²`` and the P-Delta potential from the stored states
+  (:mod:`pounding.results.plan_dataset`);
 * damping is the building's dense damping matrix (Rayleigh at its own 3-D modes, or
-  modal), the solver's dense damping block;
+  modal), the solver's dense damping block (banded with K under Rayleigh damping);
 * the ground acceleration per DOF comes from three ground rows: a_gx (row 0),
   a_gy (row 1) and a zero row (2) for the rotations (the several-ground mechanism);
-  every contact and link takes the zero row on both sides, so no differential
+  every contact takes the zero row on both sides, so no differential
   ground motion enters them: in coordinates relative to one rigid ground the
   penetration of a point is exactly ``w · q − gap``;
 * every contact point is a gap element whose two sides are the (u_n, θ) terms of
@@ -27,7 +31,7 @@ integrated now"):
   building's ``collapse``), the planes are also the solver's storey rows
   (:func:`plane_storey_arrays`): a row's drift is its weighted sum ``a · q``
   (:class:`pounding.solver.layout.StoreyTerms`), a yielding plane adds ``F − kΔ`` to
-  its link's ``kΔ`` through the same weights (its state, events, work and error-norm
+  the stiffness block's ``kΔ`` through the same weights (its state, events, work and error-norm
   entry those of a yielding storey), and every plane's drift ratio is watched.
 
 * a face with ``friction: μ`` is a friction face (:class:`pounding.solver.layout.Friction`): its
@@ -45,7 +49,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pounding.contact.links import LINK_KELVIN
 from pounding.contact import laws as contact_laws
 from pounding.model.model import WALL
 from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
@@ -58,7 +61,7 @@ from pounding.solver.tolerances import floor_tolerance_factors
 __all__ = ["GROUND_X", "GROUND_Y", "GROUND_NONE", "PlanSystem", "plan_refusal", "plan_system", "plane_storey_arrays",
            "plan_ground_rows", "plan_tolerance_factors"]
 
-#: Ground rows of a plan run: a_gx, a_gy and the zero row (rotations; contacts and planes).
+#: Ground rows of a plan run: a_gx, a_gy and the zero row (rotations; contacts).
 GROUND_X, GROUND_Y, GROUND_NONE = 0, 1, 2
 
 
@@ -69,12 +72,14 @@ class PlanSystem:
     Attributes
     ----------
     system : System
-        Contact points first (gap elements, ``n_points``), then the planes' links
-        (``n_planes``), then the P-Delta links.
+        The contact points are its gap elements (``n_points``), the planes its plane rows.
     n_points, n_planes : int
     plane_stiffness : (n_planes,) N/m
     point_face : (n_points,) int, index of each point's face in ``PlanModel.contacts``
     point_location : (n_points, 2) m, the point at rest
+    plane_weights : (n_planes, N) each plane's drift ``a · q`` over all DOF, m per DOF unit
+    p_delta_stiffness : (m,) N/m or N·m, the P-Delta terms' k_G (≤ 0; none without P-Delta)
+    p_delta_weights : (m, N) their drifts' weights: K_G = Σ k_G a aᵀ
     """
 
     system: System
@@ -83,6 +88,9 @@ class PlanSystem:
     plane_stiffness: np.ndarray
     point_face: np.ndarray
     point_location: np.ndarray
+    plane_weights: np.ndarray
+    p_delta_stiffness: np.ndarray
+    p_delta_weights: np.ndarray
 
 
 def plan_refusal(model: PlanModel) -> str | None:
@@ -114,9 +122,16 @@ def _drift_sides(offset: int, a: np.ndarray, storey: int) -> tuple[list, list]:
     return _side(upper), _side(lower)
 
 
-def _link_parameters(stiffness: float) -> np.ndarray:
-    out = np.zeros(contact_laws.N_PARAMETERS)
-    out[0] = stiffness
+def _half_bandwidth(*matrices: np.ndarray) -> int:
+    """Largest |i − k| of a nonzero entry of any of *matrices* (square, same size; 0 when all are diagonal)."""
+    rows, cols = np.nonzero(sum(m != 0.0 for m in matrices))
+    return int(np.max(np.abs(rows - cols), initial=0))
+
+
+def _global(offset: int, a: np.ndarray, n: int) -> np.ndarray:
+    """A building's (3n_b,) weights *a* over all *n* DOF (its own from *offset*)."""
+    out = np.zeros(n)
+    out[offset:offset + a.size] = a
     return out
 
 
@@ -141,29 +156,18 @@ def plan_system(model: PlanModel) -> PlanSystem:
             params.append(contact.law.kernel_parameters(side_mass(left, mass), side_mass(right, mass)))
             point_face.append(face_index)
             locations.append(point.location)
-    n_points = len(gaps)
-    plane_stiffness = []
-    links: list[tuple[float, np.ndarray, int, int]] = []
-    for b, offset in zip(model.buildings, offsets):
-        for storey, j, a in b.plane_weights():
-            stiffness = float(b.storeys[storey - 1].planes[j].stiffness)
-            links.append((stiffness, a, offset, storey))
-            plane_stiffness.append(stiffness)
-    for b, offset in zip(model.buildings, offsets):
-        if b.p_delta:
-            links += [(k, a, offset, storey) for storey, k, a in plan_geometric_terms(list(b.storeys))]
+    n_points = nc = len(gaps)
+    planes = [(float(b.storeys[storey - 1].planes[j].stiffness), a, offset, storey)
+              for b, offset in zip(model.buildings, offsets) for storey, j, a in b.plane_weights()]
+    p_delta = [(k, a, offset) for b, offset in zip(model.buildings, offsets) if b.p_delta
+               for _, k, a in plan_geometric_terms(list(b.storeys))]
+    rows = plane_storey_arrays(model, [(offset, storey, a) for _, a, offset, storey in planes])
+    plane_sides = [_drift_sides(offset, a, storey) for _, a, offset, storey in planes]
     friction = _friction_arrays(model, offsets, point_face)
-    rows = plane_storey_arrays(model, [(offset, storey, a) for _, a, offset, storey in links[:len(plane_stiffness)]])
-    for stiffness, a, offset, storey in links:
-        upper, lower = _drift_sides(offset, a, storey)
-        floors.append([f for f, _ in upper + lower])
-        weights.append([w for _, w in upper + lower])
-        gaps.append(0.0)
-        laws.append(LINK_KELVIN)
-        params.append(_link_parameters(stiffness))
-    nc = len(gaps)
     floors_arr = np.array(floors, dtype=np.int64).reshape(nc, SIDE_TERMS)
-    dense = [np.asarray(b.damping_matrix(), dtype=float).ravel() for b in model.buildings]
+    damping = [np.asarray(b.damping_matrix(), dtype=float) for b in model.buildings]
+    stiffness = [np.asarray(b.stiffness_matrix() + b.geometric_stiffness(), dtype=float) for b in model.buildings]
+    dense = [c.ravel() for c in damping]
     sizes = [b.n_dof for b in model.buildings]
     floor_ground = np.tile(np.array([GROUND_X, GROUND_Y, GROUND_NONE], dtype=np.int64), n // DOF_PER_FLOOR)
     system = System(
@@ -179,9 +183,19 @@ def plan_system(model: PlanModel) -> PlanSystem:
         contact_weights=np.ascontiguousarray(np.array(weights, dtype=float).reshape(nc, SIDE_TERMS)),
         floor_ground=floor_ground,
         contact_ground_left=np.full(nc, GROUND_NONE, dtype=np.int64),
-        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64), **rows, **friction)
-    return PlanSystem(system, n_points, len(plane_stiffness), np.asarray(plane_stiffness, dtype=float),
-                      np.asarray(point_face, dtype=np.int64), np.asarray(locations, dtype=float).reshape(n_points, 2))
+        contact_ground_right=np.full(nc, GROUND_NONE, dtype=np.int64),
+        dense_band=np.array([_half_bandwidth(c, k) for c, k in zip(damping, stiffness)], dtype=np.int64),
+        dense_stiffness=np.ascontiguousarray(np.concatenate([k.ravel() for k in stiffness]) if stiffness
+                                             else np.zeros(0)),
+        plane_floors=np.array([[f for f, _ in up + low] for up, low in plane_sides], dtype=np.int64).reshape(
+            len(planes), SIDE_TERMS),
+        plane_weights=np.array([[w for _, w in up + low] for up, low in plane_sides], dtype=float).reshape(
+            len(planes), SIDE_TERMS), **rows, **friction)
+    return PlanSystem(system, n_points, len(planes), np.array([k for k, *_ in planes], dtype=float),
+                      np.asarray(point_face, dtype=np.int64), np.asarray(locations, dtype=float).reshape(n_points, 2),
+                      np.array([_global(offset, a, n) for _, a, offset, _ in planes]).reshape(len(planes), n),
+                      np.array([k for k, _, _ in p_delta], dtype=float),
+                      np.array([_global(offset, a, n) for _, a, offset in p_delta]).reshape(len(p_delta), n))
 
 
 def _friction_arrays(model: PlanModel, offsets: list[int], point_face: list[int]) -> dict[str, np.ndarray]:
@@ -222,7 +236,7 @@ def plane_storey_arrays(model: PlanModel, drifts: list[tuple[int, int, np.ndarra
     is plane p: its hysteresis kernel and parameters (at the plane's stiffness and storey height),
     state index (−1: elastic), height, its building's collapse drift ratio (0: none), drift terms
     (:func:`_drift_sides`, the floor above then the floor below) and stiffness; ``p_delta_stiffness``
-    stays per solver floor and zero (the plan model's P-Delta terms are links).
+    stays per solver floor and zero (the plan model's P-Delta terms are in its stiffness block).
     """
     planes = [(b, ratio, s.height, p) for b, ratio in zip(model.buildings, model.collapse_drift_ratios())
               for s in b.storeys for p in s.planes]

@@ -5,7 +5,8 @@ Everything a run keeps, written as the driver accepts steps:
 * output samples at ``output_dt`` on the step's interpolant (:func:`record_sample`,
   the one sampling routine, also for the first sample and for the tail);
 * peaks of floor displacement and storey drift on every step, with extrema
-  inside a step found on the interpolant (:func:`record_floor_peaks`), and of
+  inside a step found on the interpolant (:func:`record_floor_peaks`), of a plan
+  model's plane drifts (:func:`record_plane_peaks`), and of
   every contact's force with each closed contact's samples appended to the
   trace (:func:`record_contacts`): output decimation never changes them;
 * the impact table (its columns ``IMP_*``), filled by the contact events.
@@ -22,12 +23,13 @@ from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver import storeys
 from pounding.solver.dense import extremum_in_step, hermite
-from pounding.solver.kinematics import contact_delta, drift, step_kinematics, storey_drift
+from pounding.solver.kinematics import combo, contact_delta, drift, step_kinematics, storey_drift
 from pounding.solver.status import STATUS_TABLE_LIMIT
 
 __all__ = ["FORCE_SAMPLES", "IMPACT_COLUMNS", "IMPACT_ROW_LIMIT", "TRACE_ROW_LIMIT", "Outputs", "Peaks", "grown",
            "new_outputs", "new_peaks", "closed_contact_samples", "peak_magnitude", "contact_energy",
-           "storey_outputs", "plane_outputs", "record_sample", "record_floor_peaks", "trace_rows", "record_contacts", "close_open_impacts",
+           "storey_outputs", "plane_outputs", "record_sample", "record_floor_peaks", "record_plane_peaks",
+           "trace_rows", "record_contacts", "close_open_impacts",
            "trimmed_outputs",
            "IMP_CONTACT", "IMP_TIME", "IMP_VELOCITY", "IMP_CONSTANT", "IMP_PEAK_FORCE", "IMP_END", "IMP_IMPULSE",
            "IMP_SEPARATION", "IMP_WORK"]
@@ -64,6 +66,7 @@ class Peaks(NamedTuple):
     displacement: np.ndarray  #: (N,) m
     drift: np.ndarray         #: (N,) m
     force: np.ndarray         #: (nc,) N
+    plane: np.ndarray         #: (R,) m, |drift| of a plan model's planes (Structure.plane_floors)
     fractions: np.ndarray     #: (FORCE_SAMPLES + 1,) scratch: fractions of the step
     deltas: np.ndarray        #: (FORCE_SAMPLES + 1,) scratch: penetrations, m
     values: np.ndarray        #: (FORCE_SAMPLES + 1,) scratch: forces, N
@@ -82,11 +85,11 @@ def new_outputs(n_out, lay, ground):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-def new_peaks(lay):
-    """Zero :class:`Peaks` (and its scratch)."""
+def new_peaks(lay, n_planes):
+    """Zero :class:`Peaks` (and its scratch) with *n_planes* plane drifts."""
     m = lay.n_contacts - lay.n_contacts + FORCE_SAMPLES + 1
-    return Peaks(np.zeros(lay.n_floors), np.zeros(lay.n_floors), np.zeros(lay.n_contacts), np.empty(m),
-                 np.empty(m), np.empty(m))
+    return Peaks(np.zeros(lay.n_floors), np.zeros(lay.n_floors), np.zeros(lay.n_contacts), np.zeros(n_planes),
+                 np.empty(m), np.empty(m), np.empty(m))
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
@@ -290,6 +293,28 @@ def record_floor_peaks(work, h, n, below, peaks) -> None:
             v = extremum_in_step(d0, r0, d1, r1, h)
             if v > peak_drift[j]:
                 peak_drift[j] = v
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+def record_plane_peaks(work, h, n, floors, weights, peaks) -> None:
+    """Peak |drift| of every plane of a plan model over an accepted step of *h* s (none: no planes).
+
+    A plane's drift ``Σ_k w_k·u[f_k]`` (*floors*, *weights*: ``Structure.plane_floors`` and
+    ``plane_weights``) as a storey's in :func:`record_floor_peaks`: its value at the step's end, and
+    the extremum of its Hermite cubic inside the step when its rate changes sign.
+    """
+    y, ynew, peak = work.y, work.ynew, peaks.plane
+    for p in range(peak.size):
+        d1 = combo(ynew, 0, floors, weights, p)
+        v = abs(d1)
+        if v > peak[p]:
+            peak[p] = v
+        r0 = combo(y, n, floors, weights, p)
+        r1 = combo(ynew, n, floors, weights, p)
+        if r0 * r1 < 0.0:
+            v = extremum_in_step(combo(y, 0, floors, weights, p), r0, d1, r1, h)
+            if v > peak[p]:
+                peak[p] = v
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)

@@ -4,8 +4,9 @@
 
 Storey springs and Rayleigh damping act through the tridiagonal structure
 (O(n) per evaluation); only modal damping, on request, adds a dense block per
-building.  The energy audit's rates (input and damped power, each contact's
-force and power, each yielding storey's power, the ground work) are written
+building, and a plan model's buildings their banded damping and stiffness
+blocks (its planes and P-Delta terms, :mod:`pounding.solver.plan_assembly`).
+The energy audit's rates (input and damped power, each contact's force and power, each yielding storey's power, the ground work) are written
 with the motion's (:mod:`pounding.solver.layout`).
 """
 
@@ -78,7 +79,11 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
     :class:`~pounding.solver.layout.Layout`.  *friction* (None without friction faces, pruned):
     the faces' Coulomb friction after every contact force (:mod:`pounding.solver.friction_forces`).
     """
-    mass, kst, below, a0, a1, dstart, dsize, doff, dvals = structure
+    mass, kst, below, a0, a1 = (structure.mass, structure.storey_stiffness, structure.below, structure.rayleigh_mass,
+                                structure.rayleigh_stiffness)
+    dstart, dsize, doff = structure.dense_start, structure.dense_size, structure.dense_offset
+    dvals = structure.dense_values
+    dband, dstiff = structure.dense_band, structure.dense_stiffness
     cf, cw, cgap, claw, cprm = contacts
     closed, cconst, cmode = cstate.closed, cstate.constant, cstate.mode
     n = mass.size
@@ -113,9 +118,21 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
             continue
         s0 = dstart[bidx]
         off = doff[bidx]
+        band = dband[bidx]
+        if dstiff.size > 0:  # a plan model's building: C·v and its planes' and P-Delta's K·u (K = Σ k a aᵀ)
+            for i in range(m):
+                acc = 0.0
+                spring = 0.0
+                for k in range(max(0, i - band), min(m, i + band + 1)):
+                    acc += dvals[off + i * m + k] * y[n + s0 + k]
+                    spring += dstiff[off + i * m + k] * y[s0 + k]
+                fbuf[s0 + i] += acc
+                power += acc * y[n + s0 + i]
+                fbuf[s0 + i] += spring
+            continue
         for i in range(m):
             acc = 0.0
-            for k in range(m):
+            for k in range(max(0, i - band), min(m, i + band + 1)):
                 acc += dvals[off + i * m + k] * y[n + s0 + k]
             fbuf[s0 + i] += acc
             power += acc * y[n + s0 + i]
@@ -197,8 +214,8 @@ def storey_forces(y, lay, below, kst, storey, out, fbuf):
 
     Writes the rates of the hysteretic states and of the storeys' work
     ∫F dΔ into *out*.  The caller has already applied ``kΔ`` and P-Delta to
-    every storey (a plan model's plane: its Kelvin link carries ``kΔ``; the departure enters its
-    floors with the plane's weights, :func:`pounding.solver.kinematics.storey_push`).
+    every storey (a plan model's plane: its building's dense stiffness block carries ``kΔ``; the
+    departure enters its floors with the plane's weights, :func:`pounding.solver.kinematics.storey_push`).
     The storey kernels take the parameter table and a row (no row views:
     each would be reference-counted, in the solver's innermost loop).
     """
