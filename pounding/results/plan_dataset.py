@@ -117,11 +117,16 @@ def _plane_labels(model: PlanModel) -> dict[str, Any]:
                          {"units": "m", "long_name": "the plane's line (y along x, x along y)"})}
 
 
-def _point_labels(model: PlanModel, psys: PlanSystem) -> dict[str, Any]:
+def _between(model: PlanModel, contact) -> str:
+    """``A:3-B:3`` (or ``A:1-wall``): the two floors of a contact face."""
     names = [b.name for b in model.buildings]
+    second = "wall" if contact.second == WALL else f"{names[contact.second]}:{contact.level_second}"
+    return f"{names[contact.first]}:{contact.level_first}-{second}"
+
+
+def _point_labels(model: PlanModel, psys: PlanSystem) -> dict[str, Any]:
     faces = [model.contacts[f] for f in psys.point_face]
-    between = [f"{names[c.first]}:{c.level_first}-"
-               + ("wall" if c.second == WALL else f"{names[c.second]}:{c.level_second}") for c in faces]
+    between = [_between(model, c) for c in faces]
     return {"point_between": (("point",), np.array(between, dtype=object),
                               {"long_name": "the two floors of the contact point (building:floor)"}),
             "point_face": (("point",), psys.point_face, {"units": "1", "long_name": "index of the point's face"}),
@@ -195,10 +200,8 @@ def _face_labels(model: PlanModel, psys: PlanSystem) -> dict[str, Any]:
     """Coordinates of the friction faces (``face`` dimension), {} without friction."""
     if psys.system.n_faces == 0:
         return {}
-    names = [b.name for b in model.buildings]
     faces = [(i, c) for i, c in enumerate(model.contacts) if c.friction]
-    between = [f"{names[c.first]}:{c.level_first}-" + ("wall" if c.second == WALL else f"{names[c.second]}:{c.level_second}")
-               for _, c in faces]
+    between = [_between(model, c) for _, c in faces]
     return {"face_index": (("face",), np.array([i for i, _ in faces], dtype=np.int64),
                            {"units": "1", "long_name": "index of the face (as point_face)"}),
             "face_between": (("face",), np.array(between, dtype=object), {"long_name": "the two floors of the face"}),

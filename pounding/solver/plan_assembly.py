@@ -114,6 +114,18 @@ def _side(terms: list[tuple[int, float]]) -> list[tuple[int, float]]:
     return terms + [(-1, 0.0)] * (SIDE_TERMS // 2 - len(terms))
 
 
+def _face_sides(contact, offsets: list[int], rows: np.ndarray) -> tuple[list, list]:
+    """A face's (2, 3) weight *rows* (its first side's floor, its second's; a point's penetration or the
+    face's slip) as the solver's two sides, the low side on the left."""
+    first = offsets[contact.first] + DOF_PER_FLOOR * (contact.level_first - 1)
+    one = _side(_floor_terms(first, rows[0]))
+    if contact.second == WALL:
+        two = _side([])
+    else:
+        two = _side(_floor_terms(offsets[contact.second] + DOF_PER_FLOOR * (contact.level_second - 1), rows[1]))
+    return (one, two) if contact.face.first_low else (two, one)
+
+
 def _drift_sides(offset: int, a: np.ndarray, storey: int) -> tuple[list, list]:
     """A storey drift ``a · q`` (a over one building's DOF) as two sides: the floor above, the floor below."""
     top = DOF_PER_FLOOR * (storey - 1)
@@ -143,12 +155,8 @@ def plan_system(model: PlanModel) -> PlanSystem:
     floors, weights, gaps, laws, params = [], [], [], [], []
     point_face, locations = [], []
     for face_index, contact in enumerate(model.contacts):
-        first = offsets[contact.first] + DOF_PER_FLOOR * (contact.level_first - 1)
-        second = None if contact.second == WALL else offsets[contact.second] + DOF_PER_FLOOR * (contact.level_second - 1)
         for point in contact.points:
-            one = _side(_floor_terms(first, point.weights[0]))
-            two = _side([] if second is None else _floor_terms(second, point.weights[1]))
-            left, right = (one, two) if contact.face.first_low else (two, one)
+            left, right = _face_sides(contact, offsets, point.weights)
             floors.append([f for f, _ in left + right])
             weights.append([w for _, w in left + right])
             gaps.append(contact.gap)
@@ -208,12 +216,7 @@ def _friction_arrays(model: PlanModel, offsets: list[int], point_face: list[int]
     for face_index, contact in enumerate(model.contacts):
         if not contact.friction:
             continue
-        own = offsets[contact.first] + DOF_PER_FLOOR * (contact.level_first - 1)
-        other = None if contact.second == WALL else offsets[contact.second] + DOF_PER_FLOOR * (contact.level_second - 1)
-        slip = contact.points[0].slip
-        one = _side(_floor_terms(own, slip[0]))
-        two = _side([] if other is None else _floor_terms(other, slip[1]))
-        left, right = (one, two) if contact.face.first_low else (two, one)
+        left, right = _face_sides(contact, offsets, contact.points[0].slip)
         floors.append([f for f, _ in left + right])
         weights.append([w for _, w in left + right])
         coefficient.append(float(contact.friction))
