@@ -45,7 +45,7 @@ EVENTS_PER_WINDOW_PER_CONTACT = 2000
 EVENT_NONE, EVENT_CLOSE, EVENT_SEPARATE, EVENT_RELEASE, EVENT_SWITCH0 = range(5)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def switch_crossing(claw, prm, const, mode, which, gap, kin, internal, h) -> float:
     """Fraction of the step where switch function *which* of a closed contact's mode turns negative.
 
@@ -92,7 +92,7 @@ def switch_crossing(claw, prm, const, mode, which, gap, kin, internal, h) -> flo
     return -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, events, ground):
     """Each contact's first event inside a trial step from *t* of *h* s into ``events.s`` (fraction of
     the step, −1 if none) and ``events.kind`` (EVENT_*): ``(earliest fraction, 2.0 if none; number of
@@ -159,7 +159,7 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
     return s_first, n_release
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground, friction):
     """Release of every stuck contact whose constraint force is tensile at the end of a trial step from
     *t* of *h* s (``work.forces_end``): bisected on the interpolant, into ``events.s`` and
@@ -198,7 +198,7 @@ def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, 
     return s_first
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def velocity_jump(c, t, y, lay, mass, contacts, impacts, n_imp, dvg):
     """Instantaneous impact (stereo-mechanical): jump the two floor velocities.
 
@@ -222,7 +222,7 @@ def velocity_jump(c, t, y, lay, mass, contacts, impacts, n_imp, dvg):
     return n_imp + 1
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def instant_row(impacts, row, c, t, v0, impulse, v_after) -> None:
     """Row *row* of the impact table for an instantaneous impact of contact *c* at *t*: approach *v0*
     and leaving *v_after* (m/s, δ̇ before and after), impulse (N·s) and its work, opened and closed at once."""
@@ -237,7 +237,7 @@ def instant_row(impacts, row, c, t, v0, impulse, v_after) -> None:
     impacts[row, IMP_WORK] = impulse * 0.5 * (v0 + v_after)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def switch_contact(c, upward, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg):
     """Apply a located gap closure (*upward*) or separation of contact *c* at time *t*.
 
@@ -278,7 +278,7 @@ def switch_contact(c, upward, t, y, lay, mass, contacts, cstate, impacts, n_imp,
     return n_imp
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def plastic_jump(c, y, lay, mass, contacts, dvg):
     """Remove the relative velocity of contact *c* with a plastic impulse ``m_eff·v0`` (N·s, returned).
 
@@ -296,7 +296,7 @@ def plastic_jump(c, y, lay, mass, contacts, dvg):
     return impulse
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _rigid_set(kinds, contacts, cstate, active):
     """Instantaneous contacts to resolve together at this instant into *active*, the
     closing ones first, then the stuck ones: ``(number closing, number in all)``; 0 in all when
@@ -318,7 +318,7 @@ def _rigid_set(kinds, contacts, cstate, active):
     return n_closing, n_all
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground,
                            friction):
     """Closures of instantaneous contacts (``events.kind``) together with the stuck ones, when there are
@@ -397,7 +397,7 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
     return n_imp, n_closing, n_closing - n_closing
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground,
                          friction):
     """Apply the located events ``events.kind[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.

@@ -23,7 +23,7 @@ __all__ = ["DELTA_ROUNDOFF", "hermite", "interpolate", "extremum_in_step", "firs
 DELTA_ROUNDOFF = 8.0 * 2.220446049250313e-16
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> float:
     """Cubic Hermite value at fraction *s* of a step of length *h*."""
     s2 = s * s
@@ -32,7 +32,7 @@ def hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> f
             + (-2.0 * s3 + 3.0 * s2) * y1 + (s3 - s2) * h * r1)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
     """Largest |y| of the Hermite cubic at its interior stationary points (0 if none)."""
     qa = 6.0 * y0 + 3.0 * h * r0 - 6.0 * y1 + 3.0 * h * r1
@@ -60,7 +60,7 @@ def extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> fl
     return best
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)  # with a Python wrapper: tested directly
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # with a Python wrapper: tested directly
 def first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward: bool,
                     threshold: float) -> float:
     """Fraction of the step where the Hermite cubic of δ first crosses into the far side.
@@ -135,7 +135,7 @@ def first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward:
     return -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def interpolate(work, h, s, out) -> None:
     """The state at fraction *s* of the trial step of *h* s in ``work`` (a :class:`~pounding.solver.layout.Work`)
     into *out*: every state's Hermite cubic from its values and rates (``K[0]``, ``K[6]``) at both ends."""

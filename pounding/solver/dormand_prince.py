@@ -49,15 +49,15 @@ MAX_FACTOR = 5.0
 EXCLUDED = -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground, friction):
     """Stages 2–7 of a Dormand–Prince step of size *h* from ``work.y`` at *t* (stage 1, ``K[0]``, given).
 
     Fills ``K[1..6]`` and the 5th-order solution ``work.ynew`` (stage 7 is its rate: first same as
     last); *seg* is the record step the step lies in (ground acceleration *ag*, step *dt_rec*, s).
-    One call per attempted step, with the right-hand side inlined once, in its loop: six calls of
-    :func:`rhs`, each passing its ~30 arrays, cost more than their arithmetic (this kernel counts
-    no references, so the inlined arguments cost nothing).  The weighted sums are written out per
+    One call per attempted step (itself inlined into the driver, :data:`jit.INLINED`), with the
+    right-hand side inlined once, in its loop: six calls of :func:`rhs`, each passing its ~30
+    arrays, cost more than their arithmetic.  The weighted sums are written out per
     stage (they vectorise; a loop over the tableau did not).
     """
     y, ynew, ystage, K, fbuf, forces = work.y, work.ynew, work.ystage, work.K, work.fbuf, work.forces
@@ -91,7 +91,7 @@ def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey
                    storey, ground, friction)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def fill_tolerances(tol, lay, contacts, atol, atol_velocity, floor_factor, storey) -> None:
     """Each state's absolute tolerance into *tol* (S,): *atol* (m) for displacements, *atol_velocity*
     (m/s) for velocities, each times its floor's *floor_factor* (:mod:`pounding.solver.tolerances`),
@@ -112,7 +112,7 @@ def fill_tolerances(tol, lay, contacts, atol, atol_velocity, floor_factor, store
             tol[lay.hysteretic + hi] = storey.tolerance[hi]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def normed_states(tol):
     """Indices of the states in the error norm (*tol* from :func:`fill_tolerances` not EXCLUDED), ascending."""
     count = 0
@@ -128,7 +128,7 @@ def normed_states(tol):
     return index
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def error_norm(work, h, tol, normed, rtol):
     """``(err, finite)``: the max over the states of |local error| / (tol + rtol·max(|y|, |y_new|)).
 
@@ -150,7 +150,7 @@ def error_norm(work, h, tol, normed, rtol):
     return err, True
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def step_factor(err, finite, rejected):
     """Factor of the next step size after a step with error norm *err* (Hairer et al. §II.4):
     shrink a rejected step (err > 1 or not *finite*), grow an accepted one, but not right after

@@ -33,7 +33,7 @@ __all__ = ["FRICTION_EVENT_NONE", "FRICTION_EVENT_STOP", "FRICTION_EVENT_SLIP", 
 FRICTION_EVENT_NONE, FRICTION_EVENT_STOP, FRICTION_EVENT_SLIP = 0, 1, 2
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _slip_rate_scale(y, ynew, n, friction, f) -> float:
     """Σ_k |w_k|·(|v_k(0)| + |v_k(h)|) (m/s): the round-off scale of the slip rate over a step."""
     total = 0.0
@@ -43,7 +43,7 @@ def _slip_rate_scale(y, ynew, n, friction, f) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, cstate, storey, ground,
                            friction) -> float:
     """Each face's first event in a trial step from *t* of *h* s into ``friction.event_s`` and
@@ -103,7 +103,7 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
     return s_first
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _face_closed(cstate, friction, f) -> bool:
     """True if any contact point of face *f* is closed."""
     for c in range(friction.first_point[f], friction.first_point[f] + friction.point_count[f]):
@@ -112,7 +112,7 @@ def _face_closed(cstate, friction, f) -> bool:
     return False
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _held_force(f, t, ag_t, lay, structure, contacts, cstate, work, storey, ground, friction) -> float:
     """The force (N) that would hold face *f* sticking now, with every other face in its mode."""
     scratch, deriv = work.ystage, work.K[1]
@@ -123,7 +123,7 @@ def _held_force(f, t, ag_t, lay, structure, contacts, cstate, work, storey, grou
     return friction.force[f]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _stick_or_slip(f, t, ag_t, lay, structure, contacts, cstate, work, storey, ground, friction) -> None:
     """Face *f* at zero slip rate: stick if the force that holds it is at most μN, else slip along that force.
 
@@ -143,7 +143,7 @@ def _stick_or_slip(f, t, ag_t, lay, structure, contacts, cstate, work, storey, g
         friction.direction[f] = 1.0 if held > 0.0 else -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def apply_friction_events(t, ag_t, lay, structure, contacts, cstate, work, storey, ground, friction) -> int:
     """Apply the faces' located events and follow their points' contact events at *t*; returns how many
     faces changed mode or state.
@@ -184,7 +184,7 @@ def apply_friction_events(t, ag_t, lay, structure, contacts, cstate, work, store
     return changed
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def set_friction_pending(friction, s_first) -> None:
     """Mark the faces' events at or before fraction *s_first* as pending (all cleared if *s_first* < 0)."""
     for f in range(friction.mode.size):
@@ -192,7 +192,7 @@ def set_friction_pending(friction, s_first) -> None:
         friction.pending[f] = friction.event_kind[f] if ok else FRICTION_EVENT_NONE
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def keep_friction_within(friction, h, tiny) -> None:
     """Drop the faces' events later than *tiny* seconds into a step of *h* s."""
     for f in range(friction.mode.size):
@@ -200,7 +200,7 @@ def keep_friction_within(friction, h, tiny) -> None:
             friction.event_kind[f] = FRICTION_EVENT_NONE
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def add_friction_pending(friction) -> bool:
     """Add the pending face events to the located ones; any left?"""
     found = False
@@ -212,7 +212,7 @@ def add_friction_pending(friction) -> bool:
     return found
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def record_friction(i, friction) -> None:
     """Output sample *i*: each face's N, λ (N) and mode code (0 open, ±1 slipping along ±v_t, 2 sticking)."""
     nf = friction.mode.size

@@ -30,7 +30,7 @@ FRICTION_OFF, FRICTION_SLIP, FRICTION_STICK = 0, 1, 2
 STICK_SWEEPS = 100
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _ground_term(friction, f, ag_t, ground) -> float:
     """Σ_k w_k·a_g,k (m/s²): the ground acceleration's part of the face's relative slip acceleration."""
     total = 0.0
@@ -42,7 +42,7 @@ def _ground_term(friction, f, ag_t, ground) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _stick(friction, mass, fbuf, ag_t, ground) -> None:
     """Add the sticking faces' constraint forces (``v̇_t = 0``) to ``friction.force`` and *fbuf*."""
     ff, fw = friction.floors, friction.weights
@@ -64,7 +64,7 @@ def _stick(friction, mass, fbuf, ag_t, ground) -> None:
             break
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def friction_forces(y, ag_t, mass, friction, forces, fbuf, out, first_work, ground) -> None:
     """Each face's N and λ (``friction.normal``, ``friction.force``), λ into the floor forces *fbuf*,
     and its dissipated power ``λ·v_t`` into ``out[first_work + f]`` (W).
@@ -92,7 +92,7 @@ def friction_forces(y, ag_t, mass, friction, forces, fbuf, out, first_work, grou
         out[first_work + f] = friction.force[f] * combo(y, n, ff, fw, f)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def stick_margin(friction, f) -> float:
     """μN − |λ| of a sticking face at the last right-hand side (N; < 0: the stick is lost)."""
     return friction.coefficient[f] * friction.normal[f] - abs(friction.force[f])

@@ -85,7 +85,7 @@ def initial_state(law, stiffness: float, height: float) -> np.ndarray:
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def beta(energy, reference, spent, c):
     """β = (E_i / (E_t − ΣE))^c of Ibarra et al. (2005) eq. 4, clipped to [0, 1], and whether it fails.
 
@@ -103,17 +103,17 @@ def beta(energy, reference, spent, c):
     return min(beta, 1.0), beta > 1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _slope(df, du, fallback):
     return df / du if du != 0.0 else fallback
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _side(sigma):
     return 0 if sigma > 0 else SIDE
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _unloading_deterioration(st, f, work):
     """k_u ← k_u(1 − β_k) at a reversal (elastic energy of the unloading excluded); returns a failure."""
     elastic = 0.5 * f * f / st[KUN]
@@ -122,7 +122,7 @@ def _unloading_deterioration(st, f, work):
     return fail
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _deteriorate(st, o, work, use_accelerated):
     """β_s, β_c, β_a of a new excursion applied to the backbone at offset *o*; returns (the post-capping
     intercept, failure).  E_i is the work since the last excursion."""
@@ -141,7 +141,7 @@ def _deteriorate(st, o, work, use_accelerated):
     return intercept * (1.0 - beta_c * st[o + RATE]), fail_s or fail_c or fail_a
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _place_capping_point(st, o, intercept_pc):
     intercept_p = st[o + FY] - st[o + KP] * st[o + UY]
     if st[o + KP] <= st[o + KPC]:
@@ -151,7 +151,7 @@ def _place_capping_point(st, o, intercept_pc):
     st[o + FCAP] = intercept_p + st[o + KP] * st[o + UCAP]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _backbone_force(st, o, x):
     """The backbone at offset *o* at own drift *x*, not below the residual (peak-oriented targets)."""
     if x < st[o + UY]:
@@ -168,7 +168,7 @@ def _backbone_force(st, o, x):
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def branch_force(st, u):
     """The current branch's shear (N) at drift *u* (m), and its slope (N/m)."""
     if st[FAILED] > 0.0:
@@ -196,7 +196,7 @@ def branch_force(st, u):
     return sigma * f, k
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _oriented_limits(st):
     """(lower, upper, watch) of the current branch (peak-oriented and pinching), absolute drifts."""
     branch = int(st[BRANCH])
@@ -228,14 +228,14 @@ def _oriented_limits(st):
     return -limit, INF, -1.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _bilinear_backbone(st, o, x):
     """IMKBilin's backbone at offset *o* at own drift *x*: the hardening or post-capping line, not below F_r."""
     slope = st[o + KP] if x < st[o + UCAP] else st[o + KPC]
     return max(st[o + FCAP] + (x - st[o + UCAP]) * slope, st[o + FRES])
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _bilinear_hit(st, o, x_ref, f_ref, k):
     """Smallest own drift x ≥ *x_ref* where the line f_ref + k(x − x_ref) reaches the backbone at *o*."""
     best = INF
@@ -255,7 +255,7 @@ def _bilinear_hit(st, o, x_ref, f_ref, k):
     return best
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _bilinear_limits(st):
     """(lower, upper, watch) of IMKBilin's current state, absolute drifts."""
     uu_pos, uu_neg = st[UU], st[SIDE + UU]
@@ -301,7 +301,7 @@ def _bilinear_limits(st):
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _cascade(st, x):
     """Advance along the reloading path while own drift *x* has reached the branch's end (≥: at an event)."""
     sigma = st[DIR]
@@ -325,7 +325,7 @@ def _cascade(st, x):
         st[BRANCH] = RESIDUAL
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _oriented_event(st, kind, u, f, work):
     """Peak-oriented and pinching: the branch after an event of *kind* at drift *u*; returns a failure."""
     branch = int(st[BRANCH])
@@ -392,7 +392,7 @@ def _oriented_event(st, kind, u, f, work):
     return fail
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _bilinear_event(st, kind, u, f, work):
     """IMKBilin: the state after an event of *kind* at drift *u*; returns a failure (zero strength)."""
     fail = False
@@ -456,7 +456,7 @@ def _bilinear_event(st, kind, u, f, work):
     return False
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def apply_event(st, row, kind, u, f, rate):
     """Apply an event of *kind* (KIND_*) at drift *u* (m) with shear *f* (N) and drift rate *rate* (m/s):
     update the state *st* and the kernel row *row*; returns the shear (N) of the new branch at *u*.
@@ -490,7 +490,7 @@ def apply_event(st, row, kind, u, f, rate):
     return force
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def set_row(st, row, u, at):
     """Write the current branch's slope, unloading stiffness and limits into the kernel *row*; the
     shear (N) at drift *u*.  *at* (m): the drift the branch was decided at (the limit crossed; the

@@ -109,7 +109,7 @@ from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IM
                                       new_peaks, record_contacts, record_floor_peaks, record_plane_peaks,
                                       record_sample, trace_rows,
                                       trimmed_outputs, TRACE_ROW_LIMIT)
-from pounding.solver.rhs import rhs
+from pounding.solver.rhs import rhs_inline
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
                                     STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT, STATUS_UNSTABLE)
 from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, failed_storey,
@@ -356,18 +356,26 @@ class Integration(NamedTuple):
     final_time: float
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction) -> float:
     """The state's rates *rates* at time *t* (record step *seg*), with the ground states ``ground.now``;
     returns the ground acceleration of row 0 there (m/s²).  Contact forces go to ``work.forces``."""
     ag_t = ground_at(forcing.acceleration, forcing.record_step, seg, t)
     if ground is not None:
         fill_grounds(ground, forcing.record_step, seg, t, ground.now)
-    rhs(y, ag_t, lay, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
+    rhs_inline(y, ag_t, lay, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
     return ag_t
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _rates_after(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction) -> float:
+    """:func:`_rates_at`, called rather than inlined: for the driver's sites outside its step loop's
+    every step (after events, the first and the last samples), where one more copy of the right-hand
+    side would only cost compile time."""
+    return _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _with_room(impacts, n_imp, nc):
     """The impact table *impacts* (its first *n_imp* rows used) with room for *nc* more rows (up to its cap)."""
     if n_imp + nc <= impacts.shape[0] or impacts.shape[0] >= IMPACT_ROW_LIMIT:
@@ -375,7 +383,7 @@ def _with_room(impacts, n_imp, nc):
     return grown(impacts, n_imp, min(n_imp + nc, n_imp - n_imp + IMPACT_ROW_LIMIT), n_imp - n_imp + IMPACT_ROW_LIMIT)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, events, table, storey, ground, friction):
     """Apply the storey events ``events.storey_kind``, the contact events ``events.kind`` and then the
     friction faces' (which follow their points' closures and separations) at *t*, in place:
@@ -403,7 +411,7 @@ def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, event
     return n_imp, n_applied, cap, status
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _set_pending(events, s_first, friction) -> None:
     """Mark the events at or before fraction *s_first* as those the retaken step ends at (all others
     cleared; *s_first* < 0 clears every one); the friction faces' too."""
@@ -417,7 +425,7 @@ def _set_pending(events, s_first, friction) -> None:
         set_friction_pending(friction, s_first)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _keep_events_within(events, h, tiny, friction) -> None:
     """Drop the located events later than *tiny* seconds into a step of *h* s (those at its start stay)."""
     for c in range(events.kind.size):
@@ -430,7 +438,7 @@ def _keep_events_within(events, h, tiny, friction) -> None:
         keep_friction_within(friction, h, tiny)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _with_pending(events, friction) -> bool:
     """Add the pending events (those the retaken step was shortened to) to the located ones; any left?"""
     found = False
@@ -449,7 +457,7 @@ def _with_pending(events, friction) -> bool:
     return found
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _count_events(t, n_applied, start, count, record_step):
     """Events applied in the current window of one record step: ``(its start, s; events in it)`` after
     *n_applied* more at *t* (a window that began more than *record_step* s before *t* is a new one)."""
@@ -459,7 +467,7 @@ def _count_events(t, n_applied, start, count, record_step):
     return start, count + n_applied
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_floor, stop_status):
     """The yielding storeys' first events in a trial step of *h* s, and the first stop of the run in it
     (the collapse limit's crossing, STATUS_COLLAPSED, or a loss of stability, STATUS_UNSTABLE):
@@ -488,7 +496,7 @@ def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_f
     return s_first, collapse_s, collapse_floor, stop_status
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _accept(work) -> None:
     """Accept the trial step: its end state and rate become the next step's start (first same as last)."""
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
@@ -501,7 +509,7 @@ def _accept(work) -> None:
 RIGID_BAND_FRACTION = 1e-3
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _new_contact_state(contacts):
     """Every contact open (a link: closed, engaged from the start and never open), none at rest, no impact row."""
     nc = contacts.gap.size
@@ -513,7 +521,7 @@ def _new_contact_state(contacts):
     return cstate
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _new_events(contacts, nh, tol):
     """No event located, none pending, for the contacts and *nh* yielding storeys; the rigid-impact
     scratch sized for the contacts of instantaneous laws.
@@ -540,7 +548,7 @@ def _new_events(contacts, nh, tol):
                   np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64), band, rigid)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial):
     """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile
     time."""
@@ -564,7 +572,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     t, seg = 0.0, zero
-    ag_t = _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+    ag_t = _rates_after(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
     # No contact force in the first sample (work.forces_end is still all 0; a link's first force is not kept).
     record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces_end, storey, ground, out)
     if friction is not None:
@@ -624,7 +632,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                     status = STATUS_EVENT_LIMIT
                 if status != 0:
                     break
-                _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+                _rates_after(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -680,7 +688,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
             if window_events > event_cap:
                 status = STATUS_EVENT_LIMIT
-            _rates_at(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+            _rates_after(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -692,7 +700,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     if status == 0 and i_out < n_out:
         # t_end reached within round-off before the last output sample: fill it.
         for i2 in range(i_out, n_out):
-            ag_t = _rates_at(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+            ag_t = _rates_after(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
             record_sample(i2, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
             if friction is not None:
                 record_friction(i2, friction)

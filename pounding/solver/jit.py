@@ -34,7 +34,7 @@ import os
 import sys
 from typing import Iterable
 
-__all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "shortcuts_supported", "load_registries_without_scipy",
+__all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "INLINED", "CALLED", "shortcuts_supported", "load_registries_without_scipy",
            "load_from_cache_without_refresh",
            "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES", "solver_sources",
            "stamp_solver_kernels"]
@@ -64,6 +64,23 @@ def shortcuts_supported() -> bool:
 #: numba refuses to compile an allocation in such a kernel, so the option cannot free an array in
 #: use.  Applied on the numba releases of :data:`TESTED_NUMBA` only, like the start-up shortcuts.
 NO_REFCOUNT: dict = {"_nrt": False} if shortcuts_supported() else {}
+
+#: numba options of a kernel the driver calls on every step or output sample: inlined into its
+#: caller by LLVM (numba's ``forceinline``: the LLVM ``alwaysinline`` attribute; the kernel is
+#: still compiled, typed and cached once, as its own function).  numba passes every member of a
+#: record argument as separate words on the stack (an array as 7), so a call taking ``work``,
+#: ``structure``, ``contacts``, ``cstate`` and ``storey`` copies ~300 words: on the small models
+#: these copies were most of the driver's own time (``perf``: 72 % of its samples on ``push``
+#: instructions), and the solver-only time of isolated_moat.yaml 1.6x that of 20c2fbe (issue 24).
+#: Inlined, the records are the caller's values and nothing is copied.  Results are bit-identical
+#: (inlining changes no floating-point operation: no fast-math).
+INLINED: dict = {"forceinline": True}
+
+#: numba options of every other solver kernel: ``forceinline`` set (to False) explicitly.  numba
+#: copies an unset ``forceinline`` from the compilation that triggers it, so a kernel first
+#: compiled while numba compiles an :data:`INLINED` caller would otherwise be forced inline
+#: everywhere (growing the compile time), depending on which model compiled it first.
+CALLED: dict = {"forceinline": False}
 
 
 def load_registries_without_scipy() -> None:

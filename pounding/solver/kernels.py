@@ -66,7 +66,7 @@ if any(cls.law_id >= FIRST_PLUGIN_ID for cls in laws.LAWS.values() if cls.kernel
 
 
 #: numba options of a dispatch-chain function: cached, called from compiled code only, no reference counting.
-_CHAIN_OPTIONS = dict(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+_CHAIN_OPTIONS = dict(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 
 
 def _chain_end(law_id, *args):
@@ -105,13 +105,13 @@ _plugin_internal_tolerance = _chain("internal_tolerance")
 _plugin_contact_duration = _chain("contact_duration")
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def is_permanent(law_id: int) -> bool:
     """True for link elements (pounding.contact.links): always engaged, no gap, no events, tension allowed."""
     return law_id >= FIRST_LINK_ID
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def link_force(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
     """Force of a link (N, may be negative: a pull) at relative displacement *delta* and its rate."""
     if law_id == LINK_VISCOUS:
@@ -123,7 +123,7 @@ def link_force(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q:
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
     """Per-impact constant fixed at the located gap closure (ξ for Hertz-damp, the rubber's ξb for a bumper)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -133,13 +133,13 @@ def onset_constant(law_id: int, prm: np.ndarray, v0: float) -> float:
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def is_instantaneous(law_id: int) -> bool:
     """True for laws applied as a velocity jump at closure (stereo-mechanical)."""
     return law_id == LAW_STEREO
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def restitution(law_id: int, prm: np.ndarray) -> float:
     """Coefficient of restitution e of an instantaneous law (0 for the others)."""
     if law_id == LAW_STEREO:
@@ -147,7 +147,7 @@ def restitution(law_id: int, prm: np.ndarray) -> float:
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
     """Impulse (N·s) of an instantaneous law for approach velocity *v0*: (1+e)·m_eff·v0."""
     if law_id == LAW_STEREO:
@@ -155,7 +155,7 @@ def jump_impulse(law_id: int, prm: np.ndarray, v0: float) -> float:
     return 0.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)  # called from compiled code only
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # called from compiled code only
 def _bilinear_bounds(prm: np.ndarray, delta: float) -> tuple:
     """Lower (K2·δ) and upper (K1·δy + K2·(δ − δy)) envelopes of the bilinear loop, N."""
     k1, k2, dy = prm[0], prm[1], prm[2]
@@ -163,7 +163,7 @@ def _bilinear_bounds(prm: np.ndarray, delta: float) -> tuple:
     return k2 * delta, upper
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)  # called from compiled code only
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # called from compiled code only
 def _bumper_force(prm: np.ndarray, xi_bumper: float, delta: float, delta_rate: float, xi_hard: float,
                   bumper_on: bool, hard_engaged: bool, hard_on: bool) -> float:
     """Bumper law: rubber ``δ^1.5·(kb + ξb·δ̇)`` plus, when engaged, the hard face on ``δ − δlim``, N.
@@ -186,7 +186,7 @@ def _bumper_force(prm: np.ndarray, xi_bumper: float, delta: float, delta_rate: f
     return f
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)  # called from compiled code only
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # called from compiled code only
 def potential(law_id: int, prm: np.ndarray, delta: float, q: float) -> float:
     """Elastic energy stored in the contact (J): what unloading would give back.
 
@@ -260,7 +260,7 @@ BUMPER_HARD_CLAMPED = 8
 N_SWITCHES = 3
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
     """Mode of a contact at its located gap closure with approach velocity *v0* (m/s)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -272,7 +272,7 @@ def onset_mode(law_id: int, prm: np.ndarray, v0: float) -> int:
     return 0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def switch_count(law_id: int, prm: np.ndarray) -> int:
     """How many switch functions the law has (0: the force is one formula while closed)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -290,7 +290,7 @@ def switch_count(law_id: int, prm: np.ndarray) -> int:
     return 0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, delta: float,
                delta_rate: float, q: float) -> float:
     """Contact force (N) of a closed contact in *mode* (no branch on the state inside a mode).
@@ -337,7 +337,7 @@ def mode_force(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, 
     return 0.0  # stereo-mechanical: no force history (a velocity jump; a stuck contact's force is the solver's)
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float) -> float:
     """Rate of the internal state in *mode* (N/s): the bilinear force follows K1 (elastic) or K2 (yielding)."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -349,7 +349,7 @@ def mode_internal_rate(law_id: int, prm: np.ndarray, mode: int, delta: float, de
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def link_internal_rate(law_id: int, prm: np.ndarray, delta_rate: float, q: float) -> float:
     """Rate of a link's internal state (N/s): a Maxwell element's force, ``k·(δ̇ − q/c)``."""
     if law_id == LINK_MAXWELL:
@@ -357,7 +357,7 @@ def link_internal_rate(law_id: int, prm: np.ndarray, delta_rate: float, q: float
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, which: int, delta: float,
                  delta_rate: float, q: float) -> float:
     """Switch function *which* of *mode*: positive while the mode holds, crossing 0 where it ends.
@@ -402,7 +402,7 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
     return 1.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def next_mode(law_id: int, mode: int, which: int) -> int:
     """Mode entered when switch function *which* of *mode* crosses zero."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -420,7 +420,7 @@ def next_mode(law_id: int, mode: int, which: int) -> int:
     return 1 - mode
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delta_rate: float, q: float) -> float:
     """Internal state put exactly on the branch *mode* starts on (removes the event's round-off).
 
@@ -444,7 +444,7 @@ def snapped_internal(law_id: int, prm: np.ndarray, mode: int, delta: float, delt
     return q
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def implied_mode(law_id: int, prm: np.ndarray, impact_constant: float, delta: float, delta_rate: float,
                  q: float) -> int:
     """Mode a closed contact's state implies, without the history the solver's located events carry.
@@ -482,7 +482,7 @@ def implied_mode(law_id: int, prm: np.ndarray, impact_constant: float, delta: fl
     return 0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
           delta_rate: float, q: float) -> float:
     """Contact force (N) at penetration *delta* (m), its rate (m/s) and internal state *q*, no mode given.
@@ -495,7 +495,7 @@ def force(law_id: int, prm: np.ndarray, impact_constant: float, delta: float,
     return mode_force(law_id, prm, impact_constant, mode, delta, delta_rate, q)
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float, q: float) -> float:
     """Rate of the internal state (N/s) in the mode the state implies (:func:`mode_internal_rate`); links too."""
     if law_id >= FIRST_LINK_ID:
@@ -505,7 +505,7 @@ def internal_rate(law_id: int, prm: np.ndarray, delta: float, delta_rate: float,
     return mode_internal_rate(law_id, prm, implied_mode(law_id, prm, 0.0, delta, delta_rate, q), delta, delta_rate)
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -> float:
     """Absolute error tolerance of the internal state (N): K1·atol for the bilinear force, 0 if unused."""
     if FIRST_PLUGIN_ID <= law_id < FIRST_LINK_ID:
@@ -515,7 +515,7 @@ def internal_tolerance(law_id: int, prm: np.ndarray, atol_displacement: float) -
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: float) -> float:
     """Duration estimate (s) of a free impact at approach velocity *v0* (m/s); 0 for instantaneous laws.
 
@@ -535,7 +535,7 @@ def contact_duration(law_id: int, prm: np.ndarray, v0: float, effective_mass: fl
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def rest_velocity(law_id: int, prm: np.ndarray) -> float:
     """Approach velocity (m/s) at or below which a closure is a contact at rest (docs/numerics.md).
 

@@ -41,21 +41,21 @@ __all__ = ["SIDE_TERMS", "combo", "push", "compliance", "effective_mass", "groun
 SIDE_TERMS = 4
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def combo(y, offset, cf, cw, c) -> float:
     """Σ_k w_k·y[offset + f_k] over the contact's floor terms (δ + gap for offset 0, δ̇ for offset n)."""
     return (cw[4 * c + 0] * y[offset + cf[4 * c + 0]] + cw[4 * c + 1] * y[offset + cf[4 * c + 1]]
             + cw[4 * c + 2] * y[offset + cf[4 * c + 2]] + cw[4 * c + 3] * y[offset + cf[4 * c + 3]])
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def push(fbuf, cf, cw, c, force) -> None:
     """Add contact force *force* (N, ≥ 0 pushes apart) to the floors' internal forces with the side weights."""
     for k in range(SIDE_TERMS):
         fbuf[cf[4 * c + k]] += cw[4 * c + k] * force
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def compliance(mass, cf, cw, c) -> float:
     """Σ_k cw²/m (1/kg): δ̈ per unit contact force; 1/m_eff of the contact (a wall adds nothing)."""
     total = 0.0
@@ -64,7 +64,7 @@ def compliance(mass, cf, cw, c) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def effective_mass(mass, cf, cw, c) -> float:
     """m_eff of contact *c* (kg): ``1/Σ cw²/m``; a plain floor pair as ``m_L·m_R/(m_L + m_R)``.
 
@@ -80,13 +80,13 @@ def effective_mass(mass, cf, cw, c) -> float:
     return 1.0 / compliance(mass, cf, cw, c)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def ground_weight(cf, cw, c) -> float:
     """Σ_k cw over the floor terms: 0 between two buildings, ±1 against a wall (a_g's share in δ̈)."""
     return cw[4 * c + 0] + cw[4 * c + 1] + cw[4 * c + 2] + cw[4 * c + 3]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def kick(y, n, mass, cf, cw, c, impulse) -> None:
     """Apply an impulse *impulse* (N·s, ≥ 0 pushes apart) of contact *c* to the floor velocities."""
     for k in range(SIDE_TERMS):
@@ -98,7 +98,7 @@ def kick(y, n, mass, cf, cw, c, impulse) -> None:
 # --------------------------------------------------------------------------- #
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def ground_at(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     """Piecewise-linear ground acceleration inside segment *seg* at time *t*."""
     t0 = seg * dt_rec
@@ -107,7 +107,7 @@ def ground_at(ag: np.ndarray, dt_rec: float, seg: int, t: float) -> float:
     return ag[seg] + (ag[seg + 1] - ag[seg]) * ((t - t0) / dt_rec)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def fill_grounds(ground, dt_rec, seg, t, gstate):
     """Acceleration, velocity and displacement of every ground at time *t* into *gstate* (3, G).
 
@@ -129,7 +129,7 @@ def fill_grounds(ground, dt_rec, seg, t, gstate):
         gstate[2, g] = ug[g, k] + vg[g, k] * tau + 0.5 * a0 * tau * tau + slope * tau * tau * tau / 6.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def ground_offset(ground, gstate, c, row):
     """Differential ground motion of contact *c*: ground of its left side minus ground of its right side.
 
@@ -142,7 +142,7 @@ def ground_offset(ground, gstate, c, row):
     return gstate[row, ground.left_row[c]] - gstate[row, ground.right_row[c]]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground):
     """Contact *c*'s ``Σ w·u`` (gap not subtracted) over an accepted or trial step: its value, rate
     and acceleration at both ends ``(d0, r0, d1, r1, a0, a1)`` and the round-off scale ``Σ |w·u|``
@@ -177,7 +177,7 @@ def step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground):
     return d0, r0, d1, r1, a0, a1, size
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def contact_sums(y, n, cf, cw, c):
     """Contact *c*'s ``(Σ w·u, Σ w·v)`` of state *y* (its δ + gap and δ̇ without the ground offsets),
     summed term by term from 0 (the right-hand side's form, as :func:`step_kinematics`)."""
@@ -189,7 +189,7 @@ def contact_sums(y, n, cf, cw, c):
     return delta, rate
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def contact_delta(y, contacts, ground, c) -> float:
     """Penetration δ of contact *c* (m) in state *y*: ``Σ w·u`` (:func:`combo`), plus the
     differential ground displacement of ``ground.now`` with several grounds, minus the gap."""
@@ -205,7 +205,7 @@ step_kinematics_inline = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrap
 (as a call it measured ~5 % slower on pair.yaml, min of 6 alternated runs, 9.2 against 8.7 ms)."""
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def drift(y, offset, j, b) -> float:
     """Drift of the storey under floor *j* (floor below *b*, −1 for the ground) from ``y[offset:]``.
 
@@ -214,7 +214,7 @@ def drift(y, offset, j, b) -> float:
     return y[offset + j] - y[offset + b] if b >= 0 else y[offset + j]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def drift_interpolant(y, ynew, k1, k7, n, j, b):
     """Drift and drift rate of the storey under floor *j* at both ends of a step, and their rates."""
     if b >= 0:
@@ -229,7 +229,7 @@ def drift_interpolant(y, ynew, k1, k7, n, j, b):
 # buildings' arithmetic is :func:`drift`'s, bit for bit.
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def storey_drift(y, offset, terms, below, j) -> float:
     """Drift (offset 0, m) or drift rate (offset N, m/s) of storey row *j* of state *y*."""
     if terms is None:
@@ -237,7 +237,7 @@ def storey_drift(y, offset, terms, below, j) -> float:
     return combo(y, offset, terms.floors, terms.weights, j)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def storey_interpolant(y, ynew, k1, k7, n, terms, below, j):
     """:func:`drift_interpolant` of storey row *j*: drift and drift rate at both ends of a step, their rates."""
     if terms is None:
@@ -246,7 +246,7 @@ def storey_interpolant(y, ynew, k1, k7, n, terms, below, j):
     return d0, r0, d1, r1, a0, a1
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def storey_push(fbuf, terms, below, j, force) -> None:
     """Add storey row *j*'s shear *force* (N) to the floor forces: +F on the floor above, −F on the one
     below; a plane's ``w·F`` on each of its terms (virtual work, :func:`push`)."""
@@ -259,7 +259,7 @@ def storey_push(fbuf, terms, below, j, force) -> None:
     push(fbuf, terms.floors, terms.weights, j, force)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def storey_rate_scale(y, n, terms, below, j) -> float:
     """Σ |w·v| over storey row *j*'s terms (m/s): the round-off scale of its drift rate."""
     if terms is None:
@@ -272,7 +272,7 @@ def storey_rate_scale(y, n, terms, below, j) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def storey_stiffness(kst, terms, j) -> float:
     """Elastic stiffness of storey row *j*, N/m: ``kst[j]`` (the floors' storey springs) or the plane's."""
     if terms is None:

@@ -72,7 +72,7 @@ class Peaks(NamedTuple):
     values: np.ndarray        #: (FORCE_SAMPLES + 1,) scratch: forces, N
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def new_outputs(n_out, lay, ground):
     """Empty :class:`Outputs` of *n_out* samples (*ground*: the solver's, None with one ground)."""
     n, nc = lay.n_floors, lay.n_contacts
@@ -84,7 +84,7 @@ def new_outputs(n_out, lay, ground):
                    np.empty((n_out, n_ground - n_ground + 2)))  # non-literal 2: no extra np.empty specialisation
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def new_peaks(lay, n_planes):
     """Zero :class:`Peaks` (and its scratch) with *n_planes* plane drifts."""
     m = lay.n_contacts - lay.n_contacts + FORCE_SAMPLES + 1
@@ -92,7 +92,7 @@ def new_peaks(lay, n_planes):
                  np.empty(m), np.empty(m), np.empty(m))
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def grown(table, rows, needed, limit):
     """*table* if it has *needed* rows; else a copy of its first *rows* rows, NaN-padded to twice that.
 
@@ -108,7 +108,7 @@ def grown(table, rows, needed, limit):
     return bigger
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def closed_contact_samples(claw, prm, const, mode, gap, kin, internal, h, fractions, deltas, values) -> float:
     """Sample a closed contact over a step on the interpolant; return its peak force.
 
@@ -149,7 +149,7 @@ def closed_contact_samples(claw, prm, const, mode, gap, kin, internal, h, fracti
     return best
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def peak_magnitude(values) -> float:
     """Largest |value| of equally spaced samples, refined by a parabola through the largest and its neighbours.
 
@@ -181,7 +181,7 @@ def peak_magnitude(values) -> float:
     return best
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def contact_energy(y, lay, contacts, ground) -> float:
     """Elastic energy stored in all contacts (J) for state *y* (the energy audit's contact strain)."""
     total = 0.0
@@ -191,7 +191,7 @@ def contact_energy(y, lay, contacts, ground) -> float:
     return total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def storey_outputs(y, lay, structure, storey, out, row):
     """Storey shears and energies of state *y* into ``shear[row]`` and ``energy[row]``.
 
@@ -213,7 +213,7 @@ def storey_outputs(y, lay, structure, storey, out, row):
     energy[row, 1] = 0.0
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def plane_outputs(y, lay, structure, storey, terms, out, row):
     """:func:`storey_outputs` with a *storey* record.  Its rows are the storeys (*terms* None), or a plan
     model's planes (*terms*: :class:`~pounding.solver.layout.StoreyTerms`); then ``shear[row]`` (one column
@@ -247,7 +247,7 @@ def plane_outputs(y, lay, structure, storey, terms, out, row):
     energy[row, 1] = yielding
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def record_sample(i, t, ys, rates, ag_t, lay, structure, contacts, forces, storey, ground, out) -> None:
     """Output sample *i* at time *t* (s): state *ys*, floor accelerations ``rates[N:2N]``, contact
     forces *forces*, ground acceleration *ag_t* (and with several grounds ``ground.now``), the
@@ -268,7 +268,7 @@ def record_sample(i, t, ys, rates, ag_t, lay, structure, contacts, forces, store
     storey_outputs(ys, lay, structure, storey, out, i)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def record_floor_peaks(work, h, n, below, peaks) -> None:
     """Peak |displacement| of every floor and |drift| of every storey over an accepted step of *h* s."""
     y, ynew = work.y, work.ynew
@@ -295,7 +295,7 @@ def record_floor_peaks(work, h, n, below, peaks) -> None:
                 peak_drift[j] = v
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def record_plane_peaks(work, h, n, floors, weights, peaks) -> None:
     """Peak |drift| of every plane of a plan model over an accepted step of *h* s (none: no planes).
 
@@ -317,7 +317,7 @@ def record_plane_peaks(work, h, n, floors, weights, peaks) -> None:
                 peak[p] = v
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def trace_rows(contacts, cstate) -> int:
     """Most rows a step adds to the trace: FORCE_SAMPLES + 1 per closed contact, neither a link nor stuck."""
     rows = 0
@@ -327,7 +327,7 @@ def trace_rows(contacts, cstate) -> int:
     return rows
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, trace, n_trace):
     """Peak force of every contact over an accepted step from *t* of *h* s, and the samples of every
     closed one appended to the *trace* (its first *n_trace* rows used; the caller makes room for
@@ -382,7 +382,7 @@ def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, t
     return n_trace, zero
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def close_open_impacts(y, lay, cstate, impacts) -> None:
     """Impacts still open at the end of a run: their impulse and work so far, no end."""
     for c in range(lay.n_contacts):
@@ -392,7 +392,7 @@ def close_open_impacts(y, lay, cstate, impacts) -> None:
             impacts[row, IMP_WORK] = y[lay.work + c] - impacts[row, IMP_WORK]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
 def trimmed_outputs(out, count):
     """The first *count* samples of *out* (:class:`Outputs`)."""
     return Outputs(out.time[:count], out.state[:count], out.acceleration[:count], out.force[:count],

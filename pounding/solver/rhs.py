@@ -12,6 +12,7 @@ with the motion's (:mod:`pounding.solver.layout`).
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from pounding.solver import jit
@@ -24,7 +25,7 @@ from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, dr
 __all__ = ["stuck_constraints", "rhs", "rhs_inline", "storey_forces"]
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground):
     """Constraint forces of stuck contacts (added to *forces* and *fbuf*): make every δ̈ = 0.
 
@@ -62,7 +63,7 @@ def stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground):
             break
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground, friction):
     """Time derivative of the state; contact forces are written to *forces*.
 
@@ -120,19 +121,24 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
         off = doff[bidx]
         band = dband[bidx]
         if dstiff.size > 0:  # a plan model's building: C·v and its planes' and P-Delta's K·u (K = Σ k a aᵀ)
+            # Unsigned indices: numba adds a negative-index wrap-around to every signed one (a third of
+            # this loop's instructions); these are sums of non-negative offsets.
+            row, displacement, velocity = np.uint64(off), np.uint64(s0), np.uint64(n + s0)
             for i in range(m):
                 acc = 0.0
                 spring = 0.0
                 for k in range(max(0, i - band), min(m, i + band + 1)):
-                    acc += dvals[off + i * m + k] * y[n + s0 + k]
-                    spring += dstiff[off + i * m + k] * y[s0 + k]
+                    entry, column = row + np.uint64(k), np.uint64(k)
+                    acc += dvals[entry] * y[velocity + column]
+                    spring += dstiff[entry] * y[displacement + column]
+                row += np.uint64(m)
                 fbuf[s0 + i] += acc
                 power += acc * y[n + s0 + i]
                 fbuf[s0 + i] += spring
             continue
-        for i in range(m):
+        for i in range(m):  # a shear building's modal damping block: full (its band, m − 1, not read)
             acc = 0.0
-            for k in range(max(0, i - band), min(m, i + band + 1)):
+            for k in range(m):
                 acc += dvals[off + i * m + k] * y[n + s0 + k]
             fbuf[s0 + i] += acc
             power += acc * y[n + s0 + i]
@@ -203,9 +209,10 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
     out[lay.damping_energy] = power
 
 
-rhs_inline = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always",
+rhs_inline = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED,
                   **jit.NO_REFCOUNT)(rhs.py_func)
-""":func:`rhs` inlined where numba compiles it into its caller (the Dormand–Prince stages)."""
+""":func:`rhs` inlined by LLVM into its callers on the driver's every step and output sample (the
+Dormand–Prince stages, the output samples' rates): a call would copy its ~30 arrays (:data:`jit.INLINED`)."""
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)

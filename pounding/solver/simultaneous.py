@@ -35,7 +35,7 @@ __all__ = ["delassus", "solve_lcp", "LCP_SWEEPS"]
 LCP_SWEEPS = 500
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def delassus(mass, cf, cw, active, na, G) -> None:
     """``G[i, j] = Σ_k Σ_l w_k·w_l / m_f`` over the floor terms k of contact active[i] and l of
     active[j] on the same floor f (1/kg), for i, j < *na*: the change of contact i's δ̇ per unit
@@ -54,7 +54,7 @@ def delassus(mass, cf, cw, active, na, G) -> None:
             G[i, j] = total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _solve_active(rigid, na) -> bool:
     """Solve ``G_II P_I = b_I`` on the active set I = {P > 0} into ``rigid.exact`` (Gaussian
     elimination with partial pivoting); False if it is singular there."""
@@ -91,7 +91,7 @@ def _solve_active(rigid, na) -> bool:
     return True
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def solve_lcp(rigid, na) -> None:
     """Impulses ``P ≥ 0`` (N·s) with ``s = G P − b ≥ 0`` and ``sᵀP = 0`` (module docstring) into
     ``rigid.impulse[:na]``, from ``rigid.delassus`` and ``rigid.target``.

@@ -103,7 +103,7 @@ def imk_event(y, ynew, k1, k7, lay, j, terms, below, sprm, h):
     return best, kind
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def locate_storey_events(work, h, lay, below, storey, sev_s, sev_kind) -> float:
     """Each yielding storey's first switch inside a step (:func:`storey_event`, inlined here) into
     ``sev_s`` and ``sev_kind``; returns the earliest fraction (2.0 if none).
@@ -127,7 +127,7 @@ def locate_storey_events(work, h, lay, below, storey, sev_s, sev_kind) -> float:
     return first
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def apply_storey_events(kinds, y, lay, below, storey):
     """Apply located storey events ``kinds[h]`` (STOREY_*) to the state, in place; returns how many.
 
@@ -165,7 +165,7 @@ def apply_storey_events(kinds, y, lay, below, storey):
     return applied
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def failed_storey(storey):
     """Floor of the first IMK storey at zero strength (failed at an event), −1 if none."""
     smodel, sfloor = storey.model, storey.floor
@@ -175,7 +175,7 @@ def failed_storey(storey):
     return sfloor.size - sfloor.size - 1
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def collapse_crossing(work, n, below, heights, stop_ratio, terms, h):
     """First instant in a step where a storey's |drift| exceeds ``stop_ratio[j]·height[j]``: (fraction, row).
 
@@ -201,7 +201,7 @@ def collapse_crossing(work, n, below, heights, stop_ratio, terms, h):
     return best, where
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def instability_crossing(work, lay, below, storey, stiffness, h):
     """First instant in a step where a storey with P-Delta loses its lateral resistance: (fraction, floor).
 

@@ -33,13 +33,13 @@ YIELD_POSITIVE = 1
 YIELD_NEGATIVE = -1
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def is_imk(model):
     """True for the IMK storeys (their shear is the state r; pounding.solver.imk)."""
     return model == MODEL_IMK_BILINEAR or model == MODEL_IMK_PEAK or model == MODEL_IMK_PINCHING
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def restoring_force(model, table, row, k, drift, r):
     """Storey (column) shear, N, at *drift* (m) with state *r*; P-Delta and damping not included."""
     if model == MODEL_BILINEAR:
@@ -53,7 +53,7 @@ def restoring_force(model, table, row, k, drift, r):
     return k * drift
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def state_rate(model, table, row, mode, drift_rate, r):
     """Time derivative of the state *r* at drift rate *drift_rate* (m/s) in *mode*."""
     if model == MODEL_BILINEAR:
@@ -68,7 +68,7 @@ def state_rate(model, table, row, mode, drift_rate, r):
     return 0.0
 
 
-@njit(cache=True, no_cfunc_wrapper=True, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def recoverable_energy(model, table, row, k, drift, r):
     """Energy the storey would give back on unloading to zero force, J.
 
