@@ -212,3 +212,31 @@ def test_the_solver_frees_every_array_it_allocates_and_nothing_more():
     assert 0.31 < released_at < 0.6   # the stuck contact released (its constraint path ran)
     assert allocated > 0 and made > 0
     assert (freed, released) == (allocated, made)
+
+
+def test_every_solver_kernel_states_whether_it_is_inlined():
+    """Every compiled kernel of ``pounding.solver`` sets numba's ``forceinline`` explicitly (jit.INLINED
+    or jit.CALLED).  numba copies an unset ``forceinline`` from the compilation that triggers a
+    kernel's first compile, so a kernel without it would be inlined everywhere or nowhere depending on
+    which caller compiled it first (compile time and speed would depend on the order models ran)."""
+    import importlib
+    import pkgutil
+
+    import pounding.solver
+    from numba.core.registry import CPUDispatcher
+
+    unset, inlined = [], []
+    for info in pkgutil.iter_modules(pounding.solver.__path__):
+        module = importlib.import_module(f"pounding.solver.{info.name}")
+        for name, value in vars(module).items():
+            if isinstance(value, CPUDispatcher) and value.py_func.__module__ == module.__name__:
+                options = value.targetoptions
+                if options.get("inline", "never") != "never":
+                    continue  # numba-IR inlined into its caller: never compiled on its own
+                if "forceinline" not in options:
+                    unset.append(f"{info.name}.{name}")
+                elif options["forceinline"]:
+                    inlined.append(name)
+    assert unset == []
+    # the driver's per-step kernels are the inlined ones (the argument copies they save: docs/performance.md)
+    assert {"stages", "error_norm", "locate_contact_events", "record_sample", "rhs_inline"} <= set(inlined)
