@@ -182,3 +182,31 @@ def test_every_registry_refuses_a_name_taken_twice():
         register_hysteresis(HYSTERESES["bilinear"])
     with pytest.raises(ValueError, match="separation rule 'srss' is registered twice"):
         gap.register_rule(gap.RULES["srss"])
+
+
+#: Issue 24 §1: the solver's functions fit on a screen or two and its kernels take named records.
+SOLVER_MAX_LINES = 150
+KERNEL_MAX_PARAMETERS = 12
+
+
+def _solver_functions():
+    """(module file name, function node, compiled?) for every function in ``pounding/solver``."""
+    for path in sorted((PACKAGE / "solver").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                compiled = any("njit" in ast.unparse(d) for d in node.decorator_list)
+                yield path.name, node, compiled
+
+
+def test_no_solver_function_is_longer_than_150_lines():
+    long = [(name, node.name, node.end_lineno - node.lineno + 1) for name, node, _ in _solver_functions()
+            if node.end_lineno - node.lineno + 1 > SOLVER_MAX_LINES]
+    assert long == []
+
+
+def test_no_compiled_kernel_takes_more_than_12_parameters():
+    wide = [(name, node.name, len(node.args.args)) for name, node, compiled in _solver_functions()
+            if compiled and len(node.args.args) > KERNEL_MAX_PARAMETERS]
+    assert wide == []
+    # the scan sees the kernels (a decorator spelt otherwise would hide them all)
+    assert sum(compiled for _, _, compiled in _solver_functions()) > 100

@@ -160,12 +160,12 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def locate_releases(work, h, t, seg, forcing, lay, structure, contacts, cstate, events, storey, ground, friction):
+def locate_releases(work, h, t, seg, forcing, structure, contacts, cstate, events, storey, ground, friction):
     """Release of every stuck contact whose constraint force is tensile at the end of a trial step from
     *t* of *h* s (``work.forces_end``): bisected on the interpolant, into ``events.s`` and
     ``events.kind`` (EVENT_RELEASE); returns the earliest fraction (2.0 if none).  Kept out of
     :func:`locate_contact_events` (rare, and it needs the whole right-hand side)."""
-    y, ynew, ystage, K, fbuf, forces, forces_end = work
+    y, ynew, ystage, K, fbuf, forces, forces_end, lay = work
     k1, k2, k7 = K[0], K[1], K[6]
     ag, dt_rec = forcing.acceleration, forcing.record_step
     S = lay.size
@@ -319,8 +319,7 @@ def _rigid_set(kinds, contacts, cstate, active):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground,
-                           friction):
+def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, table, storey, ground, friction):
     """Closures of instantaneous contacts (``events.kind``) together with the stuck ones, when there are
     two or more of them (:func:`_rigid_set`): one impulse each from Newton's restitution as an LCP
     (:mod:`pounding.solver.simultaneous`).  Returns ``(new impact-row count, closures handled, status)``.
@@ -332,6 +331,7 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
     energy lost), ``P·dvg`` to the ground work.  Clears ``events.kind`` of the closures handled.
     """
     y, scratch, deriv, fbuf, forces = work.y, work.ystage, work.K[1], work.fbuf, work.forces
+    impacts, n_imp = table.rows, table.count
     mass = structure.mass
     cf, cw, claw, cprm = contacts.floors, contacts.weights, contacts.law, contacts.parameters
     kinds, rigid = events.kind, events.rigid
@@ -398,8 +398,7 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work, impacts, n_imp, storey, ground,
-                         friction):
+def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work, table, storey, ground, friction):
     """Apply the located events ``events.kind[c]`` (EVENT_*) at time *t* to the state ``work.y``, in place.
 
     * Closure of a compliant contact: ξ (or the law's constant) from
@@ -419,7 +418,7 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
     Returns ``(n_imp, n_applied, first_step_cap, status)``;
     *first_step_cap* (s) is the duration estimate of the shortest newly
     closed compliant contact over STEPS_PER_CONTACT (inf if none).  The
-    impact table *impacts* (its first *n_imp* rows used) has room for a row per
+    impact table *table* (``ImpactTable``: its first ``count`` rows used) has room for a row per
     contact (up to IMPACT_ROW_LIMIT; the caller grows it, :func:`recorder.grown`).
     ``work.ystage``, ``work.K[1]``, ``work.fbuf`` and ``work.forces`` serve as scratch.
     """
@@ -432,8 +431,9 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
     iq = lay.internal
     cap = np.inf
     kinds = events.kind
-    n_imp, n_applied, status = resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work,
-                                                      impacts, n_imp, storey, ground, friction)
+    impacts = table.rows
+    n_imp, n_applied, status = resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, work, table,
+                                                      storey, ground, friction)
     if status != 0:
         return n_imp, n_applied, cap, status
     for c in range(nc):

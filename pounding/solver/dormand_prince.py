@@ -50,17 +50,18 @@ EXCLUDED = -1.0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
-def stages(work, h, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground, friction):
+def stages(work, h, t, seg, forcing, lay, structure, contacts, cstate, storey, ground, friction):
     """Stages 2–7 of a Dormand–Prince step of size *h* from ``work.y`` at *t* (stage 1, ``K[0]``, given).
 
     Fills ``K[1..6]`` and the 5th-order solution ``work.ynew`` (stage 7 is its rate: first same as
-    last); *seg* is the record step the step lies in (ground acceleration *ag*, step *dt_rec*, s).
+    last); *seg* is the record step the step lies in (*forcing*: the ground acceleration record).
     One call per attempted step (itself inlined into the driver, :data:`jit.INLINED`), with the
     right-hand side inlined once, in its loop: six calls of :func:`rhs`, each passing its ~30
     arrays, cost more than their arithmetic.  The weighted sums are written out per
     stage (they vectorise; a loop over the tableau did not).
     """
     y, ynew, ystage, K, fbuf, forces = work.y, work.ynew, work.ystage, work.K, work.fbuf, work.forces
+    ag, dt_rec = forcing.acceleration, forcing.record_step
     S = y.size
     k1, k2, k3, k4, k5, k6 = K[0], K[1], K[2], K[3], K[4], K[5]
     for stage in range(1, 7):

@@ -214,7 +214,10 @@ def add_friction_pending(friction) -> bool:
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def record_friction(i, friction) -> None:
-    """Output sample *i*: each face's N, λ (N) and mode code (0 open, ±1 slipping along ±v_t, 2 sticking)."""
+    """Output sample *i*: each face's N, λ (N) and mode code (0 open, ±1 slipping along ±v_t, 2 sticking);
+    nothing without friction faces (*friction* None: pruned)."""
+    if friction is None:
+        return
     nf = friction.mode.size
     if i >= friction.history.shape[0]:
         return

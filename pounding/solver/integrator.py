@@ -357,22 +357,22 @@ class Integration(NamedTuple):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
-def _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction) -> float:
+def _rates_at(t, seg, y, rates, forcing, structure, contacts, cstate, work, storey, ground, friction) -> float:
     """The state's rates *rates* at time *t* (record step *seg*), with the ground states ``ground.now``;
     returns the ground acceleration of row 0 there (m/s²).  Contact forces go to ``work.forces``."""
     ag_t = ground_at(forcing.acceleration, forcing.record_step, seg, t)
     if ground is not None:
         fill_grounds(ground, forcing.record_step, seg, t, ground.now)
-    rhs_inline(y, ag_t, lay, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
+    rhs_inline(y, ag_t, work.layout, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
     return ag_t
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _rates_after(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction) -> float:
+def _rates_after(t, seg, y, rates, forcing, structure, contacts, cstate, work, storey, ground, friction) -> float:
     """:func:`_rates_at`, called rather than inlined: for the driver's sites outside its step loop's
     every step (after events, the first and the last samples), where one more copy of the right-hand
     side would only cost compile time."""
-    return _rates_at(t, seg, y, rates, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+    return _rates_at(t, seg, y, rates, forcing, structure, contacts, cstate, work, storey, ground, friction)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED)
@@ -384,11 +384,12 @@ def _with_room(impacts, n_imp, nc):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, events, table, storey, ground, friction):
+def _apply_events(t, seg, forcing, structure, contacts, cstate, work, events, table, storey, ground, friction):
     """Apply the storey events ``events.storey_kind``, the contact events ``events.kind`` and then the
     friction faces' (which follow their points' closures and separations) at *t*, in place:
     ``(n_imp, n_applied, first_step_cap, status)`` (:func:`contact_events.apply_contact_events`;
     *table* with room for a row per contact, :func:`_with_room`)."""
+    lay = work.layout
     zero = lay.n_floors - lay.n_floors
     n_applied = zero
     if storey is not None:
@@ -400,7 +401,7 @@ def _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work, event
                 fill_grounds(ground, forcing.record_step, seg, t, ground.now)
             n_imp, n_contact, cap, status = apply_contact_events(
                 events, t, ground_at(forcing.acceleration, forcing.record_step, seg, t), lay, structure,
-                contacts, cstate, work, table.rows, table.count, storey, ground, friction)
+                contacts, cstate, work, table, storey, ground, friction)
             n_applied += n_contact
             break
     if friction is not None and status == 0:
@@ -458,13 +459,15 @@ def _with_pending(events, friction) -> bool:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _count_events(t, n_applied, start, count, record_step):
-    """Events applied in the current window of one record step: ``(its start, s; events in it)`` after
-    *n_applied* more at *t* (a window that began more than *record_step* s before *t* is a new one)."""
+def _count_events(t, n_applied, start, count, record_step, cap, status):
+    """Events applied in the current window of one record step: ``(its start, s; events in it; status)``
+    after *n_applied* more at *t* (a window that began more than *record_step* s before *t* is a new one);
+    the status becomes STATUS_EVENT_LIMIT when the window holds more than *cap* events, else stays *status*."""
     if t - start > record_step:
         start = t
         count = n_applied - n_applied
-    return start, count + n_applied
+    count += n_applied
+    return start, count, STATUS_EVENT_LIMIT if count > cap else status
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -548,6 +551,19 @@ def _new_events(contacts, nh, tol):
                   np.zeros(nh, dtype=np.int64), np.zeros(nh, dtype=np.int64), band, rigid)
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey, ground, friction, out):
+    """Output samples *i_out*… of *out* at the run's end *t* (reached within round-off before the last one's
+    time): the end state ``work.y`` with its rate ``work.K[0]``; returns the number of samples (all)."""
+    y, k1, k2, lay = work.y, work.K[0], work.K[1], work.layout
+    n_out = out.time.size
+    for i in range(i_out, n_out):
+        ag_t = _rates_after(t, seg, y, k2, forcing, structure, contacts, cstate, work, storey, ground, friction)
+        record_sample(i, t, y, k1, ag_t, lay, structure, contacts, work.forces, storey, ground, out)
+        record_friction(i, friction)
+    return n_out
+
+
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial):
     """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile
@@ -557,10 +573,11 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
     # Sizes and counters non-literal (``zero``): a literal reaching np.empty or a callee compiles a throw-away one.
     zero = nc - nc
-    work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((zero + 7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc))
+    work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((zero + 7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc),
+                lay)
     y, ystage, k1, k2 = work.y, work.ystage, work.K[0], work.K[1]
     # Arrays are taken out of the records once, here: each ``record.member`` in the loop counts a reference.
-    ag, below, forces, rtol = forcing.acceleration, structure.below, work.forces, settings.rtol
+    below, forces, rtol = structure.below, work.forces, settings.rtol
     for i in range(2 * n):
         y[i] = y_initial[i]
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
@@ -572,11 +589,10 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     t, seg = 0.0, zero
-    ag_t = _rates_after(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+    ag_t = _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
     # No contact force in the first sample (work.forces_end is still all 0; a link's first force is not kept).
     record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces_end, storey, ground, out)
-    if friction is not None:
-        record_friction(zero, friction)
+    record_friction(zero, friction)
     h, n_steps, n_rej, status, collapse_floor, i_out = settings.first_step, zero, zero, zero, zero - 1, zero + 1
     tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
     window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
@@ -596,7 +612,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
-            stages(work, h_try, t, seg, ag, dt_rec, lay, structure, contacts, cstate, storey, ground, friction)
+            stages(work, h_try, t, seg, forcing, lay, structure, contacts, cstate, storey, ground, friction)
             err, finite = error_norm(work, h_try, tol, normed, rtol)
             if not finite or err > 1.0:
                 n_rej += 1
@@ -611,7 +627,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 s_first = min(s_first, locate_friction_events(work, h_try, t, seg, forcing, lay, structure, contacts,
                                                               cstate, storey, ground, friction))
             if n_release > 0:
-                s_first = min(s_first, locate_releases(work, h_try, t, seg, forcing, lay, structure, contacts, cstate,
+                s_first = min(s_first, locate_releases(work, h_try, t, seg, forcing, structure, contacts, cstate,
                                                        events, storey, ground, friction))
             collapse_s = -1.0
             if storey is not None:
@@ -624,15 +640,13 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                     status = stop_status
                     break
                 impacts = _with_room(impacts, n_imp, nc)
-                n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
-                                                              events, ImpactTable(impacts, n_imp), storey, ground,
-                                                              friction)
-                window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
-                if window_events > event_cap:
-                    status = STATUS_EVENT_LIMIT
+                n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, structure, contacts, cstate, work, events,
+                                                              ImpactTable(impacts, n_imp), storey, ground, friction)
+                window_start, window_events, status = _count_events(t, n_applied, window_start, window_events, dt_rec,
+                                                                    event_cap, status)
                 if status != 0:
                     break
-                _rates_after(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+                _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -664,11 +678,9 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             t_o = min(i_out * output_dt, t_new)
             s = (t_o - t) / h_used
             interpolate(work, h_used, s, ystage)
-            ag_o = _rates_at(t_o, seg, ystage, k2, forcing, lay, structure, contacts, cstate, work, storey, ground,
-                             friction)
+            ag_o = _rates_at(t_o, seg, ystage, k2, forcing, structure, contacts, cstate, work, storey, ground, friction)
             record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, forces, storey, ground, out)
-            if friction is not None:
-                record_friction(i_out, friction)
+            record_friction(i_out, friction)
             i_out += 1
         t = t_new  # accept
         _accept(work)
@@ -681,14 +693,12 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             break
         if any_events:
             impacts = _with_room(impacts, n_imp, nc)
-            n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, lay, structure, contacts, cstate, work,
-                                                          events, ImpactTable(impacts, n_imp), storey, ground,
-                                                              friction)
+            n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, structure, contacts, cstate, work, events,
+                                                          ImpactTable(impacts, n_imp), storey, ground, friction)
         if any_events and n_applied > 0:
-            window_start, window_events = _count_events(t, n_applied, window_start, window_events, dt_rec)
-            if window_events > event_cap:
-                status = STATUS_EVENT_LIMIT
-            _rates_after(t, seg, y, k1, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
+            window_start, window_events, status = _count_events(t, n_applied, window_start, window_events, dt_rec,
+                                                                event_cap, status)
+            _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
             # The step the controller accepted before the event cut it short; a newly closed
             # compliant contact starts at a fraction of its duration estimate instead.
             h = min(h_before_events, cap)
@@ -697,14 +707,8 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         else:
             h = h_used * step_factor(err, True, rejected)
     close_open_impacts(y, lay, cstate, impacts)
-    if status == 0 and i_out < n_out:
-        # t_end reached within round-off before the last output sample: fill it.
-        for i2 in range(i_out, n_out):
-            ag_t = _rates_after(t, seg, y, k2, forcing, lay, structure, contacts, cstate, work, storey, ground, friction)
-            record_sample(i2, t, y, k1, ag_t, lay, structure, contacts, forces, storey, ground, out)
-            if friction is not None:
-                record_friction(i2, friction)
-        i_out = n_out
+    if status == 0:  # t_end reached within round-off before the last output sample: fill it
+        i_out = _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey, ground, friction, out)
     if status != STATUS_COLLAPSED and status != STATUS_UNSTABLE:
         collapse_floor = zero - 1
     return Integration(trimmed_outputs(out, i_out), peaks, impacts[:n_imp], trace[:n_trace], y,

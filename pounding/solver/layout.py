@@ -239,3 +239,4 @@ class Work(NamedTuple):
     fbuf: np.ndarray        #: (N,) scratch: floor forces
     forces: np.ndarray      #: (nc,) contact forces of the last right-hand side
     forces_end: np.ndarray  #: (nc,) contact forces at the end of the last accepted trial step
+    layout: Layout          #: the state vector's layout (the kernels that take no ``lay`` of their own read it here)

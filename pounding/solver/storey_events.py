@@ -33,7 +33,7 @@ STOREY_IMK_LOWER, STOREY_IMK_UPPER, STOREY_IMK_REVERSAL = 4 + imk.KIND_LOWER, 4 
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
-def storey_event(y, ynew, k1, k7, lay, j, terms, below, hi, model, uy, mode, h):
+def storey_event(work, lay, j, terms, below, hi, model, uy, mode, h):
     """First switch of bilinear storey *j* inside a step: ``(fraction, STOREY_*)``, fraction −1 if none.
 
     Elastic mode: ``Δ − Δ_p`` reaching ``+u_y`` or ``−u_y`` (Δ_p is constant, so
@@ -44,6 +44,7 @@ def storey_event(y, ynew, k1, k7, lay, j, terms, below, hi, model, uy, mode, h):
     """
     if model != hysteresis.MODEL_BILINEAR:
         return -1.0, STOREY_NONE
+    y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     n = lay.n_floors
     d0, r0, d1, r1, a0, a1 = storey_interpolant(y, ynew, k1, k7, n, terms, below, j)
     ih = lay.hysteretic
@@ -119,7 +120,7 @@ def locate_storey_events(work, h, lay, below, storey, sev_s, sev_kind) -> float:
         if storeys.is_imk(smodel[j]):
             s, kind = imk_event(y, ynew, k1, k7, lay, j, terms, below, sprm, h)
         else:
-            s, kind = storey_event(y, ynew, k1, k7, lay, j, terms, below, hi, smodel[j], sprm[j, 0], smode[hi], h)
+            s, kind = storey_event(work, lay, j, terms, below, hi, smodel[j], sprm[j, 0], smode[hi], h)
         sev_s[hi] = s
         sev_kind[hi] = kind
         if kind != STOREY_NONE and s < first:
