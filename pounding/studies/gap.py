@@ -579,7 +579,7 @@ def gap_tables(ds) -> dict:
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
-    from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
+    from pounding.results.plots import finish_profile_panel, plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -600,14 +600,9 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
             ax.plot(1000 * ds.rule_gap_p84.values[k, order], z, lw=1.4, marker="s", ms=3, color=f"C{k}",
                     label=f"{rule} (84th pct)")
         ax.plot(1000 * ds.gap.values[order], z, color="C3", lw=2.2, ls=":", label="model gap")
-        ax.set_xlim(left=0)
-        ax.set_ylim(bottom=0)
-        ax.set_xlabel("separation (mm)")
-        ax.set_ylabel("elevation of the contact (m)")
         rho = float(np.mean(ds.correlation.values[order]))
-        ax.set_title(f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", fontsize=9)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        finish_profile_panel(ax, "separation (mm)", "elevation of the contact (m)",
+                             f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", title_size=9)
     suptitle(fig, f"separation needed to avoid pounding, {int(ok.sum())} record(s) run\n{ds.attrs.get('title', '')}",
                  9)
     path = out / "gap_profile.png"
