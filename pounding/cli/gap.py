@@ -8,7 +8,7 @@ import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
 from pounding.cli.spectrum import add_spectrum_options
-from pounding.cli.sweep import add_cluster_options, check_study_options, print_study_warnings
+from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted, print_study_warnings
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
@@ -44,7 +44,6 @@ def _cmd_code_gap(args: argparse.Namespace) -> int:
 
 def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
-    from pounding.studies.engine.store import parts_dir
 
     from pounding.model.model import is_plan_file
 
@@ -64,10 +63,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
                        workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)
     except KeyboardInterrupt:
-        where = f"; finished records are kept in {parts_dir(args.output)}: run the same command again" \
-            if args.output else ""
-        print(f"pounding: interrupted{where}", file=sys.stderr)
-        return 130
+        return interrupted(args.output, "records")
     ok = ds.status.values == "ok"
     errors: dict[str, list[str]] = {}
     for record, message, good in zip(ds.record.values, ds.error.values, ok):
@@ -98,7 +94,7 @@ def _cmd_plan_gap(args: argparse.Namespace) -> int:
 
     from pounding.studies.plan.gap import plan_gap_study, plan_gap_summary, plan_gap_table
 
-    from pounding.cli.plan_studies import interrupted, refuse_options
+    from pounding.cli.plan_studies import refuse_options
 
     refuse_options(args, "gap", ("--code", "--plot", "--csv", "--sds", "--sd1", "--ag"))
     scale = None if args.scale is None else parse_scale_option(args.scale)
