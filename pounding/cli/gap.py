@@ -42,6 +42,13 @@ def _cmd_code_gap(args: argparse.Namespace) -> int:
     return 0
 
 
+def _study_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of the gap study (planar or plan) from the command's options."""
+    return {"scale": None if args.scale is None else parse_scale_option(args.scale), "duration": args.duration,
+            "output": args.output, "workers": args.workers, "scheduler": args.scheduler,
+            "overwrite": args.overwrite, "progress": not args.no_progress}
+
+
 def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
 
@@ -57,11 +64,8 @@ def _cmd_gap(args: argparse.Namespace) -> int:
              if value is not None]
     if given:
         raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
-    scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
-        ds = gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
-                       workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                       progress=not args.no_progress)
+        ds = gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:
         return interrupted(args.output, "records")
     ok = ds.status.values == "ok"
@@ -97,11 +101,8 @@ def _cmd_plan_gap(args: argparse.Namespace) -> int:
     from pounding.cli.plan_studies import refuse_options
 
     refuse_options(args, "gap", ("--code", "--plot", "--csv", "--sds", "--sd1", "--ag"))
-    scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
-        ds = plan_gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
-                            workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                            progress=not args.no_progress)
+        ds = plan_gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:
         return interrupted(args.output)
     ok = ds.status.values == "ok"
