@@ -50,7 +50,8 @@ def _cmd_plan_compare(args: argparse.Namespace) -> int:
     """``pounding compare MODEL.yaml`` on a plan model."""
     from pounding.studies.plan.compare import plan_compare, plan_comparison_table
 
-    from pounding.cli.plan_studies import interrupted, refuse_options
+    from pounding.cli.plan_studies import refuse_options
+    from pounding.cli.sweep import interrupted
 
     refuse_options(args, "compare", ("--plot", "--csv", "--drift-limit"))
     scale = None if args.scale is None else parse_scale_option(args.scale)

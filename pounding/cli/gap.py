@@ -8,7 +8,7 @@ import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
 from pounding.cli.spectrum import add_spectrum_options
-from pounding.cli.sweep import add_cluster_options, check_study_options, print_study_warnings
+from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted, print_study_warnings
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
@@ -42,9 +42,15 @@ def _cmd_code_gap(args: argparse.Namespace) -> int:
     return 0
 
 
+def _study_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of the gap study (planar or plan) from the command's options."""
+    return {"scale": None if args.scale is None else parse_scale_option(args.scale), "duration": args.duration,
+            "output": args.output, "workers": args.workers, "scheduler": args.scheduler,
+            "overwrite": args.overwrite, "progress": not args.no_progress}
+
+
 def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
-    from pounding.studies.engine.store import parts_dir
 
     from pounding.model.model import is_plan_file
 
@@ -58,16 +64,10 @@ def _cmd_gap(args: argparse.Namespace) -> int:
              if value is not None]
     if given:
         raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
-    scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
-        ds = gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
-                       workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                       progress=not args.no_progress)
+        ds = gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:
-        where = f"; finished records are kept in {parts_dir(args.output)}: run the same command again" \
-            if args.output else ""
-        print(f"pounding: interrupted{where}", file=sys.stderr)
-        return 130
+        return interrupted(args.output, "records")
     ok = ds.status.values == "ok"
     errors: dict[str, list[str]] = {}
     for record, message, good in zip(ds.record.values, ds.error.values, ok):
@@ -98,14 +98,11 @@ def _cmd_plan_gap(args: argparse.Namespace) -> int:
 
     from pounding.studies.plan.gap import plan_gap_study, plan_gap_summary, plan_gap_table
 
-    from pounding.cli.plan_studies import interrupted, refuse_options
+    from pounding.cli.plan_studies import refuse_options
 
     refuse_options(args, "gap", ("--code", "--plot", "--csv", "--sds", "--sd1", "--ag"))
-    scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
-        ds = plan_gap_study(args.model, args.records, scale=scale, duration=args.duration, output=args.output,
-                            workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
-                            progress=not args.no_progress)
+        ds = plan_gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:
         return interrupted(args.output)
     ok = ds.status.values == "ok"

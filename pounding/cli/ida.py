@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from pounding.cli.sweep import add_cluster_options, check_study_options
+from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 
@@ -18,7 +18,6 @@ def _cmd_ida(args: argparse.Namespace) -> int:
         parse_intensity, plot_ida
     from pounding.model.model import is_plan_file, load_model
     from pounding.results.checks import model_warnings, print_warnings
-    from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
     plan_model = is_plan_file(args.model)
@@ -54,10 +53,7 @@ def _cmd_ida(args: argparse.Namespace) -> int:
         ds = ida_study(plan, args.output, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)
     except KeyboardInterrupt:
-        where = f"; finished runs are kept in {parts_dir(args.output)}: run the same command again" \
-            if args.output else ""
-        print(f"pounding: interrupted{where}", file=sys.stderr)
-        return 130
+        return interrupted(args.output, "runs")
     status = ds.status.values
     ran = (status == "completed") | (status == "collapsed")
     failed = status == "failed"

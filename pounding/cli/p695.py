@@ -7,7 +7,7 @@ import json
 import sys
 
 from pounding.cli.ida import add_hunt_options
-from pounding.cli.sweep import add_cluster_options, check_study_options
+from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
 
 __all__ = ["register_cli", "SDCS", "SYSTEMS"]
 
@@ -36,10 +36,7 @@ def _cmd_p695(args: argparse.Namespace) -> int:
         ds = p695_study(args.model, inputs, args.output, overwrite=args.overwrite, keep_parts=args.keep_parts,
                         workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
     except KeyboardInterrupt:
-        where = f"; finished runs are kept in {ida_folder(args.output)}: run the same command again" \
-            if args.output else ""
-        print(f"pounding: interrupted{where}", file=sys.stderr)
-        return 130
+        return interrupted(args.output, "runs", ida_folder)
     print(json.dumps(p695_summary(ds), indent=2) if args.json else p695_table(ds))
     out = sys.stderr if args.json else sys.stdout
     reused = ds.attrs["n_runs"] - ds.attrs["n_run"]

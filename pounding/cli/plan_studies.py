@@ -7,11 +7,10 @@ refused in one line here.
 from __future__ import annotations
 
 import argparse
-import sys
 
 from pounding.errors import PoundingError
 
-__all__ = ["refuse_options", "interrupted"]
+__all__ = ["refuse_options"]
 
 
 def refuse_options(args: argparse.Namespace, command: str, options: tuple[str, ...]) -> None:
@@ -21,12 +20,3 @@ def refuse_options(args: argparse.Namespace, command: str, options: tuple[str, .
         if value not in (None, False):
             raise PoundingError(f"{option} is not yet available for plan models (pounding {command}); the archive "
                                 "(-o) holds every result")
-
-
-def interrupted(output) -> int:
-    """Say where an interrupted study keeps its finished scenarios; the exit status 130."""
-    from pounding.studies.engine.store import parts_dir
-
-    where = f"; finished scenarios are kept in {parts_dir(output)}: run the same command again" if output else ""
-    print(f"pounding: interrupted{where}", file=sys.stderr)
-    return 130

@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any, Callable
 
 from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.errors import PoundingError
 from pounding.studies.engine.execution import default_workers
 
 __all__ = ["register_cli", "add_cluster_options", "check_study_options", "summary_lines", "raise_if_all_failed",
-           "print_study_warnings"]
+           "print_study_warnings", "interrupted"]
 
 # --------------------------------------------------------------------------- #
 # Command line
@@ -63,6 +64,20 @@ def print_study_warnings(ds) -> None:
     from pounding.results.checks import print_warnings
 
     print_warnings(json.loads(ds.attrs.get("warnings", "[]")))
+
+
+def interrupted(output, what: str = "scenarios", folder: Callable[[Any], Any] | None = None) -> int:
+    """Say on stderr where an interrupted study keeps its finished *what* (records, runs...); the exit status 130.
+
+    *folder* gives that place from *output* (default: the archive's parts folder,
+    :func:`pounding.studies.engine.store.parts_dir`); nothing is kept without an *output*.
+    """
+    from pounding.studies.engine.store import parts_dir
+
+    where = f"; finished {what} are kept in {(folder or parts_dir)(output)}: run the same command again" \
+        if output else ""
+    print(f"pounding: interrupted{where}", file=sys.stderr)
+    return 130
 
 
 def raise_if_all_failed(ds, output) -> None:
@@ -131,7 +146,7 @@ def _cmd_plan_sweep(args: argparse.Namespace) -> int:
     from pounding.studies.plan.sweep import load_plan_sweep
     from pounding.studies.sweep.execution import plan_line, run_sweep
 
-    from pounding.cli.plan_studies import interrupted, refuse_options
+    from pounding.cli.plan_studies import refuse_options
 
     refuse_options(args, "sweep", ("--keep-histories", "--csv"))
     sweep = load_plan_sweep(args.sweep)

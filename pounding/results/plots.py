@@ -31,7 +31,8 @@ from pounding.errors import PoundingError
 from pounding.results.describe import run_title
 
 __all__ = ["plot_run", "plot_sweep", "plot_directory", "save_figure", "pyplot", "suptitle", "storey_spans", "draw_drift_profile",
-           "finish_drift_axes", "hysteresis_storeys", "hysteresis_left_out", "LOOPS_SHOWN", "sweep_axis_is_numeric"]
+           "finish_drift_axes", "finish_profile_panel", "hysteresis_storeys", "hysteresis_left_out", "LOOPS_SHOWN",
+           "sweep_axis_is_numeric"]
 
 
 def pyplot():
@@ -193,6 +194,22 @@ def finish_drift_axes(ax, bottom: np.ndarray, top: np.ndarray, *, elevation: boo
     ax.xaxis.set_major_locator(MaxNLocator(5))
     ax.set_xlabel(xlabel)
     ax.grid(alpha=0.3)
+
+
+def finish_profile_panel(ax, xlabel: str, ylabel: str, title: str, *, title_size: float,
+                         right: float | None = None) -> None:
+    """Dress a panel of a quantity against height (a study's profile or curve).
+
+    Both axes start at 0 (x up to *right* if given), then the labels, the title (font size *title_size*,
+    points), a light grid and the legend at the lower right.
+    """
+    ax.set_xlim(0, right)
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=title_size)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
 
 
 def _drift_profiles(plt, ds: xr.Dataset, path: Path, *, drift_limit: float | None = None,

@@ -30,7 +30,7 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "formula_keys", "pounding_variants", "comparison_table", "compare_tables", "differences", "reference_formula", "plot_comparison",
+__all__ = ["compare", "formula_keys", "pounding_variants", "compared_axis", "comparison_table", "compare_tables", "differences", "reference_formula", "plot_comparison",
            "pounding_change", "DEFAULT_FORMULAS"]
 
 REFERENCE = "exact"
@@ -71,11 +71,45 @@ def pounding_variants(text: str | list[str]) -> list[str]:
     return list(POUNDING_VALUES)
 
 
+def compared_axis(model: str | os.PathLike, laws: list, formulas: str | list[str] | None,
+                  contacts: str | list[str] | None, reference: str) -> dict[str, Any]:
+    """The compared axis of ``pounding compare`` (planar and plan models): ``pounding`` or ``xi``.
+
+    Parameters
+    ----------
+    model : path-like
+        The model file (named in the errors).
+    laws : list of ContactLaw
+        The law of each of the model's contacts.
+    formulas, contacts, reference
+        As in :func:`compare`: *contacts* (``with,without``) refuses *formulas* and a model without contacts;
+        otherwise the ξ formulas need a hertz-damp contact.
+
+    Returns
+    -------
+    dict
+        ``{"pounding": ["with", "without"]}`` or ``{"xi": [formula keys, the reference included]}``.
+    """
+    from pounding.contact.laws import HertzDamp
+
+    if contacts is not None:
+        if formulas is not None:
+            raise PoundingError("--xi and --contacts do not go together: --contacts compares the model with and "
+                                "without pounding under its own contact law and xi; drop --xi")
+        if not laws:
+            raise PoundingError(f"{os.fspath(model)}: the model has no contacts; there is no pounding to compare")
+        return {"pounding": pounding_variants(contacts)}
+    if not any(isinstance(law, HertzDamp) for law in laws):
+        raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only "
+                            "to law hertz-damp (--contacts with,without compares any law with and without "
+                            "pounding)")
+    return {"xi": formula_keys(DEFAULT_FORMULAS if formulas is None else formulas, reference)}
+
+
 def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = None,
                 records: str | list[str] | None = None, *, duration: float | None = None,
                 reference: str = REFERENCE, contacts: str | list[str] | None = None, scale: Any = None):
     """The sweep behind ``pounding compare``: formulas × records, or ``pounding`` (with, without) × records."""
-    from pounding.contact.laws import HertzDamp
     from pounding.model.model import load_model
     from pounding.studies.common import check_duration, record_values, study_sweep
 
@@ -83,20 +117,7 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = Non
 
     base = load_model(model)                # the model's own errors, with its file name
     base.refuse_building_records("pounding compare (it runs the model under one record at a time)")
-    axes: dict[str, Any]
-    if contacts is not None:
-        if formulas is not None:
-            raise PoundingError("--xi and --contacts do not go together: --contacts compares the model with and "
-                                "without pounding under its own contact law and xi; drop --xi")
-        if not base.gaps:
-            raise PoundingError(f"{os.fspath(model)}: the model has no contacts; there is no pounding to compare")
-        axes = {"pounding": pounding_variants(contacts)}
-    else:
-        if not any(isinstance(g.law, HertzDamp) for g in base.gaps):
-            raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only "
-                                "to law hertz-damp (--contacts with,without compares any law with and without "
-                                "pounding)")
-        axes = {"xi": formula_keys(DEFAULT_FORMULAS if formulas is None else formulas, reference)}
+    axes = compared_axis(model, [g.law for g in base.gaps], formulas, contacts, reference)
     listed = record_values(records)
     if listed is not None:
         axes["records"] = listed
@@ -162,10 +183,11 @@ def _with_pounding_change(sweep, results, **kwargs):
     return ds
 
 
-def pounding_change(ds):
-    """``(d_with − d_without) / d_without`` of the peak drift ratios, per record and storey (dims of a
-    ``--contacts with,without`` compare without ``pounding``)."""
-    drift = ds.peak_drift_ratio
+def pounding_change(ds, variable: str = "peak_drift_ratio"):
+    """``(d_with − d_without) / d_without`` of the peak drift ratios *variable* (a plan compare's
+    ``peak_plane_drift_ratio``), per record and storey (dims of a ``--contacts with,without`` compare without
+    ``pounding``)."""
+    drift = ds[variable]
     without = drift.sel(pounding="without")
     with np.errstate(invalid="ignore", divide="ignore"):
         return (drift.sel(pounding="with") - without) / without

@@ -50,7 +50,7 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.registry import add_unique
 
-__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite",
+__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "gap_attrs",
            "required_separations", "run_gap_scenario", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
            "gap_summary", "gap_table", "gap_tables", "plot_gap"]
 
@@ -317,13 +317,66 @@ def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = 
     return study_sweep(document, f"<gap {os.fspath(model)}>")
 
 
+def over_records(values: np.ndarray, ok: np.ndarray) -> dict[str, np.ndarray]:
+    """Median, 84th percentile (linear interpolation) and maximum over the records of the *ok* ones.
+
+    Parameters
+    ----------
+    values : ndarray
+        Per record along axis −2 (``record`` × contact or point, or ``rule`` × ``record`` × ...), in m.
+    ok : ndarray of bool
+        Which records ran.
+
+    Returns
+    -------
+    dict
+        ``median``, ``p84`` and ``max``: *values* without the record axis (nan where no record ran), in m.
+    """
+    good = values[..., ok, :]
+    if good.shape[-2] == 0:
+        nan = np.full(good.shape[:-2] + good.shape[-1:], np.nan)
+        return {"median": nan, "p84": nan, "max": nan}
+    return {"median": np.median(good, axis=-2), "p84": np.percentile(good, 84.0, axis=-2), "max": good.max(axis=-2)}
+
+
+def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float, kind: str | None = None) -> dict:
+    """The global attributes of a gap study's dataset, planar and plan.
+
+    Parameters
+    ----------
+    sweep : Sweep or PlanSweep
+        The study's sweep (its heading, model name and path).
+    title : str
+        The title's opening, followed by ``of`` and the sweep's heading.
+    ok : ndarray of bool
+        Which records ran (``n_records``, ``n_failed``).
+    ran : int
+        Records run by this call.
+    elapsed : float
+        Wall time of this call, s.
+    kind : str, optional
+        The dataset's ``kind`` attribute (a plan study's ``plan_gap``), after ``study``.
+    """
+    from pounding import __version__
+    from pounding.studies.common import sweep_heading
+
+    attrs: dict[str, Any] = {"title": f"{title} of {sweep_heading(sweep)}", "model_name": sweep.model_name,
+                             "source": f"pounding {__version__}", "study": "gap"}
+    if kind is not None:
+        attrs["kind"] = kind
+    attrs.update({"model_path": sweep.model_path or "",
+                  "rules": "; ".join(f"{r.key}: {r.title} ({r.reference})" for r in RULES.values()),
+                  "n_records": len(ok), "n_failed": int((~ok).sum()), "n_run": ran, "elapsed_time": elapsed,
+                  "Conventions": "CF-1.8"})
+    return attrs
+
+
 def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
                          ran: int = 0):
     """The gap study's NetCDF layout (dims ``record`` × ``contact``, and ``rule``) from per-record results."""
     import xarray as xr
 
-    from pounding import __version__
-    from pounding.studies.common import study_parts, sweep_heading
+    from pounding.studies.common import study_parts
     from pounding.results.checks import study_warnings
     from pounding.results.dataset import PGA_LONG_NAME
 
@@ -362,17 +415,8 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     ok = status == "ok"
     gap = info("gap")
 
-    def stats(values: np.ndarray) -> dict[str, np.ndarray]:
-        good = values[ok] if values.ndim == 2 else values[:, ok]
-        axis = 0 if values.ndim == 2 else 1
-        if good.shape[axis] == 0:
-            nan = np.full(good.shape[1 - axis] if values.ndim == 2 else good.shape[::2], np.nan)
-            return {"median": nan, "p84": nan, "max": nan}
-        return {"median": np.median(good, axis=axis), "p84": np.percentile(good, 84.0, axis=axis),
-                "max": np.max(good, axis=axis)}
-
-    req = stats(required)
-    sep = stats(separation)
+    req = over_records(required, ok)
+    sep = over_records(separation, ok)
     unconservative = (separation[:, ok] < required[None, ok]).mean(axis=1) if ok.any() \
         else np.full((len(rules), nc), np.nan)
     enough = (gap[None, :] >= required[ok]).sum(axis=0).astype(np.int32) if nc else np.zeros(0, np.int32)
@@ -426,19 +470,7 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "damping_left": ("contact", info("damping_left"), {"units": "1", "long_name": "left building zeta1"}),
             "damping_right": ("contact", info("damping_right"), {"units": "1", "long_name": "right building zeta1"}),
         },
-        attrs={
-            "title": f"pounding gap study of {sweep_heading(sweep)}",
-            "model_name": sweep.model_name,
-            "source": f"pounding {__version__}",
-            "study": "gap",
-            "model_path": sweep.model_path or "",
-            "rules": "; ".join(f"{r.key}: {r.title} ({r.reference})" for r in RULES.values()),
-            "n_records": nr,
-            "n_failed": int((~ok).sum()),
-            "n_run": ran,
-            "elapsed_time": elapsed,
-            "Conventions": "CF-1.8",
-        },
+        attrs=gap_attrs(sweep, "pounding gap study", ok, ran=ran, elapsed=elapsed),
     )
     warnings = study_warnings(p.get("warnings") for p in parts if p.get("status") == "ok")
     if warnings:   # each kind once for the study (pounding.results.checks)
@@ -547,7 +579,7 @@ def gap_tables(ds) -> dict:
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
-    from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
+    from pounding.results.plots import finish_profile_panel, plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -568,14 +600,9 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
             ax.plot(1000 * ds.rule_gap_p84.values[k, order], z, lw=1.4, marker="s", ms=3, color=f"C{k}",
                     label=f"{rule} (84th pct)")
         ax.plot(1000 * ds.gap.values[order], z, color="C3", lw=2.2, ls=":", label="model gap")
-        ax.set_xlim(left=0)
-        ax.set_ylim(bottom=0)
-        ax.set_xlabel("separation (mm)")
-        ax.set_ylabel("elevation of the contact (m)")
         rho = float(np.mean(ds.correlation.values[order]))
-        ax.set_title(f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", fontsize=9)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        finish_profile_panel(ax, "separation (mm)", "elevation of the contact (m)",
+                             f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", title_size=9)
     suptitle(fig, f"separation needed to avoid pounding, {int(ok.sum())} record(s) run\n{ds.attrs.get('title', '')}",
                  9)
     path = out / "gap_profile.png"

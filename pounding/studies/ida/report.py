@@ -173,7 +173,7 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
     ``fragility.png`` (fitted curves with the stripe fractions as points), per building."""
     from scipy.special import ndtr
 
-    from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
+    from pounding.results.plots import finish_profile_panel, plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -222,13 +222,9 @@ def plot_ida(ds, directory: str | os.PathLike) -> list[Path]:
                             label=name)
             if 100 * collapse_drift <= top:
                 ax.axvline(100 * collapse_drift, color="C3", lw=0.8, ls=":", label="collapse drift")
-            ax.set_xlim(0, top * 1.02)
-            ax.set_ylim(bottom=0)
-            ax.set_xlabel(f"max {_drift_of(ds)} drift ratio of {building} (%)")
-            ax.set_ylabel(f"{_im_label(ds)} level (g)")
-            ax.set_title(f"building {building}, {titles.get(variant, variant)}", fontsize=10)
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="lower right")
+            finish_profile_panel(ax, f"max {_drift_of(ds)} drift ratio of {building} (%)",
+                                 f"{_im_label(ds)} level (g)", f"building {building}, {titles.get(variant, variant)}",
+                                 title_size=10, right=top * 1.02)
     suptitle(fig, f"IDA curves, {ds.record.size} records; IM = {ds.attrs['im_description']}\n{ds.attrs.get('title', '')}",
                  9)
     path = out / "ida_curves.png"

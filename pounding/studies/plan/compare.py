@@ -84,25 +84,11 @@ def build_plan_compare(model: str | os.PathLike, formulas: str | list[str] | Non
                        reference: str = "exact", contacts: str | list[str] | None = None, scale: Any = None):
     """The plan sweep behind ``pounding compare`` on a plan model: formulas (or with, without) × record pairs."""
     from pounding.model.plan_model import load_plan_model
-    from pounding.studies.compare import DEFAULT_FORMULAS, formula_keys, pounding_variants
+    from pounding.studies.compare import compared_axis
     from pounding.studies.plan.sweep import plan_study_sweep
 
     base = load_plan_model(model)             # the model's own errors, with its file name
-    if contacts is not None:
-        if formulas is not None:
-            raise PoundingError("--xi and --contacts do not go together: --contacts compares the model with and "
-                                "without pounding under its own contact law and xi; drop --xi")
-        if not base.contacts:
-            raise PoundingError(f"{os.fspath(model)}: the model has no contacts; there is no pounding to compare")
-        axes: dict[str, Any] = {"pounding": pounding_variants(contacts)}
-    else:
-        from pounding.contact.laws import HertzDamp
-
-        if not any(isinstance(c.law, HertzDamp) for c in base.contacts):
-            raise PoundingError(f"{os.fspath(model)}: the model has no hertz-damp contacts; xi formulas apply only "
-                                "to law hertz-damp (--contacts with,without compares any law with and without "
-                                "pounding)")
-        axes = {"xi": formula_keys(DEFAULT_FORMULAS if formulas is None else formulas, reference)}
+    axes = compared_axis(model, [c.law for c in base.contacts], formulas, contacts, reference)
     document = study_document(model, "compare", axes, pair_values(records), duration, scale)
     return plan_study_sweep(document, f"<compare {os.fspath(model)}>")
 
@@ -131,11 +117,9 @@ def plan_compare(model: str | os.PathLike, formulas: str | list[str] | None = No
                                  f"corner displacements {what} ({sweep.size} scenarios) of {sweep_heading(sweep)}",
                                  **kwargs)
         if contacts is not None:
-            drift = ds.peak_plane_drift_ratio
-            without = drift.sel(pounding="without")
-            with np.errstate(invalid="ignore", divide="ignore"):
-                change = (drift.sel(pounding="with") - without) / without
-            ds["pounding_drift_change"] = change.assign_attrs(
+            from pounding.studies.compare import pounding_change
+
+            ds["pounding_drift_change"] = pounding_change(ds, "peak_plane_drift_ratio").assign_attrs(
                 units="1", long_name="change of the peak plane drift ratio due to pounding: (with - without) / "
                                      "without")
         else:

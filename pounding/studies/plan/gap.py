@@ -129,24 +129,12 @@ def run_plan_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     return result
 
 
-def _over_records(values: np.ndarray, ok: np.ndarray) -> dict[str, np.ndarray]:
-    """Median, 84th percentile and maximum over the records (axis −2) of the ok records."""
-    good = values[..., ok, :]
-    if good.shape[-2] == 0:
-        nan = np.full(good.shape[:-2] + good.shape[-1:], np.nan)
-        return {"median": nan, "p84": nan, "max": nan}
-    return {"median": np.median(good, axis=-2), "p84": np.percentile(good, 84.0, axis=-2), "max": good.max(axis=-2)}
-
-
 def assemble_plan_gap(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"), ran: int = 0):
     """The plan gap study's NetCDF layout: ``record`` × ``point`` (and ``face``, ``rule``)."""
     import xarray as xr
 
-    from pounding import __version__
-    from pounding.studies.common import sweep_heading
-    from pounding.studies.gap import RULES
-
     from pounding.studies.common import study_parts
+    from pounding.studies.gap import RULES, gap_attrs, over_records
 
     scenarios = sweep.scenarios()
     parts = study_parts(scenarios, results, PLAN_GAP_PART)
@@ -178,7 +166,7 @@ def assemble_plan_gap(sweep, results: dict[str, dict[str, Any]], *, elapsed: flo
         if faces else np.zeros((nr, 0))
     gap = info("gap")
     face_gap = np.array([gap[point_face == k][0] for k in range(len(faces))])
-    req, face_req, sep = _over_records(required, ok), _over_records(face_required, ok), _over_records(separation, ok)
+    req, face_req, sep = over_records(required, ok), over_records(face_required, ok), over_records(separation, ok)
     unconservative = (separation[:, ok] < required[None, ok]).mean(axis=1) if ok.any() else \
         np.full((len(rules), npt), np.nan)
     enough = (face_gap[None, :] >= face_required[ok]).sum(axis=0).astype(np.int32)
@@ -233,20 +221,7 @@ def assemble_plan_gap(sweep, results: dict[str, dict[str, Any]], *, elapsed: flo
             "gap": ("point", gap, {"units": "m", "long_name": "the model's gap at rest at the point"}),
             "face_gap": ("face", face_gap, {"units": "m", "long_name": "the model's gap at rest on the face"}),
         },
-        attrs={
-            "title": f"pounding gap study (plan) of {sweep_heading(sweep)}",
-            "model_name": sweep.model_name,
-            "source": f"pounding {__version__}",
-            "study": "gap",
-            "kind": "plan_gap",
-            "model_path": sweep.model_path or "",
-            "rules": "; ".join(f"{r.key}: {r.title} ({r.reference})" for r in RULES.values()),
-            "n_records": nr,
-            "n_failed": int((~ok).sum()),
-            "n_run": ran,
-            "elapsed_time": elapsed,
-            "Conventions": "CF-1.8",
-        },
+        attrs=gap_attrs(sweep, "pounding gap study (plan)", ok, ran=ran, elapsed=elapsed, kind="plan_gap"),
     )
     return ds
 

@@ -15,9 +15,7 @@ scenarios with different contacts still line up (a union over labels):
 
 from __future__ import annotations
 
-import json
 import time
-from datetime import datetime, timezone
 from typing import Any
 
 import numpy as np
@@ -152,9 +150,8 @@ def assemble_plan_sweep(sweep, results: dict[str, dict[str, Any]], *, elapsed: f
     """The plan sweep's NetCDF layout: peaks over the sweep's dimensions × floor/direction, corner, plane, point."""
     import xarray as xr
 
-    from pounding import __version__
-    from pounding.model.document import dump_document
     from pounding.studies.common import sweep_heading
+    from pounding.studies.sweep.dataset import sweep_attrs
 
     scenarios = sweep.scenarios()
     parts = study_parts(scenarios, results, PLAN_PART)
@@ -251,22 +248,7 @@ def assemble_plan_sweep(sweep, results: dict[str, dict[str, Any]], *, elapsed: f
         "point_normal": ("point", np.array(point_info["point_normal"], dtype=str),
                          {"long_name": "normal direction of the point's face"}),
     })
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-    attrs = {
-        "Conventions": "CF-1.10",
-        "title": title or f"pounding plan sweep '{sweep.name}' ({sweep.size} scenarios) of {sweep_heading(sweep)}",
-        "source": f"pounding {__version__}",
-        "history": f"{now} swept with pounding {__version__} from {sweep.label}",
-        "kind": "plan_sweep",
-        "sweep_name": sweep.name,
-        "sweep_file": sweep.label,
-        "sweep_text": sweep.text,
-        "base_model": dump_document(sweep.base_document),
-        "base_model_file": sweep.model_path or "",
-        "axes": json.dumps({a.name: a.key for a in sweep.axes}),
-        "n_scenarios": int(sweep.size),
-        "n_errors": int((status != "ok").sum()),
-        "n_run": int(ran),
-        "elapsed_time": float(elapsed),
-    }
+    attrs = sweep_attrs(sweep, status, ran=ran, elapsed=elapsed, kind="plan_sweep",
+                        title=title or f"pounding plan sweep '{sweep.name}' ({sweep.size} scenarios) of "
+                                       f"{sweep_heading(sweep)}")
     return xr.Dataset(data, coords=coords, attrs=attrs)

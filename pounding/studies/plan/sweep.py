@@ -39,8 +39,8 @@ from pounding.model import schema
 from pounding.model.document import Document, dump_document
 from pounding.model.ground_pair import pair_components
 from pounding.studies.sweep.spec import (FEMA_SETS, POUNDING_VALUES, RESERVED_NAMES, AxisEntry, Dimension, PathError,
-                                         Sweep, SweepTop, apply_path, check_overlapping_axes, parse_path,
-                                         strip_location)
+                                         Sweep, SweepTop, apply_axis_value, apply_path, check_overlapping_axes,
+                                         parse_path, set_scale, set_xi, strip_location)
 
 __all__ = ["PlanAxis", "PlanSweep", "is_plan_sweep_file", "load_plan_sweep", "plan_sweep_from_text",
            "plan_study_sweep", "expand_pairs", "plan_document", "build_plan_document"]
@@ -103,10 +103,9 @@ def _set_record(document: dict, value: str) -> None:
     ground["record"] = value
 
 
-def _set_xi(document: dict, value: Any) -> None:
-    for entry in document.get("contacts") or []:
-        if isinstance(entry, dict) and entry.get("law") == "hertz-damp":
-            entry["xi"] = value
+def _remove_contacts(document: dict) -> None:
+    """A plan model without pounding: its contacts removed (a plan model has no contacts held open)."""
+    document["contacts"] = []
 
 
 def _shift_centres(document: dict, building: int, centres: list[tuple[float, float]], axis: int,
@@ -144,23 +143,14 @@ class PlanAxis:
     def apply(self, document: dict, position: int) -> None:
         """Write value number *position* into *document* (in place)."""
         value = self.values[position]
-        if self.kind == "record":
-            _set_record(document, value)
-        elif self.kind == "scale":
-            document.setdefault("ground_motion", {})["scale"] = value
-        elif self.kind == "xi":
-            _set_xi(document, value)
-
-        elif self.kind == "contacts":
-            if value == "without":
-                document["contacts"] = []
-        elif self.kind == "fixed":   # the base model's own ground motion
+        if self.kind == "fixed":   # the base model's own ground motion
             return
-        elif self.kind == "eccentricity":
+        if self.kind == "eccentricity":
             building, axis, centres = self.target
             _shift_centres(document, building, centres, axis, float(value))
         else:
-            apply_path(document, self.steps, value, check_keys=False)
+            apply_axis_value(document, self.kind, self.steps, value, set_record=_set_record,
+                             without_contacts=_remove_contacts, check_keys=False)
 
     @property
     def units(self) -> str | None:
@@ -335,8 +325,7 @@ def plan_sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | N
             if key in ("records", "record"):
                 _set_record(document, expand_pairs(str(value))[0])
             elif key in ("scale", "xi"):
-                (_set_xi if key == "xi" else lambda d, v: d.setdefault("ground_motion", {}).update(scale=v))(
-                    document, value)
+                (set_xi if key == "xi" else set_scale)(document, value)
             else:
                 steps = parse_path(_ALIASES.get(key, key))
                 _check_path(doc, loc, steps, document, doc.key_line(loc))

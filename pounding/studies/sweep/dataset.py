@@ -11,7 +11,7 @@ from pounding.model.document import dump_document
 from pounding.studies.common import sweep_heading
 from pounding.studies.sweep.spec import Axis, Sweep
 
-__all__ = ["build_dataset"]
+__all__ = ["build_dataset", "sweep_attrs"]
 
 # --------------------------------------------------------------------------- #
 # The results dataset
@@ -153,13 +153,42 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "level_right": ("contact", np.array(contact_info["level_right"], dtype=np.int32),
                         {"units": "1", "long_name": "floor number in the right building"}),
     })
-    n_error = int((status != "ok").sum())
+    attrs = sweep_attrs(sweep, status, ran=ran, elapsed=elapsed,
+                        title=f"pounding sweep '{sweep.name}' ({sweep.size} scenarios) of {sweep_heading(sweep)}")
+    warnings = study_warnings(part.get("warnings") for part in parts if part.get("status") == "ok")
+    if warnings:   # each kind once for the study (pounding.results.checks)
+        attrs["warnings"] = json.dumps(warnings)
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def sweep_attrs(sweep, status, *, ran: int, elapsed: float, title: str, kind: str | None = None) -> dict[str, Any]:
+    """The global attributes of a sweep's dataset, planar and plan.
+
+    Parameters
+    ----------
+    sweep : Sweep or PlanSweep
+        The sweep (its name, file, text, base model and axes).
+    status : ndarray
+        Each scenario's status (``n_errors``: those not ``ok``).
+    ran : int
+        Scenarios run by this call.
+    elapsed : float
+        Wall time of this call, s.
+    title : str
+        The dataset's title.
+    kind : str, optional
+        The dataset's ``kind`` attribute (a plan sweep's ``plan_sweep``), after ``history``.
+    """
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-    attrs = {
+    attrs: dict[str, Any] = {
         "Conventions": "CF-1.10",
-        "title": f"pounding sweep '{sweep.name}' ({sweep.size} scenarios) of {sweep_heading(sweep)}",
+        "title": title,
         "source": f"pounding {__version__}",
         "history": f"{now} swept with pounding {__version__} from {sweep.label}",
+    }
+    if kind is not None:
+        attrs["kind"] = kind
+    attrs.update({
         "sweep_name": sweep.name,
         "sweep_file": sweep.label,
         "sweep_text": sweep.text,
@@ -167,14 +196,11 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         "base_model_file": sweep.model_path or "",
         "axes": json.dumps({a.name: a.key for a in sweep.axes}),
         "n_scenarios": int(sweep.size),
-        "n_errors": n_error,
+        "n_errors": int((status != "ok").sum()),
         "n_run": int(ran),
         "elapsed_time": float(elapsed),
-    }
-    warnings = study_warnings(part.get("warnings") for part in parts if part.get("status") == "ok")
-    if warnings:   # each kind once for the study (pounding.results.checks)
-        attrs["warnings"] = json.dumps(warnings)
-    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+    })
+    return attrs
 
 
 def _coord_values(labels: tuple[Any, ...]):

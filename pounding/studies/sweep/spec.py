@@ -71,7 +71,7 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field
@@ -87,7 +87,7 @@ from pounding.studies.engine.tasks import Scenario
 
 __all__ = ["Axis", "Dimension", "Sweep", "load_sweep", "sweep_from_text", "expand_records", "parse_path",
            "apply_path", "PathError", "RESERVED_NAMES", "RESULT_VARIABLES", "FEMA_SETS", "strip_location",
-           "check_overlapping_axes", "POUNDING_VALUES"]
+           "check_overlapping_axes", "POUNDING_VALUES", "apply_axis_value", "set_scale", "set_xi"]
 
 
 #: Number of records (ids) in each FEMA P695 set; every id has components a and b.
@@ -340,11 +340,16 @@ def _as_number_or_none(value: Any) -> float | None:
         return None
 
 
-def _set_xi(document: dict, value: Any) -> None:
-    """Set the ξ formula of every hertz-damp contact."""
+def set_xi(document: dict, value: Any) -> None:
+    """Set the ξ formula of every hertz-damp contact (planar and plan documents alike)."""
     for entry in document.get("contacts") or []:
         if isinstance(entry, dict) and entry.get("law") == "hertz-damp":
             entry["xi"] = value
+
+
+def set_scale(document: dict, value: Any) -> None:
+    """Set the ground motion's ``scale`` (a factor or a target intensity, planar and plan documents alike)."""
+    document.setdefault("ground_motion", {})["scale"] = value
 
 
 def _set_record(document: dict, value: str) -> None:
@@ -353,6 +358,37 @@ def _set_record(document: dict, value: str) -> None:
     if is_catalogued(value) or value.lower().endswith(".at2"):
         gm.pop("units", None)
         gm.pop("dt", None)
+
+
+def _hold_contacts_open(document: dict) -> None:
+    from pounding.model.model import hold_contacts_open
+
+    hold_contacts_open(document)
+
+
+def apply_axis_value(document: dict, kind: str, steps: tuple[Step, ...], value: Any, *,
+                     set_record: Callable[[dict, str], None] = _set_record,
+                     without_contacts: Callable[[dict], None] = _hold_contacts_open,
+                     check_keys: bool = True) -> None:
+    """Write one swept *value* of an axis of *kind* into *document* (in place).
+
+    The kinds a planar and a plan sweep share: ``record``, ``scale``, ``xi``,
+    ``contacts`` (``"without"``: *without_contacts*, which holds a planar
+    model's contacts open and removes a plan model's) and ``path`` (any other
+    kind: *steps* written by :func:`apply_path`).  *set_record* writes a record
+    (a planar spec, or a plan model's record pair).
+    """
+    if kind == "record":
+        set_record(document, value)
+    elif kind == "scale":
+        set_scale(document, value)
+    elif kind == "xi":
+        set_xi(document, value)
+    elif kind == "contacts":
+        if value == "without":
+            without_contacts(document)
+    else:
+        apply_path(document, steps, value, check_keys=check_keys)
 
 
 # --------------------------------------------------------------------------- #
@@ -447,20 +483,7 @@ class Axis:
 
     def apply(self, document: dict, position: int) -> None:
         """Write value number *position* into *document* (in place)."""
-        value = self.values[position]
-        if self.kind == "record":
-            _set_record(document, value)
-        elif self.kind == "scale":
-            document.setdefault("ground_motion", {})["scale"] = value
-        elif self.kind == "xi":
-            _set_xi(document, value)
-        elif self.kind == "contacts":
-            if value == "without":
-                from pounding.model.model import hold_contacts_open
-
-                hold_contacts_open(document)
-        else:
-            apply_path(document, self.steps, value)
+        apply_axis_value(document, self.kind, self.steps, self.values[position])
 
     @property
     def units(self) -> str | None:
@@ -695,9 +718,9 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
                 if key in ("records", "record"):
                     _set_record(document, str(value))
                 elif key == "scale":
-                    document.setdefault("ground_motion", {})["scale"] = value
+                    set_scale(document, value)
                 elif key == "xi":
-                    _set_xi(document, value)
+                    set_xi(document, value)
                 else:
                     apply_path(document, parse_path(key), value)
             except PathError as exc:
