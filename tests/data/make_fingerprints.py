@@ -51,6 +51,13 @@ STUDIES = [
              "--levels", "0.5,1.5", "--without-contacts", "--duration", "8", "--workers", "1",
              "--no-progress", "-o", "{out}"]),
     ("sweep", ["sweep", "tests/data/fingerprint_sweep.yaml", "--workers", "1", "--no-progress", "-o", "{out}"]),
+    # plan-model studies (docs/plan-models.md): record pairs, compared on plane drifts, gaps per point and face
+    ("plan-compare", ["compare", "models/corner_pair.yaml", "--xi", "ye,lankarani-nikravesh", "--duration", "8",
+                      "--workers", "1", "--no-progress", "-o", "{out}"]),
+    ("plan-gap", ["gap", "models/corner_pair.yaml", "--duration", "8", "--workers", "1", "--no-progress",
+                  "-o", "{out}"]),
+    ("plan-sweep", ["sweep", "tests/data/fingerprint_plan_sweep.yaml", "--workers", "1", "--no-progress",
+                    "-o", "{out}"]),
 ]
 
 
