@@ -239,4 +239,4 @@ def test_every_solver_kernel_states_whether_it_is_inlined():
                     inlined.append(name)
     assert unset == []
     # the driver's per-step kernels are the inlined ones (the argument copies they save: docs/performance.md)
-    assert {"stages", "error_norm", "locate_contact_events", "record_sample", "rhs_inline"} <= set(inlined)
+    assert {"stages", "error_norm", "locate_contact_events", "record_sample", "rhs"} <= set(inlined)

@@ -20,7 +20,7 @@ from pounding.solver.kinematics import (SIDE_TERMS, combo, compliance, contact_d
                                         ground_at, ground_offset, kick, step_kinematics_inline)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_ROW_LIMIT)
-from pounding.solver.rhs import rhs
+from pounding.solver.rhs import rhs_called
 from pounding.solver.simultaneous import delassus, solve_lcp
 from pounding.solver.status import STATUS_TABLE_LIMIT
 
@@ -184,7 +184,7 @@ def locate_releases(work, h, t, seg, forcing, structure, contacts, cstate, event
                     ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
                 if ground is not None:
                     fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground.now)
-                rhs(ystage, ground_at(ag, dt_rec, seg, t + mid * h_try), lay, structure, contacts, cstate, k2,
+                rhs_called(ystage, ground_at(ag, dt_rec, seg, t + mid * h_try), lay, structure, contacts, cstate, k2,
                     fbuf, forces, storey, ground, friction)
                 if forces[c] < 0.0:
                     hi = mid
@@ -378,7 +378,7 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
         n_imp += 1
     for i in range(y.size):
         scratch[i] = y[i]
-    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground, friction)
+    rhs_called(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground, friction)
     for i in range(n_closing):
         c = active[i]
         row = first_row + i
@@ -458,7 +458,7 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
                     plastic_jump(c, scratch, lay, mass, contacts, dvg)
                     closed[c] = True
                     cmode[c] = kernels.MODE_STUCK
-                    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground, friction)
+                    rhs_called(scratch, ag_t, lay, structure, contacts, cstate, deriv, fbuf, forces, storey, ground, friction)
                     # touching without approach (v0 ≤ 0, e.g. at gap 0) sticks at zero force too
                     stick = forces[c] > 0.0 or (rate <= 0.0 and forces[c] >= 0.0)
                     closed[c] = False

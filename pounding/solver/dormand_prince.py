@@ -24,7 +24,7 @@ from numba import njit
 from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver.kinematics import fill_grounds, ground_at
-from pounding.solver.rhs import rhs_inline
+from pounding.solver.rhs import rhs
 
 __all__ = ["STAGE_TIME", "SAFETY", "MIN_FACTOR", "MAX_FACTOR", "EXCLUDED", "stages", "fill_tolerances",
            "normed_states", "error_norm", "step_factor"]
@@ -88,7 +88,7 @@ def stages(work, h, t, seg, forcing, lay, structure, contacts, cstate, storey, g
         at = t + STAGE_TIME[stage] * h
         if ground is not None:
             fill_grounds(ground, dt_rec, seg, at, ground.now)
-        rhs_inline(target, ground_at(ag, dt_rec, seg, at), lay, structure, contacts, cstate, K[stage], fbuf, forces,
+        rhs(target, ground_at(ag, dt_rec, seg, at), lay, structure, contacts, cstate, K[stage], fbuf, forces,
                    storey, ground, friction)
 
 

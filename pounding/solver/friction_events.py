@@ -23,7 +23,7 @@ from pounding.solver import jit
 from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
 from pounding.solver.friction_forces import FRICTION_OFF, FRICTION_SLIP, FRICTION_STICK, stick_margin
 from pounding.solver.kinematics import SIDE_TERMS, combo, compliance, fill_grounds, ground_at, kick
-from pounding.solver.rhs import rhs
+from pounding.solver.rhs import rhs_called
 
 __all__ = ["FRICTION_EVENT_NONE", "FRICTION_EVENT_STOP", "FRICTION_EVENT_SLIP", "locate_friction_events",
            "apply_friction_events", "set_friction_pending", "keep_friction_within", "add_friction_pending",
@@ -90,7 +90,7 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
                 ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h, mid)
             if ground is not None:
                 fill_grounds(ground, dt_rec, seg, t + mid * h, ground.now)
-            rhs(ystage, ground_at(ag, dt_rec, seg, t + mid * h), lay, structure, contacts, cstate, k2, work.fbuf,
+            rhs_called(ystage, ground_at(ag, dt_rec, seg, t + mid * h), lay, structure, contacts, cstate, k2, work.fbuf,
                 work.forces, storey, ground, friction)
             if stick_margin(friction, f) < 0.0:
                 hi = mid
@@ -119,7 +119,7 @@ def _held_force(f, t, ag_t, lay, structure, contacts, cstate, work, storey, grou
     for i in range(lay.size):
         scratch[i] = work.y[i]
     friction.mode[f] = FRICTION_STICK
-    rhs(scratch, ag_t, lay, structure, contacts, cstate, deriv, work.fbuf, work.forces, storey, ground, friction)
+    rhs_called(scratch, ag_t, lay, structure, contacts, cstate, deriv, work.fbuf, work.forces, storey, ground, friction)
     return friction.force[f]
 
 

@@ -109,7 +109,7 @@ from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IM
                                       new_peaks, record_contacts, record_floor_peaks, record_plane_peaks,
                                       record_sample, trace_rows,
                                       trimmed_outputs, TRACE_ROW_LIMIT)
-from pounding.solver.rhs import rhs_inline
+from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
                                     STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT, STATUS_UNSTABLE)
 from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, failed_storey,
@@ -363,7 +363,7 @@ def _rates_at(t, seg, y, rates, forcing, structure, contacts, cstate, work, stor
     ag_t = ground_at(forcing.acceleration, forcing.record_step, seg, t)
     if ground is not None:
         fill_grounds(ground, forcing.record_step, seg, t, ground.now)
-    rhs_inline(y, ag_t, work.layout, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
+    rhs(y, ag_t, work.layout, structure, contacts, cstate, rates, work.fbuf, work.forces, storey, ground, friction)
     return ag_t
 
 

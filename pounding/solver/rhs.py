@@ -22,7 +22,7 @@ from pounding.solver.friction_forces import friction_forces
 from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, drift, ground_offset, ground_weight, push,
                                         storey_drift, storey_push, storey_stiffness)
 
-__all__ = ["stuck_constraints", "rhs", "rhs_inline", "storey_forces"]
+__all__ = ["stuck_constraints", "rhs", "rhs_called", "storey_forces"]
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
@@ -63,7 +63,7 @@ def stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground):
             break
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground, friction):
     """Time derivative of the state; contact forces are written to *forces*.
 
@@ -209,10 +209,14 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
     out[lay.damping_energy] = power
 
 
-rhs_inline = njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED,
-                  **jit.NO_REFCOUNT)(rhs.py_func)
-""":func:`rhs` inlined by LLVM into its callers on the driver's every step and output sample (the
-Dormand–Prince stages, the output samples' rates): a call would copy its ~30 arrays (:data:`jit.INLINED`)."""
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def rhs_called(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground, friction):
+    """:func:`rhs`, called rather than inlined: for the event kernels (a release's bisection, a rigid
+    impact's constraint forces, friction's holding force), which run at events, not every step, where
+    another inlined copy of the right-hand side would only cost compile time.  :func:`rhs` itself is
+    inlined (:data:`jit.INLINED`) into the Dormand–Prince stages and the output samples' rates, where
+    a call would copy its ~30 arrays every step; one function, typed once, serves both."""
+    rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground, friction)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
