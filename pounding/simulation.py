@@ -24,7 +24,7 @@ import numpy as np
 import xarray as xr
 
 from pounding.errors import PoundingError
-from pounding.errors import RecordError
+from pounding.errors import ArchiveError, ModelError, RecordError
 from pounding.memory import MEMORY_FRACTION, available_memory, check_memory
 from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
@@ -493,8 +493,13 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     if isinstance(run, xr.Dataset):
         check_archive(ds, name)
     spec = json.loads(ds.attrs["run_spec"])
-    model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
-                            path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
+    try:
+        model = model_from_text(spec["model"], name=ds.attrs.get("model_name", "model"),
+                                path=ds.attrs.get("model_path") or None, base_dir=spec.get("base_dir"))
+    except ModelError as exc:
+        # The text is the archive's copy, not the file it names: say so, or the user checks a valid YAML file.
+        raise ArchiveError(f"{name}: cannot rebuild the model stored in the archive (run_spec['model'], "
+                           f"a copy of {ds.attrs.get('model_path') or 'the model'}): {exc}") from None
     model = _archived_tolerances(model, spec)
     if model.has_building_records:
         again = simulate(model, _archived_records(model, spec, name))

@@ -122,6 +122,11 @@ def test_touching_buildings_under_a_real_record_end(tmp_path, law):
     if "stereo" in law:
         assert ds["penetration"].max() < 1e-9
     assert ds.attrs["energy_closure_error"] < 1e-3
+    # floors touching at rest close at zero approach velocity: their restitution is NaN (once inf)
+    at_rest = ds["impact_velocity"].values == 0.0
+    assert at_rest.any()
+    assert np.isnan(ds["impact_restitution"].values[at_rest]).all()
+    assert np.isfinite(ds["impact_restitution"].values[~at_rest]).all()
 
 
 def test_a_resting_contact_uses_the_velocity_floor_for_xi(tmp_path):

@@ -405,6 +405,19 @@ def test_damaged_archives(case, tmp_path, capsys, damage):
         assert "pounding: error: damaged archive: " in _error(capsys)
 
 
+def test_rerun_of_an_archive_whose_stored_model_is_invalid_names_the_archive(case, tmp_path, capsys):
+    # The error once named only the YAML file the archive was made from (valid), not the archive's copy.
+    ds = xr.open_dataset(case / "run.nc").load()
+    spec = json.loads(ds.attrs["run_spec"])
+    spec["model"] = "buildings: [\n"
+    ds.attrs["run_spec"] = json.dumps(spec)
+    ds.to_netcdf(tmp_path / "bad.nc")
+    assert main(["rerun", str(tmp_path / "bad.nc"), "-o", str(tmp_path / "x.nc")]) == 2
+    message = _error(capsys)
+    assert "bad.nc: cannot rebuild the model stored in the archive (run_spec['model']" in message
+    assert "invalid YAML" in message and not (tmp_path / "x.nc").exists()
+
+
 def test_sweep_store_problems_are_one_line_errors(case, tmp_path):
     from pounding.studies.sweep import load_sweep, run_sweep
 

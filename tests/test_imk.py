@@ -283,11 +283,26 @@ def test_hysteresis_command_reads_a_drift_file_and_drives_bouc_wen(model_file, t
     (["--storey", "A:3", "--protocol", "fema461", "--amplitude", "0.05"], "storeys 1..2"),
     (["--storey", "A:1", "--protocol", "fema461"], "needs --amplitude"),
     (["--storey", "A:1", "--protocol", "cyclic"], "cannot read the drift history"),
+    # a NaN amplitude once wrote an archive of NaN drifts; inf and 1e7 made atc24 add cycles without end
+    (["--storey", "A:1", "--protocol", "fema461", "--amplitude", "nan"], "must be a finite number > 0"),
+    (["--storey", "A:1", "--protocol", "atc24", "--amplitude", "inf"], "give at most 1"),
+    (["--storey", "A:1", "--protocol", "atc24", "--amplitude", "1e7"], "give at most 1"),
 ])
 def test_hysteresis_command_errors_are_one_line(model_file, tmp_path, capsys, argv, message):
     assert main(["hysteresis", str(model_file), *argv, "-o", str(tmp_path / "x.nc")]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "\n" not in err
+
+
+def test_a_drift_file_beyond_the_storey_height_is_refused(model_file, tmp_path, capsys):
+    """A Bouc-Wen storey driven to 1e9 m once sub-stepped for hours; the file's drift is named instead."""
+    history = tmp_path / "drifts.txt"
+    history.write_text("0\n0.02\n1e9\n0\n")
+    assert main(["hysteresis", str(model_file), "--storey", "B:2", "--protocol", str(history),
+                 "-o", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "drifts.txt: drift 3 of the file, 1e+09 m" in err and "\n" not in err
+    assert not (tmp_path / "x.nc").exists()
 
 
 def test_atc24_protocol_in_multiples_of_the_yield_drift():

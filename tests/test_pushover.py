@@ -122,6 +122,8 @@ def test_pushover_command_writes_table_archive_and_plot(model_file, tmp_path, ca
     assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
     assert (tmp_path / "again" / "pushover.png").exists()
     for argv, message in ((["--building", "C"], "no building 'C'"), (["--steps", "0"], "--steps must be at least 1"),
+                          # one step once landed past the strength loss: V_max 0 N, exit 0
+                          (["--steps", "1"], "--steps must be at least 10 (got 1)"),
                           (["--design-cs", "-1"], "--design-cs must be a number > 0")):
         assert main(["pushover", str(model_file), *argv]) == 2
         err = capsys.readouterr().err.strip()

@@ -454,7 +454,9 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     impact_count = peaks["impact_count"]
     side_names = building_names + [WALL_NAME]  # index WALL (−1) is the wall
     with np.errstate(invalid="ignore", divide="ignore"):
-        restitution = raw.impact_separation_velocity / raw.impact_velocity
+        # No ratio for floors that close at zero approach velocity (touching at rest, gap 0): NaN, not inf.
+        restitution = np.where(raw.impact_velocity > 0.0, raw.impact_separation_velocity / raw.impact_velocity,
+                               np.nan)
     has_xi = np.array([type(g.law).onset_xi for g in gaps], dtype=bool)  # the law's class says (ContactLaw)
     impact_xi = np.where(has_xi[raw.impact_contact] if ng else np.zeros(0, bool), raw.impact_constant, np.nan)
 
@@ -544,7 +546,8 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
                                          "energy dissipated by the contact during the impact "
                                          "(work of the contact force; partial if still in contact at the end)"),
         "impact_restitution": _var(("impact",), restitution, "1",
-                                   "separation velocity / approach velocity (can exceed 1 between floors of buildings)"),
+                                   "separation velocity / approach velocity (can exceed 1 between floors of buildings; "
+                                   "nan at zero approach velocity)"),
         "trace_time": _var(("trace",), raw.trace_time, "s",
                            "time of a full-resolution sample of a closed contact"),
         "trace_contact": _var(("trace",), raw.trace_contact.astype(np.int32), "1",

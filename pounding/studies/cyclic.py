@@ -53,6 +53,10 @@ POINTS_PER_LEG = 25
 #: Bouc–Wen sub-step: at most this fraction of u_y per Runge–Kutta step.
 BOUC_WEN_SUBSTEP = 0.01
 
+#: Largest |storey drift| / storey height a cyclic test accepts: a drift as large as the storey is tall is
+#: past any storey's collapse, and larger ones only cost time (Bouc–Wen sub-steps, ATC-24 cycles).
+MAX_DRIFT_RATIO = 1.0
+
 
 def amplitudes(name: str, amplitude: float, yield_drift: float | None = None) -> list[float]:
     """The cycle amplitudes (m) of protocol *name* up to *amplitude* (m), one entry per cycle.
@@ -62,8 +66,8 @@ def amplitudes(name: str, amplitude: float, yield_drift: float | None = None) ->
     PoundingError
         Unknown protocol; ``atc24`` without a yield drift (an elastic storey).
     """
-    if amplitude <= 0.0:
-        raise PoundingError(f"the protocol's amplitude must be > 0 (got {amplitude:g} m)")
+    if not (amplitude > 0.0 and np.isfinite(amplitude)):
+        raise PoundingError(f"the protocol's amplitude must be a finite number > 0 (got {amplitude:g} m)")
     if name == "fema461":
         return [a for i in range(11) for a in 2 * [amplitude * 1.4 ** (i - 10)]]
     if name == "atc24":
@@ -213,12 +217,19 @@ def hysteresis_test(model, storey: str, protocol: str, amplitude: float | None =
     if protocol in PROTOCOLS:
         if amplitude is None:
             raise PoundingError(f"the {protocol} protocol needs --amplitude (the target drift ratio, e.g. 0.05)")
+        if float(amplitude) > MAX_DRIFT_RATIO:
+            raise PoundingError(f"--amplitude is a drift ratio (drift / storey height): {float(amplitude):g} is a "
+                                f"drift larger than the {h:g} m storey; give at most {MAX_DRIFT_RATIO:g}, e.g. 0.05")
         yield_drift = None if law is None else law.yield_force_for(k, h) / k
         drifts = named_protocol(protocol, float(amplitude) * h, yield_drift)
     else:
         if amplitude is not None:
             raise PoundingError("--amplitude scales the named protocols only; a FILE gives drifts in metres")
         drifts = read_protocol(protocol)
+        peak = int(np.argmax(np.abs(drifts)))
+        if abs(drifts[peak]) > MAX_DRIFT_RATIO * h:
+            raise PoundingError(f"{protocol}: drift {peak + 1} of the file, {drifts[peak]:g} m, is larger than "
+                                f"storey {storey}'s height ({h:g} m); the file gives storey drifts in metres")
     shear = storey_response(law, k, h, drifts)
     return xr.Dataset(
         {"storey_drift": ("step", drifts, {"units": "m", "long_name": f"storey drift of {storey}"}),
