@@ -38,7 +38,15 @@ spec = pickle.load(sys.stdin.buffer)
 from pounding.solver.integrator import System, integrate
 raw = integrate(System(**spec["system"]), spec["ground"], spec["dt"], spec["duration"], **spec["settings"])
 out = dict(raw.__dict__)
-out["max_rss"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+# This process's own peak: Linux keeps ru_maxrss across exec, so it would count the pytest process that
+# spawned it (over 1 GiB late in the suite); VmHWM is the peak of this process's own memory map.
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+try:
+    with open("/proc/self/status") as status:
+        peak = next(int(line.split()[1]) * 1024 for line in status if line.startswith("VmHWM:"))
+except (OSError, StopIteration):
+    pass
+out["max_rss"] = peak
 sys.stdout.buffer.write(pickle.dumps(out))
 """
 
