@@ -274,3 +274,14 @@ def test_staggered_closures_do_not_cost_rejections():
     # (the ye formula is not exact, so compare pairs with each other: 1e-5).
     rebound = raw.impact_separation_velocity / raw.impact_velocity
     assert np.ptp(rebound) < 1e-5
+
+
+def test_every_event_kind_codes_none_as_the_shared_bookkeeping_does():
+    """The driver marks, drops and restores contact, storey and friction events with one set of kernels
+    (pounding.solver.pending), which read 0 as "no event": each kind's own "none" code must be it."""
+    from pounding.solver.contact_events import EVENT_NONE
+    from pounding.solver.friction_events import FRICTION_EVENT_NONE
+    from pounding.solver.pending import NO_EVENT
+    from pounding.solver.storey_events import STOREY_NONE
+
+    assert EVENT_NONE == STOREY_NONE == FRICTION_EVENT_NONE == NO_EVENT

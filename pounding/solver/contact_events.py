@@ -17,10 +17,10 @@ from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
 from pounding.solver.kinematics import (SIDE_TERMS, combo, compliance, contact_delta, effective_mass, fill_grounds,
-                                        ground_at, ground_offset, kick, step_kinematics_inline)
+                                        ground_offset, kick, step_kinematics_inline)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_ROW_LIMIT)
-from pounding.solver.rhs import rhs_called
+from pounding.solver.rhs import rates_within_step, rhs_called
 from pounding.solver.simultaneous import delassus, solve_lcp
 from pounding.solver.status import STATUS_TABLE_LIMIT
 
@@ -165,10 +165,7 @@ def locate_releases(work, h, t, seg, forcing, structure, contacts, cstate, event
     *t* of *h* s (``work.forces_end``): bisected on the interpolant, into ``events.s`` and
     ``events.kind`` (EVENT_RELEASE); returns the earliest fraction (2.0 if none).  Kept out of
     :func:`locate_contact_events` (rare, and it needs the whole right-hand side)."""
-    y, ynew, ystage, K, fbuf, forces, forces_end, lay = work
-    k1, k2, k7 = K[0], K[1], K[6]
-    ag, dt_rec = forcing.acceleration, forcing.record_step
-    S = lay.size
+    forces, forces_end, lay = work.forces, work.forces_end, work.layout
     closed, cmode = cstate.closed, cstate.mode
     h_try = h
     s_first = 2.0
@@ -180,12 +177,8 @@ def locate_releases(work, h, t, seg, forcing, structure, contacts, cstate, event
             hi = 1.0
             for _ in range(60):
                 mid = 0.5 * (lo + hi)
-                for i in range(S):
-                    ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h_try, mid)
-                if ground is not None:
-                    fill_grounds(ground, dt_rec, seg, t + mid * h_try, ground.now)
-                rhs_called(ystage, ground_at(ag, dt_rec, seg, t + mid * h_try), lay, structure, contacts, cstate, k2,
-                    fbuf, forces, storey, ground, friction)
+                rates_within_step(work, h_try, mid, t, seg, forcing, structure, contacts, cstate, storey, ground,
+                                  friction)
                 if forces[c] < 0.0:
                     hi = mid
                 else:

@@ -20,14 +20,13 @@ from __future__ import annotations
 from numba import njit
 
 from pounding.solver import jit
-from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
+from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing
 from pounding.solver.friction_forces import FRICTION_OFF, FRICTION_SLIP, FRICTION_STICK, stick_margin
-from pounding.solver.kinematics import SIDE_TERMS, combo, compliance, fill_grounds, ground_at, kick
-from pounding.solver.rhs import rhs_called
+from pounding.solver.kinematics import SIDE_TERMS, combo, compliance, kick
+from pounding.solver.rhs import rates_within_step, rhs_called
 
 __all__ = ["FRICTION_EVENT_NONE", "FRICTION_EVENT_STOP", "FRICTION_EVENT_SLIP", "locate_friction_events",
-           "apply_friction_events", "set_friction_pending", "keep_friction_within", "add_friction_pending",
-           "record_friction"]
+           "apply_friction_events", "record_friction"]
 
 #: A face's events: none, slip rate reaching 0, sticking force reaching μN.
 FRICTION_EVENT_NONE, FRICTION_EVENT_STOP, FRICTION_EVENT_SLIP = 0, 1, 2
@@ -55,8 +54,7 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
     interpolant; a sticking face's, μN − |λ| turning negative, bisected with the right-hand side
     on the interpolated state when it is negative at the end.
     """
-    y, ynew, ystage, K = work.y, work.ynew, work.ystage, work.K
-    k1, k2, k7 = K[0], K[1], K[6]
+    y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     n = lay.n_floors
     ff, fw = friction.floors, friction.weights
     s_first = 2.0
@@ -78,7 +76,6 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
             lost += 1
     if lost == 0:
         return s_first
-    ag, dt_rec = forcing.acceleration, forcing.record_step
     for f in range(friction.mode.size):
         if friction.event_kind[f] != FRICTION_EVENT_SLIP:
             continue
@@ -86,12 +83,7 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
         hi = 1.0
         for _ in range(60):
             mid = 0.5 * (lo + hi)
-            for i in range(lay.size):
-                ystage[i] = hermite(y[i], k1[i], ynew[i], k7[i], h, mid)
-            if ground is not None:
-                fill_grounds(ground, dt_rec, seg, t + mid * h, ground.now)
-            rhs_called(ystage, ground_at(ag, dt_rec, seg, t + mid * h), lay, structure, contacts, cstate, k2, work.fbuf,
-                work.forces, storey, ground, friction)
+            rates_within_step(work, h, mid, t, seg, forcing, structure, contacts, cstate, storey, ground, friction)
             if stick_margin(friction, f) < 0.0:
                 hi = mid
             else:
@@ -182,34 +174,6 @@ def apply_friction_events(t, ag_t, lay, structure, contacts, cstate, work, store
         if friction.mode[f] != before:
             changed += 1
     return changed
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def set_friction_pending(friction, s_first) -> None:
-    """Mark the faces' events at or before fraction *s_first* as pending (all cleared if *s_first* < 0)."""
-    for f in range(friction.mode.size):
-        ok = s_first >= 0.0 and friction.event_kind[f] != FRICTION_EVENT_NONE and friction.event_s[f] <= s_first
-        friction.pending[f] = friction.event_kind[f] if ok else FRICTION_EVENT_NONE
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def keep_friction_within(friction, h, tiny) -> None:
-    """Drop the faces' events later than *tiny* seconds into a step of *h* s."""
-    for f in range(friction.mode.size):
-        if friction.event_kind[f] != FRICTION_EVENT_NONE and friction.event_s[f] * h > tiny:
-            friction.event_kind[f] = FRICTION_EVENT_NONE
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def add_friction_pending(friction) -> bool:
-    """Add the pending face events to the located ones; any left?"""
-    found = False
-    for f in range(friction.mode.size):
-        if friction.event_kind[f] == FRICTION_EVENT_NONE:
-            friction.event_kind[f] = friction.pending[f]
-        if friction.event_kind[f] != FRICTION_EVENT_NONE:
-            found = True
-    return found
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)

@@ -95,8 +95,7 @@ from pounding.solver import kernels
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
 from pounding.solver.dense import interpolate
-from pounding.solver.friction_events import (add_friction_pending, apply_friction_events, keep_friction_within,
-                                             locate_friction_events, record_friction, set_friction_pending)
+from pounding.solver.friction_events import apply_friction_events, locate_friction_events, record_friction
 from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, normed_states,
                                             stages, step_factor)
 from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
@@ -109,10 +108,11 @@ from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IM
                                       new_peaks, record_contacts, record_floor_peaks, record_plane_peaks,
                                       record_sample, trace_rows,
                                       trimmed_outputs, TRACE_ROW_LIMIT)
+from pounding.solver.pending import add_pending, drop_later, mark_pending
 from pounding.solver.rhs import rhs
 from pounding.solver.status import (STATUS_COLLAPSED, STATUS_EVENT_LIMIT, STATUS_MESSAGES, STATUS_OK,
                                     STATUS_STEP_TOO_SMALL, STATUS_TABLE_LIMIT, STATUS_UNSTABLE)
-from pounding.solver.storey_events import (STOREY_NONE, apply_storey_events, collapse_crossing, failed_storey,
+from pounding.solver.storey_events import (apply_storey_events, collapse_crossing, failed_storey,
                                            instability_crossing, locate_storey_events)
 from pounding.solver.tolerances import floor_tolerance_factors
 
@@ -416,45 +416,28 @@ def _apply_events(t, seg, forcing, structure, contacts, cstate, work, events, ta
 def _set_pending(events, s_first, friction) -> None:
     """Mark the events at or before fraction *s_first* as those the retaken step ends at (all others
     cleared; *s_first* < 0 clears every one); the friction faces' too."""
-    for c in range(events.kind.size):
-        ok = s_first >= 0.0 and events.kind[c] != EVENT_NONE and events.s[c] <= s_first
-        events.pending[c] = events.kind[c] if ok else EVENT_NONE
-    for hi in range(events.storey_kind.size):
-        ok = s_first >= 0.0 and events.storey_kind[hi] != STOREY_NONE and events.storey_s[hi] <= s_first
-        events.storey_pending[hi] = events.storey_kind[hi] if ok else STOREY_NONE
+    mark_pending(events.kind, events.s, events.pending, s_first)
+    mark_pending(events.storey_kind, events.storey_s, events.storey_pending, s_first)
     if friction is not None:
-        set_friction_pending(friction, s_first)
+        mark_pending(friction.event_kind, friction.event_s, friction.pending, s_first)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _keep_events_within(events, h, tiny, friction) -> None:
     """Drop the located events later than *tiny* seconds into a step of *h* s (those at its start stay)."""
-    for c in range(events.kind.size):
-        if events.kind[c] != EVENT_NONE and events.s[c] * h > tiny:
-            events.kind[c] = EVENT_NONE
-    for hi in range(events.storey_kind.size):
-        if events.storey_kind[hi] != STOREY_NONE and events.storey_s[hi] * h > tiny:
-            events.storey_kind[hi] = STOREY_NONE
+    drop_later(events.kind, events.s, h, tiny)
+    drop_later(events.storey_kind, events.storey_s, h, tiny)
     if friction is not None:
-        keep_friction_within(friction, h, tiny)
+        drop_later(friction.event_kind, friction.event_s, h, tiny)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _with_pending(events, friction) -> bool:
     """Add the pending events (those the retaken step was shortened to) to the located ones; any left?"""
-    found = False
-    for c in range(events.kind.size):
-        if events.kind[c] == EVENT_NONE:
-            events.kind[c] = events.pending[c]
-        if events.kind[c] != EVENT_NONE:
-            found = True
-    for hi in range(events.storey_kind.size):
-        if events.storey_kind[hi] == STOREY_NONE:
-            events.storey_kind[hi] = events.storey_pending[hi]
-        if events.storey_kind[hi] != STOREY_NONE:
-            found = True
+    found = add_pending(events.kind, events.pending)
+    found = add_pending(events.storey_kind, events.storey_pending) or found
     if friction is not None:
-        found = add_friction_pending(friction) or found
+        found = add_pending(friction.event_kind, friction.pending) or found
     return found
 
 

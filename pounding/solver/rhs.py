@@ -18,11 +18,12 @@ from numba import njit
 from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver import storeys
+from pounding.solver.dense import interpolate
 from pounding.solver.friction_forces import friction_forces
-from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, drift, ground_offset, ground_weight, push,
-                                        storey_drift, storey_push, storey_stiffness)
+from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, drift, fill_grounds, ground_at, ground_offset,
+                                        ground_weight, push, storey_drift, storey_push, storey_stiffness)
 
-__all__ = ["stuck_constraints", "rhs", "rhs_called", "storey_forces"]
+__all__ = ["stuck_constraints", "rhs", "rhs_called", "rates_within_step", "storey_forces"]
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
@@ -217,6 +218,20 @@ def rhs_called(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, sto
     inlined (:data:`jit.INLINED`) into the Dormand–Prince stages and the output samples' rates, where
     a call would copy its ~30 arrays every step; one function, typed once, serves both."""
     rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, ground, friction)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def rates_within_step(work, h, s, t, seg, forcing, structure, contacts, cstate, storey, ground, friction) -> None:
+    """The right-hand side at fraction *s* of the trial step of *h* s from *t* (record step *seg*): the
+    step's interpolated state into ``work.ystage``, its rates into ``work.K[1]``, the contact forces into
+    ``work.forces`` (and the friction faces' into *friction*).  What the event bisections test at each
+    fraction (a stuck contact's release, a sticking face's loss of stick)."""
+    interpolate(work, h, s, work.ystage)
+    at = t + s * h
+    if ground is not None:
+        fill_grounds(ground, forcing.record_step, seg, at, ground.now)
+    rhs_called(work.ystage, ground_at(forcing.acceleration, forcing.record_step, seg, at), work.layout, structure,
+               contacts, cstate, work.K[1], work.fbuf, work.forces, storey, ground, friction)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, inline="always", **jit.NO_REFCOUNT)
