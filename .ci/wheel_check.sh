@@ -25,7 +25,7 @@ python3 -m venv "$work/venv"
 "$work/venv/bin/python" -m pip install --quiet "$wheel"
 export PATH="$work/venv/bin:$PATH"
 # Nothing of the checkout may leak in: no PYTHONPATH, and a cache of our own.
-unset PYTHONPATH POUNDING_CATALOGUE
+unset PYTHONPATH POUNDING_CATALOGUE NUMBA_CACHE_DIR POUNDING_PREBUILT
 export POUNDING_CACHE_DIR="$work/cache"
 
 mkdir "$work/user"
@@ -40,14 +40,23 @@ assert catalogue_file().is_file() and not catalogue_file().is_symlink()
 print(f"  pounding {pounding.__version__} from {here.parent}")
 EOF
 
+step "kernels compiled ahead of time, for this wheel's sources (setup.py, pounding.prebuild)"
+status=$(python -c "import pounding.solver.integrator; from pounding.solver.jit import prebuilt_status; print(prebuilt_status())")
+echo "  $status"
+case "$status" in *"for these sources"*) ;; *) echo "  the wheel's kernels are missing or ignored"; exit 1;; esac
+
 step "pounding init"
 pounding init study
 cd study
 test -f models/pair.yaml -a -f sweeps/gap_restitution.yaml -a -f examples/run_pair.py
 
-step "pounding run models/pair.yaml (first run compiles the solver)"
+step "pounding run models/pair.yaml (first run: the wheel's kernels, nothing compiled)"
 pounding run models/pair.yaml --duration 3 -o pair.nc
 test -s pair.nc
+site=$(python -c "import pathlib, pounding; print(pathlib.Path(pounding.__file__).parent)")
+compiled=$(find "$site" -name "*.nbi" -not -path "*/prebuilt/*" | wc -l)
+echo "  numba cache indexes written by the first run: $compiled"
+test "$compiled" -eq 0
 pounding info pair.nc >/dev/null
 
 step "pounding run models/pair_inelastic.yaml (yielding storeys, P-Delta)"

