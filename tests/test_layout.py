@@ -31,7 +31,8 @@ LAYERS: list[tuple[str, ...]] = [
     ("pounding.solver",),
     ("pounding.results",),
     ("pounding.simulation",),
-    ("pounding.studies", "pounding.export", "pounding.prebuild"),
+    ("pounding.studies", "pounding.export"),
+    ("pounding.prebuild",),
     ("pounding.cli",),
     ("pounding.__main__",),
 ]

@@ -213,8 +213,9 @@ _CACHE_FOLDERS: set[str] = set()
 
 
 #: Source files compiled into every solver kernel besides the ones each stamp names: the modules of
-#: contact laws written in files of their own (pounding.solver.kernels adds them), so that editing
-#: one discards the cached solver as editing contact/laws.py does.
+#: contact laws written in files of their own (pounding.solver.kernels adds them; those of the
+#: package are in :func:`solver_sources` already, a law of another package is not), so that
+#: editing one discards the cached solver as editing contact/laws.py does.
 EXTRA_SOURCES: list[str] = []
 
 
@@ -262,12 +263,15 @@ def stamp_caches_with_sources(dispatchers: Iterable, files: Iterable[str | os.Pa
 
 def solver_sources() -> list[str]:
     """Every source file compiled into the solver's kernels: the modules of ``pounding/solver``
-    and the contact-law, link and hysteresis modules whose ids and sizes they inline."""
+    and of ``pounding/contact`` (the contact laws, links and ξ formulas whose ids, sizes and
+    forces they inline, a law in a file of its own included) and ``pounding/hysteresis.py``.
+    The same list whichever module is imported first, so every kernel has the same stamp."""
     solver = os.path.dirname(os.path.abspath(__file__))
     package = os.path.dirname(solver)
+    contact = os.path.join(package, "contact")
     own = sorted(os.path.join(solver, name) for name in os.listdir(solver) if name.endswith(".py"))
-    return own + [os.path.join(package, "contact", "laws.py"), os.path.join(package, "contact", "links.py"),
-                  os.path.join(package, "hysteresis.py")]
+    laws = sorted(os.path.join(contact, name) for name in os.listdir(contact) if name.endswith(".py"))
+    return own + laws + [os.path.join(package, "hysteresis.py")]
 
 
 def stamp_solver_kernels(namespace: dict) -> None:

@@ -18,7 +18,6 @@ import sys
 
 import numpy as np
 from numba import njit
-from numba.core.dispatcher import Dispatcher
 
 from pounding.contact import laws
 from pounding.contact import links
@@ -555,5 +554,4 @@ def rest_velocity(law_id: int, prm: np.ndarray) -> float:
 
 # The kernels inline the law ids and sizes of contact/laws.py: their cached code is stale when it changes.
 jit.EXTRA_SOURCES.extend(sys.modules[cls.__module__].__file__ for cls in PLUGIN_LAWS)  # compiled into every solver
-jit.stamp_caches_with_sources([f for f in globals().values() if isinstance(f, Dispatcher)],
-                              [__file__, laws.__file__, links.__file__])
+jit.stamp_solver_kernels(globals())

@@ -89,3 +89,6 @@ def recoverable_energy(model, table, row, k, drift, r):
     if is_imk(model):
         return 0.5 * r * r / k
     return 0.5 * k * drift * drift
+
+
+jit.stamp_solver_kernels(globals())
