@@ -159,11 +159,9 @@ def _silence_stdout() -> None:
 #: Subcommands that never use dask in their own process (everything but sweep/compare).
 LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table"})
 
-#: Subcommands that run without Python's cyclic garbage collector: one run (or one archive read)
-#: leaves almost no cyclic garbage (2,300 objects in a whole ``pounding run models/pair.yaml``),
-#: while the collector traverses the ~130,000 objects the imports create some 350 times (0.07 s)
-#: and again while the interpreter shuts down (0.1 s).
-UNCOLLECTED_COMMANDS = frozenset({"run", "rerun", "info"})
+#: Subcommands of one run (or one archive read) whose process is set up for a short life
+#: (:func:`console_main`): no cyclic garbage collector, and OpenBLAS on one thread.
+SHORT_COMMANDS = frozenset({"run", "rerun", "info"})
 
 
 def console_main() -> int:
@@ -175,19 +173,29 @@ def console_main() -> int:
     costs about 0.5 s of a 2 s ``pounding run``.  Only this process-level
     entry point does it; :func:`main` called from Python leaves imports alone.
 
-    For the commands of :data:`UNCOLLECTED_COMMANDS` the cyclic garbage
-    collector is off and, at the end, every object is frozen
-    (:func:`gc.freeze`), so that neither the imports nor the interpreter's
-    shutdown pay for traversing them: 0.2 s of a 1 s warm ``pounding run``.
-    Reference counting still frees everything that is not in a cycle.
+    The commands of :data:`SHORT_COMMANDS` (one run, or one archive read)
+    also get a process made for a short life, worth 0.25 s of a 1 s warm
+    ``pounding run models/pair.yaml`` on a 2-core machine:
+
+    * the cyclic garbage collector is off and, at the end, every object is
+      frozen (:func:`gc.freeze`): a whole run leaves only ~2,300 objects of
+      cyclic garbage, while the collector would traverse the ~130,000 objects
+      the imports create some 350 times (0.07 s) and again at shutdown
+      (0.1 s); reference counting still frees everything not in a cycle;
+    * OpenBLAS runs on one thread unless ``OPENBLAS_NUM_THREADS`` says
+      otherwise: its worker threads, started when numpy loads, cost 0.05 s of
+      start-up and spin for nothing, since a run's matrices (modal analysis)
+      are far below OpenBLAS's threading threshold (every fingerprint is the
+      same either way).
     """
     argv = sys.argv[1:]
     command = _subcommand(argv)
     if command in LEAN_COMMANDS:
         for name in ("dask", "distributed"):
             sys.modules.setdefault(name, None)  # type: ignore[arg-type]
-    if command not in UNCOLLECTED_COMMANDS:
+    if command not in SHORT_COMMANDS:
         return main(argv)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")   # read when numpy loads OpenBLAS, later
     gc.disable()
     try:
         return main(argv)
