@@ -89,12 +89,17 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
     # xarray imports dask only to test for dask arrays; a `pounding run`
     # process never makes any, so the console entry point marks dask absent
     # (≈0.5 s of start-up), and the other subcommands' modules are not
-    # imported (≈0.05 s).  The run must still write a complete archive.
+    # imported (≈0.05 s); the cyclic garbage collector is off and everything is
+    # frozen at the end (≈0.2 s); OpenBLAS starts no threads (≈0.05 s).  The
+    # run must still write a complete archive.
     out = tmp_path / "run.nc"
-    code = ("import sys; from pounding.cli import console_main; "
+    code = ("import os, sys; from pounding.cli import console_main; "
+            "os.environ.pop('OPENBLAS_NUM_THREADS', None); "
             f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
             "status = console_main(); "
             "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
+            "import gc, os; assert not gc.isenabled() and gc.get_freeze_count() > 0, 'the run was collected'; "
+            "assert os.environ['OPENBLAS_NUM_THREADS'] == '1'; "
             "assert not [m for m, v in sys.modules.items() if v is not None and m.split('.')[0] in "
             "            ('matplotlib', 'distributed', 'tqdm')], 'matplotlib, distributed or tqdm imported'; "
             "other = [m for m in ('studies.sweep', 'studies.compare', 'studies.verify', 'studies.engine', "

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import gc
 import importlib
 import os
 import sys
@@ -158,6 +159,10 @@ def _silence_stdout() -> None:
 #: Subcommands that never use dask in their own process (everything but sweep/compare).
 LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table"})
 
+#: Subcommands of one run (or one archive read) whose process is set up for a short life
+#: (:func:`console_main`): no cyclic garbage collector, and OpenBLAS on one thread.
+SHORT_COMMANDS = frozenset({"run", "rerun", "info"})
+
 
 def console_main() -> int:
     """Entry point of the ``pounding`` console script and ``python -m pounding``.
@@ -167,12 +172,35 @@ def console_main() -> int:
     dask.distributed) merely to ask whether arrays are dask arrays, which
     costs about 0.5 s of a 2 s ``pounding run``.  Only this process-level
     entry point does it; :func:`main` called from Python leaves imports alone.
+
+    The commands of :data:`SHORT_COMMANDS` (one run, or one archive read)
+    also get a process made for a short life, worth 0.25 s of a 1 s warm
+    ``pounding run models/pair.yaml`` on a 2-core machine:
+
+    * the cyclic garbage collector is off and, at the end, every object is
+      frozen (:func:`gc.freeze`): a whole run leaves only ~2,300 objects of
+      cyclic garbage, while the collector would traverse the ~130,000 objects
+      the imports create some 350 times (0.07 s) and again at shutdown
+      (0.1 s); reference counting still frees everything not in a cycle;
+    * OpenBLAS runs on one thread unless ``OPENBLAS_NUM_THREADS`` says
+      otherwise: its worker threads, started when numpy loads, cost 0.05 s of
+      start-up and spin for nothing, since a run's matrices (modal analysis)
+      are far below OpenBLAS's threading threshold (every fingerprint is the
+      same either way).
     """
     argv = sys.argv[1:]
-    if _subcommand(argv) in LEAN_COMMANDS:
+    command = _subcommand(argv)
+    if command in LEAN_COMMANDS:
         for name in ("dask", "distributed"):
             sys.modules.setdefault(name, None)  # type: ignore[arg-type]
-    return main(argv)
+    if command not in SHORT_COMMANDS:
+        return main(argv)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")   # read when numpy loads OpenBLAS, later
+    gc.disable()
+    try:
+        return main(argv)
+    finally:
+        gc.freeze()   # the shutdown's collections then skip every object the command made
 
 
 if __name__ == "__main__":  # pragma: no cover
