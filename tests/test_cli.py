@@ -96,7 +96,7 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
     code = ("import os, sys; from pounding.cli import console_main; "
             "os.environ.pop('OPENBLAS_NUM_THREADS', None); "
             f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
-            "status = console_main(); "
+            "status = console_main(exit_when_done=False); "
             "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
             "import gc, os; assert not gc.isenabled() and gc.get_freeze_count() > 0, 'the run was collected'; "
             "assert os.environ['OPENBLAS_NUM_THREADS'] == '1'; "
@@ -110,6 +110,26 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
             "sys.exit(status)")
     _python_succeeds(code)
     assert open_run(out).sizes["time"] == 301
+
+
+def test_a_single_run_exits_at_once_yet_runs_exit_handlers_and_flushes_its_output(tmp_path):
+    # The console script ends a `pounding run` process without the interpreter's teardown
+    # (os._exit): the exit handlers must still run, the printed summary be complete, the archive
+    # whole, and the status the command's own (2 for a bad input).
+    out, flag = tmp_path / "run.nc", tmp_path / "handler-ran"
+    code = ("import atexit, sys; from pounding.cli import console_main; "
+            f"atexit.register(lambda: open({str(flag)!r}, 'w').write('yes')); "
+            "sys.argv = ['pounding', 'run', sys.argv[2], '--duration', '3', '-o', sys.argv[1]]; "
+            "console_main(); "
+            "raise SystemExit('console_main returned instead of ending the process')")
+    done = subprocess.run([sys.executable, "-c", code, str(out), PAIR], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert flag.read_text() == "yes"
+    assert done.stdout.rstrip().splitlines()[-1].startswith("wall time")   # the last line printed arrived
+    assert open_run(out).sizes["time"] == 301
+    bad = subprocess.run([sys.executable, "-c", code, str(tmp_path / "x.nc"), str(tmp_path / "no-such-model.yaml")],
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and bad.stderr.startswith("pounding: error:"), bad.stderr
 
 
 def test_the_command_line_imports_no_heavy_library_before_a_command_needs_it():
