@@ -29,11 +29,13 @@ class BuildWithKernels(build_py):
 
     def run(self) -> None:
         super().run()
-        if os.environ.get("POUNDING_PREBUILD", "1").strip().lower() in ("0", "no", "false", "off"):
-            print("pounding: POUNDING_PREBUILD=0, kernels not compiled ahead of time (first run compiles them)")
-            return
         root = HERE if getattr(self, "editable_mode", False) else Path(self.build_lib).resolve()
         target = root / "pounding" / "solver" / "prebuilt"
+        if os.environ.get("POUNDING_PREBUILD", "1").strip().lower() in ("0", "no", "false", "off"):
+            print("pounding: POUNDING_PREBUILD=0, kernels not compiled ahead of time (first run compiles them)")
+            if root != HERE:
+                shutil.rmtree(target, ignore_errors=True)   # none left from an earlier build in the same build/
+            return
         path = os.pathsep.join(p for p in (str(root), os.environ.get("PYTHONPATH", "")) if p)
         print(f"pounding: compiling the solver's kernels into {target} (about a minute; POUNDING_PREBUILD=0 skips)")
         done = subprocess.run([sys.executable, "-m", "pounding.prebuild", str(target)], cwd=root,

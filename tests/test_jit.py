@@ -116,10 +116,11 @@ def test_tested_numba_matches_the_pin():
     assert set(jit.TESTED_NUMBA) == {(0, minor) for minor in range(int(low), int(high))}
 
 
-# A kernel (main.py) that inlines a function of another file (law.py), cached like the solver.
+# A kernel (main.py) that inlines a function of another file (law.py), cached like the solver, loaded
+# from numba's cache or (argv[1], if given) a prebuilt folder; it prints what it wrote to numba's cache.
 TOY_LAW = "from numba import njit\n\n@njit(cache=True)\ndef stiffness():\n    return {value}\n"
 TOY_MAIN = textwrap.dedent("""
-    import json
+    import json, os, sys
     from numba import njit
     from pounding.solver import jit
     from . import law
@@ -130,7 +131,11 @@ TOY_MAIN = textwrap.dedent("""
 
     jit.stamp_caches_with_sources([force], [__file__, law.__file__])
     jit.load_from_cache_without_refresh(force)
-    print(json.dumps({"force": force(2.0), "cache_hits": int(sum(force.stats.cache_hits.values()))}))
+    if len(sys.argv) > 1:
+        jit.PREBUILT = sys.argv[1]
+    folder = force._cache._cache_path
+    print(json.dumps({"force": force(2.0), "cache_hits": int(sum(force.stats.cache_hits.values())),
+                      "written": sorted(os.listdir(folder)) if os.path.isdir(folder) else []}))
 """)
 
 
@@ -145,15 +150,18 @@ def test_cached_kernel_is_recompiled_when_a_file_it_inlines_changes(tmp_path):
                PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT), os.environ.get("PYTHONPATH", "")]))
     run = [sys.executable, "-c", "import toy.main"]
 
-    assert _last_json_line(run, env=env) == {"force": 6.0, "cache_hits": 0}  # compiled and cached
-    assert _last_json_line(run, env=env) == {"force": 6.0, "cache_hits": 1}  # loaded from the cache
+    def force_and_hits(found: dict) -> dict:
+        return {key: found[key] for key in ("force", "cache_hits")}
+
+    assert force_and_hits(_last_json_line(run, env=env)) == {"force": 6.0, "cache_hits": 0}  # compiled and cached
+    assert force_and_hits(_last_json_line(run, env=env)) == {"force": 6.0, "cache_hits": 1}  # loaded from the cache
     # Edit only law.py (same size; its time moved on, as an editor would).
     law.write_text(TOY_LAW.format(value="5.0"))
     stat = law.stat()
     os.utime(law, (stat.st_atime + 10, stat.st_mtime + 10))
     # numba alone would load the cached force() with the old stiffness inlined (6.0).
-    assert _last_json_line(run, env=env) == {"force": 10.0, "cache_hits": 0}
-    assert _last_json_line(run, env=env) == {"force": 10.0, "cache_hits": 1}
+    assert force_and_hits(_last_json_line(run, env=env)) == {"force": 10.0, "cache_hits": 0}
+    assert force_and_hits(_last_json_line(run, env=env)) == {"force": 10.0, "cache_hits": 1}
 
 
 def test_the_solver_frees_every_array_it_allocates_and_nothing_more():
@@ -243,31 +251,13 @@ def test_every_solver_kernel_states_whether_it_is_inlined():
     assert {"stages", "error_norm", "locate_contact_events", "record_sample", "rhs"} <= set(inlined)
 
 
-# A toy kernel cached like the solver's, loaded (argv[1]: a prebuilt folder) from numba's cache or the folder.
-TOY_PREBUILT = textwrap.dedent("""
-    import json, os, sys
-    from numba import njit
-    from pounding.solver import jit
-    from . import law
-
-    @njit(cache=True)
-    def force(penetration):
-        return law.stiffness() * penetration
-
-    jit.stamp_caches_with_sources([force], [__file__, law.__file__])
-    jit.load_from_cache_without_refresh(force)
-    jit.PREBUILT = sys.argv[1]
-    folder = force._cache._cache_path
-    print(json.dumps({"force": force(2.0), "cache_hits": int(sum(force.stats.cache_hits.values())),
-                      "written": sorted(os.listdir(folder)) if os.path.isdir(folder) else []}))
-""")
 
 
 def _toy_package(tmp_path: Path, stiffness: str) -> tuple[list[str], dict[str, str]]:
     package = tmp_path / "toy"
     package.mkdir(exist_ok=True)
     (package / "__init__.py").write_text("")
-    (package / "main.py").write_text(TOY_PREBUILT)
+    (package / "main.py").write_text(TOY_MAIN)
     (package / "law.py").write_text(TOY_LAW.format(value=stiffness))
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT), os.environ.get("PYTHONPATH", "")]))
     return [sys.executable, "-c", "import toy.main", str(tmp_path / "prebuilt")], env
