@@ -2,7 +2,7 @@
 
 After copying the package, ``python -m pounding.prebuild`` runs the shipped models briefly with the
 built package and puts the compiled kernels in its ``solver/prebuilt`` folder, so that an installed
-pounding's first run does not compile (docs/performance.md, "Ahead-of-time kernels").  For an
+pounding's first run does not compile (docs/performance.md, "Session 7: kernels compiled ahead of time").  For an
 editable install (``pip install -e .``) the folder is the checkout's own ``pounding/solver/prebuilt``.
 The build environment needs the packages the models run with (pyproject.toml, build-system).
 
@@ -31,7 +31,8 @@ class BuildWithKernels(build_py):
         super().run()
         root = HERE if getattr(self, "editable_mode", False) else Path(self.build_lib).resolve()
         target = root / "pounding" / "solver" / "prebuilt"
-        if os.environ.get("POUNDING_PREBUILD", "1").strip().lower() in ("0", "no", "false", "off"):
+        # the words pounding.solver.jit.prebuilt_switched_off accepts for POUNDING_PREBUILT (not importable here)
+        if os.environ.get("POUNDING_PREBUILD", "").strip().lower() in ("0", "no", "false", "off"):
             print("pounding: POUNDING_PREBUILD=0, kernels not compiled ahead of time (first run compiles them)")
             if root != HERE:
                 shutil.rmtree(target, ignore_errors=True)   # none left from an earlier build in the same build/

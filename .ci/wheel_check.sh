@@ -41,9 +41,8 @@ print(f"  pounding {pounding.__version__} from {here.parent}")
 EOF
 
 step "kernels compiled ahead of time, for this wheel's sources (setup.py, pounding.prebuild)"
-status=$(python -c "import pounding.solver.integrator; from pounding.solver.jit import prebuilt_status; print(prebuilt_status())")
-echo "  $status"
-case "$status" in *"for these sources"*) ;; *) echo "  the wheel's kernels are missing or ignored"; exit 1;; esac
+python -m pounding.prebuild --status | sed 's/^/  /'   # exit status 1 (and stop) if missing or ignored
+test "${PIPESTATUS[0]}" -eq 0
 
 step "pounding init"
 pounding init study

@@ -72,21 +72,12 @@ def fresh_caches(folder: Path, label: str) -> dict[str, str]:
     return dict(os.environ, NUMBA_CACHE_DIR=str(numba_dir), XDG_CACHE_HOME=str(xdg))
 
 
-PREBUILT_STATUS = """
-import pounding.solver.integrator
-try:
-    from pounding.solver.jit import prebuilt_status
-except ImportError:  # a tree from before them
-    print("no kernels compiled ahead of time (a tree from before them)")
-else:
-    print(prebuilt_status())
-"""
-
-
 def prebuilt_status(tree: Path) -> str:
-    """What *tree* holds of kernels compiled ahead of time (one line)."""
-    done = subprocess.run([sys.executable, "-c", PREBUILT_STATUS], cwd=tree, env=dict(os.environ, PYTHONPATH=str(tree)),
-                          capture_output=True, text=True)
+    """What *tree* holds of kernels compiled ahead of time, and whether they are used (one line)."""
+    if not (tree / "pounding" / "prebuild.py").is_file():
+        return "no kernels compiled ahead of time (a tree from before them)"
+    done = subprocess.run([sys.executable, "-m", "pounding.prebuild", "--status"], cwd=tree,
+                          env=dict(os.environ, PYTHONPATH=str(tree)), capture_output=True, text=True)
     return done.stdout.strip() or done.stderr.strip().splitlines()[-1]
 
 
@@ -142,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     trees = {"baseline": baseline, "this": ROOT}
     for name, tree in trees.items():
         compile_bytecode(tree)
-        print(f"{name} ({tree}): {prebuilt_status(tree)}" + ("; POUNDING_PREBUILT=0" if args.no_prebuilt else ""))
+        print(f"{name} ({tree}): {prebuilt_status(tree)}")
     found = measure(trees, args.cold, args.warm)
     medians = report(found)
     path = out_dir(args, "startup") / "startup.json"

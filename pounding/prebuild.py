@@ -1,5 +1,7 @@
 """Compile the solver's kernels when the package is built, so that a first run does not.
 
+``python -m pounding.prebuild --status`` says whether an installed package's kernels are used.
+
 ``python -m pounding.prebuild FOLDER`` runs every shipped model (``pounding/data/models``) for a
 fraction of a second under a shipped synthetic record, and the cyclic test of a yielding storey
 (``pounding hysteresis``), with numba caching into a temporary folder,
@@ -115,9 +117,22 @@ def prebuild(folder: str | os.PathLike, log=print) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``python -m pounding.prebuild FOLDER`` (compile into FOLDER), or ``--status``: one line on the
+    installed kernels (:func:`pounding.solver.jit.prebuilt_status`), exit status 0 if they are used."""
     parser = argparse.ArgumentParser(prog="python -m pounding.prebuild", description=__doc__.splitlines()[0])
-    parser.add_argument("folder", help="where the compiled kernels go (the package's solver/prebuilt)")
+    parser.add_argument("folder", nargs="?", help="where the compiled kernels go (the package's solver/prebuilt)")
+    parser.add_argument("--status", action="store_true",
+                        help="say whether the installed package's kernels are used here (exit status 0) or not (1)")
     args = parser.parse_args(argv)
+    if args.status:
+        import pounding.solver.kernels  # noqa: F401  (adds the law modules it compiles to jit.EXTRA_SOURCES)
+        from pounding.solver.jit import prebuilt_status
+
+        used, message = prebuilt_status()
+        print(message)
+        return 0 if used else 1
+    if args.folder is None:
+        parser.error("give the FOLDER to compile into, or --status")
     if "pounding.solver" in sys.modules:
         parser.error("the solver is already imported: run as its own process (python -m pounding.prebuild)")
     started = time.perf_counter()

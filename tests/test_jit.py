@@ -314,6 +314,13 @@ def test_the_solver_loads_its_prebuilt_kernels_with_an_empty_numba_cache(tmp_pat
     assert not [p for p in user.rglob("*") if p.is_file()]   # loaded, not compiled: the user cache stays empty
     for key in ("peak_drift_ratio", "peak_contact_force", "impact_time", "impact_velocity"):
         assert fast[key] == reference[key], key
+    # `python -m pounding.prebuild --status` (jit.prebuilt_status): used here, and not when switched off
+    status = ("import json; import pounding.solver.kernels; from pounding.solver import jit; "
+              f"jit.PREBUILT = {str(prebuilt)!r}; print(json.dumps(jit.prebuilt_status()))")
+    used, message = _last_json_line([sys.executable, "-c", status])
+    assert used is True and "for these sources" in message, message
+    used, message = _last_json_line([sys.executable, "-c", status], env=dict(os.environ, POUNDING_PREBUILT="off"))
+    assert used is False and "POUNDING_PREBUILT=off" in message, message
 
 
 def test_build_environment_pins_the_same_numba_as_the_package():

@@ -41,7 +41,8 @@ from typing import Iterable
 __all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "INLINED", "CALLED", "shortcuts_supported", "load_registries_without_scipy",
            "load_from_cache_without_refresh",
            "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES", "solver_sources",
-           "stamp_solver_kernels", "PREBUILT", "load_prebuilt", "prebuilt_status", "cache_folders"]
+           "stamp_solver_kernels", "PREBUILT", "load_prebuilt", "prebuilt_status", "prebuilt_switched_off",
+           "cache_folders"]
 
 #: numba releases (major, minor) the start-up shortcuts were tested on; keep in step with
 #: the ``numba`` pin in pyproject.toml, and widen both only after tests/test_jit.py passes.
@@ -151,7 +152,8 @@ def load_from_cache_without_refresh(dispatcher) -> None:
 #: ``setup.py``'s build step): numba cache files (an index and its data files per kernel), keyed on a
 #: hash of the solver's sources (:func:`source_stamp`) and on the machine they were compiled for.
 #: Absent in a plain checkout; read, never written, by a run; ignored if the environment variable
-#: ``POUNDING_PREBUILT`` is ``0`` (every kernel then comes from numba's cache or is compiled).
+#: ``POUNDING_PREBUILT`` is ``0`` (every kernel then comes from numba's cache or is compiled;
+#: :func:`prebuilt_switched_off`); ``python -m pounding.prebuild --status`` says whether they are used.
 PREBUILT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "prebuilt")
 
 
@@ -162,7 +164,7 @@ def load_prebuilt(cache, signature, target_context):
     *cache* is the dispatcher's numba cache; the prebuilt index is read with its file name and its
     source stamp, so a kernel built from other sources than those installed is never loaded.
     """
-    if not os.path.isdir(PREBUILT) or os.environ.get("POUNDING_PREBUILT", "").strip() == "0":
+    if prebuilt_switched_off() or not os.path.isdir(PREBUILT):
         return None
     from numba.core.caching import IndexDataCacheFile
 
@@ -176,31 +178,41 @@ def load_prebuilt(cache, signature, target_context):
         return None
 
 
-def prebuilt_status() -> str:
-    """One line on :data:`PREBUILT`: absent, or how many kernel files and whether they were built for
-    the installed sources, numba and machine (else they are ignored).  Call after importing the solver (its
-    modules add to :data:`EXTRA_SOURCES`)."""
+def prebuilt_status() -> tuple[bool, str]:
+    """Whether the kernels of :data:`PREBUILT` are used here, and one line saying why: absent,
+    switched off (``POUNDING_PREBUILT``), or how many kernel files and whether they were built for
+    the installed sources, numba and machine (else they are ignored).  Call after importing
+    ``pounding.solver.kernels`` (which adds the law modules it compiles to :data:`EXTRA_SOURCES`), as
+    ``python -m pounding.prebuild --status`` does."""
     import pickle
 
     import numba
 
     indexes = sorted(name for name in os.listdir(PREBUILT) if name.endswith(".nbi")) if os.path.isdir(PREBUILT) else []
     if not indexes:
-        return f"no prebuilt kernels in {PREBUILT}: compiled on first use"
+        return False, f"no prebuilt kernels in {PREBUILT}: compiled on first use"
+    files = len([name for name in os.listdir(PREBUILT) if name.endswith((".nbi", ".nbc"))])
+    if prebuilt_switched_off():
+        return False, f"{files} prebuilt kernel files ignored: POUNDING_PREBUILT={os.environ['POUNDING_PREBUILT']}"
     with open(os.path.join(PREBUILT, indexes[0]), "rb") as index:
         version = pickle.load(index)
         stamp, overloads = pickle.loads(index.read())
-    files = len([name for name in os.listdir(PREBUILT) if name.endswith((".nbi", ".nbc"))])
     if version != numba.__version__:
-        return f"{files} prebuilt kernel files built with numba {version}, not {numba.__version__}: ignored"
+        return False, f"{files} prebuilt kernel files built with numba {version}, not {numba.__version__}: ignored"
     if stamp != source_stamp(solver_sources()):
-        return f"{files} prebuilt kernel files built from other solver sources: ignored"
+        return False, f"{files} prebuilt kernel files built from other solver sources: ignored"
     from numba.core.registry import cpu_target
 
     machine = cpu_target.target_context.codegen().magic_tuple()
     if all(key[1] != machine for key in overloads):
-        return f"{files} prebuilt kernel files built for another machine ({next(iter(overloads))[1][1]}): ignored"
-    return f"{files} prebuilt kernel files for these sources, numba {version} and this machine in {PREBUILT}"
+        return False, f"{files} prebuilt kernel files built for another machine ({next(iter(overloads))[1][1]}): ignored"
+    return True, f"{files} prebuilt kernel files for these sources, numba {version} and this machine in {PREBUILT}"
+
+
+def prebuilt_switched_off() -> bool:
+    """True if the environment variable ``POUNDING_PREBUILT`` turns :data:`PREBUILT` off (``0``, ``no``,
+    ``false``, ``off``: the words setup.py accepts for ``POUNDING_PREBUILD``, which cannot import this)."""
+    return os.environ.get("POUNDING_PREBUILT", "").strip().lower() in ("0", "no", "false", "off")
 
 
 def cache_folders() -> list[str]:
