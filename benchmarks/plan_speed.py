@@ -49,8 +49,8 @@ import pounding  # noqa: E402
 from pounding.export.opensees import allow_tension  # noqa: E402
 from pounding.export.opensees_plan import allow_plan_tension, peak_corner_displacement, run_opensees_plan  # noqa: E402
 from pounding.model.model import model_from_text  # noqa: E402
-from pounding.model.plan_model import load_plan_model  # noqa: E402
-from pounding.simulation import simulate_plan  # noqa: E402
+from pounding.model.model import load_model  # noqa: E402
+from pounding.simulation import simulate  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402
@@ -98,19 +98,19 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     folder = out_dir(args, "plan_speed")
 
-    plan = allow_plan_tension(load_plan_model(ROOT / "models" / "corner_pair.yaml"))
+    plan = allow_plan_tension(load_model(ROOT / "models" / "corner_pair.yaml"))
     planar = allow_tension(model_from_text(ISSUE_PAIR, name="issue_pair"))
     if args.duration:
         planar = planar.with_ground_motion(duration=args.duration)
-    t_plan = _best_time(lambda: simulate_plan(plan, duration=args.duration), args.repeat)
+    t_plan = _best_time(lambda: simulate(plan, duration=args.duration), args.repeat)
     t_planar = _best_time(lambda: pounding.simulate(planar), args.repeat)
     print(f"corner_pair (27 DOF) {t_plan:.4f} s, planar 10+6 pair (16 DOF) {t_planar:.4f} s: "
           f"ratio {t_plan / t_planar:.2f} (asked <= 3)")
 
     tight = dataclasses.replace(plan, solver=dataclasses.replace(plan.solver, **REFERENCE))
-    reference = simulate_plan(tight, duration=args.duration, output_dt=CORNER_OUTPUT_DT)
+    reference = simulate(tight, duration=args.duration, output_dt=CORNER_OUTPUT_DT)
     ref = _peaks_ours(plan, reference)
-    ours = _peaks_ours(plan, simulate_plan(plan, duration=args.duration, output_dt=CORNER_OUTPUT_DT))
+    ours = _peaks_ours(plan, simulate(plan, duration=args.duration, output_dt=CORNER_OUTPUT_DT))
     rows = [{"simulator": "ours", "setting": f"rtol {DEFAULT_RTOL:g}", "time": t_plan, "errors": errors(ours, ref)}]
     for dt in (float(x) for x in args.dts.split(",")):
         peer = run_opensees_plan(plan, dt=dt, duration=args.duration)

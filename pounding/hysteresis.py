@@ -181,7 +181,10 @@ class BoucWenStorey(StoreyHysteresis):
         return self
 
     def initial_stiffness(self, stiffness: float) -> float:
-        """``k·(α + (1 − α)·A)``, N/m: dF/dΔ = αk + (1 − α)F_y·dz/dΔ with dz/dΔ = A/u_y at z = 0 (k when A = 1)."""
+        """``k·(α + (1 − α)·A)``, N/m: dF/dΔ = αk + (1 − α)F_y·dz/dΔ with dz/dΔ = A/u_y at z = 0 (exactly k when
+        A = 1, as the elastic stiffness a building's matrices use)."""
+        if float(self.A) == 1.0:
+            return float(stiffness)
         alpha = float(self.post_yield_ratio)
         return float(stiffness) * (alpha + (1.0 - alpha) * float(self.A))
 

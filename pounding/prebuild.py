@@ -66,17 +66,12 @@ def _with_synthetic_record(text: str, plan: bool) -> str:
 def _run_shipped_models(models: Path, log) -> None:
     """Run every model of the folder *models* for :data:`DURATION` s (compiling its kernels)."""
     from pounding.model.model import is_plan_file, model_from_text
-    from pounding.model.plan_model import plan_model_from_text
-    from pounding.simulation import simulate, simulate_plan
+    from pounding.simulation import simulate
 
     for path in sorted(models.glob("*.yaml")):
         started = time.perf_counter()
-        plan = is_plan_file(str(path))
-        text = _with_synthetic_record(path.read_text(encoding="utf-8"), plan)
-        if plan:
-            simulate_plan(plan_model_from_text(text, name=path.stem, base_dir=str(models)), duration=DURATION)
-        else:
-            simulate(model_from_text(text, name=path.stem, base_dir=str(models)), duration=DURATION)
+        text = _with_synthetic_record(path.read_text(encoding="utf-8"), is_plan_file(str(path)))
+        simulate(model_from_text(text, name=path.stem, base_dir=str(models)), duration=DURATION)
         log(f"  {path.name}: {time.perf_counter() - started:.1f} s")
 
 

@@ -18,7 +18,7 @@ import time as _time
 import dataclasses
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -32,19 +32,17 @@ from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
 from pounding.model.model import WALL, Model, model_from_text
 from pounding.model.scales import check_work
+from pounding.model.ground import ground_components
 from pounding.records.supports import SupportMotions, common_step, lagged, on_step, support_motions_from
 from pounding.results.archive import check_archive, open_run
 from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, run_peaks, to_dataset
-from pounding.solver.assembly import assemble, contact_side_terms
+from pounding.solver.assembly import GroundRows, assemble, contact_side_terms, refusal, tolerance_factors
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, STATUS_UNSTABLE, integrate
 
-if TYPE_CHECKING:  # plan modules load only when a plan model runs (~60 ms a planar run does not pay)
-    from pounding.model.plan_model import PlanModel
-
 __all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
-           "processed_record_for", "support_motions", "SupportMotions", "rerun", "record_path", "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION",
-           "estimate_memory", "available_memory", "check_memory", "model_inputs", "FAILED_STATUSES",
-           "refuse_failed_run", "simulate_plan", "plan_ground", "plan_with_options", "rerun_plan"]
+           "processed_record_for", "component_records", "support_motions", "SupportMotions", "rerun", "record_path",
+           "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION", "estimate_memory", "available_memory", "check_memory",
+           "model_inputs", "FAILED_STATUSES", "refuse_failed_run", "ground_rows"]
 
 #: Run statuses that studies (``ida``, sweeps) count as failed: the run ended, but its numbers are
 #: not an answer (``energy_inconsistent``: the contacts dissipated energy the run never received).
@@ -166,6 +164,11 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
     (per-building form) used instead of loading the model's.
     """
     names = [b.name for b in model.buildings]
+    if (model.ground_motion_of(0) if model.buildings else model.ground_motion).two_components:
+        if record is not None:
+            raise PoundingError(f"model '{model.name}' has two ground-motion components: give the records in its "
+                                "ground_motion (a pair, or x and y), not as a loaded Record")
+        return _two_component_supports(model, where)
     if model.has_building_records:
         if record is None:
             records = [record_for(model, building=i, where=where) for i in range(len(names))]
@@ -188,6 +191,75 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
         records = [motion] * len(names)
         ends = [(spec.duration or motion.duration + max(lags))] * len(names)
     return support_motions_from(series, step, records, lag_requested, lags, ends)
+
+
+def _scaling_period(model: Model, spec: Any) -> float | None:
+    """The first period (s) of the building a ``sa`` scaling names (``period: building A``), else None."""
+    building = getattr(spec.scale, "building", None)
+    return None if building is None else float(model.buildings[model.building_index(building)].periods[0])
+
+
+def component_records(model: Model, *, building: int | str | None = None, where: str = "yaml",
+                      factor: float | None = None) -> tuple[Record | None, Record | None]:
+    """The two horizontal components (a/x, b/y) a model's ground motion names, each read with its own factor and
+    then scaled together by ``ground_motion.scale`` (:func:`pounding.records.processing.pair_scale_factor`:
+    a factor on both, or the target of the pair's geometric mean); None where a component is absent.
+
+    *factor*: use this pair factor instead of resolving the scaling (a rerun).
+    """
+    from pounding.records.processing import pair_scale_factor, scale_record
+
+    spec = model.ground_motion if building is None else model.ground_motion_of(building)
+    loaded = [None if c is None else load_record(c.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units,
+                                                 scale=c.scale, duration=spec.duration, where=where)
+              for c in spec.components()]
+    period = _scaling_period(model, spec)
+    present = [r for r in loaded if r is not None]
+    pair = pair_scale_factor(present, spec.scale, period=period) if factor is None else float(factor)
+    return tuple(None if r is None else scale_record(r, spec.scale, period=period, factor=pair)
+                 for r in loaded)  # type: ignore[return-value]
+
+
+def _two_component_supports(model: Model, where: str) -> SupportMotions:
+    """The ground under every building as global components along x and y on one grid, and a zero row.
+
+    Each building's components are rotated by the angle of incidence
+    (:func:`pounding.model.ground.ground_components`) on the finest of their steps; a
+    wave-passage lag delays a building's pair (rounded to the step).  Identical rows are shared;
+    the zero row (rotations) comes last.
+    """
+    names = [b.name for b in model.buildings]
+    pairs = [component_records(model, building=i, where=where) for i in range(len(names))]
+    present = [r for pair in pairs for r in pair if r is not None]
+    step = min(r.time_step for r in present)
+    spec = model.ground_motion
+    requested = [spec.lag(name) for name in names]
+    lags = [round(lag / step) * step for lag in requested]
+    end = spec.duration or max(r.time_step * r.acceleration.size for r in present) + max(lags)
+    time = np.arange(int(math.ceil(end / step + 1e-9)) + 1) * step
+    zero = (np.zeros(2), 1.0)
+    series = []
+    for building, ((a, b), lag) in enumerate(zip(pairs, lags)):
+        first, second = ((zero if r is None else (r.acceleration, r.time_step)) for r in (a, b))
+        series += list(ground_components(time - lag if lag else time, first, second,
+                                         model.ground_motion_of(building).angle))
+    distinct: list[np.ndarray] = []
+    index = []
+    for values in series:
+        found = next((k for k, known in enumerate(distinct) if np.array_equal(known, values)), None)
+        index.append(len(distinct) if found is None else found)
+        if found is None:
+            distinct.append(values)
+    rows = np.stack(distinct + [np.zeros_like(time)])
+    return SupportMotions(rows, float(step), tuple(index[0::2]), tuple(p[0] for p in pairs), tuple(requested),
+                          tuple(lags), float(end), building_row_y=tuple(index[1::2]),
+                          records_y=tuple(p[1] for p in pairs), zero_row=len(distinct),
+                          angle=float(model.ground_motion.angle))
+
+
+def ground_rows(supports: SupportMotions) -> GroundRows:
+    """The solver's :class:`~pounding.solver.assembly.GroundRows` of *supports*."""
+    return GroundRows(tuple(supports.building_row), tuple(supports.building_row_y), supports.zero_row)
 
 
 def _check_modes_memory(model: Model) -> None:
@@ -278,8 +350,8 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
                            record_dt=record_dt, contacts=contacts, where=where)
     supports = _supports_for_call(model, record, scale, where)
     end_time = _checked_end_time(model, supports)
-    system, raw, wall, rows = _solve(model, supports, end_time, model.solver.output_dt)
-    ds = to_dataset(model, supports.records[0], system, raw, end_time=end_time, wall_time=wall,
+    assembly, raw, wall, rows = _solve(model, supports, end_time, model.solver.output_dt)
+    ds = to_dataset(model, supports.records[0], assembly, raw, end_time=end_time, wall_time=wall,
                     supports=dataclasses.replace(supports, rows=rows))
     mark_energy_status(ds)
     return ds
@@ -305,7 +377,9 @@ def with_overrides(model: Model, record: Record | str | list | None = None, *, x
     if changes:
         model = model.with_solver(**changes)
     gm_changes: dict[str, Any] = {}
-    if isinstance(record, str):
+    if isinstance(record, str) and model.ground_motion.two_components:
+        gm_changes.update(_pair_spec_changes(record, where))
+    elif isinstance(record, str):
         gm_changes.update(_record_spec_changes(record, record_units, record_dt, where))
     elif record_units is not None or record_dt is not None:
         raise PoundingError("record_units and record_dt apply only to a record file given as record=")
@@ -314,6 +388,18 @@ def with_overrides(model: Model, record: Record | str | list | None = None, *, x
     if duration is not None:
         gm_changes["duration"] = duration
     return model.with_ground_motion(**gm_changes) if gm_changes else model
+
+
+def _pair_spec_changes(record: str, where: str) -> dict:
+    """The ``ground_motion`` keys a record pair given to :func:`simulate` of a two-component model sets."""
+    from pounding.model.ground import pair_components
+
+    if pair_components(record) is None:
+        option = "--record" if where == "cli" else "record="
+        raise PoundingError(f"{option} {record}: a model in plan needs a catalogue pair such as fema-p695:farfield/3 "
+                            "(components a and b); for single records or files give x: {record: ...} and "
+                            "y: {record: ...} in the model's ground_motion")
+    return dict(record=record.strip(), x=None, y=None, dt=None, units=None)
 
 
 def _record_spec_changes(record: str, record_units: str | None, record_dt: float | None, where: str) -> dict:
@@ -382,16 +468,19 @@ def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]
     supports = support_motions(model, record, where="yaml")
     motion = supports.records[0]
     end_time = _positive_end_time(supports)
-    system, raw, wall, _ = _solve(model, supports, end_time, end_time)
-    peaks = run_peaks(model, system, raw)
+    assembly, raw, wall, _ = _solve(model, supports, end_time, end_time)
+    peaks = run_peaks(model, assembly, raw)
     peaks.update(record_scale=float(motion.scale), wall_time=wall)
     return peaks
 
 
 def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: float):
-    """Integrate *model* on its *supports* up to *end_time*: ``(system, raw solution, wall time in s,
+    """Integrate *model* on its *supports* up to *end_time*: ``(assembly, raw solution, wall time in s,
     the ground rows as given to the solver (G, ns))``."""
     settings = model.solver
+    why = refusal(model)
+    if why is not None:
+        raise PoundingError(f"{_where(model)}{why}")
     check_work(model, end_time, where=_where(model))   # a stiff element would take hours, silently
     step = supports.time_step
     samples_needed = int(np.ceil(end_time / step - 1e-9)) + 1
@@ -401,16 +490,20 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
     if ground.shape[0] == 1:
         ground = ground[0]
 
-    system = assemble(model, supports.building_row)
+    assembly = assemble(model, ground_rows(supports))
+    system = assembly.system
+    scaling = settings.tolerance_scaling
+    factors = tolerance_factors(model, system, float(np.max(np.abs(rows))) if rows.size and scaling else 0.0,
+                                float(settings.atol) if scaling else 0.0)
     started = _time.perf_counter()
     raw = integrate(system, ground, step, end_time, rtol=settings.rtol,
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
-                    output_dt=output_dt, scale_tolerances=settings.tolerance_scaling)
+                    output_dt=output_dt, floor_factors=factors)
     wall = _time.perf_counter() - started
     if raw.status not in (STATUS_OK, STATUS_COLLAPSED, STATUS_UNSTABLE):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
         raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
-    return system, raw, wall, rows
+    return assembly, raw, wall, rows
 
 
 def refuse_failed_run(status: str, message: str) -> None:
@@ -452,7 +545,7 @@ def estimate_memory(model: Model, end_time: float, record_dt: float, output_dt: 
     floor and contact, energies), with a factor 2 for the copies made while
     the dataset is assembled and written.
     """
-    n = sum(b.n_floors for b in model.buildings)
+    n = model.n_dof
     nc = len(model.gaps)
     n_out = end_time / output_dt + 2 if output_dt > 0 else float("inf")
     n_ground = end_time / record_dt + 2 if record_dt > 0 else float("inf")
@@ -501,6 +594,11 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
         raise ArchiveError(f"{name}: cannot rebuild the model stored in the archive (run_spec['model'], "
                            f"a copy of {ds.attrs.get('model_path') or 'the model'}): {exc}") from None
     model = _archived_tolerances(model, spec)
+    if model.ground_motion.two_components:
+        again = _rerun_two_components(model, spec, name)
+        now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
+        return again
     if model.has_building_records:
         again = simulate(model, _archived_records(model, spec, name))
         now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
@@ -519,6 +617,17 @@ def rerun(run: xr.Dataset | str | os.PathLike) -> xr.Dataset:
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     again.attrs["history"] = f"{ds.attrs.get('history', '')}\n{now} rerun of {name}".strip()
     return again
+
+
+def _rerun_two_components(model: Model, spec: dict, name: str) -> xr.Dataset:
+    """A run of a two-component model again: its archived pair factor (not re-resolved), each component's
+    samples checked against their archived SHA-256."""
+    model = model.with_ground_motion(scale=spec["scale"], duration=spec["duration"])
+    for record, expected in zip(component_records(model), spec.get("component_sha256", [])):
+        if record is not None and expected and record.metadata.get("sha256", "") != expected:
+            raise PoundingError(f"{name}: record {record.source} has changed since the run was archived; restore "
+                                "the original file")
+    return simulate(model)
 
 
 def _archived_tolerances(model: Model, spec: dict) -> Model:
@@ -545,182 +654,3 @@ def _archived_records(model: Model, spec: dict, name: str) -> list[Record]:
     return records
 
 
-def plan_ground(model: PlanModel, duration: float | None = None) -> tuple[np.ndarray, float, float]:
-    """A plan model's ground rows ``(3, ns)`` (a_gx, a_gy, zeros; m/s²), their step (s) and the end time (s).
-
-    The grid takes the finer of the two components' steps; each component is linear on its
-    own samples (:func:`pounding.model.ground_pair.ground_components`), so with equal steps
-    (a catalogue pair) the rows are exact.  End: *duration*, else the model's, else the
-    longer component's.
-    """
-    records = [r for r in model.ground_motion.records() if r is not None]
-    step = min(r.time_step for r in records)
-    end = duration or model.ground_motion.duration or max(r.time_step * r.acceleration.size for r in records)
-    time = np.arange(int(math.ceil(end / step + 1e-9)) + 1) * step
-    from pounding.solver.plan_assembly import plan_ground_rows
-
-    return plan_ground_rows(*model.ground_motion.on_grid(time)), float(step), float(end)
-
-
-def _pair_form(model: PlanModel) -> bool:
-    """True if *model*'s file gives its ground motion as a record pair (``record:``), not as components x and y."""
-    import yaml
-
-    ground = (yaml.safe_load(model.source) or {}).get("ground_motion") if model.source else None
-    return isinstance(ground, dict) and ground.get("record") is not None
-
-
-def plan_with_options(model: PlanModel, *, record: str | None = None, scale: float | None = None,
-                      xi: str | None = None, contacts: bool = True) -> PlanModel:
-    """*model* with what ``pounding run`` overrides on a plan model (one-line errors, the option named).
-
-    Parameters
-    ----------
-    record : str, optional
-        A catalogue pair (``fema-p695:farfield/3``: components a and b) instead of the model's ground motion.
-    scale : float, optional
-        The factor on both components: it replaces the pair's ``scale`` (with components given one by one,
-        ``x`` and ``y``, it multiplies each component's own scale: their ratio is kept).
-    xi : str, optional
-        ξ formula of every hertz-damp contact.
-    contacts : bool
-        False: every contact point held open (gap :data:`pounding.model.model.OPEN_GAP`), the run without
-        pounding.
-    """
-    from pounding.contact import xi as xi_formulas
-    from pounding.contact.laws import HertzDamp
-    from pounding.model.ground_pair import pair_components
-    from pounding.model.model import OPEN_GAP
-    from pounding.model.plan_schema import ComponentEntry
-
-    where = model.path or model.name
-    ground = model.ground_motion
-    if record is not None:
-        pair = pair_components(record)
-        if pair is None:
-            raise PoundingError(f"--record {record}: a plan model needs a catalogue pair such as fema-p695:farfield/3 "
-                                "(components a and b); for single records or files give x: {record: ...} and "
-                                "y: {record: ...} in the model's ground_motion")
-        components = tuple(ComponentEntry(record=c, scale=1.0 if scale is None else scale) for c in pair)
-        ground = dataclasses.replace(ground, components=components, dt=None, units=None)
-    elif scale is not None:
-        pair = _pair_form(model)
-        components = tuple(None if c is None else c.model_copy(update={"scale": scale if pair else scale * c.scale})
-                           for c in ground.components)
-        ground = dataclasses.replace(ground, components=components)
-    contact_list = list(model.contacts)
-    if xi is not None:
-        key = xi_formulas.get(xi).key
-        if not any(isinstance(c.law, HertzDamp) for c in contact_list):
-            raise PoundingError(f"--xi {xi}: {where} has no hertz-damp contacts; the xi formula applies only to "
-                                "law hertz-damp")
-        contact_list = [dataclasses.replace(c, law=type(c.law)(**{**c.law.model_dump(), "xi": key}))
-                        if isinstance(c.law, HertzDamp) else c for c in contact_list]
-    if not contacts:
-        if not contact_list:
-            raise PoundingError(f"--no-contacts: {where} has no contacts; there is no pounding to leave out")
-        contact_list = [dataclasses.replace(c, face=dataclasses.replace(c.face, gap=OPEN_GAP)) for c in contact_list]
-    return dataclasses.replace(model, ground_motion=ground, contacts=tuple(contact_list))
-
-
-def simulate_plan(model: PlanModel, *, duration: float | None = None, rtol: float | None = None,
-                  output_dt: float | None = None, record: str | None = None, scale: float | None = None,
-                  xi: str | None = None, contacts: bool = True) -> xr.Dataset:
-    """Simulate a plan model (docs/plan-models.md) under its two-component ground motion.
-
-    Lowered by :func:`pounding.solver.plan_assembly.plan_system` (the compiled kernels' storey
-    rows take the planes' weighted drifts), labelled by :func:`pounding.results.plan_dataset.plan_dataset`.
-    Friction is refused in one line.  A plane past its building's collapse drift ratio (or an IMK
-    plane at zero strength) ends the run: status ``collapsed`` (attributes :func:`_plan_status`).
-    *record*, *scale*, *xi* and *contacts* as :func:`plan_with_options`; the archive's
-    attribute ``plan_spec`` (JSON) holds the model text and these options, for
-    :func:`rerun_plan`.
-    """
-    from pounding.solver.integrator import ground_state_at
-
-    options = dict(record=record, scale=scale, xi=xi, contacts=contacts)
-    source = model
-    model = plan_with_options(model, **options)
-    from pounding.results.plan_dataset import plan_dataset
-    from pounding.solver.plan_assembly import plan_refusal, plan_system, plan_tolerance_factors
-
-    refusal = plan_refusal(model)
-    if refusal is not None:
-        raise PoundingError(f"{model.path or model.name}: {refusal}")
-    rows, step, end = plan_ground(model, duration)
-    if any(c.second == WALL and c.law.instantaneous for c in model.contacts) and np.any(rows):
-        raise PoundingError(f"{model.path or model.name}: a rigid (stereo-mechanical) contact with a wall under "
-                            "ground motion is not yet integrated in plan models; use hertz-damp")
-    settings = model.solver
-    psys = plan_system(model)
-    atol = settings.atol
-    factors = plan_tolerance_factors(model, float(np.abs(rows).max()), atol) if settings.tolerance_scaling else \
-        plan_tolerance_factors(model, 0.0, 0.0)
-    started = _time.perf_counter()
-    raw = integrate(psys.system, rows, step, end, rtol=rtol or settings.rtol, atol=atol,
-                    atol_velocity=settings.atol_velocity, output_dt=output_dt or settings.output_dt,
-                    floor_factors=factors)
-    wall = _time.perf_counter() - started
-    if raw.status not in (STATUS_OK, STATUS_COLLAPSED):
-        raise PoundingError(f"{model.path or model.name}: " + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
-    raw = dataclasses.replace(raw, support_acceleration=ground_state_at(rows, step, raw.time)[0])
-    hashes = [None if r is None else r.metadata.get("sha256", "") for r in model.ground_motion.records()]
-    spec = {"model": source.source, "name": source.name, "path": source.path,
-            "base_dir": source.ground_motion.base_dir, **options, "duration": duration, "rtol": rtol,
-            "output_dt": output_dt, "records": [None if c is None else {"record": c.record, "scale": c.scale}
-                                                for c in model.ground_motion.components],
-            "record_sha256": hashes}
-    now = datetime.now(timezone.utc)
-    from pounding import __version__
-
-    return plan_dataset(model, psys, raw, attrs={"record_step": step, "end_time": end, "wall_time": wall,
-                                                 "angle": model.ground_motion.angle,
-                                                 "created": now.isoformat(), "source": f"pounding {__version__}",
-                                                 "history": f"{now.strftime('%Y-%m-%dT%H:%M:%SZ')} simulated with "
-                                                            f"pounding {__version__}",
-                                                 "plan_spec": json.dumps(spec),
-                                                 **_plan_status(model, psys, raw)})
-
-
-def rerun_plan(run: xr.Dataset, name: str = "archive") -> xr.Dataset:
-    """Simulate again what a plan archive (:func:`simulate_plan`) recorded: its model text and options.
-
-    Refused in one line if a component's samples no longer hash to the archived SHA-256.
-    """
-    from pounding.model.plan_model import plan_model_from_text
-
-    try:
-        spec = json.loads(run.attrs["plan_spec"])
-        model = plan_model_from_text(spec["model"], name=spec["name"], path=spec["path"], base_dir=spec["base_dir"])
-        options = {k: spec[k] for k in ("record", "scale", "xi", "contacts", "duration", "rtol", "output_dt")}
-    except (KeyError, ValueError, TypeError) as exc:
-        raise PoundingError(f"damaged archive: {name}: its plan_spec attribute is missing or garbled "
-                            f"({type(exc).__name__}); run the model again") from None
-    again_model = plan_with_options(model, **{k: options[k] for k in ("record", "scale", "xi", "contacts")})
-    for component, archived in zip(again_model.ground_motion.records(), spec.get("record_sha256", [])):
-        if component is not None and archived and component.metadata.get("sha256", "") != archived:
-            raise PoundingError(f"{name}: record {component.source} has changed "
-                                "since the run was archived; restore the original file")
-    again = simulate_plan(model, **options)
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-    again.attrs["history"] = f"{run.attrs.get('history', '')}\n{now} rerun of {name}".strip()
-    return again
-
-
-def _plan_status(model: PlanModel, psys: Any, raw: Any) -> dict[str, Any]:
-    """A plan run's ``status`` and, if a plane ended it, ``status_message``, ``collapse_time`` (s),
-    ``collapse_building``, ``collapse_storey`` (``building:storey``), ``collapse_plane`` (its index in the
-    archive's ``plane`` dimension) and ``collapse_cause`` (``drift_ratio`` or ``zero_strength``)."""
-    if raw.status == STATUS_OK or raw.collapse_storey < 0:
-        return {"status": "completed"}
-    p = int(raw.collapse_storey)
-    building, storey, plane = [(b.name, i + 1, plane) for b in model.buildings
-                               for i, s in enumerate(b.storeys) for plane in s.planes][p]
-    where = f"plane {p} ({plane.direction} at {plane.at:g} m)"
-    cause = (f"{where} reached its ultimate drift (IMK plane at zero strength)" if raw.collapse_cause == "zero_strength"
-             else f"{where} passed its collapse drift ratio {psys.system.storey_stop_ratio[p]:g}")
-    message = STATUS_MESSAGES[STATUS_COLLAPSED].format(t=raw.final_time, building=building,
-                                                       storey=f"{building}:{storey}", cause=cause)
-    return {"status": "collapsed", "status_message": message, "collapse_time": float(raw.final_time),
-            "collapse_building": building, "collapse_storey": f"{building}:{storey}", "collapse_plane": p,
-            "collapse_cause": raw.collapse_cause}

@@ -12,7 +12,7 @@ from pounding.contact.laws import HertzDamp
 from pounding.errors import ModelError
 from pounding.model.model import Building, Damping, GapElement, GroundMotionSpec, Model, SolverSettings, load_model, model_from_text
 
-from pounding.model.plan_model import is_plan_file  # noqa: E402
+from pounding.model.model import is_plan_file  # noqa: E402
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 
@@ -28,7 +28,7 @@ def uniform(n: int, m: float = 2.5e5, k: float = 3.0e8, h: float = 3.2,
     """A uniform shear building (5 % Rayleigh at modes 1, 2 unless given; modal for n = 1)."""
     if damping is None:
         damping = Damping("rayleigh", ratio=0.05, modes=(1, 2)) if n > 1 else Damping("modal", modal_ratios=(0.05,))
-    return Building("U", np.full(n, m), np.full(n, k), np.full(n, h), damping)
+    return Building.shear("U", np.full(n, m), np.full(n, k), np.full(n, h), damping)
 
 
 # --------------------------------------------------------------------------- #
@@ -37,7 +37,7 @@ def uniform(n: int, m: float = 2.5e5, k: float = 3.0e8, h: float = 3.2,
 
 
 def test_two_storey_matrices_by_hand():
-    b = Building("two", np.array([2.0e5, 1.0e5]), np.array([6.0e8, 4.0e8]), np.array([4.0, 3.0]),
+    b = Building.shear("two", np.array([2.0e5, 1.0e5]), np.array([6.0e8, 4.0e8]), np.array([4.0, 3.0]),
                  Damping("rayleigh", ratio=0.05, modes=(1, 2)))
     np.testing.assert_array_equal(b.mass_matrix(), [[2.0e5, 0.0], [0.0, 1.0e5]])
     # K = [[k1 + k2, -k2], [-k2, k2]]: exact in floating point for these values
@@ -54,7 +54,7 @@ def test_two_storey_matrices_by_hand():
 
 
 def test_stiffness_matrix_is_tridiagonal_and_symmetric():
-    b = Building("x", np.linspace(1e5, 3e5, 6), np.linspace(5e8, 2e8, 6), np.full(6, 3.0),
+    b = Building.shear("x", np.linspace(1e5, 3e5, 6), np.linspace(5e8, 2e8, 6), np.full(6, 3.0),
                  Damping("rayleigh", ratio=0.05, modes=(1, 3)))
     k = b.stiffness_matrix()
     assert np.array_equal(k, k.T)
@@ -78,7 +78,7 @@ def test_uniform_building_periods_closed_form(n):
 
 
 def test_modes_are_mass_normalised_and_signed():
-    b = Building("x", np.array([3e5, 2.5e5, 2e5, 1.5e5]), np.array([4e8, 3.5e8, 3e8, 2e8]),
+    b = Building.shear("x", np.array([3e5, 2.5e5, 2e5, 1.5e5]), np.array([4e8, 3.5e8, 3e8, 2e8]),
                  np.full(4, 3.0), Damping("rayleigh", ratio=0.05, modes=(1, 2)))
     omega, phi = b.modes
     # Φᵀ M Φ = I and Φᵀ K Φ = diag(ω²); entries are O(1) (resp. O(ω²)), so 1e-10
@@ -105,7 +105,7 @@ def modal_ratios_of(b: Building) -> np.ndarray:
 
 @pytest.mark.parametrize("modes", [(1, 2), (1, 3), (3, 1), (2, 5)])
 def test_rayleigh_gives_the_ratio_at_both_modes(modes):
-    b = Building("x", np.array([3e5, 2.5e5, 2.5e5, 2e5, 1.5e5]), np.array([5e8, 4e8, 4e8, 3e8, 2e8]),
+    b = Building.shear("x", np.array([3e5, 2.5e5, 2.5e5, 2e5, 1.5e5]), np.array([5e8, 4e8, 4e8, 3e8, 2e8]),
                  np.full(5, 3.2), Damping("rayleigh", ratio=0.05, modes=modes))
     zeta = modal_ratios_of(b)
     i, j = modes
@@ -160,10 +160,10 @@ def test_damping_validation():
 def test_building_validation():
     d = Damping("modal", modal_ratios=(0.05,))
     with pytest.raises(ModelError, match=r"building x: storeys\[1\]\.mass must be > 0 \(got -1.0\)"):
-        Building("x", [1.0, -1.0], [1.0, 1.0], [1.0, 1.0], d)
+        Building.shear("x", [1.0, -1.0], [1.0, 1.0], [1.0, 1.0], d)
     with pytest.raises(ModelError, match="same length"):
-        Building("x", [1.0, 1.0], [1.0], [1.0, 1.0], d)
-    b = Building("x", [1.0, 2.0], [3.0, 4.0], [5.0, 6.0], d)
+        Building.shear("x", [1.0, 1.0], [1.0], [1.0, 1.0], d)
+    b = Building.shear("x", [1.0, 2.0], [3.0, 4.0], [5.0, 6.0], d)
     with pytest.raises(ValueError):
         b.mass[0] = 7.0
 

@@ -43,8 +43,8 @@ from pounding.cli import main  # noqa: E402
 from pounding.errors import PoundingError  # noqa: E402
 from pounding.export.opensees_plan import (allow_plan_tension, peak_corner_displacement,  # noqa: E402
                                            plan_opensees_script, run_opensees_plan)
-from pounding.model.plan_model import load_plan_model, plan_model_from_text  # noqa: E402
-from pounding.simulation import simulate_plan  # noqa: E402
+from pounding.model.model import load_model, model_from_text  # noqa: E402
+from pounding.simulation import simulate  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -86,7 +86,7 @@ def _relative(ours, peer) -> float:
 
 def _cross_check(model, duration: float) -> tuple:
     model = allow_plan_tension(model)
-    ours = simulate_plan(model, duration=duration, rtol=1e-10, output_dt=5e-4)
+    ours = simulate(model, duration=duration, rtol=1e-10, output_dt=5e-4)
     peer = run_opensees_plan(model, dt=1e-4, duration=duration)
     assert peer["converged"] and peer["cut_steps"] == 0
     return model, ours, peer
@@ -94,7 +94,7 @@ def _cross_check(model, duration: float) -> tuple:
 
 @pytest.mark.parametrize("source, duration", [("corner", 6.0), ("small", 3.0)])
 def test_plan_model_agrees_with_opensees(source, duration):
-    model = load_plan_model(CORNER) if source == "corner" else plan_model_from_text(SMALL, name="small")
+    model = load_model(CORNER) if source == "corner" else model_from_text(SMALL, name="small")
     model, ours, peer = _cross_check(model, duration)
     assert peer["impact_count"] == ours.impact_count.values.tolist()
     assert sum(peer["impact_count"]) >= 4 if source == "corner" else sum(peer["impact_count"]) >= 1
@@ -107,7 +107,7 @@ def test_plan_model_agrees_with_opensees(source, duration):
 
 def _edited(old: str, new: str):
     assert old in SMALL
-    return plan_model_from_text(SMALL.replace(old, new, 1), name="small")
+    return model_from_text(SMALL.replace(old, new, 1), name="small")
 
 
 @pytest.mark.parametrize("old, new, message", [
@@ -123,7 +123,7 @@ def test_refusals_are_one_line(old, new, message):
 
 
 def test_script_names_its_parts():
-    text, notes = plan_opensees_script(load_plan_model(CORNER), duration=1.0)
+    text, notes = plan_opensees_script(load_model(CORNER), duration=1.0)
     assert 'ops.rigidDiaphragm(3, master, *tags)' in text and 'ops.model("basic", "-ndm", 3, "-ndf", 6)' in text
     assert text.count("'Hertzdamp'") == 6 and any("tension: clamp" in n for n in notes)
     compile(text, "corner_opensees.py", "exec")

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pounding.model.plan_model import plan_model_from_text
-from pounding.results.plan_dataset import CORNERS, corner_weights, hermite_at, plan_summary
-from pounding.simulation import simulate_plan
+from pounding.model.model import model_from_text
+from pounding.results.corners import CORNERS, corner_weights, hermite_at
+from pounding.results.summary import plan_summary
+from pounding.simulation import simulate
 
 MODEL = """name: corner
 buildings:
@@ -38,7 +39,7 @@ solver: {output_dt: 0.005}
 
 @pytest.fixture(scope="module")
 def run():
-    return simulate_plan(plan_model_from_text(MODEL, name="corner"))
+    return simulate(model_from_text(MODEL, name="corner"))
 
 
 def test_corner_of_a_pure_translation_is_the_centre_of_mass_displacement():
@@ -169,10 +170,10 @@ def test_record_takes_a_catalogue_pair(model_file, tmp_path, capsys):
 
 def test_xi_is_applied_to_every_hertz_damp_point(model_file):
     from pounding.simulation import plan_with_options
-    from pounding.model.plan_model import load_plan_model
+    from pounding.model.model import load_model
 
-    model = plan_with_options(load_plan_model(model_file), xi="ye")
-    assert {c.law.xi for c in model.contacts} == {"ye"}
+    model = plan_with_options(load_model(model_file), xi="ye")
+    assert {c.law.xi for c in model.faces} == {"ye"}
 
 
 @pytest.mark.parametrize("argv, words", [

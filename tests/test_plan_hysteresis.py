@@ -7,8 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pounding.model.model import model_from_text
-from pounding.model.plan_model import plan_model_from_text
-from pounding.simulation import simulate, simulate_plan
+from pounding.simulation import simulate
 
 from plan_cases import SOLVER, bilinear as _bilinear, plan_pair as _plan_pair, two_tone_record as _record
 
@@ -30,7 +29,7 @@ ground_motion: {x: {record: REC}, y: {record: REC, scale: 0.6}, angle: 30, durat
 
 def _eccentric(tmp_path, extra: str = SOLVER):
     text = ECCENTRIC.replace("REC", _record(tmp_path)).replace("HYST", _bilinear(0.001, 0.1)) + extra
-    return plan_model_from_text(text, name="e")
+    return model_from_text(text, name="e")
 
 
 def _reference(model, duration: float) -> tuple[np.ndarray, np.ndarray]:
@@ -105,7 +104,7 @@ def _reference(model, duration: float) -> tuple[np.ndarray, np.ndarray]:
 def test_yielding_eccentric_storey_matches_scipy_with_every_switch_an_event(tmp_path):
     """Bilinear planes on an eccentric storey under two components: the solver against solve_ivp."""
     model = _eccentric(tmp_path)
-    ds = simulate_plan(model, duration=1.5)
+    ds = simulate(model, duration=1.5)
     time, ref = _reference(model, 1.5)
     assert float(ds.energy_hysteretic[-1]) > 0.05 * float(ds.energy_input.max())  # the planes yielded
     got = np.c_[ds.displacement.values[:, 0, :], ds.rotation.values[:, 0]]
@@ -132,7 +131,7 @@ def test_symmetric_plan_with_yielding_planes_reproduces_the_planar_inelastic_mod
     """Issue 26 §1 acceptance with yielding storeys: each x plane half the storey (stiffness and yield force)."""
     record = _record(tmp_path)
     a = simulate(model_from_text(_planar_pair(record, hyst), name="p"))
-    b = simulate_plan(plan_model_from_text(_plan_pair(record, hyst), name="q"))
+    b = simulate(model_from_text(_plan_pair(record, hyst), name="q"))
     assert float(a.energy_hysteretic[-1]) > 0.0 and int(a.impact_contact.size) > 0
     assert np.allclose(b.peak_displacement.values[:, 0], a.peak_displacement.values, rtol=1e-8, atol=0.0)
     assert np.all(b.peak_rotation.values == 0.0)
@@ -147,7 +146,7 @@ def test_symmetric_plan_with_yielding_planes_reproduces_the_planar_inelastic_mod
 
 def test_stop_drift_ratio_ends_the_run_at_the_first_plane_past_it(tmp_path):
     model = _eccentric(tmp_path, SOLVER.replace("output_dt", "stop_drift_ratio: 0.004, output_dt"))
-    ds = simulate_plan(model)
+    ds = simulate(model)
     assert ds.attrs["status"] == "collapsed"
     assert ds.attrs["collapse_building"] == "A" and ds.attrs["collapse_storey"] == "A:1"
     assert ds.attrs["collapse_cause"] == "drift_ratio"
@@ -163,10 +162,10 @@ def test_a_building_collapse_drift_ratio_applies_to_its_own_planes(tmp_path):
     text = (ECCENTRIC.replace("REC", _record(tmp_path)).replace(", HYST", "")
             .replace("    damping: {ratio: 0.05, modes: [1, 3]}\n",
                      "    damping: {ratio: 0.05, modes: [1, 3]}\n    collapse: {drift_ratio: 0.5}\n")) + SOLVER
-    ds = simulate_plan(plan_model_from_text(text, name="e"))
+    ds = simulate(model_from_text(text, name="e"))
     assert ds.attrs["status"] == "completed"
     tight = text.replace("drift_ratio: 0.5", "drift_ratio: 0.002")
-    ds = simulate_plan(plan_model_from_text(tight, name="e"))
+    ds = simulate(model_from_text(tight, name="e"))
     assert ds.attrs["status"] == "collapsed" and ds.attrs["collapse_building"] == "A"
     assert np.isclose(float(ds.peak_plane_drift.max()) / 3.0, 0.002, rtol=1e-9)
 
@@ -175,7 +174,7 @@ def test_energy_closes_with_yielding_planes_and_impacts(tmp_path):
     """Two components at 20° on the yielding pair, A's storeys eccentric (CM off the centre): twist, impacts."""
     text = (_plan_pair(_record(tmp_path), _bilinear(0.002, 0.05)).replace("duration: 3.0}", "angle: 20, duration: 3.0}")
             .replace("{mass: 250000.0, height: 3.2,", "{mass: 250000.0, height: 3.2, centre_of_mass: [9, 4],"))
-    ds = simulate_plan(plan_model_from_text(text, name="q"))
+    ds = simulate(model_from_text(text, name="q"))
     assert int(ds.impact_count.sum()) > 0 and float(ds.energy_hysteretic[-1]) > 0.0
     assert np.abs(ds.peak_rotation.values).max() > 0.0
     assert ds.attrs["energy_closure"] < 1e-5

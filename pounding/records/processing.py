@@ -47,7 +47,7 @@ from pounding.units import NUMBER, NUMBER_TEXT, STANDARD_GRAVITY, UNIT_CHOICES, 
 __all__ = [
     "Scaling", "Processing", "SpecProblem", "parse_scale", "parse_processing", "parse_acceleration",
     "scale_record", "process", "trim_significant_duration", "baseline_correct", "arias_intensity",
-    "fema_normalisation_factor", "TRIM_METHODS",
+    "fema_normalisation_factor", "pair_scale_factor", "TRIM_METHODS",
 ]
 
 SCALE_METHODS = ("pga", "sa", "fema-p695")
@@ -394,6 +394,38 @@ def fema_normalisation_factor(record: Record) -> float:
         raise RecordError(f"scale {{fema-p695: true}} needs a FEMA P695 record (fema-p695:<set>/<id><a|b> or its "
                           f"catalogue key); {record.name} is not one: use pga or sa scaling instead",
                           file=record.source or None)
+    return float(factor)
+
+
+def pair_scale_factor(records: list[Record], scaling: float | Scaling, *, period: float | None = None) -> float:
+    """The one factor that takes a record pair (both horizontal components) to *scaling*'s target.
+
+    A factor is itself; a target PGA or Sa(T) applies to the pair's geometric mean
+    ``√(IM_a · IM_b)`` of the components' intensities (FEMA P695 §A.8 normalises and scales
+    record pairs by their geometric-mean spectrum); ``fema-p695`` is the pair's normalisation
+    factor (one per pair in FEMA P695 Table A-4C: both components carry it).  One component
+    present: its own intensity.
+    """
+    from pounding.records.spectra import spectral_acceleration
+
+    if not isinstance(scaling, Scaling):
+        scaling = Scaling("factor", factor=float(scaling))
+    if scaling.method == "factor":
+        return float(scaling.factor)
+    if scaling.method == "fema-p695":
+        return fema_normalisation_factor(records[0])
+    t = scaling.period if period is None else period
+    if scaling.method == "pga":
+        measures = [r.pga for r in records]
+    else:
+        if t is None or not t > 0:
+            raise RecordError(f"scale {scaling.describe()}: the period is unknown; give period in seconds")
+        measures = [spectral_acceleration(r, period=t, damping=scaling.damping) for r in records]
+    mean = math.prod(measures) ** (1.0 / len(measures))
+    factor = scaling.target / mean if mean > 0 else math.inf
+    if not math.isfinite(factor):
+        raise RecordError(f"cannot scale a record pair of zero amplitude to {scaling.describe(t)}",
+                          file=records[0].source or None)
     return float(factor)
 
 

@@ -41,6 +41,15 @@ class SupportMotions:
         one applied, rounded to the record step (0 without wave passage).
     end_time : float
         Default simulated time, s: the longest record plus its lag.
+    building_row_y : tuple of int
+        Two horizontal components: each building's row along y (the rows are then the global
+        components along x and y); empty with one component (along x).
+    records_y : tuple of Record or None
+        Two components: the second (b, or y) under each building, None where absent.
+    zero_row : int
+        A row of zeros (the ground of rotations), −1 when there is none.
+    angle : float or None
+        Two components: the angle of incidence of component a (x), degrees from +x.
     """
 
     rows: np.ndarray
@@ -50,6 +59,10 @@ class SupportMotions:
     lag_requested: tuple
     lag: tuple
     end_time: float
+    building_row_y: tuple = ()
+    records_y: tuple = ()
+    zero_row: int = -1
+    angle: float | None = None
 
 
 def common_step(records: list[Record], names: list[str]) -> float:

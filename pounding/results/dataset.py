@@ -48,9 +48,14 @@ from pounding import __version__
 from pounding.contact import links as contact_links
 from pounding.records.record import Record
 from pounding.results.describe import run_title
+from pounding.model.floors import DOF_PER_FLOOR
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
+from pounding.results.corners import CORNERS, corner_displacements, floor_corners, hermite_at
+from pounding.solver.assembly import Assembly
 from pounding.solver.integrator import RawSolution, System
+from pounding.solver.kinematics import penetration as combined_penetration
+from pounding.solver.storeys import restoring_force
 from pounding.solver.status import STATUS_ENERGY_INCONSISTENT, STATUS_MESSAGES, STATUS_NAMES, STATUS_OK
 from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
@@ -369,7 +374,7 @@ def run_status(system: System, raw: RawSolution, n_gaps: int, storey: str, build
                                                             cause=collapse_reason(raw, system))
 
 
-def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
+def run_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, Any]:
     """The peaks and end-of-run state of one simulation, as plain arrays (what studies keep of a run).
 
     The same values :func:`to_dataset` stores under the same names: storey and
@@ -381,7 +386,11 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     resistance), ``collapse_building`` (its building, ``""`` if none) and ``collapse_cause``
     (:data:`pounding.solver.status.COLLAPSE_CAUSES`, ``""`` if none): the first building to collapse
     ends the run, so at most one building collapses in a run.  They do not depend on the output sampling: the solver tracks peaks at every step.
+    Planes in plan: :func:`plane_peaks`.
     """
+    if not assembly.chain:
+        return plane_peaks(model, assembly, raw)
+    system = assembly.system
     labels = _labels(model)
     heights = labels["height"]
     ng = len(model.gaps)   # the gap elements; the links follow them in the solver's arrays
@@ -408,14 +417,18 @@ def run_peaks(model: Model, system: System, raw: RawSolution) -> dict[str, Any]:
     }
 
 
-def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *,
+def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *,
                end_time: float, wall_time: float, supports=None) -> xr.Dataset:
     """Build the results dataset of one simulation.
 
     *supports* (:class:`pounding.records.supports.SupportMotions`, rows as given to
     the solver) describes the ground under each building; without it every
-    building stands on *record* (row 0 of the solution's ground).
+    building stands on *record* (row 0 of the solution's ground).  Planes as weighted rows (floors
+    in plan): :func:`plane_dataset`.
     """
+    if not assembly.chain:
+        return plane_dataset(model, record, assembly, raw, end_time=end_time, wall_time=wall_time, supports=supports)
+    system = assembly.system
     n = system.n_floors
     labels = _labels(model)
     u = raw.state[:, :n]
@@ -442,7 +455,7 @@ def to_dataset(model: Model, record: Record, system: System, raw: RawSolution, *
     storey_work = raw.state[:, lay.storey_work:lay.ground_work]
     hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
     inelastic = _inelastic_summary(system, raw, heights)
-    peaks = run_peaks(model, system, raw)
+    peaks = run_peaks(model, assembly, raw)
     # Summed over contacts and links by the solver at each output time; the links' share is taken out.
     contact_strain = raw.contact_potential - links["stored"].sum(axis=1)
     contact_work = work[:, :ng].sum(axis=1)
@@ -726,3 +739,398 @@ def run_spec(model: Model, record: Record, end_time: float, ground: dict | None 
             {"building": b.name, "record": str(ground["source"][i]), "scale": float(ground["scale"][i]),
              "record_sha256": ground["sha256"][i]} for i, b in enumerate(model.buildings)],
     }
+
+
+# --------------------------------------------------------------------------- #
+# Floors in plan: directions and rotations, corners, plane rows, contact points, faces
+# --------------------------------------------------------------------------- #
+
+
+def _plan_floor_labels(model: Model) -> dict[str, Any]:
+    buildings = [b.name for b in model.buildings for _ in range(b.n_floors)]
+    levels = [i + 1 for b in model.buildings for i in range(b.n_floors)]
+    centres = np.array([c for b in model.buildings for c in b.centres], dtype=float).reshape(-1, 2)
+    corners = floor_corners(model)
+    return {"floor_building": (("floor",), np.array(buildings, dtype=object), {"long_name": "building of the floor"}),
+            "floor_level": (("floor",), np.array(levels, dtype=np.int64),
+                            {"units": "1", "long_name": "floor number from the ground up"}),
+            "floor_centre_x": (("floor",), centres[:, 0], {"units": "m", "long_name": "x of the floor's centre of mass"}),
+            "floor_centre_y": (("floor",), centres[:, 1], {"units": "m", "long_name": "y of the floor's centre of mass"}),
+            "corner": (("corner",), np.array(CORNERS, dtype=object), {"long_name": "corner of the floor's outline"}),
+            "corner_x": (("floor", "corner"), corners[:, :, 0], {"units": "m", "long_name": "x of the corner at rest"}),
+            "corner_y": (("floor", "corner"), corners[:, :, 1], {"units": "m", "long_name": "y of the corner at rest"})}
+
+
+def _plane_labels(model: Model) -> dict[str, Any]:
+    rows = [(b.name, storey, b.storeys[storey - 1].planes[j])
+            for b in model.buildings for storey, j, _ in b.plane_weights()]
+    return {"plane_building": (("plane",), np.array([r[0] for r in rows], dtype=object),
+                               {"long_name": "building of the plane"}),
+            "plane_storey": (("plane",), np.array([r[1] for r in rows], dtype=np.int64),
+                             {"units": "1", "long_name": "storey of the plane"}),
+            "plane_direction": (("plane",), np.array([r[2].direction for r in rows], dtype=object),
+                                {"long_name": "direction the plane resists"}),
+            "plane_at": (("plane",), np.array([r[2].at for r in rows], dtype=float),
+                         {"units": "m", "long_name": "the plane's line (y along x, x along y)"})}
+
+
+def _point_labels(model: Model) -> dict[str, Any]:
+    names = [b.name for b in model.buildings]
+    faces = [model.faces[g.face] for g in model.gaps]
+    between = [f.label(names) for f in faces]
+    point_face = np.array([g.face for g in model.gaps], dtype=np.int64)
+    location = np.array([g.point for g in model.gaps], dtype=float).reshape(len(model.gaps), 2)
+    return {"point_between": (("point",), np.array(between, dtype=object),
+                              {"long_name": "the two floors of the contact point (building:floor)"}),
+            "point_face": (("point",), point_face, {"units": "1", "long_name": "index of the point's face"}),
+            "point_normal": (("point",), np.array([c.face.normal for c in faces], dtype=object),
+                             {"long_name": "normal direction of the point's face"}),
+            "point_x": (("point",), location[:, 0], {"units": "m", "long_name": "x of the point at rest"}),
+            "point_y": (("point",), location[:, 1], {"units": "m", "long_name": "y of the point at rest"})}
+
+
+def _impact_slip(model: Model, assembly: Assembly, raw: RawSolution) -> np.ndarray:
+    """(impacts,) the face's tangential slip (low side minus high side along +tangent, m) at each impact's onset.
+
+    The state at the onset is the cubic Hermite interpolant of the stored samples
+    (displacements with their velocities; :func:`hermite_at`).
+    """
+    n = assembly.system.n_floors
+    if raw.impact_contact.size == 0:
+        return np.zeros(0)
+    slip = np.array([model.scatter(c, p.slip) for c in model.faces for p in c.points]).reshape(-1, n)
+    q = hermite_at(raw.time, raw.state[:, :n], raw.state[:, n:2 * n], raw.impact_time)
+    return np.einsum("ij,ij->i", q, slip[raw.impact_contact])
+
+
+def _plane_energies(assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> dict[str, np.ndarray]:
+    """Energy histories (J): input, kinetic, damping, plane strain, P-Delta, contacts; initial energy first.
+
+    The planes' strain energy is ``Σ ½ k Δ²`` of the elastic ones at the stored states (*drift*: (nt, plane),
+    m) plus the yielding ones' recoverable energy, the P-Delta potential ``Σ ½ k_G (a · q)²``.
+    """
+    system = assembly.system
+    lay = system.layout
+    n, npt = lay.n_floors, assembly.n_points
+    state = raw.state
+    v = state[:, n:2 * n]
+    work = state[:, lay.work:lay.work + lay.n_contacts]
+    elastic = np.ones(assembly.plane_stiffness.size, dtype=bool)
+    elastic[_yielding_planes(assembly)] = False  # a yielding plane's energy: recoverable here, the rest dissipated
+    strain = 0.5 * (drift[:, elastic] ** 2) @ assembly.plane_stiffness[elastic]
+    geometric = 0.5 * ((state[:, :n] @ assembly.p_delta_weights.T) ** 2) @ assembly.p_delta_stiffness
+    hysteretic = state[:, lay.storey_work:lay.ground_work].sum(axis=1) - raw.storey_energy[:, 1]
+    return {"energy_input": state[:, lay.input_energy],
+            "energy_kinetic": 0.5 * (v * v) @ system.mass,
+            "energy_damping": state[:, lay.damping_energy],
+            "energy_plane_strain": strain + raw.storey_energy[:, 1],
+            "energy_p_delta": geometric,
+            "energy_contact": work[:, :npt].sum(axis=1),
+            "energy_hysteretic": hysteretic}
+
+
+def _friction_variables(assembly: Assembly, raw: RawSolution) -> dict[str, tuple]:
+    """The friction faces' histories (module docstring), {} without friction."""
+    system = assembly.system
+    if raw.friction_history is None:
+        return {}
+    nf, lay = system.n_faces, system.layout
+    history = raw.friction_history
+    slip = penetration(raw.state[:, :system.n_floors], system.friction_floors, system.friction_weights,
+                       np.zeros(nf), np.zeros((raw.time.size, nf)))
+    dissipated = raw.state[:, lay.friction_work:lay.friction_work + nf].sum(axis=1)
+    return {"friction_normal": _var(("time", "face"), history[:, :nf], "N", "normal force on the friction face"),
+            "friction_force": _var(("time", "face"), -history[:, nf:2 * nf], "N",
+                                   "friction on the face's low side along +tangent (the high side: the opposite)"),
+            "friction_state": _var(("time", "face"), history[:, 2 * nf:].astype(np.int64), "1",
+                                   "face: 0 open, +1/-1 slipping along +/-tangent, 2 sticking"),
+            "face_slip": _var(("time", "face"), slip, "m",
+                              "tangential slip of the low side's face relative to the high side's, along +tangent"),
+            "energy_friction": _var(("time",), dissipated, "J", "energy: friction (dissipated)")}
+
+
+def _face_labels(model: Model, assembly: Assembly) -> dict[str, Any]:
+    """Coordinates of the friction faces (``face`` dimension), {} without friction."""
+    if assembly.system.n_faces == 0:
+        return {}
+    names = [b.name for b in model.buildings]
+    faces = [(i, c) for i, c in enumerate(model.faces) if c.friction]
+    between = [c.label(names) for _, c in faces]
+    return {"face_index": (("face",), np.array([i for i, _ in faces], dtype=np.int64),
+                           {"units": "1", "long_name": "index of the face (as point_face)"}),
+            "face_between": (("face",), np.array(between, dtype=object), {"long_name": "the two floors of the face"}),
+            "face_tangent": (("face",), np.array([c.face.tangent for _, c in faces], dtype=object),
+                             {"long_name": "tangential direction of the face"}),
+            "face_friction_coefficient": (("face",), np.array([float(c.friction) for _, c in faces]),
+                                          {"units": "1", "long_name": "Coulomb friction coefficient"})}
+
+
+def _yielding_planes(assembly: Assembly) -> np.ndarray:
+    """Indices of the yielding planes, in the order of their hysteretic states (none without storey rows)."""
+    system = assembly.system
+    if system.storey_floors is None:
+        return np.zeros(0, dtype=np.int64)
+    planes = np.flatnonzero(system.storey_state >= 0)
+    return planes[np.argsort(system.storey_state[planes])]
+
+
+def _plane_shear(assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> np.ndarray:
+    """(nt, plane) shear of every plane, N: kΔ, a yielding plane's by its hysteresis at its state."""
+    system = assembly.system
+    shear = drift * assembly.plane_stiffness
+    first = system.layout.hysteretic
+    for index, p in enumerate(_yielding_planes(assembly)):
+        shear[:, p] = restoring_force.py_func(int(system.storey_model[p]), system.storey_parameters, int(p),
+                                              float(assembly.plane_stiffness[p]), drift[:, p], raw.state[:, first + index])
+    return shear
+
+
+def plan_energy_closure(ds: xr.Dataset) -> float:
+    """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of a plan archive (dimensionless)."""
+    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
+             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0))
+    initial = float(parts[0])
+    supplied = initial + ds.energy_input
+    scale = float(np.abs(supplied).max())
+    return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
+
+
+def plane_energy_closure(ds: xr.Dataset) -> float:
+    """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of an archive with plane rows (dimensionless)."""
+    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
+             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0))
+    initial = float(parts[0])
+    supplied = initial + ds.energy_input
+    scale = float(np.abs(supplied).max())
+    return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
+
+
+def _plane_rows(model: Model) -> list[tuple[str, int, Any, float]]:
+    """``(building, storey, plane, storey height m)`` of every plane row, in the solver's order."""
+    return [(b.name, storey, plane, b.storeys[storey - 1].height) for b in model.buildings
+            for storey, _, plane in b.planes()]
+
+
+def plane_labels(model: Model) -> list[str]:
+    """Each plane's label ``A:1:x@10`` (building, storey, direction and line)."""
+    return [f"{b}:{s}:{p.direction}@{float(p.at):g}" for b, s, p, _ in _plane_rows(model)]
+
+
+def _storey_peaks(model: Model, peak_ratio: np.ndarray) -> dict[str, np.ndarray]:
+    """Per storey (building:level) the largest peak |drift ratio| of its planes, and the storey's labels."""
+    rows = _plane_rows(model)
+    storeys = list(dict.fromkeys((b, s) for b, s, _, _ in rows))
+    peak = np.zeros(len(storeys))
+    for (b, s, _, _), value in zip(rows, peak_ratio):
+        k = storeys.index((b, s))
+        peak[k] = max(peak[k], float(value))
+    height = {(b, s): h for b, s, _, h in rows}
+    return {"storey": np.array([f"{b}:{s}" for b, s in storeys], dtype=object),
+            "building": np.array([b for b, _ in storeys], dtype=object),
+            "level": np.array([s for _, s in storeys], dtype=np.int32),
+            "height": np.array([height[k] for k in storeys], dtype=float), "peak": peak}
+
+
+def plane_status(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, Any]:
+    """A run's ``status`` and, if a plane ended it, ``status_message``, ``collapse_time`` (s),
+    ``collapse_building``, ``collapse_storey`` (``building:storey``), ``collapse_plane`` (its index in the
+    archive's ``plane`` dimension) and ``collapse_cause`` (``drift_ratio`` or ``zero_strength``)."""
+    if raw.status == STATUS_OK or raw.collapse_storey < 0:
+        return {"status": "completed", "status_message": "", "collapse_time": float("nan"), "collapse_storey": "",
+                "collapse_building": "", "collapse_cause": ""}
+    p = int(raw.collapse_storey)
+    building, storey, plane, _ = _plane_rows(model)[p]
+    where = f"plane {p} ({plane.direction} at {plane.at:g} m)"
+    cause = (f"{where} reached its ultimate drift (IMK plane at zero strength)" if raw.collapse_cause == "zero_strength"
+             else f"{where} passed its collapse drift ratio {assembly.system.storey_stop_ratio[p]:g}")
+    message = STATUS_MESSAGES[raw.status].format(t=raw.final_time, building=building, storey=f"{building}:{storey}",
+                                                 cause=cause, dissipated=0.0, available=0.0)
+    return {"status": STATUS_NAMES[raw.status], "status_message": message, "collapse_time": float(raw.final_time),
+            "collapse_building": building, "collapse_storey": f"{building}:{storey}", "collapse_plane": p,
+            "collapse_cause": raw.collapse_cause}
+
+
+def plane_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, Any]:
+    """The peaks of a run with plane rows as plain arrays (what studies keep of a run; :func:`run_peaks`).
+
+    ``storey`` / ``storey_building`` / ``peak_drift_ratio``: per storey the largest peak |drift ratio| of its
+    planes; ``plane`` / ``peak_plane_drift_ratio``: per plane; ``contact`` (each point ``A:1-B:1@(24,10)``),
+    ``impact_count`` and ``peak_contact_force`` (N); the status and collapse as :func:`run_peaks`.
+    """
+    heights = np.array([h for *_, h in _plane_rows(model)], dtype=float)
+    ratio = raw.peak_plane_drift / heights if heights.size else np.zeros(0)
+    storeys = _storey_peaks(model, ratio)
+    npt = assembly.n_points
+    names = [b.name for b in model.buildings]
+    status = plane_status(model, assembly, raw)
+    return {
+        "storey": [str(x) for x in storeys["storey"]],
+        "storey_building": [str(x) for x in storeys["building"]],
+        "plane": plane_labels(model),
+        "contact": [f"{model.faces[g.face].label(names)}@({g.point[0]:g},{g.point[1]:g})" for g in model.gaps],
+        "peak_drift_ratio": storeys["peak"],
+        "peak_plane_drift_ratio": ratio,
+        "residual_drift_ratio": np.full(storeys["peak"].size, np.nan),
+        "impact_count": (np.bincount(raw.impact_contact, minlength=npt)[:npt].astype(np.int32) if npt
+                         else np.zeros(0, np.int32)),
+        "peak_contact_force": raw.peak_contact_force[:npt],
+        **{k: status[k] for k in ("status", "status_message", "collapse_time", "collapse_storey",
+                                  "collapse_building", "collapse_cause")},
+    }
+
+
+def _ground_xy(supports, raw: RawSolution) -> np.ndarray | None:
+    """(nt, 2) the first building's ground acceleration along x and y at the output times, m/s²."""
+    if supports is None or not supports.building_row_y:
+        return None
+    acceleration, _, _ = kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)
+    return acceleration[:, [supports.building_row[0], supports.building_row_y[0]]]
+
+
+def _plane_variables(model: Model, assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> dict[str, tuple]:
+    """The plane rows' histories and peaks: drift (m and ratio), shear, stiffness; per storey its largest ratio."""
+    heights = np.array([h for *_, h in _plane_rows(model)], dtype=float)
+    ratio = raw.peak_plane_drift / heights if heights.size else np.zeros(0)
+    storeys = _storey_peaks(model, ratio)
+    return {
+        "plane_drift": _var(("time", "plane"), drift, "m", "drift of the plane's line"),
+        "plane_drift_ratio": _var(("time", "plane"), drift / heights, "1", "drift ratio of the plane (drift / storey "
+                                                                            "height)"),
+        "peak_plane_drift": _var(("plane",), raw.peak_plane_drift, "m", "peak |drift| of the plane (full resolution)"),
+        "peak_plane_drift_ratio": _var(("plane",), ratio, "1", "peak |drift ratio| of the plane (full resolution)"),
+        "plane_stiffness": _var(("plane",), assembly.plane_stiffness, "N/m", "elastic stiffness of the plane"),
+        "plane_shear": _var(("time", "plane"), _plane_shear(assembly, raw, drift), "N",
+                            "shear of the plane (restoring force, without P-Delta)"),
+        "peak_drift_ratio": _var(("storey",), storeys["peak"], "1",
+                                 "peak |drift ratio| of the storey: the largest of its planes' (full resolution)"),
+    }
+
+
+def _plane_coords(model: Model) -> dict[str, tuple]:
+    """Coordinates of the plane rows (with their labels and heights) and of the storeys they make up."""
+    rows = _plane_rows(model)
+    storeys = _storey_peaks(model, np.zeros(len(rows)))
+    return {"plane": ("plane", np.array(plane_labels(model), dtype=object),
+                      {"long_name": "plane label building:storey:direction@line"}),
+            "plane_height": ("plane", np.array([h for *_, h in rows], dtype=float),
+                             {"units": "m", "long_name": "height of the plane's storey"}),
+            "storey": ("storey", storeys["storey"], {"long_name": "storey label building:level"}),
+            "storey_building": ("storey", storeys["building"], {"long_name": "building of the storey"}),
+            "storey_level": ("storey", storeys["level"], {"units": "1", "long_name": "storey number above ground"}),
+            "height": ("storey", storeys["height"], {"units": "m", "long_name": "storey height"})}
+
+
+def _floor_coords(model: Model) -> dict[str, tuple]:
+    """Each floor's label ``A:1`` and elevation (besides its building, 1-based level and centre of mass)."""
+    return {"floor": ("floor", np.array([f"{b.name}:{i + 1}" for b in model.buildings for i in range(b.n_floors)],
+                                        dtype=object), {"long_name": "floor label building:level"}),
+            "elevation": ("floor", np.array([e for b in model.buildings for e in b.elevation], dtype=float),
+                          {"units": "m", "long_name": "floor elevation above ground"})}
+
+
+def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *, end_time: float,
+                    wall_time: float, status: dict[str, Any]) -> dict[str, Any]:
+    """A run's attributes with floors in plan: the model, the record pair and its factor, the solver, the status."""
+    from pounding import __version__
+
+    now = datetime.now(timezone.utc)
+    components = [] if supports is None else [r for pair in zip(supports.records, supports.records_y) for r in pair]
+    meta = record.metadata
+    spec = {"model": model.to_document(), "base_dir": model.ground_motion.base_dir, "scale": float(meta.get(
+        "scale_factor", record.scale)), "duration": float(end_time),
+            "component_sha256": [None if r is None else str(r.metadata.get("sha256", "")) for r in components[:2]]}
+    attrs = {"Conventions": "CF-1.10", "title": f"pounding plan run: {model.name}", "model": model.name,
+             "kind": "plan_run", "source": f"pounding {__version__}", "references": REFERENCES,
+             "history": f"{now.strftime('%Y-%m-%dT%H:%M:%SZ')} simulated with pounding {__version__}",
+             "created": now.isoformat(), "model_name": model.name, "model_path": str(model.path or ""),
+             "model_yaml": model.source, "run_spec": json.dumps(spec),
+             "record_name": str(model.ground_motion.record or record.name), "record_source": record.source,
+             "record_scale": float(meta.get("scale_factor", record.scale)),
+             "record_scale_method": str(meta.get("scale_method", "factor")),
+             "record_scale_description": str(meta.get("scale_description", f"factor {record.scale:g}")),
+             "record_metadata": json.dumps(meta, default=str), "record_step": float(record.time_step),
+             "angle": float(supports.angle if supports is not None and supports.angle is not None else 0.0),
+             "end_time": float(end_time), "duration": float(end_time), "wall_time": float(wall_time),
+             "solver_rtol": float(model.solver.rtol), "solver_atol": float(model.solver.atol),
+             "solver_output_dt": float(model.solver.output_dt), "solver_steps": int(raw.n_steps),
+             "solver_rejected_steps": int(raw.n_rejected),
+             "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings})}
+    attrs.update({k: v for k, v in status.items() if v != "" and not (isinstance(v, float) and np.isnan(v))})
+    if model.contacts_held_open:
+        attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
+                             "(the run without pounding)")
+    return attrs
+
+
+def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *, end_time: float,
+                  wall_time: float, supports=None) -> xr.Dataset:
+    """The archive of a run with plane rows (floors in plan): floors per direction with their rotation and
+    corners, planes (drift, drift ratio, shear), each storey's largest plane drift ratio, contact points,
+    friction faces, impacts and the energy audit."""
+    system = assembly.system
+    n = system.n_floors
+    nf = n // DOF_PER_FLOOR
+    npt = assembly.n_points
+    u = raw.state[:, :n].reshape(-1, nf, DOF_PER_FLOOR)
+    v = raw.state[:, n:2 * n].reshape(-1, nf, DOF_PER_FLOOR)
+    delta = combined_penetration(raw.state[:, :n], system.contact_floors, system.contact_weights, system.contact_gap,
+                                 np.zeros((raw.time.size, system.n_contacts)))
+    drift = raw.state[:, :n] @ assembly.plane_weights.T
+    peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
+    counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
+    corner = corner_displacements(model, u)
+    magnitude = np.hypot(corner[..., 0], corner[..., 1])
+    points = np.array([g.point for g in model.gaps], dtype=float).reshape(npt, 2)
+    location = points[raw.impact_contact] if raw.impact_contact.size else np.zeros((0, 2))
+    data = {
+        "displacement": _var(("time", "floor", "direction"), u[:, :, :2], "m",
+                             "displacement of the floor's centre of mass relative to the ground"),
+        "rotation": _var(("time", "floor"), u[:, :, 2], "rad", "rotation of the floor, counter-clockwise"),
+        "velocity": _var(("time", "floor", "direction"), v[:, :, :2], "m/s",
+                         "velocity of the floor's centre of mass relative to the ground"),
+        "rotation_rate": _var(("time", "floor"), v[:, :, 2], "rad/s", "rotation rate of the floor"),
+        "peak_displacement": _var(("floor", "direction"), peak_u[:, :2], "m",
+                                  "peak |displacement| of the centre of mass (full resolution)"),
+        "peak_rotation": _var(("floor",), peak_u[:, 2], "rad", "peak |rotation| of the floor (full resolution)"),
+        "corner_displacement": _var(("time", "floor", "corner", "direction"), corner, "m",
+                                    "displacement of the outline's corner (small rotations)"),
+        "corner_displacement_magnitude": _var(("time", "floor", "corner"), magnitude, "m",
+                                              "magnitude of the corner's displacement"),
+        "peak_corner_displacement": _var(("floor", "corner", "direction"), np.abs(corner).max(axis=0, initial=0.0),
+                                         "m", "peak |displacement| of the corner (stored samples)"),
+        "peak_corner_displacement_magnitude": _var(("floor", "corner"), magnitude.max(axis=0, initial=0.0), "m",
+                                                   "peak magnitude of the corner's displacement (stored samples)"),
+        **_plane_variables(model, assembly, raw, drift),
+        "contact_force": _var(("time", "point"), raw.contact_force[:, :npt], "N",
+                              "normal contact force at the point (compression positive)"),
+        "penetration": _var(("time", "point"), delta[:, :npt], "m", "penetration at the point (overlap positive)"),
+        "peak_contact_force": _var(("point",), raw.peak_contact_force[:npt], "N",
+                                   "peak normal contact force at the point (full resolution)"),
+        "impact_count": _var(("point",), counts, "1", "number of impacts at the point"),
+        "impact_point": _var(("impact",), raw.impact_contact, "1", "contact point of the impact"),
+        "impact_time": _var(("impact",), raw.impact_time, "s", "time of contact onset"),
+        "impact_x": _var(("impact",), location[:, 0], "m", "x of the impact's contact point at rest"),
+        "impact_y": _var(("impact",), location[:, 1], "m", "y of the impact's contact point at rest"),
+        "impact_slip": _var(("impact",), _impact_slip(model, assembly, raw), "m",
+                            "tangential slip of the face at the onset (low side minus high side, along +tangent)"),
+        "impact_velocity": _var(("impact",), raw.impact_velocity, "m/s", "approach velocity at the point at onset"),
+        "impact_peak_force": _var(("impact",), raw.impact_peak_force, "N", "peak force of the impact"),
+        "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
+    }
+    data.update(_friction_variables(assembly, raw))
+    for name, values in _plane_energies(assembly, raw, drift).items():
+        label = name.removeprefix("energy_").replace("_", " ")
+        data[name] = _var(("time",), values, "J", f"energy: {label}")
+    ground = _ground_xy(supports, raw)
+    if ground is not None:
+        data["ground_acceleration"] = _var(("time", "direction"), ground, "m/s²", "ground acceleration along x and y")
+    coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
+              "direction": ("direction", np.array(["x", "y"], dtype=object), {"long_name": "plan direction"}),
+              **_floor_coords(model), **_plan_floor_labels(model), **_plane_labels(model), **_plane_coords(model),
+              **_point_labels(model), **_face_labels(model, assembly)}
+    status = plane_status(model, assembly, raw)
+    ds = xr.Dataset(data, coords=coords, attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time,
+                                                               wall_time=wall_time, status=status))
+    ds.attrs["energy_closure"] = plane_energy_closure(ds)
+    ds.attrs["energy_closure_error"] = ds.attrs["energy_closure"]
+    return ds

@@ -59,7 +59,7 @@ BUILDING_PEAKS = {
 def oriented_document(document: dict, pair: str, orientation: str) -> dict:
     """A copy of a plan model *document* shaken by *pair* in *orientation*: components ``x`` (along the model's
     ``angle``) and ``y`` (90° further), each at scale 1 (the IDA writes its factor into both)."""
-    from pounding.model.ground_pair import pair_components
+    from pounding.model.ground import pair_components
 
     out = copy.deepcopy(document)
     ground = out.setdefault("ground_motion", {})
@@ -93,7 +93,7 @@ def build_pair_ida_plan(model: str | os.PathLike, records: str | list[str] | Non
     Parameters are those of :func:`pounding.studies.ida.plan.build_ida_plan`; *records* are record pairs
     (default: the model's own pair).  Drift limits and the collapse drift ratio apply to the planes' drift ratios.
     """
-    from pounding.model.plan_model import load_plan_model
+    from pounding.model.model import load_model as load_plan_model
     from pounding.studies.plan.compare import pair_values, study_document
     from pounding.studies.plan.sweep import build_plan_document, plan_study_sweep
 
@@ -103,7 +103,7 @@ def build_pair_ida_plan(model: str | os.PathLike, records: str | list[str] | Non
     base = load_plan_model(model)   # the model's own errors, with its file name
     label = os.fspath(model)
     measure = ida_measure(base, im, building, pair=True)
-    if without_contacts and not base.contacts:
+    if without_contacts and not base.faces:
         raise PoundingError(f"{label}: --without-contacts needs a model with contacts")
     pairs = pair_values(records) if records is not None else [_model_pair(base, label)]
     settings = {"scale": 1.0, **({} if duration is None else {"ground_motion.duration": float(duration)})}
@@ -156,8 +156,8 @@ def _building_peaks(peaks: dict[str, Any], buildings: list[str]) -> dict[str, li
 def run_pair_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     """One run of a plan model's IDA on a worker: :func:`~pounding.simulation.simulate_plan` and its peaks in the
     planar IDA part's layout (module docstring).  Never raises for a problem of the scenario (status ``error``)."""
-    from pounding.model.plan_model import plan_model_from_text
-    from pounding.simulation import simulate_plan
+    from pounding.model.model import model_from_text as plan_model_from_text
+    from pounding.simulation import simulate as simulate_plan
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
     from pounding.studies.plan.runs import plan_peaks
@@ -191,7 +191,8 @@ def run_pair_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
                 "peak_contact_force": [float(x) for x in peaks["peak_contact_force"]],
             },
             "building_peaks": _building_peaks(peaks, [b.name for b in model.buildings]),
-            "scale_factor": float(model.ground_motion.components[0].scale),
+            "scale_factor": float(model.ground_motion.scale if model.ground_motion.record is not None
+                                  else model.ground_motion.components()[0].scale),
             "solver_wall_time": peaks["solver_wall_time"],
         })
     except Exception as exc:  # noqa: BLE001 - a failing run is a result, not a crash

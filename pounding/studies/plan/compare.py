@@ -83,12 +83,12 @@ def build_plan_compare(model: str | os.PathLike, formulas: str | list[str] | Non
                        records: str | list[str] | None = None, *, duration: float | None = None,
                        reference: str = "exact", contacts: str | list[str] | None = None, scale: Any = None):
     """The plan sweep behind ``pounding compare`` on a plan model: formulas (or with, without) × record pairs."""
-    from pounding.model.plan_model import load_plan_model
+    from pounding.model.model import load_model as load_plan_model
     from pounding.studies.compare import compared_axis
     from pounding.studies.plan.sweep import plan_study_sweep
 
     base = load_plan_model(model)             # the model's own errors, with its file name
-    axes = compared_axis(model, [c.law for c in base.contacts], formulas, contacts, reference)
+    axes = compared_axis(model, [c.law for c in base.faces], formulas, contacts, reference)
     document = study_document(model, "compare", axes, pair_values(records), duration, scale)
     return plan_study_sweep(document, f"<compare {os.fspath(model)}>")
 

@@ -106,8 +106,8 @@ def run_plan_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     """One record pair of a plan gap study, on a worker: the contact-free run and each point's separations."""
     import yaml
 
-    from pounding.model.plan_model import plan_model_from_text
-    from pounding.simulation import simulate_plan
+    from pounding.model.model import model_from_text as plan_model_from_text
+    from pounding.simulation import simulate as simulate_plan
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
     from pounding.studies.plan.sweep import build_plan_document
@@ -246,13 +246,13 @@ def plan_gap_study(model: str | os.PathLike, records: str | list[str] | None = N
     run_options
         Passed to :func:`pounding.studies.sweep.execution.run_sweep`.
     """
-    from pounding.model.plan_model import load_plan_model
+    from pounding.model.model import load_model as load_plan_model
     from pounding.studies.plan.compare import pair_values, study_document
     from pounding.studies.plan.sweep import plan_study_sweep
     from pounding.studies.sweep.execution import plan_line, run_sweep
 
     base = load_plan_model(model)
-    if not base.contacts:
+    if not base.faces:
         raise PoundingError(f"{os.fspath(model)}: the model has no contacts; list the faces to check in 'contacts' "
                             "(their gaps come from the outlines)")
     document = study_document(model, "gap", {}, pair_values(records), duration, scale,

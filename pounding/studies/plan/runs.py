@@ -106,8 +106,8 @@ def run_plan_scenario(task: dict[str, Any]) -> dict[str, Any]:
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT,
                               "study": PLAN_PART}
     try:
-        from pounding.model.plan_model import plan_model_from_text
-        from pounding.simulation import simulate_plan
+        from pounding.model.model import model_from_text as plan_model_from_text
+        from pounding.simulation import simulate as simulate_plan
 
         try:
             model = plan_model_from_text(task["document"], name=task.get("name", "model"),

@@ -37,7 +37,7 @@ import yaml
 from pounding.errors import ModelError, PoundingError
 from pounding.model import schema
 from pounding.model.document import Document, dump_document
-from pounding.model.ground_pair import pair_components
+from pounding.model.ground import pair_components
 from pounding.studies.sweep.spec import (FEMA_SETS, POUNDING_VALUES, RESERVED_NAMES, AxisEntry, Dimension, PathError,
                                          Sweep, SweepTop, apply_axis_value, apply_path, check_overlapping_axes,
                                          parse_path, set_scale, set_xi, strip_location)
@@ -91,7 +91,7 @@ def plan_document(model) -> dict:
 
 def build_plan_document(document: dict, name: str = "model", base_dir: str | None = None):
     """The :class:`~pounding.model.plan_model.PlanModel` of a plain document (one located line per problem)."""
-    from pounding.model.plan_model import plan_model_from_text
+    from pounding.model.model import model_from_text as plan_model_from_text
 
     return plan_model_from_text(dump_document(document), name=name, base_dir=base_dir)
 
@@ -292,7 +292,7 @@ def _label(value: Any) -> Any:
 
 def plan_sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None = None) -> PlanSweep:
     """Validate a plan sweep's YAML *text*; relative paths are resolved against *base_dir*."""
-    from pounding.model.plan_model import load_plan_model
+    from pounding.model.model import load_model as load_plan_model
 
     doc = Document(text, label)
     if not isinstance(doc.data, dict):

@@ -25,9 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pounding.model.plan import Outline, point_weights
+from pounding.model.floors import Outline, point_weights
 
-__all__ = ["Face", "ContactPoint", "WALL_FACES", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face",
+__all__ = ["Face", "ContactPoint", "WALL_FACES", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face", "wall_side",
            "penetration_weights", "slip_weights"]
 
 #: A wall's face of a building: (normal direction, True if the building is on the low side).
@@ -141,6 +141,11 @@ def wall_face(outline: Outline, side: str, gap: float) -> Face:
     edge = low_edge if building_low else high_edge
     face_low, face_high = (edge, edge + gap) if building_low else (edge - gap, edge)
     return Face(normal, building_low, float(gap), face_low, face_high, span)
+
+
+def wall_side(face: Face) -> str:
+    """The side of the building (``east``, ``west``, ``north``, ``south``) that a wall's *face* stands beside."""
+    return next(side for side, (normal, low) in WALL_FACES.items() if normal == face.normal and low == face.first_low)
 
 
 def _on_tangent(face: Face, s: float, normal_coordinate: float) -> tuple[float, float]:
