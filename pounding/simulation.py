@@ -40,7 +40,7 @@ from pounding.solver.assembly import GroundRows, assemble, contact_side_terms, r
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, STATUS_UNSTABLE, integrate
 
 __all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
-           "processed_record_for", "component_records", "support_motions", "SupportMotions", "rerun", "record_path",
+           "processed_record_for", "component_records", "ground_on_grid", "support_motions", "SupportMotions", "rerun", "record_path",
            "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION", "estimate_memory", "available_memory", "check_memory",
            "model_inputs", "FAILED_STATUSES", "refuse_failed_run", "ground_rows"]
 
@@ -218,6 +218,15 @@ def component_records(model: Model, *, building: int | str | None = None, where:
     pair = pair_scale_factor(present, spec.scale, period=period) if factor is None else float(factor)
     return tuple(None if r is None else scale_record(r, spec.scale, period=period, factor=pair)
                  for r in loaded)  # type: ignore[return-value]
+
+
+def ground_on_grid(model: Model, time: np.ndarray, building: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """The global ground accelerations ``(a_gx, a_gy)`` (m/s²) under *building* at *time* (s), of a model with
+    two components: its records read and scaled (:func:`component_records`), rotated by the angle."""
+    zero = (np.zeros(2), 1.0)
+    a, b = component_records(model, building=building)
+    first, second = ((zero if r is None else (r.acceleration, r.time_step)) for r in (a, b))
+    return ground_components(np.asarray(time, dtype=float), first, second, model.ground_motion_of(building).angle)
 
 
 def _two_component_supports(model: Model, where: str) -> SupportMotions:

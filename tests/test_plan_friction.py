@@ -23,7 +23,7 @@ from scipy.integrate import solve_ivp
 
 from pounding.errors import PoundingError
 from pounding.model.model import model_from_text
-from pounding.simulation import simulate
+from pounding.simulation import ground_on_grid, simulate
 from pounding.solver.integrator import integrate
 from pounding.solver.kinematics import penetration
 from pounding.solver.assembly import assemble, refusal as plan_refusal, tolerance_factors, xy_ground
@@ -314,7 +314,7 @@ class _Reference:
 
     def run(self, duration: float, step: float = 0.01):
         time = np.arange(int(round(duration / step)) + 1) * step
-        grid = (time, *self.model.ground_motion.on_grid(time))
+        grid = (time, *ground_on_grid(self.model, time))
         n = self.n
         y = np.zeros(2 * n + self.k.size)
         states = [y[:n].copy()]

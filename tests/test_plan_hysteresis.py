@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pounding.model.model import model_from_text
-from pounding.simulation import simulate
+from pounding.simulation import ground_on_grid, simulate
 
 from plan_cases import SOLVER, bilinear as _bilinear, plan_pair as _plan_pair, two_tone_record as _record
 
@@ -48,7 +48,7 @@ def _reference(model, duration: float) -> tuple[np.ndarray, np.ndarray]:
     alpha = np.array([p.hysteresis.post_yield_ratio if p.hysteresis else 1.0 for _, p, _ in planes])
     step = 0.01
     time = np.arange(int(round(duration / step)) + 1) * step
-    ax, ay = model.ground_motion.on_grid(time)
+    ax, ay = ground_on_grid(model, time)
     mode = np.zeros(len(planes), dtype=int)
     nq = m.shape[0]
 

@@ -32,7 +32,7 @@ from pounding.errors import ArchiveError
 
 __all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing", "atomic_path", "check_not_input", "check_regular_file",
            "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
-           "REQUIRED_VARIABLES",
+           "REQUIRED_VARIABLES", "REQUIRED_PLANE_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
 
 #: Seconds an interrupted archive write may still take before the process exits regardless.
@@ -530,6 +530,10 @@ REQUIRED_VARIABLES = ("displacement", "contact_force", "ground_acceleration", "p
                       "impact_contact", "impact_time", "trace_contact", "trace_force", "trace_penetration",
                       "trace_time", "storey_building", "storey_level", "contact", "law", "xi_formula",
                       "building_left", "building_right", "level_left", "level_right", "gap", "time")
+#: Variables every run archive of planes as weighted rows (floors in plan) has instead.
+REQUIRED_PLANE_VARIABLES = ("displacement", "rotation", "contact_force", "peak_drift_ratio", "peak_plane_drift",
+                            "peak_displacement", "peak_contact_force", "impact_count", "impact_point", "impact_time",
+                            "plane_building", "plane_storey", "point_between", "floor_building", "floor_level", "time")
 #: Attributes, with the type they must have.
 REQUIRED_ATTRIBUTES = {"title": str, "history": str, "model_name": str, "record_name": str, "run_spec": str,
                        "periods": str, "record_metadata": str, "record_scale": float, "duration": float,
@@ -553,7 +557,8 @@ def check_archive(ds: xr.Dataset, source: str | os.PathLike = "archive") -> None
     """
     import json
 
-    missing = [name for name in REQUIRED_VARIABLES if name not in ds.variables]
+    required = REQUIRED_PLANE_VARIABLES if "plane" in ds.dims else REQUIRED_VARIABLES
+    missing = [name for name in required if name not in ds.variables]
     if missing:
         raise _damaged(source, f"variable{'s' if len(missing) > 1 else ''} {', '.join(missing[:5])} missing")
     for name, kind in REQUIRED_ATTRIBUTES.items():

@@ -836,7 +836,7 @@ def _friction_variables(assembly: Assembly, raw: RawSolution) -> dict[str, tuple
         return {}
     nf, lay = system.n_faces, system.layout
     history = raw.friction_history
-    slip = penetration(raw.state[:, :system.n_floors], system.friction_floors, system.friction_weights,
+    slip = combined_penetration(raw.state[:, :system.n_floors], system.friction_floors, system.friction_weights,
                        np.zeros(nf), np.zeros((raw.time.size, nf)))
     dissipated = raw.state[:, lay.friction_work:lay.friction_work + nf].sum(axis=1)
     return {"friction_normal": _var(("time", "face"), history[:, :nf], "N", "normal force on the friction face"),
@@ -1036,7 +1036,8 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
     now = datetime.now(timezone.utc)
     components = [] if supports is None else [r for pair in zip(supports.records, supports.records_y) for r in pair]
     meta = record.metadata
-    spec = {"model": model.to_document(), "base_dir": model.ground_motion.base_dir, "scale": float(meta.get(
+    spec = {"model": model.to_document(), "base_dir": model.ground_motion.base_dir,
+            "record": str(model.ground_motion.record or record.source), "scale": float(meta.get(
         "scale_factor", record.scale)), "duration": float(end_time),
             "component_sha256": [None if r is None else str(r.metadata.get("sha256", "")) for r in components[:2]]}
     attrs = {"Conventions": "CF-1.10", "title": f"pounding plan run: {model.name}", "model": model.name,

@@ -56,17 +56,13 @@ def describe_plan(ds) -> str:
     floors, outline and planes, and the contact points per face (the peaks are :func:`plan_summary`'s)."""
     import numpy as np
 
-    spec = json.loads(ds.attrs.get("plan_spec", "{}") or "{}")
-    components = [f"{axis} {c['record']} x{c['scale']:g}" for axis, c in zip(("a/x", "b/y"), spec.get("records", []))
-                  if c]
-    options = [text for text, on in ((f"--record {spec.get('record')}", spec.get("record")),
-                                     (f"--scale {spec.get('scale')}", spec.get("scale") is not None),
-                                     (f"--xi {spec.get('xi')}", spec.get("xi")),
-                                     ("--no-contacts (every contact held open)", spec.get("contacts") is False))
-               if on]
-    lines = [f"plan model '{ds.attrs.get('model', '')}' under {', '.join(components) or 'its ground motion'}, "
-             f"angle {float(ds.attrs.get('angle', 0.0)):g} deg, {float(ds.time[-1]):.2f} s"
-             + (f" ({'; '.join(options)})" if options else "")]
+    attrs = ds.attrs
+    record = attrs.get("record_name", "its ground motion")
+    intensity = scale_text(float(attrs.get("record_scale", 1.0)), str(attrs.get("record_scale_method", "factor")),
+                           str(attrs.get("record_scale_description", "")))
+    held = "; every contact held open" if str(attrs.get("contacts", "")).startswith("held open") else ""
+    lines = [f"plan model '{attrs.get('model', '')}' under {record}, {intensity}, "
+             f"angle {float(attrs.get('angle', 0.0)):g} deg, {float(ds.time[-1]):.2f} s{held}"]
     lines.append("buildings (floors, outline m, planes per direction):")
     for name in dict.fromkeys(ds.floor_building.values):
         floors = np.flatnonzero(ds.floor_building.values == name)
