@@ -87,14 +87,14 @@ def test_archive_corners_follow_the_floor_kinematics(run):
     for name, var in ds.data_vars.items():
         assert var.attrs.get("units") and var.attrs.get("long_name"), name
     # B's outline, not A's, for B's floor
-    b = int(np.flatnonzero(ds.floor_building.values == "B")[0])
+    b = int(np.flatnonzero(ds.building.values == "B")[0])
     assert list(ds.corner_x.values[b]) == [20.02, 30.0, 30.0, 20.02]
 
 
 def test_impact_table_has_the_point_location_and_the_slip(run):
     ds = run
-    assert ds.sizes["impact"] > 0 and ds.contact_force.dims == ("time", "point")
-    points = ds.impact_point.values
+    assert ds.sizes["impact"] > 0 and ds.contact_force.dims == ("time", "contact")
+    points = ds.impact_contact.values
     assert np.array_equal(ds.impact_x.values, ds.point_x.values[points])
     assert np.array_equal(ds.impact_y.values, ds.point_y.values[points])
     # a wall on A's south face: the slip is A's x-motion along its south edge (y = 0) at the onset
@@ -117,7 +117,7 @@ def test_impact_table_has_the_point_location_and_the_slip(run):
 def test_summary_names_the_peak_roof_rotation_and_the_peak_corner(run):
     text = plan_summary(run)
     ds = run
-    a = ds.floor_building.values == "A"
+    a = ds.building.values == "A"
     peaks = ds.peak_corner_displacement_magnitude.values[a]
     row, corner = np.unravel_index(np.argmax(peaks), peaks.shape)
     assert f"peak roof rotation {ds.peak_rotation.values[a][-1]:.3e} rad" in text
@@ -198,7 +198,7 @@ def test_csv_holds_the_floor_histories_of_the_archive(model_file, tmp_path, caps
     table = pd.read_csv(tmp_path / "h.csv")
     with xr.open_dataset(out) as ds:
         assert list(table.columns) == ["time [s]"] + [f"{b}:{lv} {c}" for b, lv in
-                                                       zip(ds.floor_building.values, ds.floor_level.values)
+                                                       zip(ds.building.values, ds.level.values)
                                                        for c in ("x [m]", "y [m]", "theta [rad]")]
         assert np.array_equal(table["time [s]"].values, ds.time.values)
         assert np.array_equal(table["A:2 y [m]"].values, ds.displacement.values[:, 1, 1])
@@ -243,10 +243,10 @@ def test_plan_view_is_at_the_largest_impact(run):
     force = run.contact_force.values
     assert force[sample, point] == force.max() > 0.0
     shown = shown_floors(run, point)
-    a, b = (int(np.flatnonzero(run.floor_building.values == n)[-1]) for n in ("A", "B"))
+    a, b = (int(np.flatnonzero(run.building.values == n)[-1]) for n in ("A", "B"))
     between = str(run.point_between.values[point])
     level = int(between.split(":")[1].split("-")[0])
-    assert shown["A"] == int(np.flatnonzero((run.floor_building.values == "A") & (run.floor_level.values == level))[0])
+    assert shown["A"] == int(np.flatnonzero((run.building.values == "A") & (run.level.values == level))[0])
     assert shown["B"] == b and a >= shown["A"]
 
 
@@ -261,7 +261,7 @@ def test_info_describes_a_plan_archive_with_its_peaks(archive, capsys):
     code, out, _ = _run_cli(capsys, "info", archive)
     assert code == 0 and "[plan archive]" in out
     with xr.open_dataset(archive) as ds:
-        roof = float(ds.peak_rotation.values[ds.floor_building.values == "A"][-1])
+        roof = float(ds.peak_rotation.values[ds.building.values == "A"][-1])
         assert f"peak roof rotation {roof:.3e} rad" in out
         assert f"{float(ds.peak_contact_force[0]) / 1e3:.4g} kN" in out
         assert f"impacts {int(ds.impact_count.sum())} at" in out

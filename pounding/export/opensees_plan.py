@@ -59,7 +59,7 @@ from pounding import __version__
 from pounding.errors import PoundingError
 from pounding.export.opensees import DEFAULT_DT, contact_material, inert, run_script, SCRIPT_PARTS, tension_allowed
 from pounding.model.model import WALL
-from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
+from pounding.model.floors import DOF_PER_FLOOR, geometric_terms as plan_geometric_terms
 from pounding.model.model import Model as PlanModel
 
 __all__ = ["plan_opensees_script", "plan_export_refusal", "allow_plan_tension", "plan_with_xi", "outline_corners",
@@ -71,7 +71,7 @@ CORNERS = (("SW", 0, 0), ("SE", 1, 0), ("NE", 1, 1), ("NW", 0, 1))
 
 def plan_export_refusal(model: PlanModel) -> str | None:
     """Why *model* cannot be exported to OpenSees (one line), or None."""
-    if any(c.friction for c in model.contacts):
+    if any(c.friction for c in model.faces):
         return "the OpenSees export does not write friction (Coulomb friction on a face has no exact element here)"
     for b in model.buildings:
         if b.damping.kind != "rayleigh":
@@ -84,8 +84,7 @@ def plan_export_refusal(model: PlanModel) -> str | None:
 
 
 def _with_laws(model: PlanModel, change) -> PlanModel:
-    contacts = tuple(dataclasses.replace(c, law=change(c.law)) for c in model.contacts)
-    return dataclasses.replace(model, contacts=contacts)
+    return model.with_laws(change)
 
 
 def allow_plan_tension(model: PlanModel) -> PlanModel:
@@ -100,7 +99,7 @@ def plan_with_xi(model: PlanModel, name: str) -> PlanModel:
     from pounding.contact.xi import registry as xi_formulas
 
     key = xi_formulas.get(name).key
-    if not any(isinstance(c.law, HertzDamp) for c in model.contacts):
+    if not any(isinstance(c.law, HertzDamp) for c in model.faces):
         raise PoundingError(f"model '{model.name}' has no hertz-damp contacts; the xi formula applies only to "
                             "law hertz-damp")
     return _with_laws(model, lambda law: type(law)(**{**law.model_dump(), "xi": key})
@@ -232,7 +231,7 @@ def plan_opensees_script(model: PlanModel, *, dt: float = DEFAULT_DT, xi: str | 
 
     names = [b.name for b in model.buildings]
     contacts = []
-    for c in model.contacts:
+    for c in model.faces:
         first = (c.first, c.level_first)
         second = None if c.second == WALL else (c.second, c.level_second)
         label = f"{names[c.first]}:{c.level_first}-" + ("wall" if second is None else f"{names[c.second]}:{c.level_second}")

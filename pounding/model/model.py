@@ -172,8 +172,10 @@ class GapElement:
         return f"{names[building]}:{level}" if at is None else f"{names[building]}:s{level}@{at:g}"
 
     def label(self, names: list[str]) -> str:
-        """Gap element label, e.g. ``A:3-B:3``, ``A:1-wall``, ``A:3-B:s4@0.5``."""
-        return f"{self.side_label(names, 'left')}-{self.side_label(names, 'right')}"
+        """Gap element label, e.g. ``A:3-B:3``, ``A:1-wall``, ``A:3-B:s4@0.5``; a point in plan adds its place,
+        ``A:3-B:3@(24,10)``."""
+        where = "" if self.point is None else f"@({self.point[0]:g},{self.point[1]:g})"
+        return f"{self.side_label(names, 'left')}-{self.side_label(names, 'right')}{where}"
 
     def level_document(self, side: str) -> Any:
         """The YAML of one side: a floor number, or ``{storey: s, at: x}``."""
@@ -525,6 +527,10 @@ class Model:
             return laws[id(law)]
 
         return self._with_contacts(law=renamed)
+
+    def with_laws(self, change: Any) -> Model:
+        """The same model with every contact's law replaced by ``change(law)`` (points of a face follow it)."""
+        return self._with_contacts(law=change)
 
     def _with_contacts(self, *, law: Any = None, gap: float | None = None) -> Model:
         """The same model with every contact's law changed by *law* (a function) and/or its gap set to *gap* (m).

@@ -532,8 +532,8 @@ REQUIRED_VARIABLES = ("displacement", "contact_force", "ground_acceleration", "p
                       "building_left", "building_right", "level_left", "level_right", "gap", "time")
 #: Variables every run archive of planes as weighted rows (floors in plan) has instead.
 REQUIRED_PLANE_VARIABLES = ("displacement", "rotation", "contact_force", "peak_drift_ratio", "peak_plane_drift",
-                            "peak_displacement", "peak_contact_force", "impact_count", "impact_point", "impact_time",
-                            "plane_building", "plane_storey", "point_between", "floor_building", "floor_level", "time")
+                            "peak_displacement", "peak_contact_force", "impact_count", "impact_contact", "impact_time",
+                            "plane_building", "plane_storey", "point_between", "building", "level", "contact", "time")
 #: Attributes, with the type they must have.
 REQUIRED_ATTRIBUTES = {"title": str, "history": str, "model_name": str, "record_name": str, "run_spec": str,
                        "periods": str, "record_metadata": str, "record_scale": float, "duration": float,

@@ -67,7 +67,7 @@ def corner_displacements(model, u: np.ndarray) -> np.ndarray:
 
 def peak_corner(ds, building: str) -> tuple[int, int, float]:
     """Building *building*'s largest peak corner displacement magnitude: (floor level, corner index, m)."""
-    floors = np.flatnonzero(ds.floor_building.values == building)
+    floors = np.flatnonzero(ds.building.values == building)
     peaks = ds.peak_corner_displacement_magnitude.values[floors]
     row, corner = np.unravel_index(int(np.argmax(peaks)), peaks.shape)
-    return int(ds.floor_level.values[floors[row]]), int(corner), float(peaks[row, corner])
+    return int(ds.level.values[floors[row]]), int(corner), float(peaks[row, corner])

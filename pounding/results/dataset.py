@@ -224,6 +224,32 @@ def _penetration(u: np.ndarray, system: System, ground_displacement: np.ndarray)
     return kinematics.penetration(u, system.contact_floors, system.contact_weights, system.contact_gap, differential)
 
 
+def contact_coords(model: Model) -> dict[str, tuple]:
+    """Coordinates of the ``contact`` dimension: every gap element's label, its two sides (building and floor;
+    the low side along the normal on the left), gap at rest, law, ξ formula and parameters."""
+    gaps = model.gaps
+    side_names = [b.name for b in model.buildings] + [WALL_NAME]  # index WALL (−1) is the wall
+    return {
+        "contact": ("contact", np.array([g.label(side_names[:-1]) for g in gaps], dtype=object),
+                    {"long_name": "gap element label"}),
+        "building_left": ("contact", np.array([side_names[g.left] for g in gaps], dtype=object),
+                          {"long_name": "left building of the gap element"}),
+        "building_right": ("contact", np.array([side_names[g.right] for g in gaps], dtype=object),
+                           {"long_name": "right building of the gap element"}),
+        "level_left": ("contact", np.array([g.level_left for g in gaps], dtype=np.int32),
+                       {"units": "1", "long_name": "floor number in the left building"}),
+        "level_right": ("contact", np.array([g.level_right for g in gaps], dtype=np.int32),
+                        {"units": "1", "long_name": "floor number in the right building"}),
+        "gap": ("contact", np.array([g.gap for g in gaps], dtype=float),
+                {"units": "m", "long_name": "gap at rest"}),
+        "law": ("contact", np.array([g.law.name for g in gaps], dtype=object), {"long_name": "contact law"}),
+        "xi_formula": ("contact", np.array([getattr(g.law, "xi", "") for g in gaps], dtype=object),
+                       {"long_name": "formula for the Hertz-damp damping constant"}),
+        "law_parameters": ("contact", np.array([g.law.describe() for g in gaps], dtype=object),
+                           {"long_name": "contact law and its parameters"}),
+    }
+
+
 def _column_point_coords(gaps) -> dict:
     """``at_left`` / ``at_right``: the column point's fraction of the storey height (NaN for a floor or a wall)."""
     def column(side: str) -> np.ndarray:
@@ -486,22 +512,7 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "storey_building": ("storey", labels["building"], {"long_name": "building of the storey"}),
         "storey_level": ("storey", labels["level"], {"units": "1", "long_name": "storey number above ground"}),
         "height": ("storey", heights, {"units": "m", "long_name": "storey height"}),
-        "contact": ("contact", np.array(contact_names, dtype=object), {"long_name": "gap element label"}),
-        "building_left": ("contact", np.array([side_names[g.left] for g in gaps], dtype=object),
-                          {"long_name": "left building of the gap element"}),
-        "building_right": ("contact", np.array([side_names[g.right] for g in gaps], dtype=object),
-                           {"long_name": "right building of the gap element"}),
-        "level_left": ("contact", np.array([g.level_left for g in gaps], dtype=np.int32),
-                       {"units": "1", "long_name": "floor number in the left building"}),
-        "level_right": ("contact", np.array([g.level_right for g in gaps], dtype=np.int32),
-                        {"units": "1", "long_name": "floor number in the right building"}),
-        "gap": ("contact", np.array([g.gap for g in gaps], dtype=float),
-                {"units": "m", "long_name": "gap at rest"}),
-        "law": ("contact", np.array([g.law.name for g in gaps], dtype=object), {"long_name": "contact law"}),
-        "xi_formula": ("contact", np.array([getattr(g.law, "xi", "") for g in gaps], dtype=object),
-                       {"long_name": "formula for the Hertz-damp damping constant"}),
-        "law_parameters": ("contact", np.array([g.law.describe() for g in gaps], dtype=object),
-                           {"long_name": "contact law and its parameters"}),
+        **contact_coords(model),
         "link": ("link", np.array([f"{building_names[k.left]}:{k.level_left}-{building_names[k.right]}:"
                                    f"{k.level_right}" for k in model.links], dtype=object),
                  {"long_name": "link label left:level-right:level"}),
@@ -751,8 +762,8 @@ def _plan_floor_labels(model: Model) -> dict[str, Any]:
     levels = [i + 1 for b in model.buildings for i in range(b.n_floors)]
     centres = np.array([c for b in model.buildings for c in b.centres], dtype=float).reshape(-1, 2)
     corners = floor_corners(model)
-    return {"floor_building": (("floor",), np.array(buildings, dtype=object), {"long_name": "building of the floor"}),
-            "floor_level": (("floor",), np.array(levels, dtype=np.int64),
+    return {"building": (("floor",), np.array(buildings, dtype=object), {"long_name": "building of the floor"}),
+            "level": (("floor",), np.array(levels, dtype=np.int64),
                             {"units": "1", "long_name": "floor number from the ground up"}),
             "floor_centre_x": (("floor",), centres[:, 0], {"units": "m", "long_name": "x of the floor's centre of mass"}),
             "floor_centre_y": (("floor",), centres[:, 1], {"units": "m", "long_name": "y of the floor's centre of mass"}),
@@ -780,13 +791,13 @@ def _point_labels(model: Model) -> dict[str, Any]:
     between = [f.label(names) for f in faces]
     point_face = np.array([g.face for g in model.gaps], dtype=np.int64)
     location = np.array([g.point for g in model.gaps], dtype=float).reshape(len(model.gaps), 2)
-    return {"point_between": (("point",), np.array(between, dtype=object),
+    return {"point_between": (("contact",), np.array(between, dtype=object),
                               {"long_name": "the two floors of the contact point (building:floor)"}),
-            "point_face": (("point",), point_face, {"units": "1", "long_name": "index of the point's face"}),
-            "point_normal": (("point",), np.array([c.face.normal for c in faces], dtype=object),
+            "point_face": (("contact",), point_face, {"units": "1", "long_name": "index of the point's face"}),
+            "point_normal": (("contact",), np.array([c.face.normal for c in faces], dtype=object),
                              {"long_name": "normal direction of the point's face"}),
-            "point_x": (("point",), location[:, 0], {"units": "m", "long_name": "x of the point at rest"}),
-            "point_y": (("point",), location[:, 1], {"units": "m", "long_name": "y of the point at rest"})}
+            "point_x": (("contact",), location[:, 0], {"units": "m", "long_name": "x of the point at rest"}),
+            "point_y": (("contact",), location[:, 1], {"units": "m", "long_name": "y of the point at rest"})}
 
 
 def _impact_slip(model: Model, assembly: Assembly, raw: RawSolution) -> np.ndarray:
@@ -967,7 +978,7 @@ def plane_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str,
         "storey": [str(x) for x in storeys["storey"]],
         "storey_building": [str(x) for x in storeys["building"]],
         "plane": plane_labels(model),
-        "contact": [f"{model.faces[g.face].label(names)}@({g.point[0]:g},{g.point[1]:g})" for g in model.gaps],
+        "contact": [g.label(names) for g in model.gaps],
         "peak_drift_ratio": storeys["peak"],
         "peak_plane_drift_ratio": ratio,
         "residual_drift_ratio": np.full(storeys["peak"].size, np.nan),
@@ -1102,13 +1113,13 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
         "peak_corner_displacement_magnitude": _var(("floor", "corner"), magnitude.max(axis=0, initial=0.0), "m",
                                                    "peak magnitude of the corner's displacement (stored samples)"),
         **_plane_variables(model, assembly, raw, drift),
-        "contact_force": _var(("time", "point"), raw.contact_force[:, :npt], "N",
+        "contact_force": _var(("time", "contact"), raw.contact_force[:, :npt], "N",
                               "normal contact force at the point (compression positive)"),
-        "penetration": _var(("time", "point"), delta[:, :npt], "m", "penetration at the point (overlap positive)"),
-        "peak_contact_force": _var(("point",), raw.peak_contact_force[:npt], "N",
+        "penetration": _var(("time", "contact"), delta[:, :npt], "m", "penetration at the point (overlap positive)"),
+        "peak_contact_force": _var(("contact",), raw.peak_contact_force[:npt], "N",
                                    "peak normal contact force at the point (full resolution)"),
-        "impact_count": _var(("point",), counts, "1", "number of impacts at the point"),
-        "impact_point": _var(("impact",), raw.impact_contact, "1", "contact point of the impact"),
+        "impact_count": _var(("contact",), counts, "1", "number of impacts at the point"),
+        "impact_contact": _var(("impact",), raw.impact_contact, "1", "contact point of the impact (index along contact)"),
         "impact_time": _var(("impact",), raw.impact_time, "s", "time of contact onset"),
         "impact_x": _var(("impact",), location[:, 0], "m", "x of the impact's contact point at rest"),
         "impact_y": _var(("impact",), location[:, 1], "m", "y of the impact's contact point at rest"),
@@ -1128,7 +1139,7 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
     coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
               "direction": ("direction", np.array(["x", "y"], dtype=object), {"long_name": "plan direction"}),
               **_floor_coords(model), **_plan_floor_labels(model), **_plane_labels(model), **_plane_coords(model),
-              **_point_labels(model), **_face_labels(model, assembly)}
+              **contact_coords(model), **_point_labels(model), **_face_labels(model, assembly)}
     status = plane_status(model, assembly, raw)
     ds = xr.Dataset(data, coords=coords, attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time,
                                                                wall_time=wall_time, status=status))

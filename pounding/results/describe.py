@@ -64,16 +64,16 @@ def describe_plan(ds) -> str:
     lines = [f"plan model '{attrs.get('model', '')}' under {record}, {intensity}, "
              f"angle {float(attrs.get('angle', 0.0)):g} deg, {float(ds.time[-1]):.2f} s{held}"]
     lines.append("buildings (floors, outline m, planes per direction):")
-    for name in dict.fromkeys(ds.floor_building.values):
-        floors = np.flatnonzero(ds.floor_building.values == name)
+    for name in dict.fromkeys(ds.building.values):
+        floors = np.flatnonzero(ds.building.values == name)
         xs, ys = ds.corner_x.values[floors[0]], ds.corner_y.values[floors[0]]
         mine = ds.plane_building.values == name
         directions = ds.plane_direction.values[mine]
         lines.append(f"  {name}: {floors.size} floor{'s' if floors.size > 1 else ''}, [[{xs.min():g}, {ys.min():g}], [{xs.max():g}, {ys.max():g}]], "
                      f"{int((directions == 'x').sum())} along x and {int((directions == 'y').sum())} along y")
-    if ds.sizes.get("point", 0):
+    if ds.sizes.get("contact", 0):
         lines.append("contact points (floors: location m, normal, impacts, peak normal force):")
-        for p in range(ds.sizes["point"]):
+        for p in range(ds.sizes["contact"]):
             lines.append(f"  {ds.point_between.values[p]}: ({float(ds.point_x[p]):g}, {float(ds.point_y[p]):g}), "
                          f"{ds.point_normal.values[p]}, {int(ds.impact_count[p])} impacts, "
                          f"{float(ds.peak_contact_force[p]) / 1e3:.4g} kN")

@@ -31,7 +31,7 @@ __all__ = ["plot_plan_run", "plan_view_instant", "shown_floors"]
 
 def plan_view_instant(ds: xr.Dataset) -> tuple[int, int | None]:
     """The sample of the plan view and the contact point of the largest force there (None without impacts)."""
-    force = ds.contact_force.values if ds.sizes.get("point", 0) else np.zeros((ds.sizes["time"], 0))
+    force = ds.contact_force.values if ds.sizes.get("contact", 0) else np.zeros((ds.sizes["time"], 0))
     if force.size and float(force.max()) > 0.0:
         sample, point = np.unravel_index(int(np.argmax(force)), force.shape)
         return int(sample), int(point)
@@ -41,7 +41,7 @@ def plan_view_instant(ds: xr.Dataset) -> tuple[int, int | None]:
 
 def shown_floors(ds: xr.Dataset, point: int | None) -> dict[str, int]:
     """The floor index drawn per building: the one in the contact *point* (``A:2-B:1``, ``A:1-wall``), else the roof."""
-    buildings, levels = ds.floor_building.values, ds.floor_level.values
+    buildings, levels = ds.building.values, ds.level.values
     shown = {str(b): int(np.flatnonzero(buildings == b)[-1]) for b in dict.fromkeys(buildings)}
     if point is not None:
         for side in str(ds.point_between.values[point]).split("-"):
@@ -82,7 +82,7 @@ def _plan_view(plt, ds: xr.Dataset, path: Path) -> float:
         moved = rest + factor * corner[f]
         ax.fill(*np.r_[rest, rest[:1]].T, fill=False, ls="--", lw=0.8, color=colour)
         ax.plot(*np.r_[moved, moved[:1]].T, lw=1.6, color=colour,
-                label=f"{name} floor {int(ds.floor_level.values[f])}")
+                label=f"{name} floor {int(ds.level.values[f])}")
         magnitude = np.hypot(corner[f, :, 0], corner[f, :, 1])
         c = int(np.argmax(magnitude))
         if magnitude[c] > best[1]:
@@ -90,9 +90,9 @@ def _plan_view(plt, ds: xr.Dataset, path: Path) -> float:
     if best[0] is not None and best[1] > 0.0:
         f, c, at = best[0]
         ax.plot(*at, marker="*", ms=14, color="k", zorder=5)
-        ax.annotate(f"{ds.floor_building.values[f]}:{int(ds.floor_level.values[f])} {ds.corner.values[c]}: "
+        ax.annotate(f"{ds.building.values[f]}:{int(ds.level.values[f])} {ds.corner.values[c]}: "
                     f"{1e3 * best[1]:.1f} mm", at, textcoords="offset points", xytext=(8, 8), fontsize=8)
-    if ds.sizes.get("point", 0):
+    if ds.sizes.get("contact", 0):
         ax.plot(ds.point_x.values, ds.point_y.values, "o", ms=4, color="0.3", label="contact points")
         force = ds.contact_force.values[sample]
         top = float(force.max())
@@ -115,16 +115,16 @@ def _plan_view(plt, ds: xr.Dataset, path: Path) -> float:
             f"y {float(ds.point_y[point]):.2f} m)" if point is not None else "no impacts: largest corner displacement")
     suptitle(fig, f"{ds.attrs.get('model', '')}: plan at t = {t:.3f} s, {what}\n"
                   f"displacements x{factor:g}; dashed: at rest; arrows: normal forces (largest "
-                  f"{_force_text(float(ds.contact_force.values[sample].max())) if ds.sizes.get('point', 0) else '0'})")
+                  f"{_force_text(float(ds.contact_force.values[sample].max())) if ds.sizes.get('contact', 0) else '0'})")
     save_figure(fig, path)
     return t
 
 
 def _roof_rotation(plt, ds: xr.Dataset, path: Path, instant: float) -> None:
-    names = list(dict.fromkeys(ds.floor_building.values))
+    names = list(dict.fromkeys(ds.building.values))
     fig, axes = plt.subplots(len(names), 1, figsize=(9.0, 1.0 + 2.2 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
-        roof = int(np.flatnonzero(ds.floor_building.values == name)[-1])
+        roof = int(np.flatnonzero(ds.building.values == name)[-1])
         ax.plot(ds.time.values, 1e3 * ds.rotation.values[:, roof], lw=0.8)
         ax.axvline(instant, ls="--", lw=0.8, color="C3")
         ax.set_ylabel(f"{name} roof θ (mrad)")

@@ -18,8 +18,8 @@ __all__ = ["plan_summary", "compare_runs"]
 def plan_summary(ds: xr.Dataset) -> str:
     """A few lines: peak displacement and roof rotation per building, impacts, energy closure."""
     lines = [f"{ds.attrs.get('model', '')}: plan run to {float(ds.time[-1]):.3f} s"]
-    for name in dict.fromkeys(ds.floor_building.values):
-        floors = ds.floor_building.values == name
+    for name in dict.fromkeys(ds.building.values):
+        floors = ds.building.values == name
         peak = ds.peak_displacement.values[floors]
         roof = ds.peak_rotation.values[floors][-1]
         lines.append(f"  {name}: peak displacement x {1e3 * peak[:, 0].max():.2f} mm, "
@@ -31,7 +31,7 @@ def plan_summary(ds: xr.Dataset) -> str:
     if "energy_friction" in ds:
         lines.append(_friction_line(ds))
     lines.append(f"  impacts {int(ds.impact_count.sum())} at {int((ds.impact_count > 0).sum())} of "
-                 f"{ds.sizes.get('point', 0)} points; energy closure {ds.attrs['energy_closure']:.1e}")
+                 f"{ds.sizes.get('contact', 0)} points; energy closure {ds.attrs['energy_closure']:.1e}")
     return "\n".join(lines)
 
 

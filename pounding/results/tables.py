@@ -94,14 +94,14 @@ def plan_tables(ds) -> dict:
     displacement of the centre of mass per floor and direction), ``rotations`` (peak rotation per floor),
     ``corners`` (peak corner displacement per floor, corner and direction, with its magnitude), ``planes``
     (peak drift per plane) and ``points`` (impacts and peak normal force per contact point)."""
-    floor = ["floor_building", "floor_level"]
+    floor = ["building", "level"]
     tables = {"floors": long_table(ds, ["peak_displacement"], extra=floor),
               "rotations": long_table(ds, ["peak_rotation"], extra=floor),
               "corners": long_table(ds, ["peak_corner_displacement"],
                                     extra=floor + ["corner_x", "corner_y", "peak_corner_displacement_magnitude"]),
               "planes": long_table(ds, ["peak_plane_drift"], extra=["plane_building", "plane_storey",
                                                                     "plane_direction", "plane_at", "plane_stiffness"])}
-    if ds.sizes.get("point", 0):
+    if ds.sizes.get("contact", 0):
         tables["points"] = long_table(ds, ["impact_count", "peak_contact_force"],
                                       extra=["point_between", "point_normal", "point_x", "point_y"])
     return tables
@@ -115,7 +115,7 @@ def plan_history_table(ds):
 
     columns: dict[str, np.ndarray] = {header(ds, "time"): ds.time.values}
     u, theta = ds.displacement.values, ds.rotation.values
-    for f, (name, level) in enumerate(zip(ds.floor_building.values, ds.floor_level.values)):
+    for f, (name, level) in enumerate(zip(ds.building.values, ds.level.values)):
         columns[f"{name}:{level} x [{ds.displacement.attrs['units']}]"] = u[:, f, 0]
         columns[f"{name}:{level} y [{ds.displacement.attrs['units']}]"] = u[:, f, 1]
         columns[f"{name}:{level} theta [{ds.rotation.attrs['units']}]"] = theta[:, f]

@@ -136,7 +136,7 @@ def plan_rows(ds, building: str) -> list[tuple[str, str, Any]]:
     peak corner displacement (mm), centre-of-mass displacement (mm, either direction) and rotation (mrad).
     """
     planes = (ds.plane_building == building).values
-    floors = (ds.floor_building == building).values
+    floors = (ds.building == building).values
     rows: list[tuple[str, str, Any]] = []
     drift = ds.peak_plane_drift_ratio.isel(plane=planes)
     storeys = ds.plane_storey.values[planes]
@@ -171,7 +171,7 @@ def plan_comparison_table(ds, reference: str = "exact") -> str:
     failed = int((ds.status != "ok").sum())
     if failed:
         lines.append(f"{failed} of {ds.status.size} scenario(s) failed and are left out of the means below")
-    for building in dict.fromkeys(str(b) for b in ds.floor_building.values):
+    for building in dict.fromkeys(str(b) for b in ds.building.values):
         lines += ["", f"building {building}: storey rows = largest peak plane drift ratio of the storey, %; corner, "
                       "CM (mm) and rotation (mrad) = the building's largest; mean over records, and [mean, max |.|] "
                       f"over records of the difference from {reference}, % of {reference}"]

@@ -67,7 +67,7 @@ def _plane_labels(ds) -> list[str]:
 
 def plan_peaks(model, ds) -> dict[str, Any]:
     """The peaks of a plan run *ds* of *model* as plain data (module docstring)."""
-    floors = [f"{b}:{int(lv)}" for b, lv in zip(ds.floor_building.values, ds.floor_level.values)]
+    floors = [f"{b}:{int(lv)}" for b, lv in zip(ds.building.values, ds.level.values)]
     heights = {b.name: [s.height for s in b.storeys] for b in model.buildings}
     plane_height = [heights[str(b)][int(s) - 1] for b, s in zip(ds.plane_building.values, ds.plane_storey.values)]
     points = [f"{between}@({float(x):g},{float(y):g})" for between, x, y in
@@ -75,8 +75,8 @@ def plan_peaks(model, ds) -> dict[str, Any]:
     energy = ds.energy_contact.values
     return {
         "floor": floors,
-        "floor_building": [str(b) for b in ds.floor_building.values],
-        "floor_level": [int(x) for x in ds.floor_level.values],
+        "floor_building": [str(b) for b in ds.building.values],
+        "floor_level": [int(x) for x in ds.level.values],
         "peak_displacement": ds.peak_displacement.values.tolist(),
         "peak_rotation": ds.peak_rotation.values.tolist(),
         "peak_corner_displacement": corner_peaks(model, ds).tolist(),
