@@ -14,12 +14,9 @@ __all__ = ["register_cli"]
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
-    from pounding.model.model import is_plan_file
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
-    if is_plan_file(args.model):
-        return _cmd_plan_compare(args)
     check_csv(args, [args.model])
     scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
@@ -43,29 +40,6 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     if args.plot:
         for png in plot_comparison(ds, args.plot, args.reference, drift_limit=args.drift_limit):
             print(f"wrote {png}")
-    return 0
-
-
-def _cmd_plan_compare(args: argparse.Namespace) -> int:
-    """``pounding compare MODEL.yaml`` on a plan model."""
-    from pounding.studies.plan.compare import plan_compare, plan_comparison_table
-
-    from pounding.cli.plan_studies import refuse_options
-    from pounding.cli.sweep import interrupted
-
-    refuse_options(args, "compare", ("--plot", "--csv", "--drift-limit"))
-    scale = None if args.scale is None else parse_scale_option(args.scale)
-    try:
-        ds = plan_compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,
-                          reference=args.reference, contacts=args.contacts, scale=scale, workers=args.workers,
-                          scheduler=args.scheduler, overwrite=args.overwrite, progress=not args.no_progress)
-    except KeyboardInterrupt:
-        return interrupted(args.output)
-    raise_if_all_failed(ds, args.output)
-    print(plan_comparison_table(ds, args.reference))
-    print_study_warnings(ds)
-    if args.output:
-        print(f"wrote {args.output}")
     return 0
 
 

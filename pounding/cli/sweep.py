@@ -108,10 +108,6 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
     if args.workers is not None and args.workers < 1:
         raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
-    from pounding.studies.plan.sweep import is_plan_sweep_file
-
-    if is_plan_sweep_file(args.sweep):
-        return _cmd_plan_sweep(args)
     sweep = load_sweep(args.sweep)
     check_csv(args, [args.sweep])
     output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
@@ -137,33 +133,6 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         print(f"ran {ds.attrs['n_run']} scenarios in {ds.attrs['elapsed_time']:.1f} s ({rate:.2f} scenarios/s)")
     print(f"wrote {output}")
     write_csv_option(args, "sweep", ds)
-    return 0
-
-
-def _cmd_plan_sweep(args: argparse.Namespace) -> int:
-    """``pounding sweep SWEEP.yaml`` whose model is a plan model."""
-    from pounding.studies.plan.runs import assemble_plan_sweep, run_plan_scenario
-    from pounding.studies.plan.sweep import load_plan_sweep
-    from pounding.studies.sweep.execution import plan_line, run_sweep
-
-    from pounding.cli.plan_studies import refuse_options
-
-    refuse_options(args, "sweep", ("--keep-histories", "--csv"))
-    sweep = load_plan_sweep(args.sweep)
-    output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
-    _announce_invalid(sweep, args.strict)
-    print(plan_line(sweep), file=sys.stderr)
-    try:
-        ds = run_sweep(sweep, output, runner=run_plan_scenario, assemble=assemble_plan_sweep, workers=args.workers,
-                       scheduler=args.scheduler, overwrite=args.overwrite, keep_parts=args.keep_parts,
-                       progress=not args.no_progress)
-    except KeyboardInterrupt:
-        return interrupted(output)
-    raise_if_all_failed(ds, output)
-    for line in summary_lines(ds):
-        print(line)
-    print_study_warnings(ds)
-    print(f"wrote {output}")
     return 0
 
 

@@ -9,17 +9,23 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 from typing import Any
 
 from pounding.errors import PoundingError
 
-__all__ = ["study_parts", "record_list", "record_values", "study_sweep", "check_duration", "finite_or_none", "records_text",
-           "scale_spec_text", "sweep_heading"]
+__all__ = ["study_parts", "record_list", "record_values", "pair_values", "study_document", "study_sweep",
+           "document_model", "floor_states", "check_duration", "finite_or_none", "records_text", "scale_spec_text",
+           "sweep_heading"]
 
 
-def record_list(text: str | list[str] | None) -> list[str] | None:
-    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given."""
-    from pounding.studies.sweep.spec import expand_records
+def record_list(text: str | list[str] | None, *, pairs: bool = False) -> list[str] | None:
+    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given.
+
+    *pairs*: the model's ground motion has two components, so the records are pairs (``fema-p695:farfield``:
+    the 22 pairs; :func:`pounding.studies.sweep.spec.expand_pairs`).
+    """
+    from pounding.studies.sweep.spec import record_expander
 
     if text is None:
         return None
@@ -27,16 +33,18 @@ def record_list(text: str | list[str] | None) -> list[str] | None:
     records: list[str] = []
     for item in items:
         try:
-            expanded = expand_records(item)
+            expanded = record_expander(pairs)(item)
         except PoundingError as exc:
             raise PoundingError(f"--records: {exc}") from None
         records += [r for r in expanded if r not in records]
     if not records:
-        raise PoundingError("--records needs a set (fema-p695:farfield) or a comma-separated list of records")
+        raise PoundingError("--records needs record pairs, e.g. fema-p695:farfield or fema-p695:farfield/1,"
+                            "fema-p695:farfield/2" if pairs else
+                            "--records needs a set (fema-p695:farfield) or a comma-separated list of records")
     return records
 
 
-def record_values(records: str | list[str] | None, model: Any = None) -> list[str] | None:
+def record_values(records: str | list[str] | None, model: Any = None, *, pairs: bool = False) -> list[str] | None:
     """The ``records`` axis of a study: the `--records` option (files made absolute), else *model*'s own record.
 
     Parameters
@@ -45,14 +53,77 @@ def record_values(records: str | list[str] | None, model: Any = None) -> list[st
         The option as given (see :func:`record_list`).
     model : pounding.model.model.Model, optional
         Whose record is the default; without it, None when *records* is None.
+    pairs : bool
+        The records are pairs (a ground motion of two components); *model*'s own is its pair (None when it gives
+        its components one by one: the study runs them as they are).
     """
-    listed = record_list(records)
+    listed = record_list(records, pairs=pairs)
     if listed is not None:
         return [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
     if model is None:
         return None
     motion = model.ground_motion
+    if motion.two_components:
+        return None if motion.record is None else [motion.record]
     return [motion.record if motion.is_catalogue else str(motion.record_path)]
+
+
+def pair_values(records: str | list[str] | None) -> list[str] | None:
+    """The record pairs of a ``--records`` option (``fema-p695:farfield``, or pairs separated by commas)."""
+    return record_list(records, pairs=True)
+
+
+def study_document(model: str | os.PathLike, prefix: str, axes: dict[str, Any], records: list[str] | None,
+                   duration: float | None, scale: Any, settings: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The sweep document of a study over *axes* × *records* (compare, gap...) of the model file *model*.
+
+    Parameters
+    ----------
+    model : path-like
+        The model file.
+    prefix : str
+        The study (``compare``): the sweep is named ``PREFIX-STEM``.
+    axes : dict
+        The study's own axes; ``records`` is added after them unless *records* is None (the model's own).
+    records : list of str, optional
+        The records (or record pairs).
+    duration : float, optional
+        Simulated time, s (``ground_motion.duration``).
+    scale : float or mapping, optional
+        ``ground_motion.scale`` of every run: a factor or a target (``{pga: 0.4g}``; on a record pair the
+        target of its geometric mean, :mod:`pounding.studies.sweep.scaling`).
+    settings : dict, optional
+        Further fixed changes (``set``), before the scale and duration.
+    """
+    path = os.path.abspath(os.fspath(model))
+    if records is not None:
+        axes = {**axes, "records": records}
+    document: dict[str, Any] = {"name": f"{prefix}-{Path(path).stem}", "model": path, "axes": axes}
+    settings = dict(settings or {})
+    if scale is not None:
+        settings["scale"] = scale
+    if check_duration(duration) is not None:
+        settings["ground_motion.duration"] = float(duration)
+    if settings:
+        document["set"] = settings
+    return document
+
+
+def document_model(document: dict[str, Any], name: str = "model", base_dir: str | None = None):
+    """The :class:`~pounding.model.model.Model` of a plain model *document* (one line per problem)."""
+    from pounding.model.model import model_from_data
+
+    return model_from_data(document, name=name, base_dir=base_dir)
+
+
+def floor_states(ds) -> tuple[Any, Any]:
+    """``(q, q̇)`` (time, DOF) of a run archive whose floors move in plan, in the model's DOF order (u_x, u_y, θ per
+    floor; m, rad)."""
+    import numpy as np
+
+    q = np.concatenate([ds.displacement.values, ds.rotation.values[:, :, None]], axis=2)
+    qd = np.concatenate([ds.velocity.values, ds.rotation_rate.values[:, :, None]], axis=2)
+    return q.reshape(q.shape[0], -1), qd.reshape(qd.shape[0], -1)
 
 
 def study_sweep(document: dict[str, Any], label: str):
@@ -119,8 +190,8 @@ def sweep_heading(sweep) -> str:
     records: list[str] = [str(ground.get("record", ""))]
     swept = False
     for axis in sweep.axes:
-        if axis.kind == "record":
-            records = [str(v) for v in axis.values]
+        if axis.kind == "record":   # None: the model's own ground motion (components given one by one)
+            records = [str(v) if v is not None else str(label) for v, label in zip(axis.values, axis.labels)]
         swept = swept or axis.kind == "scale" or "scale" in str(axis.key).split(".")[-1:]
     intensity = "scale swept" if swept else scale_spec_text(ground.get("scale"))
     return f"model '{sweep.model_name}' under {records_text(records)}, {intensity}"

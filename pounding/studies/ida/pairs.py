@@ -74,7 +74,7 @@ def oriented_document(document: dict, pair: str, orientation: str) -> dict:
 
 def _model_pair(model, path: str) -> str:
     """The record pair of a plan model's own ground motion (the default ``--records``)."""
-    from pounding.studies.plan.sweep import plan_document
+    from pounding.studies.sweep.spec import model_document as plan_document
 
     record = (plan_document(model).get("ground_motion") or {}).get("record")
     if not isinstance(record, str):
@@ -94,8 +94,8 @@ def build_pair_ida_plan(model: str | os.PathLike, records: str | list[str] | Non
     (default: the model's own pair).  Drift limits and the collapse drift ratio apply to the planes' drift ratios.
     """
     from pounding.model.model import load_model as load_plan_model
-    from pounding.studies.plan.compare import pair_values, study_document
-    from pounding.studies.plan.sweep import build_plan_document, plan_study_sweep
+    from pounding.studies.common import pair_values, study_document
+    from pounding.studies.common import document_model as build_plan_document, study_sweep as plan_study_sweep
 
     override = collapse_drift
     levels, drift_limits, collapse_drift = check_ida_inputs(im, scaling, levels, hunt, limits, collapse_drift, mce,
@@ -141,10 +141,10 @@ def build_pair_ida_plan(model: str | os.PathLike, records: str | list[str] | Non
 
 def _building_peaks(peaks: dict[str, Any], buildings: list[str]) -> dict[str, list[float]]:
     """Per building (in *buildings* order) its peak roof rotation (rad) and peak corner displacement (m)."""
-    owner = np.array(peaks["floor_building"], dtype=object)
-    level = np.array(peaks["floor_level"])
+    owner = np.array(peaks["building"], dtype=object)
+    level = np.array(peaks["level"])
     rotation = np.abs(np.array(peaks["peak_rotation"], dtype=float))
-    corners = np.array(peaks["peak_corner_displacement"], dtype=float).reshape(owner.size, -1)
+    corners = np.array(peaks["peak_corner_displacement_magnitude"], dtype=float).reshape(owner.size, -1)
     roof, corner = [], []
     for name in buildings:
         mine = owner == name
@@ -160,7 +160,7 @@ def run_pair_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     from pounding.simulation import simulate as simulate_plan
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
-    from pounding.studies.plan.runs import plan_peaks
+    from pounding.studies.sweep.scenario import scenario_peaks
 
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": IDA_PART,
@@ -168,7 +168,7 @@ def run_pair_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model = plan_model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
         ds = simulate_plan(model)
-        peaks = plan_peaks(model, ds)
+        peaks = scenario_peaks(ds)
         status = str(ds.attrs["status"])
         collapse_time = float(ds.attrs.get("collapse_time", math.nan))
         height = np.array(peaks["plane_height"], dtype=float)
@@ -186,7 +186,7 @@ def run_pair_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
                 "residual_drift_ratio": [None] * height.size,
             },
             "contacts": {  # the contact points, in the place of the planar IDA's contacts
-                "contact": list(peaks["point"]),
+                "contact": list(peaks["contact"]),
                 "impact_count": [int(x) for x in peaks["impact_count"]],
                 "peak_contact_force": [float(x) for x in peaks["peak_contact_force"]],
             },

@@ -73,7 +73,7 @@ def point_separations(model, ds) -> dict[str, list]:
     """
     from pounding.model.model import WALL
     from pounding.studies.gap import cqc_correlation, max_hermite
-    from pounding.studies.plan.runs import floor_states
+    from pounding.studies.common import floor_states
 
     names = [b.name for b in model.buildings]
     q, qd = floor_states(ds)
@@ -110,7 +110,7 @@ def run_plan_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     from pounding.simulation import simulate as simulate_plan
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
-    from pounding.studies.plan.sweep import build_plan_document
+    from pounding.studies.common import document_model as build_plan_document
 
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": PLAN_GAP_PART,
@@ -247,8 +247,8 @@ def plan_gap_study(model: str | os.PathLike, records: str | list[str] | None = N
         Passed to :func:`pounding.studies.sweep.execution.run_sweep`.
     """
     from pounding.model.model import load_model as load_plan_model
-    from pounding.studies.plan.compare import pair_values, study_document
-    from pounding.studies.plan.sweep import plan_study_sweep
+    from pounding.studies.common import pair_values, study_document
+    from pounding.studies.common import study_sweep as plan_study_sweep
     from pounding.studies.sweep.execution import plan_line, run_sweep
 
     base = load_plan_model(model)

@@ -23,7 +23,7 @@ def _union(results: Iterable[dict[str, Any]], name: str, extra: tuple[str, ...])
     info: dict[str, list] = {k: [] for k in extra}
     seen: set[str] = set()
     for part in results:
-        if part.get("status") != "ok":
+        if part.get("status") != "ok" or name not in part:
             continue
         for i, label in enumerate(part[name]):
             if label not in seen:
@@ -34,101 +34,117 @@ def _union(results: Iterable[dict[str, Any]], name: str, extra: tuple[str, ...])
     return labels, info
 
 
-def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
-                  ran: int = 0):
-    """Assemble the results NetCDF layout from per-scenario results."""
-    import numpy as np
-    import xarray as xr
+class _Layout:
+    """Where each scenario's labelled peaks go: the sweep's shape and the union of every scenario's labels."""
 
-    from pounding.results.checks import study_warnings
-    from pounding.results.dataset import PGA_LONG_NAME
+    def __init__(self, sweep: Sweep, parts: list[dict[str, Any]]):
+        self.dims = tuple(d.name for d in sweep.dimensions)
+        self.shape = sweep.shape
+        self.index = [s.index for s in sweep.scenarios()]
+        self.ok = [p if p.get("status") == "ok" else {} for p in parts]
+        self.parts = parts
 
-    scenarios = sweep.scenarios()
-    parts = [results.get(s.key, {"status": "error", "error": "not run"}) for s in scenarios]
-    storeys, storey_info = _union(parts, "storey", ("storey_building", "storey_level", "height"))
-    floors, floor_info = _union(parts, "floor", ("building", "level", "elevation"))
-    contacts, contact_info = _union(parts, "contact", ("building_left", "building_right", "level_left",
-                                                       "level_right"))
-    shape = sweep.shape
-    dims = tuple(d.name for d in sweep.dimensions)
+    def labels(self, name: str, extra: tuple[str, ...]) -> tuple[list, dict[str, list]]:
+        """The union over the scenarios of labels *name* (in order of appearance) and their *extra* lists."""
+        return _union(self.parts, name, extra)
 
-    def full(extra: int | None, value, dtype):
-        return np.full(shape + ((extra,) if extra is not None else ()), value, dtype=dtype)
+    def spread(self, name: str, labels: list, key: str, fill: Any = float("nan"), dtype: Any = float):
+        """Each scenario's list *key* (along its labels *name*) placed on the union *labels*; *fill* elsewhere."""
+        import numpy as np
 
-    drift = full(len(storeys), np.nan, float)
-    displacement = full(len(floors), np.nan, float)
-    force = full(len(contacts), np.nan, float)
-    impacts = full(len(contacts), -1, np.int32)
-    closure = full(None, np.nan, float)
-    wall = full(None, np.nan, float)
-    solver_wall = full(None, np.nan, float)
-    scale_factor = full(None, np.nan, float)
-    intensity = full(None, np.nan, float)
-    status = np.empty(shape, dtype=object)
-    run_status = np.full(shape, "", dtype=object)
-    end_time = full(None, np.nan, float)
-    error = np.empty(shape, dtype=object)
-    scenario_id = np.empty(shape, dtype=object)
-    storey_at = {s: i for i, s in enumerate(storeys)}
-    floor_at = {s: i for i, s in enumerate(floors)}
-    contact_at = {s: i for i, s in enumerate(contacts)}
-    for scenario, part in zip(scenarios, parts):
-        at = scenario.index
-        status[at] = part.get("status", "error")
-        error[at] = part.get("error", "") or ""
-        scenario_id[at] = scenario.key[:16]
-        wall[at] = part.get("wall_time", np.nan)
-        if part.get("status") != "ok":
-            continue
-        for label, value in zip(part["storey"], part["peak_drift_ratio"]):
-            drift[at + (storey_at[label],)] = value
-        for label, value in zip(part["floor"], part["peak_displacement"]):
-            displacement[at + (floor_at[label],)] = value
-        for label, f, n in zip(part["contact"], part["peak_contact_force"], part["impact_count"]):
-            force[at + (contact_at[label],)] = f
-            impacts[at + (contact_at[label],)] = n
-        closure[at] = part["energy_closure_error"]
-        run_status[at] = part.get("run_status", "unknown")   # parts written before it was recorded
-        end_time[at] = part.get("end_time", np.nan)
-        scale_factor[at] = part.get("scale_factor", np.nan)
-        intensity[at] = part.get("intensity", np.nan)
-        solver_wall[at] = part["solver_wall_time"]
+        tail = next((np.shape(p[key])[1:] for p in self.ok if p.get(key)), ())
+        out = np.full(self.shape + (len(labels),) + tuple(tail), fill, dtype=dtype)
+        at = {label: i for i, label in enumerate(labels)}
+        for where, part in zip(self.index, self.ok):
+            for label, value in zip(part.get(name, []), part.get(key, [])):
+                out[where + (at[label],)] = value
+        return out
 
-    def var(extra_dim, data, units, long_name, **attrs):
+    def scalar(self, key: str, fill: Any = float("nan"), dtype: Any = float, *, every: bool = False,
+               missing: Any = None):
+        """One value per scenario: *fill* where it failed (unless *every*), *missing* (default *fill*) where
+        a scenario that ran has no *key* (a part stored before it was recorded)."""
+        import numpy as np
+
+        out = np.full(self.shape, fill, dtype=dtype)
+        for where, part in zip(self.index, self.parts if every else self.ok):
+            if part or every:
+                out[where] = part.get(key, fill if missing is None else missing)
+        return out
+
+    def var(self, extra: tuple[str, ...], data: Any, units: str | None, long_name: str, **attrs: Any) -> tuple:
         attrs = {"units": units, "long_name": long_name, **attrs} if units is not None else \
             {"long_name": long_name, **attrs}
-        return (dims + ((extra_dim,) if extra_dim else ()), data, attrs)
+        return (self.dims + extra, data, attrs)
 
-    data_vars = {
-        "peak_drift_ratio": var("storey", drift, "1", "peak storey drift ratio (drift / storey height)"),
-        "peak_displacement": var("floor", displacement, "m", "peak floor displacement relative to the ground"),
-        "peak_contact_force": var("contact", force, "N", "peak contact force of the gap element"),
-        "impact_count": var("contact", impacts, "1", "number of impacts (gap closures)",
-                            comment="-1 where the scenario has no result (status != ok)"),
-        "energy_closure_error": var(None, closure, "1", "max |E_in - sum of energies| / max |E_in|"),
-        "scale_factor": var(None, scale_factor, "1",
-                            "factor applied to the record as stored (catalogue or file), after processing"),
-        "intensity": var(None, intensity, "m s-2", PGA_LONG_NAME),
-        "wall_time": var(None, wall, "s", "wall time of the scenario on its worker (model, record, solver)"),
-        "solver_wall_time": var(None, solver_wall, "s", "wall time of the integration alone"),
-        "status": var(None, status.astype(str), None, "scenario status: ok or error"),
-        "run_status": var(None, run_status.astype(str), None,
-                          "how the run ended: completed, collapsed or unstable (peaks of a collapsed or unstable "
-                          "run are those up to end_time); empty where status != ok, unknown for a resumed part "
-                          "that predates it"),
-        "end_time": var(None, end_time, "s", "time at which the run ended (the record's end unless it collapsed)"),
-        "error": var(None, error.astype(str), None, "error message of a failed scenario (empty if ok)"),
-        "scenario_id": var(None, scenario_id.astype(str), None,
-                           "first 16 hex digits of the scenario hash (name of its part file)"),
-    }
-    coords: dict[str, Any] = {}
-    for dim in sweep.dimensions:
-        if dim.zipped:
-            coords[dim.name] = (dim.name, np.arange(dim.size, dtype=np.int32),
-                                {"long_name": "zip group of " + ", ".join(a.key for a in dim.axes)})
-        for axis in dim.axes:
-            coords[axis.name] = (dim.name, _coord_values(axis.labels), _axis_attrs(axis))
-    coords.update({
+
+def _plan_extras(layout: _Layout, floors: list[str]) -> tuple[dict[str, tuple], dict[str, tuple]]:
+    """The variables and coordinates of the peaks only floors in plan have, where the scenarios have them:
+    rotations, corners, planes, the contact dissipation (module :mod:`~pounding.studies.sweep.scenario`)."""
+    import numpy as np
+
+    data: dict[str, tuple] = {}
+    coords: dict[str, tuple] = {}
+    if any("peak_rotation" in p for p in layout.ok):
+        data["peak_rotation"] = layout.var(("floor",), layout.spread("floor", floors, "peak_rotation"), "rad",
+                                           "peak |rotation| of the floor (full resolution)")
+    corners = next((p["corner"] for p in layout.ok if "corner" in p), None)
+    if corners is not None:
+        data["peak_corner_displacement_magnitude"] = layout.var(
+            ("floor", "corner"), layout.spread("floor", floors, "peak_corner_displacement_magnitude"), "m",
+            "peak magnitude of the displacement of the outline's corner (stored samples)")
+        coords["corner"] = ("corner", np.array(corners, dtype=str), {"long_name": "corner of the floor's outline"})
+    planes, info = layout.labels("plane", ("plane_building", "plane_storey", "plane_direction", "plane_at",
+                                           "plane_height"))
+    if planes:
+        data.update({
+            "peak_plane_drift": layout.var(("plane",), layout.spread("plane", planes, "peak_plane_drift"), "m",
+                                           "peak |drift| of the plane (full resolution)"),
+            "peak_plane_drift_ratio": layout.var(("plane",), layout.spread("plane", planes, "peak_plane_drift_ratio"),
+                                                 "1", "peak |drift ratio| of the plane (drift / storey height)"),
+            "contact_dissipation": layout.var((), layout.scalar("contact_dissipation"), "J",
+                                              "work of all contacts at the end of the run (energy they dissipated)"),
+        })
+        coords.update({
+            "plane": ("plane", np.array(planes, dtype=str), {"long_name": "plane label building:storey:direction@line"}),
+            "plane_building": ("plane", np.array(info["plane_building"], dtype=str),
+                               {"long_name": "building of the plane"}),
+            "plane_storey": ("plane", np.array(info["plane_storey"], dtype=np.int32),
+                             {"units": "1", "long_name": "storey of the plane"}),
+            "plane_direction": ("plane", np.array(info["plane_direction"], dtype=str),
+                                {"long_name": "direction the plane resists"}),
+            "plane_at": ("plane", np.array(info["plane_at"], dtype=float),
+                         {"units": "m", "long_name": "the plane's line (y along x, x along y)"}),
+            "plane_height": ("plane", np.array(info["plane_height"], dtype=float),
+                             {"units": "m", "long_name": "height of the plane's storey"}),
+        })
+    return data, coords
+
+
+def _contact_places(layout: _Layout, contacts: list[str]) -> dict[str, tuple]:
+    """The contact points' places (x, y at rest, the face's normal) when the scenarios have them (in plan)."""
+    import numpy as np
+
+    if not any("point_x" in p for p in layout.ok):
+        return {}
+    _, info = layout.labels("contact", ("point_x", "point_y", "point_normal"))
+    return {"point_x": ("contact", np.array(info["point_x"], dtype=float),
+                        {"units": "m", "long_name": "x of the contact point at rest"}),
+            "point_y": ("contact", np.array(info["point_y"], dtype=float),
+                        {"units": "m", "long_name": "y of the contact point at rest"}),
+            "point_normal": ("contact", np.array(info["point_normal"], dtype=str),
+                             {"long_name": "normal direction of the contact point's face"})}
+
+
+def _label_coords(layout: _Layout) -> tuple[dict[str, tuple], list[str], list[str], list[str]]:
+    """The storey, floor and contact coordinates (unions over the scenarios) and the three label lists."""
+    import numpy as np
+
+    storeys, storey_info = layout.labels("storey", ("storey_building", "storey_level", "height"))
+    floors, floor_info = layout.labels("floor", ("building", "level", "elevation"))
+    contacts, contact_info = layout.labels("contact", ("building_left", "building_right", "level_left",
+                                                       "level_right"))
+    coords = {
         "storey": ("storey", np.array(storeys, dtype=str),
                    {"long_name": "storey label building:level (storey i between floors i-1 and i)"}),
         "storey_building": ("storey", np.array(storey_info["storey_building"], dtype=str),
@@ -152,7 +168,80 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
                        {"units": "1", "long_name": "floor number in the left building"}),
         "level_right": ("contact", np.array(contact_info["level_right"], dtype=np.int32),
                         {"units": "1", "long_name": "floor number in the right building"}),
-    })
+    }
+    return coords, storeys, floors, contacts
+
+
+def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
+                  ran: int = 0):
+    """Assemble the results NetCDF layout from per-scenario results (planar and plan models alike).
+
+    Over the sweep's dimensions: ``peak_drift_ratio`` (storey), ``peak_displacement`` (floor; floors in plan:
+    floor × direction), ``peak_contact_force`` and ``impact_count`` (contact), ``scale_factor``, ``intensity``
+    and the scenario's status; floors in plan add ``peak_rotation``, ``peak_corner_displacement_magnitude``
+    (floor × corner), ``peak_plane_drift(_ratio)`` (plane) and ``contact_dissipation``.
+    """
+    import numpy as np
+    import xarray as xr
+
+    from pounding.results.checks import study_warnings
+    from pounding.results.dataset import PGA_LONG_NAME
+    from pounding.studies.sweep.scaling import PAIR_PGA_LONG_NAME
+
+    scenarios = sweep.scenarios()
+    parts = [results.get(s.key, {"status": "error", "error": "not run"}) for s in scenarios]
+    layout = _Layout(sweep, parts)
+    coords, storeys, floors, contacts = _label_coords(layout)
+    displacement = layout.spread("floor", floors, "peak_displacement")
+    in_plan = displacement.ndim > len(layout.shape) + 1
+    status = layout.scalar("status", "error", object, every=True)
+    var = layout.var
+    data_vars = {
+        "peak_drift_ratio": var(("storey",), layout.spread("storey", storeys, "peak_drift_ratio"), "1",
+                                "peak storey drift ratio (drift / storey height)"
+                                + ("; a storey in plan: the largest of its planes'" if in_plan else "")),
+        "peak_displacement": var(("floor", "direction") if in_plan else ("floor",), displacement, "m",
+                                 "peak |displacement| of the floor's centre of mass relative to the ground"
+                                 if in_plan else "peak floor displacement relative to the ground"),
+        "peak_contact_force": var(("contact",), layout.spread("contact", contacts, "peak_contact_force"), "N",
+                                  "peak contact force of the gap element"),
+        "impact_count": var(("contact",), layout.spread("contact", contacts, "impact_count", -1, np.int32), "1",
+                            "number of impacts (gap closures)",
+                            comment="-1 where the scenario has no result (status != ok)"),
+        "energy_closure_error": var((), layout.scalar("energy_closure_error"), "1",
+                                    "max |E_in - sum of energies| / max |E_in|"),
+        "scale_factor": var((), layout.scalar("scale_factor"), "1",
+                            "factor applied to the record as stored (catalogue or file), after processing"
+                            + ("; one factor on both components of the pair" if sweep.pairs else "")),
+        "intensity": var((), layout.scalar("intensity"), "m s-2", PAIR_PGA_LONG_NAME if sweep.pairs else
+                         PGA_LONG_NAME),
+        "wall_time": var((), layout.scalar("wall_time", every=True), "s",
+                         "wall time of the scenario on its worker (model, record, solver)"),
+        "solver_wall_time": var((), layout.scalar("solver_wall_time"), "s", "wall time of the integration alone"),
+        "status": var((), status.astype(str), None, "scenario status: ok or error"),
+        "run_status": var((), layout.scalar("run_status", "", object, missing="unknown").astype(str), None,
+                          "how the run ended: completed, collapsed or unstable (peaks of a collapsed or unstable "
+                          "run are those up to end_time); empty where status != ok, unknown for a resumed part "
+                          "that predates it"),
+        "end_time": var((), layout.scalar("end_time"), "s",
+                        "time at which the run ended (the record's end unless it collapsed)"),
+        "error": var((), np.array([p.get("error", "") or "" for p in parts], dtype=object).reshape(layout.shape)
+                     .astype(str), None, "error message of a failed scenario (empty if ok)"),
+        "scenario_id": var((), np.array([s.key[:16] for s in scenarios], dtype=object).reshape(layout.shape)
+                           .astype(str), None, "first 16 hex digits of the scenario hash (name of its part file)"),
+    }
+    extras, extra_coords = _plan_extras(layout, floors)
+    data_vars.update(extras)
+    for dim in sweep.dimensions:
+        if dim.zipped:
+            coords[dim.name] = (dim.name, np.arange(dim.size, dtype=np.int32),
+                                {"long_name": "zip group of " + ", ".join(a.key for a in dim.axes)})
+        for axis in dim.axes:
+            coords[axis.name] = (dim.name, _coord_values(axis.labels), _axis_attrs(axis, sweep))
+    coords.update(extra_coords)
+    coords.update(_contact_places(layout, contacts))
+    if in_plan:
+        coords["direction"] = ("direction", np.array(["x", "y"], dtype=str), {"long_name": "plan direction"})
     attrs = sweep_attrs(sweep, status, ran=ran, elapsed=elapsed,
                         title=f"pounding sweep '{sweep.name}' ({sweep.size} scenarios) of {sweep_heading(sweep)}")
     warnings = study_warnings(part.get("warnings") for part in parts if part.get("status") == "ok")
@@ -161,12 +250,12 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
-def sweep_attrs(sweep, status, *, ran: int, elapsed: float, title: str, kind: str | None = None) -> dict[str, Any]:
-    """The global attributes of a sweep's dataset, planar and plan.
+def sweep_attrs(sweep, status, *, ran: int, elapsed: float, title: str) -> dict[str, Any]:
+    """The global attributes of a sweep's dataset.
 
     Parameters
     ----------
-    sweep : Sweep or PlanSweep
+    sweep : Sweep
         The sweep (its name, file, text, base model and axes).
     status : ndarray
         Each scenario's status (``n_errors``: those not ``ok``).
@@ -176,8 +265,6 @@ def sweep_attrs(sweep, status, *, ran: int, elapsed: float, title: str, kind: st
         Wall time of this call, s.
     title : str
         The dataset's title.
-    kind : str, optional
-        The dataset's ``kind`` attribute (a plan sweep's ``plan_sweep``), after ``history``.
     """
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     attrs: dict[str, Any] = {
@@ -186,8 +273,6 @@ def sweep_attrs(sweep, status, *, ran: int, elapsed: float, title: str, kind: st
         "source": f"pounding {__version__}",
         "history": f"{now} swept with pounding {__version__} from {sweep.label}",
     }
-    if kind is not None:
-        attrs["kind"] = kind
     attrs.update({
         "sweep_name": sweep.name,
         "sweep_file": sweep.label,
@@ -213,10 +298,20 @@ def _coord_values(labels: tuple[Any, ...]):
     return np.array([str(v) for v in labels], dtype=str)
 
 
-def _axis_attrs(axis: Axis) -> dict[str, str]:
-    long_name = {"record": "ground-motion record", "scale": "scale factor on the record",
-                 "xi": "xi formula of every hertz-damp contact",
-                 "contacts": "with: the contacts as modelled; without: every contact held open (no pounding)"}.get(axis.kind, f"swept model value {axis.key}")
+def _axis_attrs(axis: Axis, sweep: Sweep) -> dict[str, str]:
+    """``long_name``, ``sweep_axis`` and ``units`` of an axis's coordinate (its records pairs when *sweep*'s are)."""
+    if axis.kind == "eccentricity":
+        building, direction, _ = axis.target
+        name = sweep.base_document["buildings"][building]["name"]
+        long_name = f"shift of every floor's centre of mass of building {name} along {'xy'[direction]}"
+    else:
+        long_name = {"record": "ground-motion record pair (components a and b)" if sweep.pairs else
+                     "ground-motion record",
+                     "scale": "scale factor on both components of the pair" if sweep.pairs else
+                     "scale factor on the record",
+                     "xi": "xi formula of every hertz-damp contact",
+                     "contacts": "with: the contacts as modelled; without: every contact held open (no pounding)"
+                     }.get(axis.kind, f"swept model value {axis.key}")
     attrs = {"long_name": long_name, "sweep_axis": axis.key}
     if axis.units:
         attrs["units"] = axis.units

@@ -1,4 +1,12 @@
-"""One scenario of a sweep, run on a worker: a model document in, a small dict of peaks out."""
+"""One scenario of a sweep, run on a worker: a model document in, a small dict of peaks out.
+
+The peaks are read from the run's archive by what it holds (:func:`scenario_peaks`), for
+every model: the storeys (peak drift ratio; a storey of a building in plan: the largest of its
+planes'), the floors (peak displacement; in plan per direction x, y), the contacts (impacts and
+peak force; in plan each contact point, with its place and normal), the scale factor, the
+intensity reached and how the run ended.  A run whose floors move in plan also has rotations,
+corners and planes: their peaks are kept when the archive has their dimensions.
+"""
 
 from __future__ import annotations
 
@@ -10,11 +18,97 @@ from pounding.studies.engine.keys import PARTS_FORMAT
 from pounding.studies.engine.tasks import one_line
 from pounding.studies.sweep.spec import strip_location
 
-__all__ = ["run_scenario"]
+__all__ = ["run_scenario", "scenario_model_of", "scenario_peaks"]
 
 # --------------------------------------------------------------------------- #
 # One scenario (runs on a worker)
 # --------------------------------------------------------------------------- #
+
+
+def _texts(values) -> list[str]:
+    return [str(x) for x in values]
+
+
+def _floats(values) -> list[float]:
+    return [float(x) for x in values]
+
+
+def _ints(values) -> list[int]:
+    return [int(x) for x in values]
+
+
+def _plan_peaks(ds) -> dict[str, Any]:
+    """The peaks of a run's floors in plan, where the archive has them (module docstring): rotations,
+    corners, planes, the contact points' places and the contacts' dissipated energy."""
+    out: dict[str, Any] = {}
+    if "peak_rotation" in ds:
+        out["peak_rotation"] = _floats(ds.peak_rotation.values)
+    if "corner" in ds.dims and "peak_corner_displacement_magnitude" in ds:
+        out["corner"] = _texts(ds.corner.values)
+        out["peak_corner_displacement_magnitude"] = ds.peak_corner_displacement_magnitude.values.tolist()
+    if "plane" in ds.dims:
+        out.update(plane=_texts(ds.plane.values), plane_building=_texts(ds.plane_building.values),
+                   plane_storey=_ints(ds.plane_storey.values), plane_direction=_texts(ds.plane_direction.values),
+                   plane_at=_floats(ds.plane_at.values), plane_height=_floats(ds.plane_height.values),
+                   peak_plane_drift=_floats(ds.peak_plane_drift.values),
+                   peak_plane_drift_ratio=_floats(ds.peak_plane_drift_ratio.values))
+        energy = ds.energy_contact.values
+        out["contact_dissipation"] = float(energy[-1]) if energy.size else 0.0
+    if "point_x" in ds.coords:
+        out.update(point_x=_floats(ds.point_x.values), point_y=_floats(ds.point_y.values),
+                   point_normal=_texts(ds.point_normal.values))
+    return out
+
+
+def scenario_peaks(ds) -> dict[str, Any]:
+    """What a study keeps of a run archive *ds* as plain data (module docstring): labels and peaks."""
+    return {
+        "run_status": str(ds.attrs["status"]),   # completed, collapsed or unstable
+        "end_time": float(ds.time.values[-1]),
+        "storey": _texts(ds.storey.values),
+        "storey_building": _texts(ds.storey_building.values),
+        "storey_level": _ints(ds.storey_level.values),
+        "height": _floats(ds.height.values),
+        "floor": _texts(ds.floor.values),
+        "building": _texts(ds.building.values),
+        "level": _ints(ds.level.values),
+        "elevation": _floats(ds.elevation.values),
+        "contact": _texts(ds.contact.values),
+        "building_left": _texts(ds.building_left.values),
+        "building_right": _texts(ds.building_right.values),
+        "level_left": _ints(ds.level_left.values),
+        "level_right": _ints(ds.level_right.values),
+        "peak_drift_ratio": _floats(ds.peak_drift_ratio.values),
+        "peak_displacement": ds.peak_displacement.values.tolist(),   # (floor,) or in plan (floor, direction)
+        "peak_contact_force": _floats(ds.peak_contact_force.values),
+        "impact_count": _ints(ds.impact_count.values),
+        "energy_closure_error": float(ds.attrs["energy_closure_error"]),
+        "solver_wall_time": float(ds.attrs["wall_time"]),
+        **_plan_peaks(ds),
+    }
+
+
+def scenario_model_of(task: dict[str, Any]):
+    """The model a scenario *task* runs: from its plain data (or YAML text), a record pair scaled to its target
+    (:mod:`pounding.studies.sweep.scaling`).
+
+    Raises
+    ------
+    ModelError
+        ``invalid model: ...`` (one line, no location in the scenario's document).
+    """
+    from pounding.model.document import parse_document
+    from pounding.studies.sweep.scaling import pair_scaled, scenario_model
+
+    try:
+        data = task.get("data")
+        if data is None:
+            data = parse_document(task["document"], f"<{task.get('name', 'model')}>").data
+        model, target = scenario_model(data, name=task.get("name", "model"), source=task["document"],
+                                       base_dir=task.get("base_dir"))
+    except ModelError as exc:
+        raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
+    return model if target is None else pair_scaled(model, target)
 
 
 def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
@@ -27,52 +121,18 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT}
     try:
-        from pounding.model.model import model_from_data, model_from_text
         from pounding.results.checks import run_warnings
-        from pounding.results.dataset import record_pga
         from pounding.simulation import refuse_failed_run, simulate
+        from pounding.studies.sweep.scaling import run_intensity
 
-        try:
-            if task.get("data") is not None:
-                model = model_from_data(task["data"], name=task.get("name", "model"), source=task["document"],
-                                        base_dir=task.get("base_dir"))
-            else:
-                model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
-        except ModelError as exc:
-            raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
+        model = scenario_model_of(task)
         ds = simulate(model)
         refuse_failed_run(ds.attrs["status"], ds.attrs.get("status_message", ""))   # energy_inconsistent: an error
-        result.update({
-            "warnings": run_warnings(ds),
-            "scale_factor": float(ds.attrs["record_scale"]),
-            "intensity": record_pga(ds)[1],
-            "status": "ok",
-            "run_status": str(ds.attrs["status"]),   # completed, collapsed or unstable
-            "end_time": float(ds.time.values[-1]),
-            "storey": [str(x) for x in ds.storey.values],
-            "storey_building": [str(x) for x in ds.storey_building.values],
-            "storey_level": [int(x) for x in ds.storey_level.values],
-            "height": [float(x) for x in ds.height.values],
-            "floor": [str(x) for x in ds.floor.values],
-            "building": [str(x) for x in ds.building.values],
-            "level": [int(x) for x in ds.level.values],
-            "elevation": [float(x) for x in ds.elevation.values],
-            "contact": [str(x) for x in ds.contact.values],
-            "building_left": [str(x) for x in ds.building_left.values],
-            "building_right": [str(x) for x in ds.building_right.values],
-            "level_left": [int(x) for x in ds.level_left.values],
-            "level_right": [int(x) for x in ds.level_right.values],
-            "peak_drift_ratio": [float(x) for x in ds.peak_drift_ratio.values],
-            "peak_displacement": [float(x) for x in ds.peak_displacement.values],
-            "peak_contact_force": [float(x) for x in ds.peak_contact_force.values],
-            "impact_count": [int(x) for x in ds.impact_count.values],
-            "energy_closure_error": float(ds.attrs["energy_closure_error"]),
-            "solver_wall_time": float(ds.attrs["wall_time"]),
-        })
+        result.update({"warnings": run_warnings(ds), "scale_factor": float(ds.attrs["record_scale"]),
+                       "intensity": run_intensity(model, ds), "status": "ok", **scenario_peaks(ds)})
         if task.get("keep_history"):
             result["dataset"] = ds
     except Exception as exc:  # noqa: BLE001 - a failing scenario is a result, not a crash
         result["error"] = f"{task.get('where', 'scenario')}: {one_line(exc)}"
     result["wall_time"] = time.perf_counter() - started
     return result
-

