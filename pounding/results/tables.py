@@ -130,13 +130,27 @@ def scenario_dims(ds) -> tuple[str, ...]:
 def sweep_tables(ds) -> dict:
     """Tables of a sweep (or compare) archive: ``storeys`` (peak drift ratio per scenario and storey),
     ``contacts`` (impacts and peak force per scenario and contact) and ``scenarios`` (status, energy
-    closure error, error message).  A failed scenario's values are NaN."""
+    closure error, error message).  A failed scenario's values are NaN.
+
+    Where the archive has them (floors in plan): ``planes`` (peak drift ratio and drift per scenario and
+    plane), ``floors`` (peak displacement per scenario, floor and direction, and peak rotation) and ``corners``
+    (peak corner displacement per scenario, floor and corner)."""
     tables = {"storeys": long_table(ds, ["peak_drift_ratio"], extra=_present(ds, ["status", "storey_building",
                                                                                    "storey_level"]))}
     if ds.sizes.get("contact", 0):
         tables["contacts"] = long_table(ds, _present(ds, ["impact_count", "peak_contact_force"]),
-                                        extra=_present(ds, ["status"]))
-    tables["scenarios"] = long_table(ds, _present(ds, ["status", "energy_closure_error", "error"]))
+                                        extra=_present(ds, ["status", "point_x", "point_y", "point_normal"]))
+    if ds.sizes.get("plane", 0):
+        tables["planes"] = long_table(ds, ["peak_plane_drift_ratio", "peak_plane_drift"], extra=_present(
+            ds, ["status", "plane_building", "plane_storey", "plane_direction", "plane_at"]))
+    if "direction" in ds.dims and "peak_displacement" in ds:
+        tables["floors"] = long_table(ds, ["peak_displacement"], extra=_present(ds, ["status", "building", "level",
+                                                                                     "peak_rotation"]))
+    if "peak_corner_displacement_magnitude" in ds:
+        tables["corners"] = long_table(ds, ["peak_corner_displacement_magnitude"],
+                                       extra=_present(ds, ["status", "building", "level"]))
+    tables["scenarios"] = long_table(ds, _present(ds, ["status", "scale_factor", "intensity", "energy_closure_error",
+                                                       "error"]))
     return tables
 
 

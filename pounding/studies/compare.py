@@ -18,6 +18,10 @@ drift ratio without and with pounding, the change ``(d_with − d_without) /
 d_without`` (mean and largest over the records, also archived as
 ``pounding_drift_change``) and the record where pounding raises it most;
 ``--plot`` draws the two profiles beside the change per storey.
+
+A model in plan is compared by the same code on the same archive layout (record pairs; a storey's drift is
+the largest of its planes'); its table adds, per building, the largest peak corner and centre-of-mass
+displacements and the roof's peak rotation (:func:`building_rows`), read from the archive's dimensions.
 """
 
 from __future__ import annotations
