@@ -16,6 +16,7 @@ import pytest
 import xarray as xr
 
 from pounding.cli import main
+from pounding.results.tables import sweep_tables
 
 ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
@@ -136,6 +137,10 @@ def test_sweep_csv_has_numeric_axes_with_their_units(written):
     assert "gap [m]" in table
     assert sorted(set(table["gap [m]"])) == [0.01, 0.03]
     np.testing.assert_array_equal(table["peak_drift_ratio [-]"], ds.peak_drift_ratio.values.ravel())
+    scenarios = _read(csv.with_name("sweep.scenarios.csv"))   # every study archive: each scenario's factor and PGA
+    np.testing.assert_array_equal(scenarios["scale_factor [-]"], ds.scale_factor.values.ravel())
+    np.testing.assert_array_equal(scenarios["intensity [m s-2]"], ds.intensity.values.ravel())
+    assert "planes" not in sweep_tables(ds) and "corners" not in sweep_tables(ds)   # floors in plan only
 
 
 @pytest.mark.parametrize("kind", list(COMMANDS))
