@@ -368,14 +368,14 @@ def element_arrays(model: Model, mass: np.ndarray, ground: GroundRows) -> dict[s
         laws.append(gap.law.law_id)
         params.append(gap.law.kernel_parameters(side_mass(terms_left, mass), side_mass(terms_right, mass)))
     for link in model.links:
-        lf = model.dof_offsets[link.left] + link.level_left - 1
-        rf = model.dof_offsets[link.right] + link.level_right - 1
-        left.append(lf)
-        right.append(rf)
-        floors.append([lf, -1, rf, -1])
-        weights.append([1.0, 0.0, -1.0, 0.0])
-        ground_left.append(ground.of(link.left, "x"))
-        ground_right.append(ground.of(link.right, "x"))
+        terms_left, main_left = side_terms(model, link.left, link.level_left, None, link.point, link.normal)
+        terms_right, main_right = side_terms(model, link.right, link.level_right, None, link.point, link.normal)
+        left.append(main_left)
+        right.append(main_right)
+        floors.append([f for f, _ in terms_left] + [f for f, _ in terms_right])
+        weights.append([w for _, w in terms_left] + [0.0 - w for _, w in terms_right])
+        ground_left.append(ground.of(link.left, link.normal))
+        ground_right.append(ground.of(link.right, link.normal))
         gaps.append(0.0)
         laws.append(link.law.law_id)
         params.append(link.law.kernel_parameters())
