@@ -151,12 +151,14 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
         rayleigh = chain and building.damping.kind == "rayleigh"
         c_mass, c_stiff = building.rayleigh_coefficients if rayleigh else (0.0, 0.0)
         a0.append(np.full(n, c_mass) if rayleigh else np.zeros(n))
-        a1.append(np.full(n, c_stiff) if rayleigh else np.zeros(n))
+        a1.append(c_stiff * _tangent_ratios(building) if rayleigh else np.zeros(n))
         dense_size.append(0 if rayleigh else n)
         if not rayleigh:
             damping = np.asarray(building.damping_matrix(), dtype=float)
+            # The springs act with their elastic stiffness (a yielding plane's row adds F − kΔ); damping is on the
+            # initial tangent (the building's damping matrix).
             k = (np.zeros((n, n)) if chain else
-                 np.asarray(building.stiffness_matrix() + building.geometric_stiffness(), dtype=float))
+                 np.asarray(building.stiffness_matrix(initial=False) + building.geometric_stiffness(), dtype=float))
             dense_values.append(damping.ravel())
             dense_stiffness.append(k.ravel())
             dense_band.append(n - 1 if chain else _half_bandwidth(damping, k))
@@ -179,6 +181,14 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
         arrays["dense_stiffness"] = np.ascontiguousarray(np.concatenate(dense_stiffness) if dense_stiffness
                                                          else np.zeros(0))
     return arrays
+
+
+def _tangent_ratios(building: Any) -> np.ndarray:
+    """(n,) each storey's tangent stiffness at rest over its elastic stiffness: 1 exactly, but for a Bouc–Wen
+    storey with A ≠ 1, so that the chain's Rayleigh term ``a1·k`` acts on the initial tangent as the damping
+    matrix does (docs/physics.md §7)."""
+    return np.array([1.0 if p.hysteresis is None or p.initial_stiffness == float(p.stiffness)
+                     else p.initial_stiffness / float(p.stiffness) for s in building.storeys for p in s.planes])
 
 
 def _bands(sizes: list[int], bands: list[int]) -> np.ndarray:
