@@ -741,6 +741,8 @@ def run_script(source: str, name: str) -> dict:
         done = subprocess.run([sys.executable, str(script), "-o", str(peaks_file)], capture_output=True,
                               text=True, cwd=folder)
         if not peaks_file.exists():
-            last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+            # OpenSees prints "Process 0 Terminating" as the interpreter exits: the script's own last word is before
+            last = ([line for line in done.stderr.splitlines() if line.strip() and "Process 0 Terminating" not in line]
+                    or ["no output"])[-1]
             raise PoundingError(f"the OpenSees script for {name} failed (exit {done.returncode}): {last}")
         return json.loads(peaks_file.read_text(encoding="utf-8"))
