@@ -119,7 +119,7 @@ def domain_modes(model: PlanModel) -> list[tuple[float, float, str, int]]:
 
 
 def _repeated_frequency(model: PlanModel) -> str | None:
-    """Why OpenSees' modalDamping cannot write *model*'s modal damping (two modes, one frequency, two ratios), or None."""
+    """Why OpenSees' modalDamping cannot write *model*'s modal damping (one frequency, two ratios), or None."""
     if all(b.damping.kind != "modal" for b in model.buildings):
         return None
     rows = domain_modes(model)
@@ -286,7 +286,8 @@ def _contact_rows(model: PlanModel, nodes: _Nodes, element: int, notes: list[str
     for c in model.contacts:
         first = (c.first, c.level_first)
         second = None if c.second == WALL else (c.second, c.level_second)
-        label = f"{names[c.first]}:{c.level_first}-" + ("wall" if second is None else f"{names[c.second]}:{c.level_second}")
+        label = f"{names[c.first]}:{c.level_first}-" + (
+            "wall" if second is None else f"{names[c.second]}:{c.level_second}")
         material, warnings = contact_material(c.law, c.gap)
         notes += [w for w in warnings if w not in notes]
         for point in c.points:
@@ -299,8 +300,8 @@ def _contact_rows(model: PlanModel, nodes: _Nodes, element: int, notes: list[str
 
 def _damping_rows(model: PlanModel, masters: dict[tuple[int, int], int],
                   plane_elements: dict[int, list[int]]) -> tuple[list[tuple], list[float], list[float]]:
-    """(Rayleigh rows ``(name, a0, a1, plane elements, master nodes)`` of the Rayleigh-damped buildings,
-    the modal ratios of the domain's modes in OpenSees' order and their ω² (1/s²); both empty without modal damping)."""
+    """(Rayleigh rows ``(name, a0 1/s, a1 s, plane elements, master nodes)`` of the Rayleigh-damped buildings,
+    the modal ratios of the domain's modes in OpenSees' order, their ω² (1/s²)); both empty without modal damping."""
     rayleigh = []
     for b_index, b in enumerate(model.buildings):
         if b.damping.kind == "rayleigh":
@@ -519,7 +520,7 @@ def build(log_file=None):
 
 
 def modal_damping():
-    """OpenSees' modalDamping with every building's own modes (call after the nodes and diaphragms, before any element).
+    """OpenSees' modalDamping with our modes and ratios: after the nodes and diaphragms, before any element.
 
     The eigen analysis sees the planes as Elastic stand-ins of their initial tangent only (the stiffness our
     modes are of: no P-Delta, no contact, and no hysteretic material's own idea of its tangent), all N modes of
