@@ -164,9 +164,9 @@ def test_plan_model_agrees_with_opensees(source, duration):
     assert peer["plane"][0].startswith("A:1:") and len(peer["plane"]) == ours.sizes["plane"]
 
 
-def _edited(old: str, new: str, text: str = SMALL):
-    assert old in text
-    return plan_model_from_text(text.replace(old, new, 1), name="small")
+def _edited(old: str, new: str):
+    assert old in SMALL
+    return plan_model_from_text(SMALL.replace(old, new, 1), name="small")
 
 
 def _yield_drifts(model) -> np.ndarray:

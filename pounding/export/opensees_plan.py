@@ -38,8 +38,9 @@ writes, for a model whose buildings take ``plan:``:
   uncoupled at rest this is each building's ``MΦ diag(2ζω) ΦᵀM`` over its 3n
   modes, our damping matrix.  The masters must come last in node order: in
   OpenSees 3.7 (``IncrementalIntegrator::setupModal``) a diaphragm slave's DOF
-  group copies its own node's eigenvector rows (never set: zero) into its
-  master's equations, and the last DOF group written wins.  The system is
+  group copies its own node's eigenvector rows (which OpenSees never fills for a
+  constrained node) over its master's equations, and the last DOF group written
+  wins: numbered first, the masters get a wrong modal matrix.  The system is
   ``FullGeneral`` (the modal matrix couples every floor of a building;
   ``BandGeneral`` would drop what lies outside the elements' band);
 * with ``p_delta: true``, per storey one ``zeroLength`` at the weight's centroid
@@ -58,7 +59,8 @@ writes, for a model whose buildings take ``plan:``:
 Refused in one line (:func:`plan_export_refusal`): friction (``friction:`` on a
 contact), and modal damping in a model where two modes share a frequency with
 different damping ratios (OpenSees sets one ratio per mode of the whole domain
-and picks its own eigenvectors of a repeated frequency).  The differences from
+in its eigen solver's order, and the order and eigenvectors of modes at one
+frequency are that solver's choice; with one ratio any choice gives our matrix).  The differences from
 our solver that remain are the planar export's (module
 :mod:`pounding.export.opensees`): Hertzdamp reads its ξ one step after closure
 and never clamps the pull before separation (compare with ``tension: allow``,
@@ -84,8 +86,8 @@ import numpy as np
 
 from pounding import __version__
 from pounding.errors import PoundingError
-from pounding.export.opensees import (DEFAULT_DT, SCRIPT_PARTS, contact_material, inert, initial_tangent, run_script,
-                                      storey_material, tension_allowed)
+from pounding.export.opensees import initial_tangent, storey_material
+from pounding.export.opensees import DEFAULT_DT, contact_material, inert, run_script, SCRIPT_PARTS, tension_allowed
 from pounding.model.model import WALL
 from pounding.model.plan import DOF_PER_FLOOR, plan_geometric_terms
 from pounding.model.plan_model import PlanModel
@@ -126,9 +128,10 @@ def _repeated_frequency(model: PlanModel) -> str | None:
     for (w1, r1, b1, m1), (w2, r2, b2, m2) in zip(rows, rows[1:]):
         if w2 - w1 <= REPEATED_FREQUENCY * w2 and r1 != r2:
             return (f"modal damping: mode {m1} of {b1} and mode {m2} of {b2} share a frequency "
-                    f"({math.sqrt(w2) / (2.0 * math.pi):.6g} Hz, ω² within {REPEATED_FREQUENCY:g}) with damping "
-                    f"ratios {r1:g} and {r2:g} (0 for a Rayleigh-damped building): OpenSees' modalDamping sets one "
-                    "ratio per mode of the whole domain, and its eigenvectors of a repeated frequency may mix the two")
+                    f"({math.sqrt(w2) / (2.0 * math.pi):.6g} Hz, ω² within {REPEATED_FREQUENCY:g}) but take damping "
+                    f"ratios {r1:g} and {r2:g} (0 for a Rayleigh-damped building): OpenSees' modalDamping gives one "
+                    "ratio per mode of the whole domain in its eigen solver's order, and the order and eigenvectors "
+                    "of modes at one frequency are that solver's choice, so it cannot write this damping matrix")
     return None
 
 
@@ -201,8 +204,8 @@ class _Nodes:
     """Node numbering: slaves by floor and rest location, fixed ground nodes by location, then the masters.
 
     The masters are numbered after every other node (:meth:`numbered`): OpenSees' modal damping reads the
-    eigenvectors DOF group by DOF group in node order, and a diaphragm slave's group writes zeros into its
-    master's equations, so the master must come last (module docstring).
+    eigenvectors DOF group by DOF group in node order, and a diaphragm slave's group writes its own node's
+    (unfilled) rows over its master's equations, so the master must come last (module docstring).
     """
 
     def __init__(self) -> None:
@@ -527,7 +530,7 @@ def modal_damping():
     the domain (-fullGenLapack: ARPACK finds at most N - 1); then the stand-ins go.  OpenSees damps with
     sum 2 zeta omega (M phi)(M phi)^T over the domain's mass-normalised modes, in the force and the tangent.
     The masters have the highest node tags: OpenSees reads the modal vectors DOF group by DOF group in node
-    order, and a diaphragm slave's group writes zeros into its master's equations (the master must come last).
+    order, and a diaphragm slave's group writes its node's unfilled rows over its master's equations.
     """
     stand_ins = []
     for ele, i, j, direction, _k, _label, _material, k0 in PLANES:
