@@ -283,9 +283,11 @@ class PlanContactEntry(ContactEntry):
         if self.gap is not None and self.gap < 0.0:
             raise problem("must be >= 0", at=here + ("gap",))
         levels = contact_levels(index, self, first, second)
-        if any(a is not None or b is not None for (_, a), (_, b) in levels):
-            raise problem("column points {storey, at} are for planar models; a plan contact joins floors",
-                          kind="error", at=here + ("levels",), fallback=True)
+        if self.friction and any(a is not None or b is not None for (_, a), (_, b) in levels):
+            raise problem("Coulomb friction on a face needs the slip of two floors; a column point {storey, at} "
+                          "slides with the column's deflection between two floors, which the friction face does not "
+                          "follow: remove friction or strike a floor", kind="error", at=here + ("friction",),
+                          line="key", colon=False)
         self._pairs = tuple((a[0], b[0]) for a, b in levels)
         self._points = tuple((a[1], b[1]) for a, b in levels)
         self._face = self._wall_face(index, first) if second is None else self._geometry_face(index, first, second)
