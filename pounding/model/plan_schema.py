@@ -20,6 +20,7 @@ from pounding.model import plan, plan_contacts
 from pounding.model.document import Document, Location, plural
 from pounding.model.ground_pair import pair_components
 from pounding.model.schema import (TAGS, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
+                                   DesignEntry,
                                    HysteresisUnion, ModalEntry, between_indices, list_shape, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
                                    as_number, contact_levels, hysteresis_parameters, located, problem,
                                    record_reference, storey_count, units_name, validate)
@@ -140,11 +141,11 @@ def _no_own_record(value: Any) -> Any:
 
 
 class PlanBuildingEntry(SchemaEntry):
-    """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``."""
+    """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``, ``design``."""
 
     WHAT: ClassVar[str] = "a mapping {name, plan, storeys, damping}"
     CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": PlanStoreyEntry, "plan": PlanEntry,
-                                                      "collapse": CollapseEntry}
+                                                      "collapse": CollapseEntry, "design": DesignEntry}
 
     name: Annotated[str, BeforeValidator(located(as_name))] = Field(description="unique building name")
     plan: PlanEntry = Field(description="{outline: [[x0, y0], [x1, y1]]}")
@@ -154,6 +155,9 @@ class PlanBuildingEntry(SchemaEntry):
     p_delta: Annotated[bool, BeforeValidator(located(as_bool))] = Field(
         False, description="leaning-column P-Delta from the floor weights, true or false")
     ground_motion: Annotated[Any, BeforeValidator(_no_own_record)] = None
+    design: DesignEntry | None = Field(
+        None, description="design factors per code for pounding gap --code, e.g. {asce7_22: {R: 8, Cd: 5.5, Ie: 1}, "
+                          "ec8: {q: 3.9}}")
     collapse: CollapseEntry | None = Field(
         None, description="this building's collapse criterion {drift_ratio}: any of its planes' |drift ratio| "
                           "(default: solver.stop_drift_ratio)")
