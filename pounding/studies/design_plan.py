@@ -81,7 +81,7 @@ from pounding.studies.design import (EC8_MEAN_RECORDS, SUITE_PERIODS, ModalRespo
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ACCIDENTAL_ECCENTRICITY", "ORTHOGONAL_FRACTION", "TORSIONAL_IRREGULARITY", "EXTREME_TORSIONAL_IRREGULARITY",
-           "AMPLIFICATION_LIMIT", "DirectionalDesign", "plan_dimension", "edge_weights", "principal_mode",
+           "AMPLIFICATION_LIMIT", "ROTD_SAMPLES_PER_PERIOD", "DirectionalDesign", "plan_dimension", "edge_weights", "principal_mode",
            "modal_floor_forces", "ec8_floor_forces", "torsion_displacements", "torsion_ratios",
            "torsional_amplification", "asce7_22_design_category", "directional_designs", "combine_directions",
            "floor_weights", "point_design_displacement", "building_designs", "plan_code_displacements",
@@ -545,13 +545,15 @@ def _building_summary(building, found: dict[str, Any], code: str) -> dict[str, A
     text = (f"RSA with {found['spectra'][building.name].name}, {rsa.n_modes} mode(s), {mass} of the mass, CQC; "
             f"accidental torsion +-5 % ({torsion}) as static moments; "
             + ("directions 100 % + 30 % (§12.5.3.1)" if code == "asce7-22" else "directions SRSS (§4.3.3.5.1)"))
+    ratio = design["irregularity"]
+    kind = ("Type 1b" if ratio > EXTREME_TORSIONAL_IRREGULARITY else "Type 1a" if ratio > TORSIONAL_IRREGULARITY
+            else "no torsional irregularity")
+    text += f"; end drift ratio {ratio:.3f} ({kind})"
     if code == "asce7-22":
         amplification = np.concatenate([item.amplification for item in directions.values()])
-        text += (f"; SDC {design['category']}{' or above' if design['category'] == 'D' else ''}, end drift ratio "
-                 f"{design['irregularity']:.3f}: " + (f"A_x {amplification.min():.2f}-{amplification.max():.2f}"
-                                                       if design["amplified"] else "A_x not required"))
-    else:
-        text += f"; end drift ratio {design['irregularity']:.3f}"
+        text += (f", SDC {design['category']}{' or above' if design['category'] == 'D' else ''}: "
+                 + (f"A_x {amplification.min():.2f}-{amplification.max():.2f}" if design["amplified"]
+                    else "A_x not required"))
     return {"description": text, "modes": rsa.n_modes, "periods": rsa.periods.tolist(),
             "spectrum": found["spectra"][building.name].name, "design_factor": found["scale"][building.name],
             "mass_fraction": {d: item.rsa.mass_fraction for d, item in directions.items()},
