@@ -18,10 +18,10 @@ __all__ = ["register_cli"]
 def _cmd_code_gap(args: argparse.Namespace, *, plan: bool = False) -> int:
     """``pounding gap MODEL --code CODE ...``: the code's separations beside the simulated requirement.
 
-    A plan model (*plan*) is checked at every contact point (:func:`pounding.studies.design_plan.plan_code_gap_study`).
+    A plan model (*plan*) is checked at every contact point (:func:`pounding.studies.design_directions.plan_code_gap_study`).
     """
     from pounding.studies.design import code_gap_study, code_gap_summary, code_gap_table
-    from pounding.studies.design_plan import plan_code_gap_study
+    from pounding.studies.design_directions import plan_code_gap_study
 
     for given, option in ((args.scale, "--scale"), (args.output, "-o"), (args.plot, "--plot"), (args.csv, "--csv")):
         if given is not None:

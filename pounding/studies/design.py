@@ -33,7 +33,7 @@ first, that reach 90 % of the mass in *each* horizontal direction (ASCE 7-22
 combination w · q of the DOF (a point's displacement along a face normal) is
 combined from its modal values, CQC(w · u_k) (:meth:`ModalResponse.at`).  The
 plan-only steps (accidental torsion, the two directions, contact points) are
-in :mod:`pounding.studies.design_plan`.
+in :mod:`pounding.studies.design_directions`.
 """
 
 from __future__ import annotations
@@ -665,7 +665,7 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
 def code_gap_table(result: dict[str, Any]) -> str:
     """The code check as a printed table (millimetres): one row per level pair, or per contact point of a plan model.
 
-    A plan model's result (:func:`pounding.studies.design_plan.plan_code_gap_study`) adds the model's
+    A plan model's result (:func:`pounding.studies.design_directions.plan_code_gap_study`) adds the model's
     gap per point, names the sides ``1`` and ``2`` (the contact's first and second building) and describes
     each building's analysis in its own ``description``.
     """

@@ -1,4 +1,10 @@
-"""``pounding gap --code`` on plan models: 3-D response spectra, accidental torsion, a separation per contact point.
+"""Design displacements along two horizontal directions with accidental torsion, per contact point.
+
+What ``pounding gap --code`` computes for buildings whose floors are in plan (rigid floors with
+u_x, u_y, θ): 3-D response spectra along each direction, accidental torsion, the two directions
+combined, and the code's separation at every contact point.  A building whose floors have one
+degree of freedom has none of these: its modal response along x is the whole answer
+(:mod:`pounding.studies.design`, which this module builds on).
 
 A plan building (docs/plan-models.md: rigid floors with u_x, u_y, θ) is
 analysed on its own, as a planar one (:func:`pounding.studies.design.modal_response`,

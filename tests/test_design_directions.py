@@ -20,7 +20,7 @@ from pounding.records.design_spectra import asce7_22_spectrum, ec8_ground_parame
 from pounding.records.load import load_record
 from pounding.records.spectra import response_spectrum
 from pounding.studies.design import modal_response
-from pounding.studies.design_plan import (asce7_22_design_category, combine_directions, directional_designs,
+from pounding.studies.design_directions import (asce7_22_design_category, combine_directions, directional_designs,
                                           ec8_floor_forces, floor_weights, pair_set_spectra, plan_code_displacements,
                                           plan_code_separations, point_design_displacement, rotd100)
 from pounding.units import STANDARD_GRAVITY
@@ -244,7 +244,7 @@ def test_walls_and_points_of_a_plan_model(tmp_path):
         "    damping: {ratio: 0.02, modes: [1, 4]}", "    damping: {ratio: 0.02, modes: [1, 4]}\n" + DESIGN.rstrip())
     path = tmp_path / "moat.yaml"
     path.write_text(text, encoding="utf-8")
-    from pounding.studies.design_plan import building_designs
+    from pounding.studies.design_directions import building_designs
 
     model = load_model(path)
     found = plan_code_displacements(model, "ec8", EC8, building_designs(model, path))
