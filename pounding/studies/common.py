@@ -91,7 +91,7 @@ def study_document(model: str | os.PathLike, prefix: str, axes: dict[str, Any], 
         Simulated time, s (``ground_motion.duration``).
     scale : float or mapping, optional
         ``ground_motion.scale`` of every run: a factor or a target (``{pga: 0.4g}``; on a record pair the
-        target of its geometric mean, :mod:`pounding.studies.sweep.scaling`).
+        target of its geometric mean: :func:`pounding.records.processing.pair_scale_factor`).
     settings : dict, optional
         Further fixed changes (``set``), before the scale and duration.
     """

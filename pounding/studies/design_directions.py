@@ -586,7 +586,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
         (``first``, ``second``: the sides' design displacements; ``gap``: the model's), ``sides``.
     """
     from pounding.model.model import load_model
-    from pounding.studies.plan.compare import pair_values
+    from pounding.studies.common import pair_values
     from pounding.studies.plan.gap import plan_gap_study
 
     model = load_model(model_path)

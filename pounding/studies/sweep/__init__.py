@@ -1,8 +1,7 @@
 """Parameter sweeps: ``pounding sweep SWEEP.yaml -o SWEEP.nc``.
 
 ``spec``       the sweep file: axes, paths into the model, scenarios
-``scenario``   one scenario, run on a worker, and what a study keeps of its run
-``scaling``    a scenario's model, a record pair scaled to a target, the intensity reached
+``scenario``   one scenario, run on a worker, and what a study keeps of its run (peaks, intensity)
 ``execution``  the sweep on the study engine (:mod:`pounding.studies.engine`: parts store, Dask, resume)
 ``dataset``    the results NetCDF layout
 """

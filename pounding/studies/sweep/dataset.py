@@ -186,7 +186,7 @@ def build_dataset(sweep: Sweep, results: dict[str, dict[str, Any]], *, elapsed: 
 
     from pounding.results.checks import study_warnings
     from pounding.results.dataset import PGA_LONG_NAME
-    from pounding.studies.sweep.scaling import PAIR_PGA_LONG_NAME
+    from pounding.studies.sweep.scenario import PAIR_PGA_LONG_NAME
 
     scenarios = sweep.scenarios()
     parts = [results.get(s.key, {"status": "error", "error": "not run"}) for s in scenarios]

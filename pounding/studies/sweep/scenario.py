@@ -5,7 +5,8 @@ every model: the storeys (peak drift ratio; a storey of a building in plan: the 
 planes'), the floors (peak displacement; in plan per direction x, y), the contacts (impacts and
 peak force; in plan each contact point, with its place and normal), the scale factor, the
 intensity reached and how the run ended.  A run whose floors move in plan also has rotations,
-corners and planes: their peaks are kept when the archive has their dimensions.
+corners and planes: their peaks are kept when the archive has their dimensions.  The intensity of a record
+pair is the geometric mean of its two components' PGAs (:func:`run_intensity`).
 """
 
 from __future__ import annotations
@@ -18,7 +19,11 @@ from pounding.studies.engine.keys import PARTS_FORMAT
 from pounding.studies.engine.tasks import one_line
 from pounding.studies.sweep.spec import strip_location
 
-__all__ = ["run_scenario", "scenario_model_of", "scenario_peaks"]
+__all__ = ["run_scenario", "scenario_peaks", "run_intensity", "PAIR_PGA_LONG_NAME"]
+
+#: long_name of a study's ``intensity`` when its records are pairs (:func:`run_intensity`).
+PAIR_PGA_LONG_NAME = ("peak ground acceleration (PGA) of the scaled record pair: the geometric mean of its two "
+                      "components' own PGAs, each times the factors on it")
 
 # --------------------------------------------------------------------------- #
 # One scenario (runs on a worker)
@@ -88,27 +93,25 @@ def scenario_peaks(ds) -> dict[str, Any]:
     }
 
 
-def scenario_model_of(task: dict[str, Any]):
-    """The model a scenario *task* runs: from its plain data (or YAML text), a record pair scaled to its target
-    (:mod:`pounding.studies.sweep.scaling`).
+def run_intensity(model, ds) -> float:
+    """The PGA a run of *model* reached, m/s²: its record's own PGA times the factor on it
+    (:func:`pounding.results.dataset.record_pga`); with two components the geometric mean of theirs (each its own
+    PGA times the factors on it; the peak of its samples as run when the file does not say), as a target on a pair
+    applies to the pair's geometric mean (:func:`pounding.records.processing.pair_scale_factor`)."""
+    import math
 
-    Raises
-    ------
-    ModelError
-        ``invalid model: ...`` (one line, no location in the scenario's document).
-    """
-    from pounding.model.document import parse_document
-    from pounding.studies.sweep.scaling import pair_scaled, scenario_model
+    from pounding.results.dataset import record_pga
+    from pounding.simulation import component_records
+    from pounding.units import STANDARD_GRAVITY
 
-    try:
-        data = task.get("data")
-        if data is None:
-            data = parse_document(task["document"], f"<{task.get('name', 'model')}>").data
-        model, target = scenario_model(data, name=task.get("name", "model"), source=task["document"],
-                                       base_dir=task.get("base_dir"))
-    except ModelError as exc:
-        raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
-    return model if target is None else pair_scaled(model, target)
+    if not model.ground_motion.two_components:
+        return record_pga(ds)[1]
+    peaks = []
+    for record in component_records(model, factor=float(ds.attrs["record_scale"])):
+        if record is not None:
+            own = record.metadata.get("pga_g")
+            peaks.append(float(own) * STANDARD_GRAVITY * float(record.scale) if own is not None else record.pga)
+    return float(math.prod(peaks) ** (1.0 / len(peaks))) if peaks else float("nan")
 
 
 def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
@@ -121,11 +124,18 @@ def run_scenario(task: dict[str, Any]) -> dict[str, Any]:
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "format": PARTS_FORMAT}
     try:
+        from pounding.model.model import model_from_data, model_from_text
         from pounding.results.checks import run_warnings
         from pounding.simulation import refuse_failed_run, simulate
-        from pounding.studies.sweep.scaling import run_intensity
 
-        model = scenario_model_of(task)
+        try:
+            if task.get("data") is not None:
+                model = model_from_data(task["data"], name=task.get("name", "model"), source=task["document"],
+                                        base_dir=task.get("base_dir"))
+            else:
+                model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
+        except ModelError as exc:
+            raise ModelError(f"invalid model: {strip_location(str(exc))}") from None
         ds = simulate(model)
         refuse_failed_run(ds.attrs["status"], ds.attrs.get("status_message", ""))   # energy_inconsistent: an error
         result.update({"warnings": run_warnings(ds), "scale_factor": float(ds.attrs["record_scale"]),

@@ -819,10 +819,10 @@ class _Base:
 
     def problem(self, candidate: dict) -> str | None:
         """Why *candidate* (the document with values written in) is not a valid model; None if it is."""
-        from pounding.studies.sweep.scaling import scenario_model
+        from pounding.model.model import model_from_data
 
         try:
-            scenario_model(candidate, name=self.model.name, base_dir=self.folder)
+            model_from_data(candidate, name=self.model.name, base_dir=self.folder)
         except ModelError as exc:
             return strip_location(str(exc))
         return None
