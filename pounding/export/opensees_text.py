@@ -178,8 +178,8 @@ SCRIPT_SOLUTION = '''        # Unbalanced force below 1e-12 of the stiffest stor
         ops.analysis("Transient")'''
 
 #: The shared parts by their template field names.
-SCRIPT_PARTS = {"imports": SCRIPT_IMPORTS, "read_rows": SCRIPT_READ_ROWS, "stepping": SCRIPT_STEPPING, "main": SCRIPT_MAIN,
-                "contact_recorders": SCRIPT_CONTACT_RECORDERS, "contact_peaks": SCRIPT_CONTACT_PEAKS,
+SCRIPT_PARTS = {"imports": SCRIPT_IMPORTS, "read_rows": SCRIPT_READ_ROWS, "stepping": SCRIPT_STEPPING,
+                "main": SCRIPT_MAIN, "contact_recorders": SCRIPT_CONTACT_RECORDERS, "contact_peaks": SCRIPT_CONTACT_PEAKS,
                 "solution": SCRIPT_SOLUTION}
 
 
