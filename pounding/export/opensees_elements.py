@@ -179,14 +179,14 @@ class PDelta(NamedTuple):
 
 
 class Contact(NamedTuple):
-    """A contact point as a ``zeroLength`` from the low side's node to the high side's."""
+    """A contact point as a ``zeroLength`` from the low side's node to the high side's, along *direction*."""
 
     element: int
     low: int
     high: int
-    direction: int
     material: list
     label: str
+    direction: int
 
 
 class LinkElement(NamedTuple):
@@ -195,9 +195,9 @@ class LinkElement(NamedTuple):
     element: int
     left: int
     right: int
-    direction: int
     materials: list
     label: str
+    direction: int
 
 
 @dataclass
@@ -273,8 +273,8 @@ def _contacts(domain: Domain, model) -> None:
         low = domain.nodes.fixed(g.right, point) if g.left == WALL else domain.nodes.floor(g.left, g.level_left, point)
         high = domain.nodes.fixed(g.left, point) if g.right == WALL else \
             domain.nodes.floor(g.right, g.level_right, point)
-        domain.contacts.append(Contact(domain.elements + 1, low, high, DIRECTION_DOF[g.normal], material,
-                                       g.label(names)))
+        domain.contacts.append(Contact(domain.elements + 1, low, high, material, g.label(names),
+                                       DIRECTION_DOF[g.normal]))
 
 
 def _links(domain: Domain, model) -> None:
@@ -284,8 +284,8 @@ def _links(domain: Domain, model) -> None:
         element = domain.elements + 1
         domain.links.append(LinkElement(element, domain.nodes.floor(link.left, link.level_left, link.point),
                                         domain.nodes.floor(link.right, link.level_right, link.point),
-                                        DIRECTION_DOF[link.normal], link_materials(link.law, element),
-                                        link.label(names)))
+                                        link_materials(link.law, element), link.label(names),
+                                        DIRECTION_DOF[link.normal]))
 
 
 def _corners(domain: Domain, model) -> None:

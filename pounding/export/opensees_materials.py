@@ -41,8 +41,8 @@ HERTZDAMP_CLAMP_NOTE = ("hertz-damp with tension: clamp — OpenSees' Hertzdamp 
 CONTACT_LAWS_WITHOUT_MATERIAL = {
     "stereo-mechanical": "its impact is an instantaneous jump of the floors' velocities by the coefficient of "
                          "restitution, not a force on a deformation that a material can give",
-    "kelvin": "its dashpot acts only while the gap is closed, and no OpenSees gap material carries a viscous "
-              "term",
+    "kelvin": "it is a linear spring and a linear dashpot acting only while the gap is closed, and OpenSees' gap "
+              "materials are elastic (ElasticPPGap), hysteretic (ImpactMaterial) or Hertz-damped (Hertzdamp)",
     "jankowski": "it damps the approach only (none in the restitution phase), and no OpenSees material switches "
                  "its damping with the sign of the velocity",
     "bumper": "its hard face engages inside the layer at the compression limit with its own impact velocity, "

@@ -177,10 +177,48 @@ SCRIPT_SOLUTION = '''        # Unbalanced force below 1e-12 of the stiffest stor
         ops.integrator("Newmark", 0.5, 0.25)
         ops.analysis("Transient")'''
 
+SCRIPT_ANALYSE_HEAD = '''    """Run the analysis; return the peaks and the solver wall time.
+
+    Peaks are read at every committed step; an impact is a step on which a
+    gap element carries force after a step on which it carried none.
+    """
+    own = workdir is None
+    workdir = tempfile.mkdtemp(prefix="pounding-opensees-") if own else workdir
+    try:
+        build(os.path.join(workdir, "opensees.log"))'''
+
+SCRIPT_RUN_FACTS = '''            "dt": dt,
+            "duration": duration,
+            "end_time": end,
+            "converged": status == 0,
+            "cut_steps": cut_steps,
+            "wall_time": wall,'''
+
+SCRIPT_RESULTS_TAIL = '''            "contact": [row[4] for row in CONTACTS],
+            "peak_contact_force": peak_force,
+            "impact_count": impacts,
+            "link": [row[4] for row in LINKS],
+            "peak_link_force": peak_link,
+        }
+    finally:
+        if own:
+            shutil.rmtree(workdir, ignore_errors=True)'''
+
+#: The notes, imports and constants at the top of both forms (formatted with the header's fields).
+SCRIPT_CONSTANTS = '''{notes}
+{imports}
+MODEL_NAME = {name_literal}
+UNBALANCE_TOLERANCE = {unbalance}  # N
+DT = {dt}
+DURATION = {duration}
+RECORD_NAME = {record_name_literal}
+RECORD_DT = {record_dt}'''
+
 #: The shared parts by their template field names.
 SCRIPT_PARTS = {"imports": SCRIPT_IMPORTS, "read_rows": SCRIPT_READ_ROWS, "stepping": SCRIPT_STEPPING,
                 "main": SCRIPT_MAIN, "contact_recorders": SCRIPT_CONTACT_RECORDERS, "contact_peaks": SCRIPT_CONTACT_PEAKS,
-                "solution": SCRIPT_SOLUTION}
+                "solution": SCRIPT_SOLUTION, "analyse_head": SCRIPT_ANALYSE_HEAD, "run_facts": SCRIPT_RUN_FACTS,
+                "results_tail": SCRIPT_RESULTS_TAIL}
 
 
 AXIS_TEMPLATE = '''#!/usr/bin/env python3
@@ -194,14 +232,7 @@ Units SI (kg, N/m, m, s).  Model:
 Record: {record_name} x {record_scale}, {n_samples} samples at {record_dt} s (m/s^2),
 simulated for {duration} s.
 """
-{notes}
-{imports}
-MODEL_NAME = {name_literal}
-UNBALANCE_TOLERANCE = {unbalance}  # N
-DT = {dt}
-DURATION = {duration}
-RECORD_NAME = {record_name_literal}
-RECORD_DT = {record_dt}
+{constants}
 RECORD = [  # ground acceleration, m/s^2, linear between samples, 0 after the last
 {record}
 ]
@@ -280,15 +311,7 @@ def build(log_file=None):
 
 
 def analyse(dt=DT, duration=DURATION, workdir=None):
-    """Run the analysis; return the peaks and the solver wall time.
-
-    Peaks are read at every committed step; an impact is a step on which a
-    gap element carries force after a step on which it carried none.
-    """
-    own = workdir is None
-    workdir = tempfile.mkdtemp(prefix="pounding-opensees-") if own else workdir
-    try:
-        build(os.path.join(workdir, "opensees.log"))
+{analyse_head}
         floor_nodes = [tag for tag, _l, _m in FLOORS]
         storey_elements = [row[0] for row in STOREYS]
         contact_elements = [row[0] for row in CONTACTS]
@@ -319,25 +342,12 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             "model": MODEL_NAME,
             "record": RECORD_NAME,
             "simulator": "OpenSeesPy Newmark(1/2, 1/4) + Newton",
-            "dt": dt,
-            "duration": duration,
-            "end_time": end,
-            "converged": status == 0,
-            "cut_steps": cut_steps,
-            "wall_time": wall,
+{run_facts}
             "floor": [row[1] for row in FLOORS],
             "peak_displacement": peak_u,
             "storey": [row[4] for row in STOREYS],
             "peak_drift_ratio": [d / row[5] for d, row in zip(peak_drift, STOREYS)],
-            "contact": [row[4] for row in CONTACTS],
-            "peak_contact_force": peak_force,
-            "impact_count": impacts,
-            "link": [row[4] for row in LINKS],
-            "peak_link_force": peak_link,
-        }}
-    finally:
-        if own:
-            shutil.rmtree(workdir, ignore_errors=True)
+{results_tail}
 
 
 {main}
@@ -355,14 +365,7 @@ Units SI (kg, N/m, m, s).  Model:
 Ground: {record_name}, two components a_gx, a_gy (angle {angle} deg applied), {n_samples} samples at {record_dt} s
 (m/s^2), simulated for {duration} s.
 """
-{notes}
-{imports}
-MODEL_NAME = {name_literal}
-UNBALANCE_TOLERANCE = {unbalance}  # N
-DT = {dt}
-DURATION = {duration}
-RECORD_NAME = {record_name_literal}
-RECORD_DT = {record_dt}
+{constants}
 RECORD_X = [  # ground acceleration along x, m/s^2, linear between samples, 0 after the last
 {record_x}
 ]
@@ -395,12 +398,12 @@ P_DELTA = [
 RAYLEIGH = [
 {rayleigh}
 ]
-# contact points: (element, low-side node, high-side node, normal direction, material args, contact label)
+# contact points: (element, low-side node, high-side node, material args, contact label, normal direction)
 CONTACTS = [
 {contacts}
 ]
-# links (permanent dampers, no gap): (element, low-side node, high-side node, normal direction,
-# materials [[tag, type, args...], ...] the last of which is the element's, link label)
+# links (permanent dampers, no gap): (element, low-side node, high-side node,
+# materials [[tag, type, args...], ...] the last of which is the element's, link label, normal direction)
 LINKS = [
 {links}
 ]
@@ -451,10 +454,10 @@ def build(log_file=None):
         for tag, k in zip(tags, ks):
             ops.uniaxialMaterial("Elastic", tag, k)
         ops.element("zeroLength", ele, i, j, "-mat", *tags, "-dir", *directions, "-doRayleigh", 0)
-    for ele, i, j, direction, material, _label in CONTACTS:
+    for ele, i, j, material, _label, direction in CONTACTS:
         ops.uniaxialMaterial(material[0], ele, *material[1:])
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", direction, "-doRayleigh", 0)
-    for ele, i, j, direction, materials, _label in LINKS:
+    for ele, i, j, materials, _label, direction in LINKS:
         for tag, kind, *args in materials:
             ops.uniaxialMaterial(kind, tag, *args)
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", direction, "-doRayleigh", 0)
@@ -515,15 +518,7 @@ def _storey_peaks(peak_drift):
 
 
 def analyse(dt=DT, duration=DURATION, workdir=None):
-    """Run the analysis; return the peaks and the solver wall time.
-
-    Peaks are read at every committed step; an impact is a step on which a
-    contact point carries force after a step on which it carried none.
-    """
-    own = workdir is None
-    workdir = tempfile.mkdtemp(prefix="pounding-opensees-") if own else workdir
-    try:
-        build(os.path.join(workdir, "opensees.log"))
+{analyse_head}
         masters = [row[0] for row in MASTERS]
         corner_nodes = [row[0] for row in CORNERS]
         plane_elements = [row[0] for row in PLANES]
@@ -556,12 +551,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             "model": MODEL_NAME,
             "record": RECORD_NAME,
             "simulator": "OpenSeesPy Newmark(1/2, 1/4) + Newton, rigid diaphragms",
-            "dt": dt,
-            "duration": duration,
-            "end_time": end,
-            "converged": status == 0,
-            "cut_steps": cut_steps,
-            "wall_time": wall,
+{run_facts}
             "floor": [row[1] for row in MASTERS],
             "peak_displacement": [u[3 * i:3 * i + 2] for i in range(len(masters))],
             "peak_rotation": [u[3 * i + 2] for i in range(len(masters))],
@@ -571,15 +561,7 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             "peak_plane_drift": peak_drift,
             "storey": storeys,
             "peak_drift_ratio": peak_ratio,
-            "contact": [row[5] for row in CONTACTS],
-            "peak_contact_force": peak_force,
-            "impact_count": impacts,
-            "link": [row[5] for row in LINKS],
-            "peak_link_force": peak_link,
-        }}
-    finally:
-        if own:
-            shutil.rmtree(workdir, ignore_errors=True)
+{results_tail}
 
 
 {main}
@@ -588,12 +570,13 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
 
 def _header(model, domain, ground: ScriptGround, dt: float, notes: list[str]) -> dict:
     """The template fields both forms share: names, notes, summary, time steps, the tolerance."""
-    return dict(version=__version__, name=inert(model.name), name_literal=repr(str(model.name)),
-                summary="\n".join("#   " + inert(line) for line in model.summary_lines()),
-                notes="\n".join("# NOTE: " + inert(n) for n in notes), record_name=inert(ground.name),
-                record_name_literal=repr(str(ground.name)), record_dt=fmt(ground.time_step),
-                duration=fmt(ground.end_time), dt=fmt(dt), n_samples=ground.components[0].size,
-                unbalance=fmt(1e-12 * max(s.stiffness for s in domain.springs)), **SCRIPT_PARTS)
+    fields = dict(version=__version__, name=inert(model.name), name_literal=repr(str(model.name)),
+                  summary="\n".join("#   " + inert(line) for line in model.summary_lines()),
+                  notes="\n".join("# NOTE: " + inert(n) for n in notes), record_name=inert(ground.name),
+                  record_name_literal=repr(str(ground.name)), record_dt=fmt(ground.time_step),
+                  duration=fmt(ground.end_time), dt=fmt(dt), n_samples=ground.components[0].size,
+                  unbalance=fmt(1e-12 * max(s.stiffness for s in domain.springs)), **SCRIPT_PARTS)
+    return {**fields, "constants": SCRIPT_CONSTANTS.format(**fields)}
 
 
 def axis_script(model, domain, ground: ScriptGround, dt: float, notes: list[str]) -> str:
@@ -618,8 +601,7 @@ def axis_script(model, domain, ground: ScriptGround, dt: float, notes: list[str]
                       for s in domain.springs),
         p_delta=_rows((p.element, p.below, p.node, p.stiffness[0], p.storey) for p in domain.p_delta),
         buildings=_rows(domain.rayleigh), dashpots=_rows(domain.dashpots),
-        contacts=_rows((c.element, c.low, c.high, c.material, c.label) for c in domain.contacts),
-        links=_rows((k.element, k.left, k.right, k.materials, k.label) for k in domain.links))
+        contacts=_rows(c[:5] for c in domain.contacts), links=_rows(k[:5] for k in domain.links))
 
 
 def diaphragm_script(model, domain, ground: ScriptGround, dt: float, notes: list[str], *, eigen_offset: int,
