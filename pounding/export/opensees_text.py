@@ -615,7 +615,8 @@ def diaphragm_script(model, domain, ground: ScriptGround, dt: float, notes: list
     nodes = domain.nodes
     return DIAPHRAGM_TEMPLATE.format(
         **_header(model, domain, ground, dt, notes), angle=fmt(ground.angle or 0.0),
-        record_x=_samples(ground.components[0]), record_y=_samples(ground.components[1]),
+        record_x=_samples(ground.components[0]),
+        record_y=_samples(ground.components[1] if len(ground.components) > 1 else 0.0 * ground.components[0]),
         masters=_rows(nodes.masters), slaves=_rows(nodes.slaves), fixed=_rows(nodes.fixed_rows),
         planes=_rows(domain.springs), p_delta=_rows(domain.p_delta), rayleigh=_rows(domain.rayleigh),
         contacts=_rows(domain.contacts), links=_rows(domain.links), corners=_rows(domain.corners),
