@@ -184,7 +184,7 @@ def plan_system(model: PlanModel) -> PlanSystem:
         dense_start=np.asarray(offsets, dtype=np.int64), dense_size=np.asarray(sizes, dtype=np.int64),
         dense_offset=np.asarray(np.cumsum([0] + [s * s for s in sizes])[:-1], dtype=np.int64),
         dense_values=np.ascontiguousarray(np.concatenate(dense) if dense else np.zeros(0)),
-        contact_left=floors_arr[:, 0].copy(), contact_right=floors_arr[:, 2].copy(),
+        contact_left=floors_arr[:, 0].copy(), contact_right=floors_arr[:, SIDE_TERMS // 2].copy(),
         contact_gap=np.asarray(gaps, dtype=float), contact_law=np.asarray(laws, dtype=np.int64),
         contact_parameters=np.ascontiguousarray(np.array(params, dtype=float).reshape(nc, contact_laws.N_PARAMETERS)),
         contact_floors=np.ascontiguousarray(floors_arr),
