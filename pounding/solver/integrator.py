@@ -98,8 +98,8 @@ from pounding.solver.dense import interpolate
 from pounding.solver.friction_events import apply_friction_events, locate_friction_events, record_friction
 from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, normed_states,
                                             stages, step_factor)
-from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
-                                        kernel_terms)
+from pounding.solver.kinematics import (NARROW_TERMS, SIDE_TERMS, fill_grounds, ground_at, ground_kinematics,
+                                        ground_state_at, kernel_terms)
 from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, Forcing, Friction, Grounds, Layout, Settings, Storeys,
                                     StoreyTerms, Structure, Work, state_layout)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
@@ -255,8 +255,8 @@ class System:
                     "contact_ground_left": np.zeros(self.contact_gap.size, dtype=np.int64),
                     "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64),
                     "dense_band": np.asarray(self.dense_size, dtype=np.int64) - 1, "dense_stiffness": np.zeros(0),
-                    "plane_floors": np.zeros((0, SIDE_TERMS), dtype=np.int64),
-                    "plane_weights": np.zeros((0, SIDE_TERMS))}
+                    "plane_floors": np.zeros((0, NARROW_TERMS), dtype=np.int64),
+                    "plane_weights": np.zeros((0, NARROW_TERMS))}
         for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)

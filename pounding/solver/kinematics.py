@@ -445,15 +445,23 @@ def kernel_terms(floors: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, n
         raise ValueError(f"terms of shapes {floors.shape} and {weights.shape}: expected one (rows, 2·t) shape "
                          f"with 1 ≤ t ≤ {TERMS_PER_SIDE} terms per side")
     rows, given = weights.shape[0], weights.shape[1] // 2
-    present = np.flatnonzero(np.any(weights.reshape(rows, 2, given) != 0.0, axis=(0, 1)))
-    half = NARROW_TERMS // 2 if present.size == 0 or present[-1] < NARROW_TERMS // 2 else TERMS_PER_SIDE
-    kept = min(given, half)
-    flat_floors = np.zeros((rows, 2, half), dtype=np.int64)
-    flat_weights = np.zeros((rows, 2, half))
-    flat_weights[:, :, :kept] = weights.reshape(rows, 2, given)[:, :, :kept]
-    flat_floors[:, :, :kept] = np.where(flat_weights[:, :, :kept] == 0.0, 0,
-                                        floors.reshape(rows, 2, given)[:, :, :kept])
-    return flat_floors.reshape(-1), flat_weights.reshape(-1), row_width(2 * half)
+    half = NARROW_TERMS // 2
+    if given > half:
+        sides = weights.reshape(rows, 2, given)
+        if sides[:, :, half:].any():
+            half = TERMS_PER_SIDE
+        else:  # a side's terms past the second are absent in every row: the narrow layout
+            weights = sides[:, :, :half].reshape(rows, 2 * half)
+            floors = floors.reshape(rows, 2, given)[:, :, :half].reshape(rows, 2 * half)
+    if given < half:  # each side's own terms, then absent ones
+        padded = np.zeros((rows, 2, half))
+        padded[:, :, :given] = weights.reshape(rows, 2, given)
+        weights = padded.reshape(rows, 2 * half)
+        padded = np.zeros((rows, 2, half), dtype=np.int64)
+        padded[:, :, :given] = floors.reshape(rows, 2, given)
+        floors = padded.reshape(rows, 2 * half)
+    flat_floors = np.ascontiguousarray(np.where(weights == 0.0, 0, floors), dtype=np.int64).reshape(-1)
+    return flat_floors, np.ascontiguousarray(weights, dtype=float).reshape(-1), row_width(2 * half)
 
 
 def penetration(u: np.ndarray, floors: np.ndarray, weights: np.ndarray, gap: np.ndarray,
