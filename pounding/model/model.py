@@ -205,6 +205,9 @@ class ContactFace:
         Applied at each point.
     friction : float or None
         Coulomb μ on the face.
+    at_first, at_second : float or None
+        A side that is a point of a column: ``level_*`` is its storey and ``at_*`` the fraction of its
+        height above the floor below (None: a floor).
     """
 
     contact: int
@@ -216,6 +219,8 @@ class ContactFace:
     points: tuple[outline.ContactPoint, ...]
     law: Any
     friction: float | None = None
+    at_first: float | None = None
+    at_second: float | None = None
 
     @property
     def gap(self) -> float:
@@ -229,10 +234,10 @@ class ContactFace:
 
     def point_elements(self, index: int) -> tuple[GapElement, ...]:
         """The face's gap elements (one per point, the low side on the left), *index* its place in ``Model.faces``."""
-        low, high = ((self.first, self.level_first), (self.second, self.level_second)) if self.face.first_low \
-            else ((self.second, self.level_second), (self.first, self.level_first))
-        return tuple(GapElement(self.contact, low[0], high[0], low[1], high[1], self.face.gap, self.law,
-                                normal=self.face.normal, point=tuple(float(v) for v in p.location), face=index)
+        first, second = (self.first, self.level_first, self.at_first), (self.second, self.level_second, self.at_second)
+        low, high = (first, second) if self.face.first_low else (second, first)
+        return tuple(GapElement(self.contact, low[0], high[0], low[1], high[1], self.face.gap, self.law, low[2],
+                                high[2], normal=self.face.normal, point=tuple(float(v) for v in p.location), face=index)
                      for p in self.points)
 
 
@@ -761,9 +766,13 @@ def _face_documents(model: Model) -> list[dict[str, Any]]:
         faces = [f for f in model.faces if f.contact == contact]
         first = faces[0]
         wall = first.second == WALL
+        def side(level: int, at: float | None) -> Any:
+            return int(level) if at is None else {"storey": int(level), "at": float(at)}
+
         entry: dict[str, Any] = {"between": [names[first.first], schema.WALL_NAME if wall else names[first.second]],
-                                 "levels": [f.level_first for f in faces] if wall else
-                                 [[f.level_first, f.level_second] for f in faces]}
+                                 "levels": [side(f.level_first, f.at_first) for f in faces] if wall else
+                                 [[side(f.level_first, f.at_first), side(f.level_second, f.at_second)]
+                                  for f in faces]}
         if wall:
             entry["face"] = outline.wall_side(first.face)
         if wall or first.gap >= OPEN_GAP:
@@ -828,12 +837,12 @@ def _build_plan(entry: Any, *, name: str, text: str, path: str | None, base_dir:
     faces = []
     for index, c in enumerate(entry.contacts):
         first, second = c.sides
-        for level_first, level_second in c.pairs:
+        for (level_first, level_second), (at_first, at_second) in zip(c.pairs, c.points):
             centre_first = buildings[first].centres[level_first - 1]
             centre_second = None if second == WALL else buildings[second].centres[level_second - 1]
             points = outline.face_points(c.plan_face, centre_first, centre_second)
             faces.append(ContactFace(index, first, second, level_first, level_second, c.plan_face, points,
-                                     c.parameters, c.friction))
+                                     c.parameters, c.friction, at_first, at_second))
     links = tuple(_plan_link(index, e, pair) for index, e in enumerate(entry.links) for pair in e.pairs)
     own = tuple(_pair_spec(b.ground_motion, base_dir) for b in entry.buildings) if entry.ground_motion is None else ()
     ground_motion = own[0] if own else _pair_spec(entry.ground_motion, base_dir)

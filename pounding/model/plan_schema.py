@@ -21,7 +21,7 @@ from pounding.model import floors as plan, outline as plan_contacts
 from pounding.model.document import Document, Location, plural
 from pounding.model.ground import pair_components
 from pounding.model.schema import (OPEN_GAP, TAGS, WavePassageEntry, ground_motion_fits, processing_value, scale_value, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
-                                   LinkEntry,
+                                   DesignEntry, LinkEntry,
                                    HysteresisUnion, ModalEntry, between_indices, list_shape, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
                                    as_number, contact_levels, hysteresis_parameters, located, problem,
                                    record_reference, storey_count, units_name, validate)
@@ -135,11 +135,11 @@ class PlanEntry(SchemaEntry):
 
 
 class PlanBuildingEntry(SchemaEntry):
-    """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``."""
+    """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``, ``design``."""
 
     WHAT: ClassVar[str] = "a mapping {name, plan, storeys, damping}"
     CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": PlanStoreyEntry, "plan": PlanEntry,
-                                                      "collapse": CollapseEntry}
+                                                      "collapse": CollapseEntry, "design": DesignEntry}
 
     name: Annotated[str, BeforeValidator(located(as_name))] = Field(description="unique building name")
     plan: PlanEntry = Field(description="{outline: [[x0, y0], [x1, y1]]}")
@@ -150,6 +150,9 @@ class PlanBuildingEntry(SchemaEntry):
         False, description="leaning-column P-Delta from the floor weights, true or false")
     ground_motion: PlanGroundMotionEntry | None = Field(
         None, description="this building's own record pair (every building then needs one; no model-level ground_motion)")
+    design: DesignEntry | None = Field(
+        None, description="design factors per code for pounding gap --code, e.g. {asce7_22: {R: 8, Cd: 5.5, Ie: 1}, "
+                          "ec8: {q: 3.9}}")
     collapse: CollapseEntry | None = Field(
         None, description="this building's collapse criterion {drift_ratio}: any of its planes' |drift ratio| "
                           "(default: solver.stop_drift_ratio)")
@@ -283,9 +286,11 @@ class PlanContactEntry(ContactEntry):
         if self.gap is not None and self.gap < 0.0:
             raise problem("must be >= 0", at=here + ("gap",))
         levels = contact_levels(index, self, first, second)
-        if any(a is not None or b is not None for (_, a), (_, b) in levels):
-            raise problem("column points {storey, at} are for planar models; a plan contact joins floors",
-                          kind="error", at=here + ("levels",), fallback=True)
+        if self.friction and any(a is not None or b is not None for (_, a), (_, b) in levels):
+            raise problem("Coulomb friction on a face needs the slip of two floors; a column point {storey, at} "
+                          "slides with the column's deflection between two floors, which the friction face does not "
+                          "follow: remove friction or strike a floor", kind="error", at=here + ("friction",),
+                          line="key", colon=False)
         self._pairs = tuple((a[0], b[0]) for a, b in levels)
         self._points = tuple((a[1], b[1]) for a, b in levels)
         self._face = self._wall_face(index, first) if second is None else self._geometry_face(index, first, second)
