@@ -91,9 +91,11 @@ def test_planar_model_and_its_twin_agree_in_opensees(pair_peaks):
 @pytest.mark.parametrize("name, message", [
     ("pair_wave_passage", "does not write multi-support excitation.*MultipleSupport pattern"),
     ("pair_bumper", "contact law 'bumper' has no OpenSees counterpart: its hard face"),
+    ("pair_column", "strikes a column between floors: a column point moves as a weighted mean of two floors"),
 ])
 def test_a_model_and_its_twin_are_refused_alike(name, message):
-    # The refusals read the description (a ground motion per support, a contact's law), not the model kind.
+    # The refusals read the description (a ground motion per support, a contact's law, a column point), not the
+    # model kind.
     for model in twin_of(name):
         with pytest.raises(PoundingError, match=message) as info:
             opensees_script(model, duration=1.0)
