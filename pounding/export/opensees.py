@@ -98,6 +98,9 @@ def export_refusal(model) -> str | None:
     (:mod:`pounding.export.opensees_materials`).
     """
     names = [b.name for b in model.buildings]
+    if len({b.dofs_per_floor for b in model.buildings}) > 1:
+        return ("the OpenSees export writes floors with one DOF or floors in plan, not both in one domain (a floor "
+                "with one DOF has no u_y or rotation for a diaphragm's contact to act on)")
     if model.is_multi_support:
         return ("the OpenSees export does not write multi-support excitation (a record per building or a wave "
                 "passage): it needs OpenSees' MultipleSupport pattern with each support's ground displacement, "
@@ -108,6 +111,11 @@ def export_refusal(model) -> str | None:
         return (f"contact {friction.label(names)}: the OpenSees export does not write friction (OpenSees' frictional "
                 "contact elements take their normal force from their own penalty spring, not from the Hertz "
                 "material beside them); export the model without friction:")
+    column = next((g for g in model.gaps if g.has_column_point), None)
+    if column is not None:
+        return (f"contact {column.label(names)} strikes a column between floors: a column point moves as a weighted "
+                "mean of two floors, and OpenSees joins nodes (the shear model has no column element to put a node "
+                "on); export a model with floor-to-floor and wall contacts only")
     return repeated_frequency(model)
 
 

@@ -42,7 +42,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from pounding.errors import PoundingError
 from pounding.export.opensees_damping import (ModalDamping, dashpot_network, modal_damping, rayleigh_row,
                                               writes_damping_matrix)
 from pounding.export.opensees_materials import contact_material, link_materials, storey_material
@@ -262,11 +261,6 @@ def _contacts(domain: Domain, model) -> None:
     """Add every contact point along its normal (walls: the fixed node at the point)."""
     names = [b.name for b in model.buildings]
     for g in model.gaps:
-        if g.has_column_point:
-            raise PoundingError(f"contact {g.label(names)} strikes a column between floors: a column point moves "
-                                "as a weighted mean of two floors, and OpenSees joins nodes (the shear model "
-                                "has no column element to put a node on); export a model with floor-to-floor and "
-                                "wall contacts only")
         material, warnings = contact_material(g.law, g.gap)
         domain.notes += [w for w in warnings if w not in domain.notes]
         point = g.point
@@ -305,16 +299,13 @@ def build_domain(model) -> Domain:
     Elements are numbered building by building (its planes, its P-Delta springs, its dashpots), then the
     contact points, then the links.
 
+    *model* is one the export accepts (:func:`pounding.export.opensees.export_refusal`).
+
     Raises
     ------
     PoundingError
-        One line: floors of different kinds in one model, a column point, a contact or link law without an
-        OpenSees material.
+        One line: a contact or link law without an OpenSees material.
     """
-    kinds = {b.dofs_per_floor for b in model.buildings}
-    if len(kinds) != 1:
-        raise PoundingError("the OpenSees export writes a row of floors with one DOF or floors in plan, not both "
-                            "in one domain (a floor with one DOF has no y or rotation for the diaphragms' contacts)")
     domain = Domain(DiaphragmNodes(model) if model.in_plan else AxisNodes(model))
     regions = []
     for b_index, b in enumerate(model.buildings):
