@@ -420,7 +420,7 @@ def register_cli(sub) -> None:
     run.add_argument("--output-dt", type=float, help="sampling of stored histories, s")
     run.add_argument("-o", "--output", help="NetCDF archive (default: MODEL-STEM.nc)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing archive")
-    run.add_argument("--plot", metavar="DIR", help="also write the four PNG figures to DIR (see pounding plot)")
+    run.add_argument("--plot", metavar="DIR", help="also write the run's PNG figures to DIR (see pounding plot)")
     add_csv_option(run)
     add_plot_options(run)
     run.set_defaults(func=_cmd_run)
@@ -440,7 +440,7 @@ def register_cli(sub) -> None:
     info.set_defaults(func=_cmd_info)
 
     plot = sub.add_parser("plot", help="draw the PNG figures of an archive (run, sweep, compare or verify)",
-                          description="Redraw an archive's figures: a run's four figures, compare's two, a "
+                          description="Redraw an archive's figures: a run's (those its data call for), compare's two, a "
                                       "sweep's peak drifts against each axis, verify's e_post against e_pre.")
     plot.add_argument("run", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare or verify")
     plot.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the PNG files "

@@ -535,9 +535,9 @@ def _magnification(ds: xr.Dataset, extent: float) -> float:
     return float(max(m for m in (1.0, 2.0, 5.0) if m * decade <= factor) * decade)
 
 
-def _peak_friction(ds: xr.Dataset) -> list[tuple[float, float, str, float, str]]:
-    """Per friction face that carried a force: the mean location of its points (x, y, m), its tangent, its
-    largest sampled friction force on the low side (signed, N) and its label."""
+def _peak_friction(ds: xr.Dataset) -> list[tuple[float, float, str, float]]:
+    """Per friction face that carried a force: the mean location of its points (x, y, m), its tangent and its
+    largest sampled friction force on the low side (signed, N)."""
     if "friction_force" not in ds:
         return []
     faces = []
@@ -548,7 +548,7 @@ def _peak_friction(ds: xr.Dataset) -> list[tuple[float, float, str, float, str]]
         if history[k] == 0.0 or points.size == 0:
             continue
         faces.append((float(ds.point_x.values[points].mean()), float(ds.point_y.values[points].mean()),
-                      str(ds.face_tangent.values[f]), float(history[k]), str(ds.face_between.values[f])))
+                      str(ds.face_tangent.values[f]), float(history[k])))
     return faces
 
 
@@ -570,7 +570,7 @@ def _draw_forces(ax, ds: xr.Dataset, extent: float) -> str:
     friction = _peak_friction(ds)
     top = max([float(peaks.max(initial=0.0))] + [abs(f[3]) for f in friction])
     if top <= 0.0:
-        return "no impacts" + ("" if ds.sizes["contact"] else " (no contact points)")
+        return "no impacts"
     locations: dict[tuple[float, float, str], int] = {}
     for p in np.flatnonzero(peaks > 0.0):   # a location's floors overlap in plan: its largest peak
         key = (float(ds.point_x.values[p]), float(ds.point_y.values[p]), str(ds.point_normal.values[p]))
@@ -583,7 +583,7 @@ def _draw_forces(ax, ds: xr.Dataset, extent: float) -> str:
         ax.annotate(force_text(float(peaks[p])), (x + along[0], y + along[1]), textcoords="offset points",
                     xytext=(3, 0) if normal == "x" else (0, 3), ha="left" if normal == "x" else "center",
                     va="center" if normal == "x" else "bottom", fontsize=7, color="C3")
-    for x, y, tangent, force, _ in friction:
+    for x, y, tangent, force in friction:
         length = 0.1 * extent * force / top
         shift = 0.01 * extent
         _arrow_pair(ax, (x, y), (-length, 0.0) if tangent == "x" else (0.0, -length), "C2",
@@ -666,6 +666,8 @@ def _plan_view(plt, ds: xr.Dataset, path: Path) -> float:
 
 
 def _roof_rotation(plt, ds: xr.Dataset, path: Path, instant: float) -> None:
+    """Draw ``roof_rotation.png``: per building its roof rotation (or a note where it is round-off) and its roof's
+    most displaced corner beside its centre of mass, the plan view's *instant* (s) dashed."""
     rotating = rotating_buildings(ds)
     fig, axes = plt.subplots(len(rotating), 2, figsize=(10.0, 1.2 + 2.2 * len(rotating)), sharex=True,
                              squeeze=False)
