@@ -79,8 +79,10 @@ def _ground_lines(ds: xr.Dataset) -> list[str]:
         along = ", ".join(f"{a / STANDARD_GRAVITY:.3g} g ({a:.3g} m/s2) along {d}"
                           for a, d in zip(peak, ds.direction.values))
         angle = float(ds.attrs.get("angle", 0.0))
+        several = ds.attrs.get("multi_support")   # wave passage, a record pair per building: the first one's ground
         return [f"peak ground acceleration as run (x{float(ds.attrs['record_scale']):.4g}"
-                f"{f', component a at {angle:g} deg from +x' if angle else ''}): {along}"]
+                f"{f', component a at {angle:g} deg from +x' if angle else ''}"
+                f"{f', {several}: under the first building' if several else ''}): {along}"]
 
     def line(label: str, own: float, scaled: float, factor: float) -> str:
         return (f"{label} {own / STANDARD_GRAVITY:.3g} g ({own:.3g} m/s2) as recorded, "
