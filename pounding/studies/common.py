@@ -15,7 +15,8 @@ from typing import Any
 from pounding.errors import PoundingError
 
 __all__ = ["study_parts", "record_list", "record_values", "study_sweep", "check_duration", "finite_or_none", "records_text",
-           "scale_spec_text", "sweep_heading", "record_sweep", "floor_states", "dof_peaks", "ground_pga"]
+           "scale_spec_text", "sweep_heading", "record_sweep", "floor_states", "dof_peaks",
+           "ground_pga"]
 
 
 def record_list(text: str | list[str] | None) -> list[str] | None:
@@ -145,7 +146,8 @@ def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dic
 
     A model shaken by one component takes records (a set such as ``fema-p695:farfield`` is its 44
     components); a model shaken by two (floors in plan) takes record pairs (``fema-p695:farfield`` is
-    its 22 pairs), both components of a pair in one scenario.  Default: the model's own record (pair).
+    its 22 pairs), both components of a pair in one scenario.  Default: the model's own record (pair; its
+    components given one by one: one scenario, its ``record`` coordinate ``x=FILE...``).
 
     Parameters
     ----------
@@ -173,11 +175,8 @@ def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dic
     from pounding.studies.plan.sweep import plan_study_sweep
 
     pairs = pair_values(records) if records is not None else [base.ground_motion.record]
-    if pairs[0] is None:
-        raise PoundingError(f"{os.fspath(model)}: its ground motion is given as components x and y; a study of "
-                            "several runs takes record pairs: give --records fema-p695:farfield (or pairs such as "
-                            "fema-p695:farfield/1,fema-p695:farfield/2)")
-    document["axes"] = {"records": pairs}
+    # components given one by one (x, y) and no --records: the model's own, one scenario
+    document["axes"] = {"records": pairs} if pairs != [None] else {}
     return plan_study_sweep(document, label)
 
 

