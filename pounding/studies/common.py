@@ -19,10 +19,16 @@ __all__ = ["study_parts", "record_list", "record_values", "study_sweep", "check_
            "ground_pga"]
 
 
-def record_list(text: str | list[str] | None) -> list[str] | None:
-    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given."""
+def record_list(text: str | list[str] | None, *, pairs: bool = False) -> list[str] | None:
+    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given.
+
+    *pairs*: the model's ground motion has two components, so the records are pairs (``fema-p695:farfield``:
+    the 22 pairs; a single component is refused in one line).
+    """
     from pounding.studies.sweep.spec import expand_records
 
+    if pairs:   # the pairs of the plan sweep, until the one sweep spec expands them (issue 37)
+        from pounding.studies.plan.sweep import expand_pairs as expand_records
     if text is None:
         return None
     items = [r.strip() for r in (text.split(",") if isinstance(text, str) else text) if r.strip()]
@@ -34,11 +40,13 @@ def record_list(text: str | list[str] | None) -> list[str] | None:
             raise PoundingError(f"--records: {exc}") from None
         records += [r for r in expanded if r not in records]
     if not records:
-        raise PoundingError("--records needs a set (fema-p695:farfield) or a comma-separated list of records")
+        raise PoundingError("--records needs record pairs, e.g. fema-p695:farfield or fema-p695:farfield/1,"
+                            "fema-p695:farfield/2" if pairs else
+                            "--records needs a set (fema-p695:farfield) or a comma-separated list of records")
     return records
 
 
-def record_values(records: str | list[str] | None, model: Any = None) -> list[str] | None:
+def record_values(records: str | list[str] | None, model: Any = None, *, pairs: bool = False) -> list[str] | None:
     """The ``records`` axis of a study: the `--records` option (files made absolute), else *model*'s own record.
 
     Parameters
@@ -47,13 +55,18 @@ def record_values(records: str | list[str] | None, model: Any = None) -> list[st
         The option as given (see :func:`record_list`).
     model : pounding.model.model.Model, optional
         Whose record is the default; without it, None when *records* is None.
+    pairs : bool
+        The records are pairs (a ground motion of two components); *model*'s own is its pair (None when it gives
+        its components one by one: the study runs them as they are).
     """
-    listed = record_list(records)
+    listed = record_list(records, pairs=pairs)
     if listed is not None:
         return [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
     if model is None:
         return None
     motion = model.ground_motion
+    if motion.two_components:
+        return None if motion.record is None else [motion.record]
     return [motion.record if motion.is_catalogue else str(motion.record_path)]
 
 
@@ -165,18 +178,15 @@ def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dic
         Where an error is said to be (``<gap models/pair.yaml>``).
     """
     path = os.path.abspath(os.fspath(model))
-    document: dict[str, Any] = {"name": f"{prefix}-{Path(path).stem}", "model": path, "set": settings}
-    if not base.ground_motion.two_components:
-        document["axes"] = {"records": record_values(records, base)}
+    pairs = bool(base.ground_motion.two_components)
+    values = record_values(records, base, pairs=pairs)
+    document: dict[str, Any] = {"name": f"{prefix}-{Path(path).stem}", "model": path, "set": settings,
+                                "axes": {} if values is None else {"records": values}}
+    if not pairs:
         return study_sweep(document, label)
-    # Record pairs: the pair sweep of the plan studies, until the one sweep of every model kind takes them
-    # (issue 37; pounding.studies.sweep).
-    from pounding.studies.plan.compare import pair_values
+    # Record pairs: the plan sweep, until the one sweep of every model kind reads them (issue 37).
     from pounding.studies.plan.sweep import plan_study_sweep
 
-    pairs = pair_values(records) if records is not None else [base.ground_motion.record]
-    # components given one by one (x, y) and no --records: the model's own, one scenario
-    document["axes"] = {"records": pairs} if pairs != [None] else {}
     return plan_study_sweep(document, label)
 
 
