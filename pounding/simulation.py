@@ -210,8 +210,11 @@ def component_records(model: Model, *, building: int | str | None = None, where:
     from pounding.records.processing import pair_scale_factor, scale_record
 
     spec = model.ground_motion if building is None else model.ground_motion_of(building)
-    loaded = [None if c is None else load_record(c.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units,
-                                                 scale=c.scale, duration=spec.duration, where=where)
+    from pounding.records.processing import process
+
+    loaded = [None if c is None else process(load_record(c.record, base_dir=spec.base_dir, dt=spec.dt,
+                                                         units=spec.units, scale=c.scale, duration=spec.duration,
+                                                         where=where), spec.processing)
               for c in spec.components()]
     period = _scaling_period(model, spec)
     present = [r for r in loaded if r is not None]

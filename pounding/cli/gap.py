@@ -15,9 +15,13 @@ from pounding.errors import PoundingError
 __all__ = ["register_cli"]
 
 
-def _cmd_code_gap(args: argparse.Namespace) -> int:
-    """``pounding gap MODEL --code CODE ...``: the code's separations beside the simulated requirement."""
+def _cmd_code_gap(args: argparse.Namespace, *, plan: bool = False) -> int:
+    """``pounding gap MODEL --code CODE ...``: the code's separations beside the simulated requirement.
+
+    A plan model (*plan*) is checked at every contact point (:func:`pounding.studies.design_directions.plan_code_gap_study`).
+    """
     from pounding.studies.design import code_gap_study, code_gap_summary, code_gap_table
+    from pounding.studies.design_directions import plan_code_gap_study
 
     for given, option in ((args.scale, "--scale"), (args.output, "-o"), (args.plot, "--plot"), (args.csv, "--csv")):
         if given is not None:
@@ -33,13 +37,22 @@ def _cmd_code_gap(args: argparse.Namespace) -> int:
         if args.ag is None:
             raise PoundingError("--code ec8 needs --ag (design ground acceleration on ground type A, g)")
         options = {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
-    result = code_gap_study(args.model, args.code, options, args.records, duration=args.duration,
-                            workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
+    study = plan_code_gap_study if plan else code_gap_study
+    result = study(args.model, args.code, options, args.records, duration=args.duration,
+                   workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
     if args.json:
         print(json.dumps(code_gap_summary(result), indent=2))
     else:
         print(code_gap_table(result))
     return 0
+
+
+def _refuse_spectrum_without_code(args: argparse.Namespace) -> None:
+    """A design spectrum's option (--sds, --sd1, --ag) without --code is refused in one line."""
+    given = [option for option, value in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag))
+             if value is not None]
+    if given:
+        raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
 
 
 def _study_options(args: argparse.Namespace) -> dict:
@@ -53,13 +66,15 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
 
     check_study_options(args)
+    if args.code:   # the code's separations: design.py for a row, design_directions.py for floors in plan
+        from pounding.model.model import is_plan_file
+
+        if is_plan_file(args.model):
+            return _cmd_code_gap(args, plan=True)
     check_csv(args, [args.model])
     if args.code:
         return _cmd_code_gap(args)
-    given = [option for option, value in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag))
-             if value is not None]
-    if given:
-        raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
+    _refuse_spectrum_without_code(args)
     try:
         ds = gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:
@@ -114,7 +129,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--plot", metavar="DIR", help="write gap_profile.png to DIR")
     add_csv_option(parser)
     parser.add_argument("--code", choices=("asce7-22", "ec8"),
-                        help="report the code's separation per level pair from design spectra (modal "
+                        help="report the code's separation per level pair (per contact point of a plan model, "
+                             "with accidental torsion and both directions) from design spectra (modal "
                              "response-spectrum analysis of each building with its design: factors in the model) "
                              "beside the requirement of the records scaled to the code's spectrum (refuses --scale, "
                              "-o, --plot); docs/design-codes.md")

@@ -92,8 +92,8 @@ from pounding.errors import PoundingError
 from pounding.model.schema import WALL
 
 __all__ = ["opensees_script", "opensees_script_and_notes", "run_opensees", "run_script", "allow_tension",
-           "tension_allowed", "inert", "SCRIPT_PARTS", "contact_material",
-           "link_materials", "storey_material", "imk_material", "IMK_MATERIALS", "LAMBDA_OFF", "BILINEAR_NOTE", "DEFAULT_DT"]
+           "tension_allowed", "inert", "SCRIPT_PARTS", "contact_material", "link_materials", "storey_material",
+           "initial_tangent", "imk_material", "IMK_MATERIALS", "LAMBDA_OFF", "BILINEAR_NOTE", "DEFAULT_DT"]
 
 #: Default OpenSees time step, s.
 DEFAULT_DT = 1.0e-4
@@ -272,8 +272,9 @@ def storey_material(law, stiffness: float, height: float) -> list:
                         "(supported: bilinear, bouc-wen, imk-bilinear, imk-peak-oriented, imk-pinching)")
 
 
-def _initial_tangent(law, stiffness: float) -> float:
-    """The initial tangent OpenSees gives the storey material (what ``-rayleigh a0 0 a1 0`` damps)."""
+def initial_tangent(law, stiffness: float) -> float:
+    """The initial tangent (N/m) OpenSees gives the material of :func:`storey_material` (what ``-rayleigh a0 0 a1 0``
+    damps): ``(α + (1 − α)A)·k`` for Bouc–Wen, the elastic *stiffness* k (N/m) otherwise."""
     from pounding.hysteresis import BoucWenStorey
 
     if isinstance(law, BoucWenStorey):
@@ -358,7 +359,7 @@ def opensees_script_and_notes(model, record=None, *, dt: float = DEFAULT_DT, xi:
             for level in range(1, b.n_floors + 1):
                 # Our solver damps a1·k; OpenSees damps a1·(initial tangent): make up any difference.
                 k = float(b.stiffness[level - 1])
-                missing = k - _initial_tangent(b.hysteresis[level - 1], k)
+                missing = k - initial_tangent(b.hysteresis[level - 1], k)
                 if missing != 0.0:
                     element += 1
                     below = ground if level == 1 else floor_node[(b_index, level - 1)]
@@ -740,6 +741,8 @@ def run_script(source: str, name: str) -> dict:
         done = subprocess.run([sys.executable, str(script), "-o", str(peaks_file)], capture_output=True,
                               text=True, cwd=folder)
         if not peaks_file.exists():
-            last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+            # OpenSees prints "Process 0 Terminating" as the interpreter exits: the script's own last word is before
+            last = ([line for line in done.stderr.splitlines() if line.strip() and "Process 0 Terminating" not in line]
+                    or ["no output"])[-1]
             raise PoundingError(f"the OpenSees script for {name} failed (exit {done.returncode}): {last}")
         return json.loads(peaks_file.read_text(encoding="utf-8"))

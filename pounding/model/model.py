@@ -205,6 +205,9 @@ class ContactFace:
         Applied at each point.
     friction : float or None
         Coulomb μ on the face.
+    at_first, at_second : float or None
+        A side that is a point of a column: ``level_*`` is its storey and ``at_*`` the fraction of its
+        height above the floor below (None: a floor).
     """
 
     contact: int
@@ -216,6 +219,8 @@ class ContactFace:
     points: tuple[outline.ContactPoint, ...]
     law: Any
     friction: float | None = None
+    at_first: float | None = None
+    at_second: float | None = None
 
     @property
     def gap(self) -> float:
@@ -229,28 +234,33 @@ class ContactFace:
 
     def point_elements(self, index: int) -> tuple[GapElement, ...]:
         """The face's gap elements (one per point, the low side on the left), *index* its place in ``Model.faces``."""
-        low, high = ((self.first, self.level_first), (self.second, self.level_second)) if self.face.first_low \
-            else ((self.second, self.level_second), (self.first, self.level_first))
-        return tuple(GapElement(self.contact, low[0], high[0], low[1], high[1], self.face.gap, self.law,
-                                normal=self.face.normal, point=tuple(float(v) for v in p.location), face=index)
+        first, second = (self.first, self.level_first, self.at_first), (self.second, self.level_second, self.at_second)
+        low, high = (first, second) if self.face.first_low else (second, first)
+        return tuple(GapElement(self.contact, low[0], high[0], low[1], high[1], self.face.gap, self.law, low[2],
+                                high[2], normal=self.face.normal, point=tuple(float(v) for v in p.location), face=index)
                      for p in self.points)
 
 
 @dataclass(frozen=True)
 class Link:
     """A permanent link (damper) between floor ``level_left`` of building ``left``
-    and floor ``level_right`` of building ``right = left + 1``: always engaged,
-    no gap, pulls as well as pushes (docs/physics.md §9).
+    and floor ``level_right`` of building ``right`` (in a planar row ``right = left + 1``): always
+    engaged, no gap, pulls as well as pushes (docs/physics.md §9).
 
     Attributes
     ----------
     entry : int
         Index of the YAML ``links`` entry it came from.
     left, right : int
-        Building indices (left to right).
+        Building indices (the low side along the normal on the left).
     level_left, level_right : int
         1-based floor numbers.
     law : LinkLaw
+    normal : {"x", "y"}
+        The direction it acts along (a planar row: x).
+    point : (float, float) or None
+        Where it joins the floors in plan, m: the middle of the facing edges' overlap (None: floors of
+        one degree of freedom).
     """
 
     entry: int
@@ -259,6 +269,13 @@ class Link:
     level_left: int
     level_right: int
     law: LinkLaw
+    normal: str = "x"
+    point: tuple[float, float] | None = None
+
+    def label(self, names: list[str]) -> str:
+        """``A:4-B:4`` (a point in plan adds its place, ``A:4-B:4@(24,13)``)."""
+        where = "" if self.point is None else f"@({self.point[0]:g},{self.point[1]:g})"
+        return f"{names[self.left]}:{self.level_left}-{names[self.right]}:{self.level_right}{where}"
 
 
 @dataclass(frozen=True)
@@ -749,9 +766,13 @@ def _face_documents(model: Model) -> list[dict[str, Any]]:
         faces = [f for f in model.faces if f.contact == contact]
         first = faces[0]
         wall = first.second == WALL
+        def side(level: int, at: float | None) -> Any:
+            return int(level) if at is None else {"storey": int(level), "at": float(at)}
+
         entry: dict[str, Any] = {"between": [names[first.first], schema.WALL_NAME if wall else names[first.second]],
-                                 "levels": [f.level_first for f in faces] if wall else
-                                 [[f.level_first, f.level_second] for f in faces]}
+                                 "levels": [side(f.level_first, f.at_first) for f in faces] if wall else
+                                 [[side(f.level_first, f.at_first), side(f.level_second, f.at_second)]
+                                  for f in faces]}
         if wall:
             entry["face"] = outline.wall_side(first.face)
         if wall or first.gap >= OPEN_GAP:
@@ -816,21 +837,39 @@ def _build_plan(entry: Any, *, name: str, text: str, path: str | None, base_dir:
     faces = []
     for index, c in enumerate(entry.contacts):
         first, second = c.sides
-        for level_first, level_second in c.pairs:
+        for (level_first, level_second), (at_first, at_second) in zip(c.pairs, c.points):
             centre_first = buildings[first].centres[level_first - 1]
             centre_second = None if second == WALL else buildings[second].centres[level_second - 1]
             points = outline.face_points(c.plan_face, centre_first, centre_second)
             faces.append(ContactFace(index, first, second, level_first, level_second, c.plan_face, points,
-                                     c.parameters, c.friction))
-    gm = entry.ground_motion
-    x, y = ((None if c is None else Component(c.record, float(c.scale))) for c in (gm.x, gm.y))
-    ground_motion = _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
-                             units=gm.units, base_dir=base_dir, processing=None, wave_passage=None,
-                             angle=float(gm.angle), x=x, y=y)
+                                     c.parameters, c.friction, at_first, at_second))
+    links = tuple(_plan_link(index, e, pair) for index, e in enumerate(entry.links) for pair in e.pairs)
+    own = tuple(_pair_spec(b.ground_motion, base_dir) for b in entry.buildings) if entry.ground_motion is None else ()
+    ground_motion = own[0] if own else _pair_spec(entry.ground_motion, base_dir)
     solver = _trusted(SolverSettings, **entry.solver.model_dump())
     return _trusted(Model, name=entry.name or name, buildings=buildings, gaps=face_elements(tuple(faces)),
                     ground_motion=ground_motion, solver=solver, source=text, path=path,
-                    building_ground_motions=(), links=(), faces=tuple(faces))
+                    building_ground_motions=own, links=links, faces=tuple(faces))
+
+
+def _pair_spec(gm: Any, base_dir: str | None) -> GroundMotionSpec:
+    """The :class:`GroundMotionSpec` of a validated two-component ground-motion entry."""
+    x, y = ((None if c is None else Component(c.record, float(c.scale))) for c in (gm.x, gm.y))
+    return _trusted(GroundMotionSpec, record=gm.record, scale=gm.scale, duration=gm.duration, dt=gm.dt,
+                    units=gm.units, base_dir=base_dir, processing=gm.processing, wave_passage=gm.wave_passage,
+                    angle=float(gm.angle), x=x, y=y)
+
+
+def _plan_link(index: int, entry: Any, pair: tuple[int, int]) -> Link:
+    """The link of a plan entry's level pair: at the middle of the facing edges' overlap, along the normal."""
+    face = entry.plan_face
+    first, second = entry.sides
+    middle = 0.5 * (face.span[0] + face.span[1])
+    point = (face.face_low, middle) if face.normal == "x" else (middle, face.face_low)
+    (low, level_low), (high, level_high) = ((first, pair[0]), (second, pair[1])) if face.first_low else \
+        ((second, pair[1]), (first, pair[0]))
+    return Link(index, low, high, level_low, level_high, entry.parameters, face.normal, (float(point[0]),
+                                                                                          float(point[1])))
 
 
 def model_from_text(text: str, *, name: str = "model", path: str | None = None,

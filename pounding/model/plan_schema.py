@@ -20,13 +20,14 @@ from pydantic import BaseModel, BeforeValidator, Discriminator, Field, PrivateAt
 from pounding.model import floors as plan, outline as plan_contacts
 from pounding.model.document import Document, Location, plural
 from pounding.model.ground import pair_components
-from pounding.model.schema import (OPEN_GAP, TAGS, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
+from pounding.model.schema import (OPEN_GAP, TAGS, WavePassageEntry, ground_motion_fits, processing_value, scale_value, WALL, WALL_NAME, BuildingEntry, CollapseEntry, ContactEntry, ContactGeometry, Damping,
+                                   DesignEntry, LinkEntry,
                                    HysteresisUnion, ModalEntry, between_indices, list_shape, ModelEntry, OptionalPositiveNumber, PositiveNumber, Problem, SchemaEntry, as_bool, as_name,
                                    as_number, contact_levels, hysteresis_parameters, located, problem,
                                    record_reference, storey_count, units_name, validate)
 
 __all__ = ["PlaneEntry", "PlanStoreyEntry", "PlanStoreyShorthand", "PlanEntry", "PlanBuildingEntry",
-           "PlanContactEntry", "ComponentEntry", "PlanGroundMotionEntry", "PlanModelEntry",
+           "PlanContactEntry", "PlanLinkEntry", "ComponentEntry", "PlanGroundMotionEntry", "PlanModelEntry",
            "validate_plan", "GAP_TOLERANCE"]
 
 #: An explicit ``gap`` may differ from the plan's by at most this, m.
@@ -133,19 +134,12 @@ class PlanEntry(SchemaEntry):
         description="the floor outline [[x0, y0], [x1, y1]], m, in the plan frame shared by all buildings")
 
 
-def _no_own_record(value: Any) -> Any:
-    if value is not None:
-        raise problem("a plan model takes one model-level ground_motion (two components, an angle); records per "
-                      "building are not supported with plan models", kind="error", line="key")
-    return value
-
-
 class PlanBuildingEntry(SchemaEntry):
-    """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``."""
+    """A plan building: ``name``, ``plan``, ``storeys`` (with planes), ``damping``, ``p_delta``, ``design``."""
 
     WHAT: ClassVar[str] = "a mapping {name, plan, storeys, damping}"
     CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"storeys": PlanStoreyEntry, "plan": PlanEntry,
-                                                      "collapse": CollapseEntry}
+                                                      "collapse": CollapseEntry, "design": DesignEntry}
 
     name: Annotated[str, BeforeValidator(located(as_name))] = Field(description="unique building name")
     plan: PlanEntry = Field(description="{outline: [[x0, y0], [x1, y1]]}")
@@ -154,7 +148,11 @@ class PlanBuildingEntry(SchemaEntry):
     damping: Damping = Field(description="e.g. {ratio: 0.05, modes: [1, 3]} or {modal: [0.05, 0.05]}")
     p_delta: Annotated[bool, BeforeValidator(located(as_bool))] = Field(
         False, description="leaning-column P-Delta from the floor weights, true or false")
-    ground_motion: Annotated[Any, BeforeValidator(_no_own_record)] = None
+    ground_motion: PlanGroundMotionEntry | None = Field(
+        None, description="this building's own record pair (every building then needs one; no model-level ground_motion)")
+    design: DesignEntry | None = Field(
+        None, description="design factors per code for pounding gap --code, e.g. {asce7_22: {R: 8, Cd: 5.5, Ie: 1}, "
+                          "ec8: {q: 3.9}}")
     collapse: CollapseEntry | None = Field(
         None, description="this building's collapse criterion {drift_ratio}: any of its planes' |drift ratio| "
                           "(default: solver.stop_drift_ratio)")
@@ -206,6 +204,10 @@ class PlanBuildingEntry(SchemaEntry):
 
     @model_validator(mode="after")
     def _modes_exist(self) -> PlanBuildingEntry:
+        if self.ground_motion is not None and self.ground_motion.wave_passage is not None:
+            raise problem("belongs to the model-level ground_motion (one record pair reaching every building with "
+                          "a time lag); a building's own ground_motion is applied without lag", kind="error",
+                          at=("ground_motion", "wave_passage"), line="key", colon=False)
         n = plan.PLAN_DOFS * self.n_floors
         if isinstance(self.damping, ModalEntry):
             if len(self.damping.modal) > n:
@@ -284,9 +286,11 @@ class PlanContactEntry(ContactEntry):
         if self.gap is not None and self.gap < 0.0:
             raise problem("must be >= 0", at=here + ("gap",))
         levels = contact_levels(index, self, first, second)
-        if any(a is not None or b is not None for (_, a), (_, b) in levels):
-            raise problem("column points {storey, at} are for planar models; a plan contact joins floors",
-                          kind="error", at=here + ("levels",), fallback=True)
+        if self.friction and any(a is not None or b is not None for (_, a), (_, b) in levels):
+            raise problem("Coulomb friction on a face needs the slip of two floors; a column point {storey, at} "
+                          "slides with the column's deflection between two floors, which the friction face does not "
+                          "follow: remove friction or strike a floor", kind="error", at=here + ("friction",),
+                          line="key", colon=False)
         self._pairs = tuple((a[0], b[0]) for a, b in levels)
         self._points = tuple((a[1], b[1]) for a, b in levels)
         self._face = self._wall_face(index, first) if second is None else self._geometry_face(index, first, second)
@@ -318,13 +322,42 @@ class PlanContactEntry(ContactEntry):
         return face
 
 
+class PlanLinkEntry(LinkEntry):
+    """A link between floors of two plan buildings that face each other: it acts along the face normal at the
+    middle of the overlap of their facing edges."""
+
+    _face: Any = PrivateAttr(None)
+
+    @property
+    def plan_face(self) -> plan_contacts.Face:
+        """The face the link spans (after the model's check)."""
+        return self._face
+
+    def resolve(self, index: int, buildings: list) -> None:
+        """Check ``between`` (two plan buildings that face each other) and ``levels``; keep the face."""
+        first, second = _plan_between(index, self.between, buildings, "links")
+        if WALL in (first, second):
+            raise problem("links join the floors of two buildings; a wall takes contacts only", kind="error",
+                          at=(index, "between"))
+        self._left, self._right = first, second
+        levels = contact_levels(index, self, buildings[first], buildings[second])
+        self._pairs = tuple((a[0], b[0]) for a, b in levels)
+        self._points = tuple((a[1], b[1]) for a, b in levels)
+        face = plan_contacts.facing(buildings[first].plan.outline, buildings[second].plan.outline)
+        if face is None:
+            raise problem(f"buildings {buildings[first].name} and {buildings[second].name} do not face each other: "
+                          f"their outlines {_outline_text(buildings[first])} and {_outline_text(buildings[second])} "
+                          "share no edge span along x or y", kind="error", at=(index, "between"))
+        self._face = face
+
+
 def _outline_text(building: PlanBuildingEntry) -> str:
     (x0, y0), (x1, y1) = building.plan.outline
     return f"[[{x0:g}, {y0:g}], [{x1:g}, {y1:g}]]"
 
 
-def _plan_between(index: int, value: Any, buildings: list) -> tuple[int, int]:
-    """``between`` of a plan contact: two building names or a building and the wall, both plan buildings."""
+def _plan_between(index: int, value: Any, buildings: list, section: str = "contacts") -> tuple[int, int]:
+    """``between`` of a plan contact (or link): two building names or a building and the wall, both plan buildings."""
     at: Location = (index, "between")
     names = [b.name for b in buildings]
     indices = between_indices(index, value, buildings, "two building names (or a building and wall), e.g. [A, B]")
@@ -353,13 +386,14 @@ class ComponentEntry(SchemaEntry):
     scale: PositiveNumber = Field(1.0, description="a factor on the component")
 
 
-def _refused(what: str) -> Any:
-    def check(value: Any) -> Any:
-        if value is not None:
-            raise problem(f"{what} is not supported with plan models", kind="error", line="key", colon=False)
-        return value
-
-    return check
+def _pair_processing(value: Any) -> Any:
+    """``processing`` of a record pair: baseline correction only (each component corrected on its own)."""
+    processing = processing_value(value)
+    if processing is not None and processing.trim is not None:
+        raise problem("trim applies to one record: trimming each component of a pair to its own significant "
+                      "duration would shift one against the other in time; trim the pair's records beforehand "
+                      "(keep baseline: true here)", kind="error", at=("trim",), line="key", colon=False)
+    return processing
 
 
 class PlanGroundMotionEntry(SchemaEntry):
@@ -370,7 +404,9 @@ class PlanGroundMotionEntry(SchemaEntry):
 
     record: Annotated[str | None, BeforeValidator(located(lambda v: None if v is None else record_reference(v)))] = \
         Field(None, description="a catalogue pair, e.g. fema-p695:farfield/1 (components a and b)")
-    scale: PositiveNumber = Field(1.0, description="a factor on both components of the pair")
+    scale: Annotated[Any, BeforeValidator(scale_value)] = Field(
+        1.0, description="a factor on both components, or a target for the pair's geometric-mean spectrum: "
+                         "{pga: 0.4g}, {sa: 0.8g, period: 1.0 | building A}, {fema-p695: true}")
     x: ComponentEntry | None = Field(None, description="the first component {record, scale}")
     y: ComponentEntry | None = Field(None, description="the second component {record, scale}")
     angle: Number = Field(0.0, description="degrees: component a (x) acts at this angle counter-clockwise from +x, "
@@ -379,8 +415,11 @@ class PlanGroundMotionEntry(SchemaEntry):
     dt: OptionalPositiveNumber = Field(None, description="time step of one-column text records, s")
     units: Annotated[str | None, BeforeValidator(located(lambda v: None if v is None else units_name(v)))] = Field(
         None, description="g, m/s2 or cm/s2 (gal)")
-    processing: Annotated[Any, BeforeValidator(_refused("processing (trim, baseline)"))] = None
-    wave_passage: Annotated[Any, BeforeValidator(_refused("wave passage (a time lag per building)"))] = None
+    processing: Annotated[Any, BeforeValidator(_pair_processing)] = Field(
+        None, description="{baseline: true}: each component baseline-corrected")
+    wave_passage: WavePassageEntry | None = Field(
+        None, description="{apparent_velocity: 500.0, position: {A: 0.0, B: 30.0}}: the pair reaches each building "
+                          "with a time lag")
 
     @model_validator(mode="after")
     def _one_form(self) -> PlanGroundMotionEntry:
@@ -395,9 +434,6 @@ class PlanGroundMotionEntry(SchemaEntry):
                 raise problem("must be a catalogue pair such as fema-p695:farfield/1 (components a and b) in a plan "
                               "model; for single records write x: {record: ...} and y: {record: ...}",
                               at=("record",))
-        elif self.scale != 1.0:
-            raise problem("applies to a record pair; give each component its own scale", kind="error",
-                          at=("scale",), line="key", colon=False)
         return self
 
     def components(self) -> tuple[ComponentEntry | None, ComponentEntry | None]:
@@ -420,12 +456,8 @@ class PlanModelEntry(ModelEntry):
     ground_motion: PlanGroundMotionEntry | None = Field(
         None, description="e.g. {record: fema-p695:farfield/1, angle: 0} or {x: {record: ...}, y: {record: ...}}")
 
-    @field_validator("links", mode="before")
-    @classmethod
-    def _no_links(cls, value: Any) -> Any:
-        if value:
-            raise problem("links are not supported with plan models yet", kind="error", line="key", colon=False)
-        return value
+    links: Annotated[list[PlanLinkEntry], BeforeValidator(lambda v: [] if v is None else v)] = Field(
+        default_factory=list, description="list of link entries (permanent dampers between facing floors)")
 
     @field_validator("buildings")
     @classmethod
@@ -441,8 +473,11 @@ class PlanModelEntry(ModelEntry):
 
     @field_validator("ground_motion")
     @classmethod
-    def _period_building(cls, ground_motion: Any) -> Any:
-        return ground_motion
+    def _period_building(cls, ground_motion: Any, info: Any) -> Any:
+        buildings = info.data.get("buildings")
+        if ground_motion is None or buildings is None:
+            return ground_motion
+        return ground_motion_fits(ground_motion, [b.name for b in buildings])
 
     @model_validator(mode="after")
     def _all_plan(self) -> PlanModelEntry:
@@ -455,7 +490,7 @@ class PlanModelEntry(ModelEntry):
         return self
 
 
-PlanModelEntry.CHILDREN = {"buildings": PlanBuildingEntry, "contacts": PlanContactEntry,
+PlanModelEntry.CHILDREN = {"buildings": PlanBuildingEntry, "contacts": PlanContactEntry, "links": PlanLinkEntry,
                            "ground_motion": PlanGroundMotionEntry}
 PlanBuildingEntry.model_rebuild()
 PlanModelEntry.model_rebuild()

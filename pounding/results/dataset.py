@@ -153,17 +153,22 @@ def _storey_drift(u: np.ndarray, below: np.ndarray) -> np.ndarray:
 
 
 def _link_results(system: System, raw: RawSolution, ng: int,
-                  ground_displacement: np.ndarray | None = None) -> dict[str, np.ndarray]:
+                  ground_displacement: np.ndarray | None = None, *, weighted: bool = False) -> dict[str, np.ndarray]:
     """Per link (the elements after the *ng* contacts): deformation, work and stored energy histories.
 
     Stored energy (docs/physics.md §9): ½kδ² in a Kelvin spring, q²/(2k) in a Maxwell spring, none
-    in a dashpot (the solver's ``kernels.potential`` of the same elements, vectorised here).
+    in a dashpot (the solver's ``kernels.potential`` of the same elements, vectorised here).  *weighted*:
+    the deformation is the links' weighted sums of terms (points of floors in plan), not a floor difference.
     """
     n = system.n_floors
     lay = system.layout
     u = raw.state[:, :n]
     left, right = system.contact_left[ng:], system.contact_right[ng:]
-    deformation = np.take(u, left, axis=1) - np.take(u, right, axis=1)
+    if weighted:
+        deformation = combined_penetration(u, system.contact_floors[ng:], system.contact_weights[ng:],
+                                           np.zeros(left.size), np.zeros((u.shape[0], left.size)))
+    else:
+        deformation = np.take(u, left, axis=1) - np.take(u, right, axis=1)
     if ground_displacement is not None:
         # Total displacements: the differential ground displacement of the link's two ends (docs/physics.md §10).
         deformation = deformation + (np.take(ground_displacement, system.contact_ground_left[ng:], axis=1)
@@ -832,6 +837,7 @@ def _plane_energies(assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> 
     geometric = 0.5 * ((state[:, :n] @ assembly.p_delta_weights.T) ** 2) @ assembly.p_delta_stiffness
     hysteretic = state[:, lay.storey_work:lay.ground_work].sum(axis=1) - raw.storey_energy[:, 1]
     return {"energy_input": state[:, lay.input_energy],
+            "energy_ground_work": state[:, lay.ground_work],
             "energy_kinetic": 0.5 * (v * v) @ system.mass,
             "energy_damping": state[:, lay.damping_energy],
             "energy_plane_strain": strain + raw.storey_energy[:, 1],
@@ -899,9 +905,10 @@ def _plane_shear(assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> np.
 def plan_energy_closure(ds: xr.Dataset) -> float:
     """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of a plan archive (dimensionless)."""
     parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
-             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0))
+             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0)
+             + ds.get("energy_link_dissipated", 0.0) + ds.get("energy_link_strain", 0.0))
     initial = float(parts[0])
-    supplied = initial + ds.energy_input
+    supplied = initial + ds.energy_input + ds.get("energy_ground_work", 0.0)
     scale = float(np.abs(supplied).max())
     return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
 
@@ -909,9 +916,10 @@ def plan_energy_closure(ds: xr.Dataset) -> float:
 def plane_energy_closure(ds: xr.Dataset) -> float:
     """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of an archive with plane rows (dimensionless)."""
     parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
-             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0))
+             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0)
+             + ds.get("energy_link_dissipated", 0.0) + ds.get("energy_link_strain", 0.0))
     initial = float(parts[0])
-    supplied = initial + ds.energy_input
+    supplied = initial + ds.energy_input + ds.get("energy_ground_work", 0.0)
     scale = float(np.abs(supplied).max())
     return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
 
@@ -1071,7 +1079,44 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
     if model.contacts_held_open:
         attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
                              "(the run without pounding)")
+    attrs["multi_support"] = ("per-building records" if model.has_building_records else
+                              "wave passage" if model.ground_motion.wave_passage is not None else "")
     return attrs
+
+
+def _plane_link_variables(model: Model, assembly: Assembly, raw: RawSolution, supports) -> dict[str, tuple]:
+    """The links' histories, peaks and energies of a run with floors in plan ({} without links)."""
+    if not model.links:
+        return {}
+    npt = assembly.n_points
+    grounds = None
+    if supports is not None and supports.rows.shape[0] > 1:
+        grounds = kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)[2]
+    links = _link_results(assembly.system, raw, npt, grounds, weighted=True)
+    return {
+        "link_force": _var(("time", "link"), raw.contact_force[:, npt:], "N",
+                           "link force (> 0 pushes the floors apart, < 0 pulls them together)"),
+        "link_deformation": _var(("time", "link"), links["deformation"], "m",
+                                 "relative displacement of the link's two points along its normal, low side minus high"),
+        "peak_link_force": _var(("link",), raw.peak_contact_force[npt:], "N",
+                                "peak absolute link force, tracked on every step"),
+        "link_dissipated_energy": _var(("link",), links["work"][-1] - links["stored"][-1], "J",
+                                       "energy dissipated by the link over the run"),
+        "energy_link_dissipated": _var(("time",), links["work"].sum(axis=1) - links["stored"].sum(axis=1), "J",
+                                       "energy dissipated by the links"),
+        "energy_link_strain": _var(("time",), links["stored"].sum(axis=1), "J", "elastic energy stored in the links"),
+    }
+
+
+def _link_coords(model: Model) -> dict[str, tuple]:
+    """The ``link`` dimension's labels and laws ({} without links)."""
+    if not model.links:
+        return {}
+    names = [b.name for b in model.buildings]
+    return {"link": ("link", np.array([k.label(names) for k in model.links], dtype=object),
+                     {"long_name": "link label left:level-right:level"}),
+            "link_law": ("link", np.array([k.law.describe() for k in model.links], dtype=object),
+                         {"long_name": "link element and its parameters"})}
 
 
 def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *, end_time: float,
@@ -1085,8 +1130,9 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
     npt = assembly.n_points
     u = raw.state[:, :n].reshape(-1, nf, DOF_PER_FLOOR)
     v = raw.state[:, n:2 * n].reshape(-1, nf, DOF_PER_FLOOR)
-    delta = combined_penetration(raw.state[:, :n], system.contact_floors, system.contact_weights, system.contact_gap,
-                                 np.zeros((raw.time.size, system.n_contacts)))
+    grounds = (kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)[2] if supports is not None
+               else np.zeros((raw.time.size, 1)))
+    delta = _penetration(raw.state[:, :n], system, grounds)
     drift = raw.state[:, :n] @ assembly.plane_weights.T
     peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
     counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
@@ -1130,6 +1176,7 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
     }
     data.update(_friction_variables(assembly, raw))
+    data.update(_plane_link_variables(model, assembly, raw, supports))
     for name, values in _plane_energies(assembly, raw, drift).items():
         label = name.removeprefix("energy_").replace("_", " ")
         data[name] = _var(("time",), values, "J", f"energy: {label}")
@@ -1139,7 +1186,7 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
     coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
               "direction": ("direction", np.array(["x", "y"], dtype=object), {"long_name": "plan direction"}),
               **_floor_coords(model), **_plan_floor_labels(model), **_plane_labels(model), **_plane_coords(model),
-              **contact_coords(model), **_point_labels(model), **_face_labels(model, assembly)}
+              **contact_coords(model), **_point_labels(model), **_face_labels(model, assembly), **_link_coords(model)}
     status = plane_status(model, assembly, raw)
     ds = xr.Dataset(data, coords=coords, attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time,
                                                                wall_time=wall_time, status=status))

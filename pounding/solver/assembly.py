@@ -151,12 +151,14 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
         rayleigh = chain and building.damping.kind == "rayleigh"
         c_mass, c_stiff = building.rayleigh_coefficients if rayleigh else (0.0, 0.0)
         a0.append(np.full(n, c_mass) if rayleigh else np.zeros(n))
-        a1.append(np.full(n, c_stiff) if rayleigh else np.zeros(n))
+        a1.append(c_stiff * _tangent_ratios(building) if rayleigh else np.zeros(n))
         dense_size.append(0 if rayleigh else n)
         if not rayleigh:
             damping = np.asarray(building.damping_matrix(), dtype=float)
+            # The springs act with their elastic stiffness (a yielding plane's row adds F − kΔ); damping is on the
+            # initial tangent (the building's damping matrix).
             k = (np.zeros((n, n)) if chain else
-                 np.asarray(building.stiffness_matrix() + building.geometric_stiffness(), dtype=float))
+                 np.asarray(building.stiffness_matrix(initial=False) + building.geometric_stiffness(), dtype=float))
             dense_values.append(damping.ravel())
             dense_stiffness.append(k.ravel())
             dense_band.append(n - 1 if chain else _half_bandwidth(damping, k))
@@ -179,6 +181,14 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
         arrays["dense_stiffness"] = np.ascontiguousarray(np.concatenate(dense_stiffness) if dense_stiffness
                                                          else np.zeros(0))
     return arrays
+
+
+def _tangent_ratios(building: Any) -> np.ndarray:
+    """(n,) each storey's tangent stiffness at rest over its elastic stiffness: 1 exactly, but for a Bouc–Wen
+    storey with A ≠ 1, so that the chain's Rayleigh term ``a1·k`` acts on the initial tangent as the damping
+    matrix does (docs/physics.md §7)."""
+    return np.array([1.0 if p.hysteresis is None or p.initial_stiffness == float(p.stiffness)
+                     else p.initial_stiffness / float(p.stiffness) for s in building.storeys for p in s.planes])
 
 
 def _bands(sizes: list[int], bands: list[int]) -> np.ndarray:
@@ -368,14 +378,14 @@ def element_arrays(model: Model, mass: np.ndarray, ground: GroundRows) -> dict[s
         laws.append(gap.law.law_id)
         params.append(gap.law.kernel_parameters(side_mass(terms_left, mass), side_mass(terms_right, mass)))
     for link in model.links:
-        lf = model.dof_offsets[link.left] + link.level_left - 1
-        rf = model.dof_offsets[link.right] + link.level_right - 1
-        left.append(lf)
-        right.append(rf)
-        floors.append([lf, -1, rf, -1])
-        weights.append([1.0, 0.0, -1.0, 0.0])
-        ground_left.append(ground.of(link.left, "x"))
-        ground_right.append(ground.of(link.right, "x"))
+        terms_left, main_left = side_terms(model, link.left, link.level_left, None, link.point, link.normal)
+        terms_right, main_right = side_terms(model, link.right, link.level_right, None, link.point, link.normal)
+        left.append(main_left)
+        right.append(main_right)
+        floors.append([f for f, _ in terms_left] + [f for f, _ in terms_right])
+        weights.append([w for _, w in terms_left] + [0.0 - w for _, w in terms_right])
+        ground_left.append(ground.of(link.left, link.normal))
+        ground_right.append(ground.of(link.right, link.normal))
         gaps.append(0.0)
         laws.append(link.law.law_id)
         params.append(link.law.kernel_parameters())

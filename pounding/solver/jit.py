@@ -38,7 +38,7 @@ import os
 import sys
 from typing import Iterable
 
-__all__ = ["TESTED_NUMBA", "NO_REFCOUNT", "INLINED", "CALLED", "shortcuts_supported", "load_registries_without_scipy",
+__all__ = ["TESTED_NUMBA", "PYTHON_ONLY", "NO_REFCOUNT", "INLINED", "CALLED", "shortcuts_supported", "load_registries_without_scipy",
            "load_from_cache_without_refresh",
            "stamp_caches_with_sources", "source_stamp", "EXTRA_SOURCES", "solver_sources",
            "stamp_solver_kernels", "PREBUILT", "load_prebuilt", "prebuilt_status", "prebuilt_switched_off",
@@ -273,15 +273,21 @@ def stamp_caches_with_sources(dispatchers: Iterable, files: Iterable[str | os.Pa
             cache_file._source_stamp = stamp
 
 
+#: Solver modules no kernel is compiled from or reads (the model's lowering into arrays, the tolerance
+#: factors): editing them keeps the compiled kernels.
+PYTHON_ONLY = ("assembly.py", "tolerances.py")
+
+
 def solver_sources() -> list[str]:
     """Every source file compiled into the solver's kernels: the modules of ``pounding/solver``
-    and of ``pounding/contact`` (the contact laws, links and ξ formulas whose ids, sizes and
+    (but :data:`PYTHON_ONLY`) and of ``pounding/contact`` (the contact laws, links and ξ formulas whose ids, sizes and
     forces they inline, a law in a file of its own included) and ``pounding/hysteresis.py``.
     The same list whichever module is imported first, so every kernel has the same stamp."""
     solver = os.path.dirname(os.path.abspath(__file__))
     package = os.path.dirname(solver)
     contact = os.path.join(package, "contact")
-    own = sorted(os.path.join(solver, name) for name in os.listdir(solver) if name.endswith(".py"))
+    own = sorted(os.path.join(solver, name) for name in os.listdir(solver)
+                 if name.endswith(".py") and name not in PYTHON_ONLY)
     laws = sorted(os.path.join(contact, name) for name in os.listdir(contact) if name.endswith(".py"))
     return own + laws + [os.path.join(package, "hysteresis.py")]
 

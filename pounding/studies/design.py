@@ -21,6 +21,19 @@ EN 1998-1 §4.3.3.3.1(3)); all modes if the building has fewer.  The codes'
 spectra are at 5 % damping; the CQC coefficients use the building's damping
 (5 % for the codes' usual models), so a building damped otherwise mixes the
 two — this is said, not corrected.
+
+The same functions serve plan buildings (docs/plan-models.md: rigid floors with
+u_x, u_y, θ): the difference is in the data.  A planar building is a building
+whose floors have one DOF, shaken along x; a plan building has three per
+floor, M = diag(m, m, m r²), and is shaken along x or y with the influence
+vector r (1 on every u_x, resp. u_y, 0 on θ): Γ_k = φ_kᵀ M r and the
+participating mass is Γ_k² / (rᵀ M r).  Its modes are the fewest, from the
+first, that reach 90 % of the mass in *each* horizontal direction (ASCE 7-22
+§12.9.1.1, EN 1998-1 §4.3.3.3.1(3)), and any response that is a linear
+combination w · q of the DOF (a point's displacement along a face normal) is
+combined from its modal values, CQC(w · u_k) (:meth:`ModalResponse.at`).  The
+plan-only steps (accidental torsion, the two directions, contact points) are
+in :mod:`pounding.studies.design_directions`.
 """
 
 from __future__ import annotations
@@ -34,12 +47,14 @@ import numpy as np
 from pounding.studies.gap import cqc_correlation
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION",
+__all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION", "dof_per_floor", "ground_influence",
+           "modal_damping", "modes_for_mass", "response_directions",
            "Separation", "asce7_22_inelastic_displacement", "asce7_22_separation", "asce7_22_displacements",
            "EC8_SAME_LEVELS_FACTOR", "ec8_design_displacement", "ec8_separation", "is1893_separation",
            "nzs1170_5_separation", "NTC_2004_HEIGHT", "NTC_2004_SIMPLIFIED", "NTC_2004_MINIMUM", "ntc2004_setback",
            "ntc2004_separation", "SUITE_FRACTION", "SUITE_PERIODS", "EC8_MEAN_RECORDS", "ASCE_RECORDS",
-           "suite_scale_factor", "Intensity", "record_set_spectra", "code_displacements", "code_separations",
+           "suite_scale_factor", "Intensity", "record_set_spectra", "code_setup", "code_displacements",
+           "pair_separation", "code_separations",
            "code_gap_study", "code_gap_table", "code_gap_summary"]
 
 #: Participating mass the modes of a response-spectrum analysis must reach (ASCE 7-22 §12.9.1.1, EC8 §4.3.3.3.1).
@@ -48,7 +63,7 @@ MASS_FRACTION = 0.90
 
 @dataclass(frozen=True, eq=False)
 class ModalResponse:
-    """The response-spectrum analysis of one building.
+    """The response-spectrum analysis of one building along one direction.
 
     Attributes
     ----------
@@ -57,15 +72,18 @@ class ModalResponse:
     periods, damping : (m,) ndarray
         Periods (s) and damping ratios of the m modes used.
     participation : (m,) ndarray
-        Participation factors Γ_k = φ_kᵀ M 1 of the mass-normalised modes, kg^½.
+        Participation factors Γ_k = φ_kᵀ M r of the mass-normalised modes, kg^½.
     mass_ratio : (m,) ndarray
-        Effective modal mass Γ_k² over the building's mass.
+        Effective modal mass Γ_k² over the building's mass (rᵀ M r) along the direction.
     sa : (m,) ndarray
         Spectral acceleration at each mode's period, g.
-    modal_displacement : (m, n) ndarray
-        Peak floor displacements of each mode, m, signed (Γ_k φ_k Sd_k).
-    displacement : (n,) ndarray
-        CQC combination of the modes: peak floor displacements, m, floor 1 first.
+    modal_displacement : (m, N) ndarray
+        Peak displacements of each mode, signed (Γ_k φ_k Sd_k), at every DOF: m (rad on a plan floor's θ).
+    displacement : (N,) ndarray
+        CQC combination of the modes at every DOF: a planar building's floor displacements (m, floor 1
+        first); a plan building's (u_x, u_y, θ) per floor.
+    direction : {"x", "y"}
+        The direction of the ground motion (a planar building: x).
     """
 
     building: str
@@ -76,6 +94,7 @@ class ModalResponse:
     sa: np.ndarray
     modal_displacement: np.ndarray
     displacement: np.ndarray
+    direction: str = "x"
 
     @property
     def n_modes(self) -> int:
@@ -86,6 +105,22 @@ class ModalResponse:
     def mass_fraction(self) -> float:
         """Participating mass of the modes used, as a fraction of the building's mass."""
         return float(self.mass_ratio.sum())
+
+    def at(self, weights: Any) -> np.ndarray:
+        """CQC of the modal values of the responses ``w · q`` (m): *weights* (N,) or (k, N) → (k,).
+
+        Each mode's response is ``w · u_k`` (signed), then the modes are combined
+        (:func:`cqc_combine`): a point's displacement is combined as itself, not
+        from the combined centre and rotation.
+        """
+        w = np.atleast_2d(np.asarray(weights, dtype=float))
+        return cqc_combine(self.modal_displacement @ w.T, self.periods, self.damping)
+
+    def inertia_forces(self, mass: Any) -> np.ndarray:
+        """(N,) CQC of the modes' inertia forces ω_k² M u_k at every DOF (N; N·m on θ), *mass* the (N,) diagonal of M."""
+        omega = 2.0 * np.pi / self.periods
+        modal = self.modal_displacement * (omega ** 2)[:, None] * np.asarray(mass, dtype=float)[None, :]
+        return cqc_combine(modal, self.periods, self.damping)
 
 
 def cqc_combine(modal: Any, periods: Any, damping: Any) -> np.ndarray:
@@ -110,37 +145,96 @@ def cqc_combine(modal: Any, periods: Any, damping: Any) -> np.ndarray:
     return np.sqrt(np.maximum(np.einsum("in,ij,jn->n", r, rho, r), 0.0))
 
 
-def modal_response(building, spectrum, *, mass_fraction: float = MASS_FRACTION) -> ModalResponse:
-    """Peak floor displacements of *building* on its own under *spectrum*, by modes and CQC.
+def dof_per_floor(building) -> int:
+    """Degrees of freedom per floor: 1 for a planar (shear) building, 3 (u_x, u_y, θ) for a plan building."""
+    return int(building.mass_matrix().shape[0] // building.n_floors)
+
+
+def response_directions(building) -> tuple[str, ...]:
+    """The directions a building is shaken along: ``("x",)`` planar, ``("x", "y")`` plan."""
+    return ("x",) if dof_per_floor(building) == 1 else ("x", "y")
+
+
+def ground_influence(building, direction: str = "x") -> np.ndarray:
+    """(N,) influence vector r of a ground motion along *direction*: 1 on every floor's translation that way, 0 on θ."""
+    per = dof_per_floor(building)
+    if direction not in response_directions(building):
+        raise ValueError(f"building {building.name} is shaken along {' or '.join(response_directions(building))} "
+                         f"(got {direction!r})")
+    r = np.zeros(per * building.n_floors)
+    r["xy".index(direction)::per] = 1.0
+    return r
+
+
+def modal_damping(building) -> np.ndarray:
+    """(N,) damping ratio of every mode: Rayleigh ``(a0/ω + a1·ω)/2`` at its two targeted modes, or its modal ratios."""
+    omega = np.asarray(building.modes[0], dtype=float)
+    damping = building.damping
+    if damping.kind == "modal":
+        return np.asarray(damping.ratios(omega.size), dtype=float)
+    i, j = damping.modes
+    wi, wj = float(omega[i - 1]), float(omega[j - 1])
+    a0, a1 = 2.0 * damping.ratio * wi * wj / (wi + wj), 2.0 * damping.ratio / (wi + wj)
+    return 0.5 * (a0 / omega + a1 * omega)
+
+
+def _mass_ratios(building, direction: str) -> np.ndarray:
+    omega, phi = building.modes
+    mass = np.diag(building.mass_matrix())
+    r = ground_influence(building, direction)
+    return (phi.T @ (mass * r)) ** 2 / float(mass @ r)
+
+
+def modes_for_mass(building, mass_fraction: float = MASS_FRACTION) -> int:
+    """The fewest modes, from the first, whose effective masses reach *mass_fraction* along every direction.
+
+    ASCE 7-22 §12.9.1.1 ("in each of the orthogonal horizontal directions");
+    EN 1998-1 §4.3.3.3.1(3).  All modes if the building has fewer.
+    """
+    count = 1
+    for direction in response_directions(building):
+        cumulative = np.cumsum(_mass_ratios(building, direction))
+        count = max(count, int(np.searchsorted(cumulative, mass_fraction - 1e-12) + 1))
+    return min(count, int(building.modes[0].size))
+
+
+def modal_response(building, spectrum, *, mass_fraction: float = MASS_FRACTION, direction: str = "x",
+                   n_modes: int | None = None) -> ModalResponse:
+    """Peak displacements of *building* on its own under *spectrum* along *direction*, by modes and CQC.
 
     Parameters
     ----------
-    building : pounding.model.Building
-        A shear building (its elastic storey stiffnesses; yielding is not modelled here).
+    building : pounding.model.Building or PlanBuilding
+        A shear building (one DOF per floor) or a plan building (three); its
+        elastic (initial) stiffness: yielding is not modelled here.
     spectrum : DesignSpectrum
         Anything with ``sa(periods) -> Sa in g`` (:mod:`pounding.records.design_spectra`).
     mass_fraction : float
-        Participating mass the modes must reach (default 90 %).
+        Participating mass the modes must reach in every direction (default 90 %).
+    direction : {"x", "y"}
+        The ground motion's direction (a planar building: x only).
+    n_modes : int, optional
+        Use exactly this many modes (default :func:`modes_for_mass`).
 
     Returns
     -------
     ModalResponse
     """
     omega, phi = building.modes
-    mass = np.asarray(building.mass, dtype=float)
-    gamma_all = phi.T @ mass
-    ratio_all = gamma_all ** 2 / mass.sum()
-    needed = int(np.searchsorted(np.cumsum(ratio_all), mass_fraction - 1e-12) + 1)
-    m = min(max(needed, 1), omega.size)
+    mass = np.diag(building.mass_matrix())
+    r = ground_influence(building, direction)
+    gamma_all = phi.T @ (mass * r)
+    ratio_all = gamma_all ** 2 / float(mass @ r)
+    m = modes_for_mass(building, mass_fraction) if n_modes is None else min(max(int(n_modes), 1), omega.size)
     w = np.asarray(omega[:m])
     periods = 2.0 * np.pi / w
     sa = spectrum.sa(periods)
     sd = sa * STANDARD_GRAVITY / w ** 2
     modal = (gamma_all[:m] * sd)[:, None] * np.asarray(phi[:, :m]).T
-    damping = np.asarray(building.modal_damping_ratios[:m], dtype=float)
+    damping = modal_damping(building)[:m]
     return ModalResponse(building=building.name, periods=periods, damping=damping, participation=gamma_all[:m],
                          mass_ratio=ratio_all[:m], sa=np.asarray(sa, dtype=float), modal_displacement=modal,
-                         displacement=cqc_combine(modal, periods, damping))
+                         displacement=cqc_combine(modal, periods, damping), direction=direction)
 
 
 # --------------------------------------------------------------------------- #
@@ -376,19 +470,74 @@ def record_set_spectra(model, records: list[str], periods: Any, *, duration: flo
     return np.array(psa), np.array(pga)
 
 
-def _design_of(model, code: str, key: str, example: str):
-    """Each building's design factors for *code* (``design.<key>``), refused in one line when missing."""
+def _design_of(model, code: str, key: str, example: str, designs: list | None = None):
+    """Each building's design factors for *code* (``design.<key>``), refused in one line when missing.
+
+    *designs* gives each building's ``design`` entry where the building object does not carry it.
+    """
     from pounding.errors import ModelError
 
     found = []
     for index, b in enumerate(model.buildings):
-        entry = getattr(b.design, key, None) if b.design is not None else None
+        design = b.design if designs is None else designs[index]
+        entry = getattr(design, key, None) if design is not None else None
         if entry is None:
             where = f"{model.path}: " if model.path else ""
             raise ModelError(f"{where}buildings[{index}] ({b.name}) has no design.{key}: --code {code} needs each "
                              f"building's factors, e.g. design: {{{key}: {example}}} (docs/design-codes.md)")
         found.append(entry)
     return found
+
+
+def code_setup(model, code: str, spectrum_options: dict[str, Any], designs: list | None = None) -> dict[str, Any]:
+    """The code's spectra and factors per building, the intensities of the records, the statistic and the rule.
+
+    Parameters
+    ----------
+    model : Model or PlanModel
+    code : {"asce7-22", "ec8"}
+    spectrum_options : dict
+        ASCE 7-22: ``sds``, ``sd1``, ``tl``; Eurocode 8: ``type``, ``ground``, ``ag``, ``beta``.
+    designs : list, optional
+        Each building's ``design`` entry (default: the buildings' own ``design``).
+
+    Returns
+    -------
+    dict
+        ``factors`` [the building's design factors], ``spectra`` {building: DesignSpectrum of its RSA},
+        ``scale`` {building: the factor from the elastic RSA displacement to the code's design displacement:
+        C_d/R (δ_max = u I_e/R, δ_M = C_d δ_max/I_e) or q_d}, ``intensities`` [Intensity], ``statistic``, ``rule``.
+    """
+    from pounding.records.design_spectra import asce7_22_spectrum, ec8_spectrum
+
+    if code == "asce7-22":
+        factors = _design_of(model, code, "asce7_22", "{R: 8, Cd: 5.5, Ie: 1.0}", designs)
+        sds, sd1, tl = spectrum_options["sds"], spectrum_options["sd1"], spectrum_options["tl"]
+        design, mce = asce7_22_spectrum(sds, sd1, tl), asce7_22_spectrum(sds, sd1, tl, mce=True)
+        intensities = [
+            Intensity("design", design, "the level of §12.12.2's delta_M (design spectrum, §11.4.5; 2/3 of MCE_R)"),
+            Intensity("MCE_R", mce, "the target spectrum of response-history analysis, ASCE 7-22 ch. 16 (§16.2.1)")]
+        return {"factors": factors, "spectra": {b.name: design for b in model.buildings},
+                "scale": {b.name: float(asce7_22_displacements(1.0, f.R, f.Cd, f.Ie))
+                          for b, f in zip(model.buildings, factors)},
+                "intensities": intensities, "statistic": "mean",
+                "rule": "ASCE 7-22 §12.12.2: delta_M = Cd delta_max / Ie; delta_MT = SRSS"}
+    if code == "ec8":
+        factors = _design_of(model, code, "ec8", "{q: 3.9}", designs)
+        kind, ground, ag, beta = (spectrum_options[k] for k in ("type", "ground", "ag", "beta"))
+        elastic = ec8_spectrum(kind, ground, ag)
+        soil = elastic.sa([0.0])[0]   # a_g S
+        intensities = [Intensity("design", elastic, "the elastic spectrum of the design seismic action, EN 1998-1 "
+                                                    "§3.2.3.1.2(4) (mean >= 90 % over 0.2-2 T1, mean PGA >= a_g S)",
+                                 pga_target=float(soil))]
+        return {"factors": factors,
+                "spectra": {b.name: ec8_spectrum(kind, ground, ag, q=f.q, beta=beta)
+                            for b, f in zip(model.buildings, factors)},
+                "scale": {b.name: float(f.qd or f.q) for b, f in zip(model.buildings, factors)},
+                "intensities": intensities,
+                "statistic": "mean (>= 7 records) or max (fewer), EN 1998-1 §4.3.3.4.3(3)",
+                "rule": "EN 1998-1 §4.4.2.7: d_s = q_d d_e (4.23); SRSS; x0.7 where floor levels coincide"}
+    raise ValueError(f"unknown code {code!r}")
 
 
 def code_displacements(model, code: str, spectrum_options: dict[str, Any]) -> dict[str, Any]:
@@ -409,38 +558,27 @@ def code_displacements(model, code: str, spectrum_options: dict[str, Any]) -> di
         [Intensity], ``statistic`` (how the records' results are combined),
         ``rule`` (the clause).
     """
-    from pounding.records.design_spectra import asce7_22_spectrum, ec8_spectrum
-
-    rsa, spectra, displacement = {}, {}, {}
-    if code == "asce7-22":
-        factors = _design_of(model, code, "asce7_22", "{R: 8, Cd: 5.5, Ie: 1.0}")
-        design = asce7_22_spectrum(spectrum_options["sds"], spectrum_options["sd1"], spectrum_options["tl"])
-        mce = asce7_22_spectrum(spectrum_options["sds"], spectrum_options["sd1"], spectrum_options["tl"], mce=True)
-        for b, f in zip(model.buildings, factors):
-            rsa[b.name] = modal_response(b, design)
-            spectra[b.name] = design
+    setup = code_setup(model, code, spectrum_options)
+    rsa, displacement = {}, {}
+    for b, f in zip(model.buildings, setup["factors"]):
+        rsa[b.name] = modal_response(b, setup["spectra"][b.name])
+        if code == "asce7-22":
             displacement[b.name] = asce7_22_displacements(rsa[b.name].displacement, f.R, f.Cd, f.Ie)
-        intensities = [
-            Intensity("design", design, "the level of §12.12.2's delta_M (design spectrum, §11.4.5; 2/3 of MCE_R)"),
-            Intensity("MCE_R", mce, "the target spectrum of response-history analysis, ASCE 7-22 ch. 16 (§16.2.1)")]
-        return {"displacement": displacement, "rsa": rsa, "spectra": spectra, "intensities": intensities,
-                "statistic": "mean", "rule": "ASCE 7-22 §12.12.2: delta_M = Cd delta_max / Ie; delta_MT = SRSS"}
-    if code == "ec8":
-        factors = _design_of(model, code, "ec8", "{q: 3.9}")
-        kind, ground, ag, beta = (spectrum_options[k] for k in ("type", "ground", "ag", "beta"))
-        elastic = ec8_spectrum(kind, ground, ag)
-        for b, f in zip(model.buildings, factors):
-            spectra[b.name] = ec8_spectrum(kind, ground, ag, q=f.q, beta=beta)
-            rsa[b.name] = modal_response(b, spectra[b.name])
+        else:
             displacement[b.name] = ec8_design_displacement(rsa[b.name].displacement, f.qd or f.q)
-        soil = elastic.sa([0.0])[0]   # a_g S
-        intensities = [Intensity("design", elastic, "the elastic spectrum of the design seismic action, EN 1998-1 "
-                                                    "§3.2.3.1.2(4) (mean >= 90 % over 0.2-2 T1, mean PGA >= a_g S)",
-                                 pga_target=float(soil))]
-        return {"displacement": displacement, "rsa": rsa, "spectra": spectra, "intensities": intensities,
-                "statistic": "mean (>= 7 records) or max (fewer), EN 1998-1 §4.3.3.4.3(3)",
-                "rule": "EN 1998-1 §4.4.2.7: d_s = q_d d_e (4.23); SRSS; x0.7 where floor levels coincide"}
-    raise ValueError(f"unknown code {code!r}")
+    return {"displacement": displacement, "rsa": rsa, "spectra": setup["spectra"],
+            "intensities": setup["intensities"], "statistic": setup["statistic"], "rule": setup["rule"]}
+
+
+def pair_separation(code: str, first: float, second: float, *, same_levels: bool) -> Separation:
+    """The code's separation of two points with design displacements *first* and *second* (m).
+
+    ASCE 7-22 §12.12.2 (:func:`asce7_22_separation`) or EN 1998-1 §4.4.2.7
+    (:func:`ec8_separation`, its 0.7 where *same_levels*).
+    """
+    if code == "asce7-22":
+        return asce7_22_separation(first, second)
+    return ec8_separation(first, second, same_levels=same_levels)
 
 
 def code_separations(model, code: str, displacement: dict[str, np.ndarray], *,
@@ -458,7 +596,7 @@ def code_separations(model, code: str, displacement: dict[str, np.ndarray], *,
         d2 = float(displacement[right.name][g.level_right - 1])
         z1, z2 = float(left.elevation[g.level_left - 1]), float(right.elevation[g.level_right - 1])
         same = abs(z1 - z2) <= tolerance + 1e-9
-        sep = asce7_22_separation(d1, d2) if code == "asce7-22" else ec8_separation(d1, d2, same_levels=same)
+        sep = pair_separation(code, d1, d2, same_levels=same)
         rows.append({"contact": g.label(names), "left": d1, "right": d2, "elevation": max(z1, z2),
                      "same_levels": same, "separation": sep})
     return rows
@@ -525,35 +663,48 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
 
 
 def code_gap_table(result: dict[str, Any]) -> str:
-    """The code check as a printed table (millimetres)."""
+    """The code check as a printed table (millimetres): one row per level pair, or per contact point of a plan model.
+
+    A plan model's result (:func:`pounding.studies.design_directions.plan_code_gap_study`) adds the model's
+    gap per point, names the sides ``1`` and ``2`` (the contact's first and second building) and describes
+    each building's analysis in its own ``description``.
+    """
     def mm(value: float) -> str:
         return "-" if not math.isfinite(value) else f"{1000 * value:.1f}"
 
+    first, second = result.get("sides", ("left", "right"))
+    short = {"left": "L", "right": "R", "first": "1", "second": "2"}
     lines = [f"code {result['code']}: {result['rule']}"]
     for name, b in result["buildings"].items():
-        lines.append(f"  {name}: RSA with {b['spectrum']}, {b['modes']} mode(s), "
-                     f"{100 * b['mass_fraction']:.1f} % of the mass, CQC")
+        lines.append(f"  {name}: " + (b.get("description") or f"RSA with {b['spectrum']}, {b['modes']} mode(s), "
+                                      f"{100 * b['mass_fraction']:.1f} % of the mass, CQC"))
     for item in result["intensities"]:
         low, high = item["period_range"]
-        lines.append(f"records at {item['name']} level: x{item['factor']:.3f} on every record (mean spectrum >= 90 % "
-                     f"of {item['target']} over {low:.3f}-{high:.3f} s) - {item['why']}; "
-                     f"{item['records_ok']} record(s), {item['statistic']} used")
+        lines.append(f"records at {item['name']} level: x{item['factor']:.3f} on every record (mean "
+                     f"{item.get('spectrum_kind', 'spectrum')} >= 90 % of {item['target']} over {low:.3f}-{high:.3f} "
+                     f"s) - {item['why']}; {item['records_ok']} record(s), {item['statistic']} used")
         for record, error in item["failed"].items():
             lines.append(f"  record failed at {item['name']} level: {record}: {error}")
     if result["code"] == "asce7-22" and any(i["records_ok"] < ASCE_RECORDS for i in result["intensities"]):
         lines.append(f"  (ASCE 7-22 ch. 16 asks for {ASCE_RECORDS} records; fewer were run)")
     names = [i["name"] for i in result["intensities"]]
-    head = (f"{'contact':<12} {'code L':>7} {'code R':>7} {'same prop':>9} {'prop lines':>10}  "
+    rows = result["contacts"]
+    width = max([12] + [len(row["contact"]) for row in rows])
+    gap = "gap" in (rows[0] if rows else {})
+    head = (f"{'point' if gap else 'contact':<{width}} " + (f"{'gap':>6} " if gap else "")
+            + f"{'code ' + short[first]:>7} {'code ' + short[second]:>7} {'same prop':>9} {'prop lines':>10}  "
             + "  ".join(f"{'sim ' + n + ' mean/max':>22}" for n in names) + "  flag")
-    lines.append("separations (mm): the code's design displacements of the left and right floors, the code's separation "
-                 "on one property and between property lines, and the simulated requirement")
+    lines.append(f"separations (mm): the code's design displacements of the {first} and {second} "
+                 f"{'sides at the point' if gap else 'floors'}, the code's separation on one property and between "
+                 "property lines, and the simulated requirement")
     lines.append(head)
-    for row in result["contacts"]:
+    for row in rows:
         sep = row["separation"]
         cells = "  ".join(f"{mm(row['simulated'][n]['mean']) + '/' + mm(row['simulated'][n]['max']):>22}" for n in names)
         unsafe = [n for n in names if row["simulated"][n]["unconservative"]]
         flag = ("UNCONSERVATIVE at " + ", ".join(unsafe)) if unsafe else "ok"
-        lines.append(f"{row['contact']:<12} {mm(row['left']):>7} {mm(row['right']):>7} {mm(sep.same_property):>9} "
+        lines.append(f"{row['contact']:<{width}} " + (f"{mm(row['gap']):>6} " if gap else "")
+                     + f"{mm(row[first]):>7} {mm(row[second]):>7} {mm(sep.same_property):>9} "
                      f"{mm(sep.property_lines):>10}  {cells}  {flag}")
     lines.append("flag: the code's same-property separation is below the simulated requirement (the statistic used) "
                  "at that intensity")
@@ -562,10 +713,11 @@ def code_gap_table(result: dict[str, Any]) -> str:
 
 def code_gap_summary(result: dict[str, Any]) -> dict[str, Any]:
     """The code check as one JSON-ready document (metres)."""
+    first, second = result.get("sides", ("left", "right"))
     out = dict(result)
     out["contacts"] = [{**{k: v for k, v in row.items() if k != "separation"},
                         "same_property": row["separation"].same_property,
-                        "setback_left": row["separation"].setback_left,
-                        "setback_right": row["separation"].setback_right,
+                        f"setback_{first}": row["separation"].setback_left,
+                        f"setback_{second}": row["separation"].setback_right,
                         "property_lines": row["separation"].property_lines} for row in result["contacts"]]
     return out
