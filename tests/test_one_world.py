@@ -31,6 +31,10 @@ DURATION = 10.0
 TIGHT = {"rtol": 1e-12, "atol": 1e-14, "atol_velocity": 1e-13, "tolerance_scaling": False}
 #: Agreement of every peak, relative to its largest value: two converged solutions (module docstring).
 AGREE = 1e-10
+#: Agreement of the peak contact forces: a Hertz force k δ^1.5 turns a relative difference ε of the floors'
+#: displacements u into 1.5 ε u/δ of the force, with u/δ ~ 1e2 (centimetres of sway, sub-millimetre overlaps):
+#: the 1e-13 of the displacements (observed) becomes up to 2e-10 (observed at pair_column's column points).
+AGREE_FORCE = 1e-9
 
 
 def _relative(a, b) -> float:
@@ -72,7 +76,7 @@ def test_contacts_agree_point_by_point(twins):
     points = twin.impact_count.values.reshape(-1, 2)
     assert np.array_equal(points[:, 0], points[:, 1]) and np.array_equal(points[:, 0], row.impact_count.values)
     force = twin.peak_contact_force.values.reshape(-1, 2)
-    assert _relative(row.peak_contact_force.values, force.sum(axis=1)) < AGREE
+    assert _relative(row.peak_contact_force.values, force.sum(axis=1)) < AGREE_FORCE
     assert int(row.impact_count.sum()) > 0 or name == "pair_links"   # the links keep pair_links apart
 
 

@@ -297,7 +297,7 @@ def _column_shear_variables(system: System, raw: RawSolution, gaps) -> dict:
             continue
         at = g.at_left if side == "left" else g.at_right
         # the storey of the column point is the storey under the side's upper floor term
-        storey = int(system.contact_floors[c, 1 if side == "left" else 3])
+        storey = int(system.contact_floors[c, 1 if side == "left" else system.contact_floors.shape[1] // 2 + 1])
         shear = raw.storey_shear[:, storey]
         demand[:, c] = column_shear_demand(shear, raw.contact_force[:, c], at, side)
         best = float(np.max(demand[:, c])) if nt else 0.0

@@ -16,7 +16,7 @@ from numba import njit
 from pounding.solver import jit
 from pounding.solver import kernels
 from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing, hermite
-from pounding.solver.kinematics import (SIDE_TERMS, combo, compliance, contact_delta, effective_mass, fill_grounds,
+from pounding.solver.kinematics import (combo, compliance, contact_delta, effective_mass, fill_grounds, floor_pair,
                                         ground_offset, kick, step_kinematics_inline)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
                                       IMP_SEPARATION, IMP_TIME, IMP_VELOCITY, IMP_WORK, IMPACT_ROW_LIMIT)
@@ -107,7 +107,7 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
     k1, k7 = K[0], K[6]
     dt_rec = forcing.record_step
     n, iq = lay.n_floors, lay.internal
-    cf, cw, cgap, claw, cprm = contacts
+    cf, cw, width, cgap, claw, cprm = contacts
     closed, cconst, cmode = cstate.closed, cstate.constant, cstate.mode
     event_s, event_kind = events.s, events.kind
     h_try = h
@@ -122,7 +122,7 @@ def locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, event
         event_s[c] = -1.0
         event_kind[c] = EVENT_NONE
         # δ, δ̇ at both ends of the step, their rates (k1, k7), and the round-off scale of δ.
-        d0, r0, d1, r1, q0, q1, size = step_kinematics_inline(y, ynew, k1, k7, n, cf, cw, c, ground)
+        d0, r0, d1, r1, q0, q1, size = step_kinematics_inline(y, ynew, k1, k7, n, cf, cw, width, c, ground)
         d0 -= cgap[c]
         d1 -= cgap[c]
         floor = DELTA_ROUNDOFF * (size + abs(cgap[c]))
@@ -204,10 +204,11 @@ def velocity_jump(c, t, y, lay, mass, contacts, impacts, n_imp, dvg):
     ``J·dvg`` it does goes to the ground-work state (the last one).
     """
     n, cf, cw, claw, cprm = lay.n_floors, contacts.floors, contacts.weights, contacts.law, contacts.parameters
-    v0 = combo(y, n, cf, cw, c) + dvg
+    width = contacts.width
+    v0 = combo(y, n, cf, cw, width, c) + dvg
     impulse = kernels.jump_impulse(claw[c], cprm[c], v0)
-    kick(y, n, mass, cf, cw, c, impulse)
-    v_after = combo(y, n, cf, cw, c) + dvg
+    kick(y, n, mass, cf, cw, width, c, impulse)
+    v_after = combo(y, n, cf, cw, width, c) + dvg
     y[lay.impulse + c] += impulse
     y[lay.work + c] += impulse * 0.5 * (v0 + v_after)
     y[lay.ground_work] += impulse * dvg
@@ -241,7 +242,7 @@ def switch_contact(c, upward, t, y, lay, mass, contacts, cstate, impacts, n_imp,
     """
     n, cf, cw, claw, cprm = lay.n_floors, contacts.floors, contacts.weights, contacts.law, contacts.parameters
     closed, cconst, open_imp = cstate.closed, cstate.constant, cstate.open_row
-    rate = combo(y, n, cf, cw, c) + dvg
+    rate = combo(y, n, cf, cw, contacts.width, c) + dvg
     if upward:
         if kernels.is_instantaneous(claw[c]):
             return velocity_jump(c, t, y, lay, mass, contacts, impacts, n_imp, dvg)
@@ -279,12 +280,12 @@ def plastic_jump(c, y, lay, mass, contacts, dvg):
     contact's energy-audit states, ``J·dvg`` to the ground work (*dvg*: the
     contact's differential ground velocity, m/s, part of ``v0 = δ̇``).
     """
-    n, cf, cw = lay.n_floors, contacts.floors, contacts.weights
-    v0 = combo(y, n, cf, cw, c) + dvg
-    impulse = effective_mass(mass, cf, cw, c) * v0
-    kick(y, n, mass, cf, cw, c, impulse)
+    n, cf, cw, width = lay.n_floors, contacts.floors, contacts.weights, contacts.width
+    v0 = combo(y, n, cf, cw, width, c) + dvg
+    impulse = effective_mass(mass, cf, cw, width, c) * v0
+    kick(y, n, mass, cf, cw, width, c, impulse)
     y[lay.impulse + c] += impulse
-    y[lay.work + c] += impulse * 0.5 * (v0 + (combo(y, n, cf, cw, c) + dvg))
+    y[lay.work + c] += impulse * 0.5 * (v0 + (combo(y, n, cf, cw, width, c) + dvg))
     y[lay.ground_work] += impulse * dvg
     return impulse
 
@@ -326,7 +327,7 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
     y, scratch, deriv, fbuf, forces = work.y, work.ystage, work.K[1], work.fbuf, work.forces
     impacts, n_imp = table.rows, table.count
     mass = structure.mass
-    cf, cw, claw, cprm = contacts.floors, contacts.weights, contacts.law, contacts.parameters
+    cf, cw, width, claw, cprm = contacts.floors, contacts.weights, contacts.width, contacts.law, contacts.parameters
     kinds, rigid = events.kind, events.rigid
     active, rate, dvg, impulse = rigid.active, rigid.rate, rigid.dvg, rigid.impulse
     n = mass.size
@@ -340,19 +341,19 @@ def resolve_rigid_contacts(events, t, ag_t, lay, structure, contacts, cstate, wo
         dvg[i] = 0.0
         if ground is not None:
             dvg[i] = ground_offset(ground, ground.now, c, 1)
-        rate[i] = combo(y, n, cf, cw, c) + dvg[i]
+        rate[i] = combo(y, n, cf, cw, width, c) + dvg[i]
         e = 0.0
         if i < n_closing and rate[i] > kernels.rest_velocity(claw[c], cprm[c]):
             e = kernels.restitution(claw[c], cprm[c])
         rigid.target[i] = rate[i] + e * max(rate[i], 0.0)
-    delassus(mass, cf, cw, active, na, rigid.delassus)
+    delassus(mass, cf, cw, width, active, na, rigid.delassus)
     solve_lcp(rigid, na)
     for i in range(na):
-        kick(y, n, mass, cf, cw, active[i], impulse[i])
+        kick(y, n, mass, cf, cw, width, active[i], impulse[i])
     first_row = n_imp
     for i in range(na):
         c = active[i]
-        after = combo(y, n, cf, cw, c) + dvg[i]
+        after = combo(y, n, cf, cw, width, c) + dvg[i]
         y[lay.impulse + c] += impulse[i]
         y[lay.work + c] += impulse[i] * 0.5 * (rate[i] + after)
         y[lay.ground_work] += impulse[i] * dvg[i]
@@ -417,7 +418,7 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
     """
     y, scratch, deriv, fbuf, forces = work.y, work.ystage, work.K[1], work.fbuf, work.forces
     mass = structure.mass
-    cf, cw, cgap, claw, cprm = contacts
+    cf, cw, width, cgap, claw, cprm = contacts
     closed, cconst, cmode, open_imp = cstate.closed, cstate.constant, cstate.mode, cstate.open_row
     n = mass.size
     nc = cgap.size
@@ -437,7 +438,7 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
         dvg = 0.0
         if ground is not None:
             dvg = ground_offset(ground, ground.now, c, 1)
-        rate = combo(y, n, cf, cw, c) + dvg
+        rate = combo(y, n, cf, cw, width, c) + dvg
         if kind == EVENT_CLOSE:
             if n_imp + 1 > IMPACT_ROW_LIMIT:
                 status = STATUS_TABLE_LIMIT
@@ -477,21 +478,20 @@ def apply_contact_events(events, t, ag_t, lay, structure, contacts, cstate, work
                 continue
             if rate < 0.0:
                 # A tangency located to round-off (δ̇ ~ −1e-17 m/s): a grazing touch, v0 = 0.
-                k = SIDE_TERMS * c
-                if cw[k] == 1.0 and cw[k + 1] == 0.0 and cw[k + 2] == -1.0 and cw[k + 3] == 0.0:
+                if floor_pair(cw, width, c):
                     # a plain floor pair: the pre-weighted form, bit for bit (see effective_mass)
-                    lf = cf[k]
-                    rf = cf[k + 2]
+                    lf = cf[len(width) * c]
+                    rf = cf[len(width) * c + len(width) // 2]
                     y[n + lf] -= rate * mass[rf] / (mass[lf] + mass[rf])
                     y[n + rf] += rate * mass[lf] / (mass[lf] + mass[rf])
                 else:
-                    kick(y, n, mass, cf, cw, c, rate / compliance(mass, cf, cw, c))
+                    kick(y, n, mass, cf, cw, width, c, rate / compliance(mass, cf, cw, width, c))
                 rate = 0.0
             # kind == EVENT_CLOSE (a run-time True, like the separation's False): one specialisation
             n_imp = switch_contact(c, kind == EVENT_CLOSE, t, y, lay, mass, contacts, cstate, impacts, n_imp, dvg)
             cmode[c] = kernels.onset_mode(claw[c], cprm[c], rate)
             cstate.rest_band[c] = events.band[c] if rate <= kernels.rest_velocity(claw[c], cprm[c]) else 0.0
-            m_eff = effective_mass(mass, cf, cw, c)
+            m_eff = effective_mass(mass, cf, cw, width, c)
             duration = kernels.contact_duration(claw[c], cprm[c], rate, m_eff)
             if duration > 0.0:
                 cap = min(cap, duration / STEPS_PER_CONTACT)

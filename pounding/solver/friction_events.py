@@ -22,7 +22,7 @@ from numba import njit
 from pounding.solver import jit
 from pounding.solver.dense import DELTA_ROUNDOFF, first_crossing
 from pounding.solver.friction_forces import FRICTION_OFF, FRICTION_SLIP, FRICTION_STICK, stick_margin
-from pounding.solver.kinematics import SIDE_TERMS, combo, compliance, kick
+from pounding.solver.kinematics import combo, compliance, kick
 from pounding.solver.rhs import rates_within_step, rhs_called
 
 __all__ = ["FRICTION_EVENT_NONE", "FRICTION_EVENT_STOP", "FRICTION_EVENT_SLIP", "locate_friction_events",
@@ -36,7 +36,8 @@ FRICTION_EVENT_NONE, FRICTION_EVENT_STOP, FRICTION_EVENT_SLIP = 0, 1, 2
 def _slip_rate_scale(y, ynew, n, friction, f) -> float:
     """Σ_k |w_k|·(|v_k(0)| + |v_k(h)|) (m/s): the round-off scale of the slip rate over a step."""
     total = 0.0
-    for k in range(SIDE_TERMS * f, SIDE_TERMS * f + SIDE_TERMS):
+    terms = len(friction.width)
+    for k in range(terms * f, terms * f + terms):
         j = n + friction.floors[k]
         total += abs(friction.weights[k]) * (abs(y[j]) + abs(ynew[j]))
     return total
@@ -56,7 +57,7 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
     """
     y, ynew, k1, k7 = work.y, work.ynew, work.K[0], work.K[6]
     n = lay.n_floors
-    ff, fw = friction.floors, friction.weights
+    ff, fw, width = friction.floors, friction.weights, friction.width
     s_first = 2.0
     lost = 0
     for f in range(friction.mode.size):
@@ -65,8 +66,9 @@ def locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, c
         if friction.mode[f] == FRICTION_SLIP:
             sign = friction.direction[f]
             floor = DELTA_ROUNDOFF * _slip_rate_scale(y, ynew, n, friction, f)
-            s = first_crossing(sign * combo(y, n, ff, fw, f), sign * combo(k1, n, ff, fw, f),
-                               sign * combo(ynew, n, ff, fw, f), sign * combo(k7, n, ff, fw, f), h, False, floor)
+            s = first_crossing(sign * combo(y, n, ff, fw, width, f), sign * combo(k1, n, ff, fw, width, f),
+                               sign * combo(ynew, n, ff, fw, width, f), sign * combo(k7, n, ff, fw, width, f), h,
+                               False, floor)
             if s >= 0.0:
                 friction.event_s[f] = s
                 friction.event_kind[f] = FRICTION_EVENT_STOP
@@ -124,10 +126,10 @@ def _stick_or_slip(f, t, ag_t, lay, structure, contacts, cstate, work, storey, g
     """
     y, mass = work.y, structure.mass
     n = lay.n_floors
-    ff, fw = friction.floors, friction.weights
-    rate = combo(y, n, ff, fw, f)
-    impulse = rate / compliance(mass, ff, fw, f)
-    kick(y, n, mass, ff, fw, f, impulse)
+    ff, fw, width = friction.floors, friction.weights, friction.width
+    rate = combo(y, n, ff, fw, width, f)
+    impulse = rate / compliance(mass, ff, fw, width, f)
+    kick(y, n, mass, ff, fw, width, f, impulse)
     y[lay.friction_work + f] += impulse * 0.5 * rate
     held = _held_force(f, t, ag_t, lay, structure, contacts, cstate, work, storey, ground, friction)
     if abs(held) > friction.coefficient[f] * friction.normal[f]:
@@ -148,7 +150,7 @@ def apply_friction_events(t, ag_t, lay, structure, contacts, cstate, work, store
     ``work.forces`` serve as scratch.
     """
     n = lay.n_floors
-    ff, fw = friction.floors, friction.weights
+    ff, fw, width = friction.floors, friction.weights, friction.width
     changed = 0
     for f in range(friction.mode.size):
         kind = friction.event_kind[f]
@@ -157,7 +159,7 @@ def apply_friction_events(t, ag_t, lay, structure, contacts, cstate, work, store
         if not _face_closed(cstate, friction, f):
             friction.mode[f] = FRICTION_OFF
         elif before == FRICTION_OFF:
-            rate = combo(work.y, n, ff, fw, f)
+            rate = combo(work.y, n, ff, fw, width, f)
             if rate != 0.0:
                 friction.mode[f] = FRICTION_SLIP
                 friction.direction[f] = 1.0 if rate > 0.0 else -1.0

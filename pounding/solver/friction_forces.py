@@ -20,7 +20,7 @@ from __future__ import annotations
 from numba import njit
 
 from pounding.solver import jit
-from pounding.solver.kinematics import SIDE_TERMS, combo, compliance, push
+from pounding.solver.kinematics import combo, compliance, push
 
 __all__ = ["FRICTION_OFF", "FRICTION_SLIP", "FRICTION_STICK", "friction_forces", "stick_margin"]
 
@@ -34,7 +34,8 @@ STICK_SWEEPS = 100
 def _ground_term(friction, f, ag_t, ground) -> float:
     """Σ_k w_k·a_g,k (m/s²): the ground acceleration's part of the face's relative slip acceleration."""
     total = 0.0
-    for k in range(SIDE_TERMS * f, SIDE_TERMS * f + SIDE_TERMS):
+    terms = len(friction.width)
+    for k in range(terms * f, terms * f + terms):
         if ground is None:
             total += friction.weights[k] * ag_t
         else:
@@ -45,7 +46,8 @@ def _ground_term(friction, f, ag_t, ground) -> float:
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _stick(friction, mass, fbuf, ag_t, ground) -> None:
     """Add the sticking faces' constraint forces (``v̇_t = 0``) to ``friction.force`` and *fbuf*."""
-    ff, fw = friction.floors, friction.weights
+    ff, fw, width = friction.floors, friction.weights, friction.width
+    terms = len(width)
     for _ in range(STICK_SWEEPS):
         largest = 0.0
         scale = 0.0
@@ -53,11 +55,11 @@ def _stick(friction, mass, fbuf, ag_t, ground) -> None:
             if friction.mode[f] != FRICTION_STICK:
                 continue
             rate = -_ground_term(friction, f, ag_t, ground)
-            for k in range(SIDE_TERMS * f, SIDE_TERMS * f + SIDE_TERMS):
+            for k in range(terms * f, terms * f + terms):
                 rate -= fw[k] * fbuf[ff[k]] / mass[ff[k]]
-            change = rate / compliance(mass, ff, fw, f)
+            change = rate / compliance(mass, ff, fw, width, f)
             friction.force[f] += change
-            push(fbuf, ff, fw, f, change)
+            push(fbuf, ff, fw, width, f, change)
             largest = max(largest, abs(change))
             scale = max(scale, abs(friction.force[f]))
         if largest <= 1e-13 * scale:
@@ -72,7 +74,7 @@ def friction_forces(y, ag_t, mass, friction, forces, fbuf, out, first_work, grou
     Called by the right-hand side after every contact force (*forces*) is in *fbuf*.
     """
     n = mass.size
-    ff, fw = friction.floors, friction.weights
+    ff, fw, width = friction.floors, friction.weights, friction.width
     n_stick = 0
     for f in range(friction.mode.size):
         normal = 0.0
@@ -82,14 +84,14 @@ def friction_forces(y, ag_t, mass, friction, forces, fbuf, out, first_work, grou
         force = 0.0
         if friction.mode[f] == FRICTION_SLIP:
             force = friction.coefficient[f] * friction.normal[f] * friction.direction[f]
-            push(fbuf, ff, fw, f, force)
+            push(fbuf, ff, fw, width, f, force)
         elif friction.mode[f] == FRICTION_STICK:
             n_stick += 1
         friction.force[f] = force
     if n_stick > 0:
         _stick(friction, mass, fbuf, ag_t, ground)
     for f in range(friction.mode.size):
-        out[first_work + f] = friction.force[f] * combo(y, n, ff, fw, f)
+        out[first_work + f] = friction.force[f] * combo(y, n, ff, fw, width, f)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)

@@ -98,8 +98,8 @@ from pounding.solver.dense import interpolate
 from pounding.solver.friction_events import apply_friction_events, locate_friction_events, record_friction
 from pounding.solver.dormand_prince import (MAX_FACTOR, MIN_FACTOR, SAFETY, error_norm, fill_tolerances, normed_states,
                                             stages, step_factor)
-from pounding.solver.kinematics import (SIDE_TERMS, fill_grounds, ground_at, ground_kinematics, ground_state_at,
-                                        kernel_terms)
+from pounding.solver.kinematics import (NARROW_TERMS, SIDE_TERMS, fill_grounds, ground_at, ground_kinematics,
+                                        ground_state_at, kernel_terms)
 from pounding.solver.layout import (ContactState, RigidWork, Contacts, Events, Forcing, Friction, Grounds, Layout, Settings, Storeys,
                                     StoreyTerms, Structure, Work, state_layout)
 from pounding.solver.recorder import (IMP_CONSTANT, IMP_CONTACT, IMP_END, IMP_IMPULSE, IMP_PEAK_FORCE,
@@ -152,8 +152,9 @@ class System:
     dense_stiffness : flat float array, optional
         Dense stiffness blocks laid out as *dense_values*, N/m (a plan model's planes and P-Delta
         terms, K = Σ k a aᵀ); default empty: none.
-    plane_floors, plane_weights : (R, SIDE_TERMS) int and float, optional
-        A plan model's plane drifts ``Σ_k w_k·u[floor_k]`` (floor −1: none), whose full-resolution
+    plane_floors, plane_weights : (R, 2·t) int and float, optional
+        A plan model's plane drifts ``Σ_k w_k·u[floor_k]`` (floor −1: none; two sides of t ≤ TERMS_PER_SIDE
+        terms, the floor above and the floor below, like a contact's), whose full-resolution
         peaks the run records (``RawSolution.peak_plane_drift``); default none.
     contact_left, contact_right : (nc,) int, floor index of each gap element's left and right side
         (−1: a fixed wall; for a point of a column, the floor above it)
@@ -169,10 +170,13 @@ class System:
         collapse drift ratio; 0: never)
     storey_imk : (nh, imk.N_STATE) float, optional
         Initial discrete state of each IMK storey (row of its hysteretic state; other rows unused)
-    contact_floors : (nc, SIDE_TERMS) int, optional
-        Floor terms of each contact ``[left, left, right, right]`` (−1: none, the ground or a wall);
-        default from ``contact_left`` / ``contact_right``: ``[left, −1, right, −1]``.
-    contact_weights : (nc, SIDE_TERMS) float, optional
+    contact_floors : (nc, 2·t) int, optional
+        Floor terms of each contact, its left side's t terms then its right side's, t ≤ TERMS_PER_SIDE
+        (``[left, left, right, right]`` for t = 2; −1: none, the ground or a wall); the solver lays each
+        array out at the narrowest width its rows fit, two or four terms per side
+        (:func:`pounding.solver.kinematics.kernel_terms`); default from ``contact_left`` /
+        ``contact_right``: ``[left, −1, right, −1]``.
+    contact_weights : (nc, 2·t) float, optional
         Their weights: δ = Σ_k w_k·u[floor_k] − gap, the force enters floor_k as w_k·F (left
         weights ≥ 0, right ≤ 0); default ``[1, 0, −1, 0]`` (−1 sides get weight 0).
     floor_ground : (N,) int, row of the ground-acceleration array that moves each floor's building
@@ -180,12 +184,12 @@ class System:
     contact_ground_left, contact_ground_right : (nc,) int, ground row under the left and the right
         side of each gap element: their differential displacement enters the penetration
         (``pounding.solver.assembly.assemble``; a wall takes the row of the building it faces)
-    storey_floors, storey_weights : (R, SIDE_TERMS) int and float, optional
+    storey_floors, storey_weights : (R, 2·t) int and float, optional
         A plan model's storey rows, its planes (``pounding.solver.plan_assembly``): row p's drift is
         ``Σ_k w_k·u[floor_k]`` (floor −1: none).  Then the storey fields above are per plane (R), not per
         floor, and ``storey_row_stiffness`` (R,) N/m holds each plane's elastic stiffness.  None: the
         storey under floor j, drift ``u[j] − u[below[j]]``.
-    friction_floors, friction_weights : (nf, SIDE_TERMS) int and float, optional
+    friction_floors, friction_weights : (nf, 2·t) int and float, optional
         A plan model's Coulomb friction faces: face f's slip rate is ``Σ_k w_k·v[floor_k]``
         (:class:`pounding.solver.layout.Friction`); None: no friction (the solver's friction code is pruned).
     friction_coefficient : (nf,) μ of each face
@@ -239,7 +243,7 @@ class System:
             none = np.full(nc, -1, dtype=np.int64)
             object.__setattr__(self, "contact_floors", np.ascontiguousarray(np.stack([left, none, right, none], 1)))
             weights = np.stack([(left >= 0) * 1.0, np.zeros(nc), (right >= 0) * -1.0, np.zeros(nc)], 1)
-            object.__setattr__(self, "contact_weights", np.ascontiguousarray(weights.reshape(nc, SIDE_TERMS)))
+            object.__setattr__(self, "contact_weights", np.ascontiguousarray(weights.reshape(nc, 4)))
 
         # Storey fields left out: linear elastic storeys of unit height, no P-Delta, no collapse check.
         n = int(self.mass.size)
@@ -251,8 +255,8 @@ class System:
                     "contact_ground_left": np.zeros(self.contact_gap.size, dtype=np.int64),
                     "contact_ground_right": np.zeros(self.contact_gap.size, dtype=np.int64),
                     "dense_band": np.asarray(self.dense_size, dtype=np.int64) - 1, "dense_stiffness": np.zeros(0),
-                    "plane_floors": np.zeros((0, SIDE_TERMS), dtype=np.int64),
-                    "plane_weights": np.zeros((0, SIDE_TERMS))}
+                    "plane_floors": np.zeros((0, NARROW_TERMS), dtype=np.int64),
+                    "plane_weights": np.zeros((0, NARROW_TERMS))}
         for key, value in defaults.items():
             if getattr(self, key) is None:
                 object.__setattr__(self, key, value)
@@ -522,7 +526,8 @@ def _new_events(contacts, nh, tol):
         if kernels.is_instantaneous(contacts.law[c]):
             ni += 1
         smallest = np.inf
-        for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+        terms = len(contacts.width)
+        for k in range(terms * c, terms * c + terms):
             if contacts.weights[k] != 0.0:
                 smallest = min(smallest, tol[contacts.floors[k]])
         if smallest < np.inf:
@@ -568,7 +573,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     cstate, events = _new_contact_state(contacts), _new_events(contacts, nh, tol)
     normed = normed_states(tol)
     out = new_outputs(n_out, lay, ground)
-    peaks = new_peaks(lay, structure.plane_weights.size // SIDE_TERMS)
+    peaks = new_peaks(lay, structure.plane_weights.size // len(structure.plane_width))
     impacts, n_imp = grown(np.empty((zero, zero + IMPACT_COLUMNS)), zero, zero + 64, zero + IMPACT_ROW_LIMIT), zero
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     t, seg = 0.0, zero
@@ -649,7 +654,8 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
         record_floor_peaks(work, h_used, n, below, peaks)
-        record_plane_peaks(work, h_used, n, structure.plane_floors, structure.plane_weights, peaks)
+        record_plane_peaks(work, h_used, n, structure.plane_floors, structure.plane_weights, structure.plane_width,
+                           peaks)
         rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
         if rows > trace.shape[0]:
             trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
@@ -781,14 +787,15 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
         y_initial[: system.n_floors] = initial_displacement
     if initial_velocity is not None:
         y_initial[system.n_floors:] = initial_velocity
-    # Absent terms (the ground, a wall: floor −1) go to the kernels as floor 0 with weight 0.
-    floors, weights = kernel_terms(system.contact_floors, system.contact_weights)
-    plane_floors, plane_weights = kernel_terms(system.plane_floors, system.plane_weights)
+    # Absent terms (the ground, a wall: floor −1) go to the kernels as floor 0 with weight 0, each array at the
+    # narrowest width its rows fit (kinematics.kernel_terms; the width's type selects the compiled kernels).
+    planes = kernel_terms(system.plane_floors, system.plane_weights)
     structure = Structure(system.mass, system.storey_stiffness, system.below, system.rayleigh_mass,
                           system.rayleigh_stiffness, system.dense_start, system.dense_size, system.dense_offset,
                           system.dense_values, np.asarray(system.dense_band, dtype=np.int64),
-                          np.ascontiguousarray(system.dense_stiffness, dtype=np.float64), plane_floors, plane_weights)
-    contacts = Contacts(floors, weights, system.contact_gap, system.contact_law, system.contact_parameters)
+                          np.ascontiguousarray(system.dense_stiffness, dtype=np.float64), *planes)
+    contacts = Contacts(*kernel_terms(system.contact_floors, system.contact_weights), system.contact_gap,
+                        system.contact_law, system.contact_parameters)
     factors = np.ones(system.n_floors)
     if floor_factors is not None:
         factors = np.array(floor_factors, dtype=np.float64, copy=True)
@@ -823,9 +830,9 @@ def _friction_argument(system: System, duration: float, output_dt: float) -> Fri
     nf = system.n_faces
     if nf == 0:
         return None
-    floors, weights = kernel_terms(system.friction_floors, system.friction_weights)
     n_out = int(math.floor(duration / output_dt + 1e-9)) + 1
-    return Friction(floors, weights, np.ascontiguousarray(system.friction_coefficient, dtype=np.float64),
+    return Friction(*kernel_terms(system.friction_floors, system.friction_weights),
+                    np.ascontiguousarray(system.friction_coefficient, dtype=np.float64),
                     np.ascontiguousarray(system.friction_first_point, dtype=np.int64),
                     np.ascontiguousarray(system.friction_point_count, dtype=np.int64),
                     np.zeros(nf, dtype=np.int64), np.ones(nf), np.zeros(nf), np.zeros(nf), np.full(nf, -1.0),

@@ -87,15 +87,18 @@ class Structure(NamedTuple):
     dense_values: np.ndarray        #: flat dense damping blocks, N·s/m
     dense_band: np.ndarray          #: (B,) int, half-bandwidth of each block (entries beyond: zero; m − 1: full)
     dense_stiffness: np.ndarray     #: flat dense stiffness blocks, N/m, laid out as *dense_values* (empty: none)
-    plane_floors: np.ndarray        #: (R·SIDE_TERMS,) int, a plan model's plane drifts' floor terms (empty: none)
-    plane_weights: np.ndarray       #: (R·SIDE_TERMS,) their weights (drift ``Σ_k w_k·u[f_k]``, its peak recorded)
+    plane_floors: np.ndarray        #: (R·width,) int, a plan model's plane drifts' floor terms (empty: none)
+    plane_weights: np.ndarray       #: (R·width,) their weights (drift ``Σ_k w_k·u[f_k]``, its peak recorded)
+    plane_width: tuple              #: terms per plane row, as its type (:func:`.kinematics.row_width`)
 
 
 class Contacts(NamedTuple):
-    """Gap elements and links (nc); term k of contact c at ``SIDE_TERMS·c + k`` (:mod:`.kinematics`)."""
+    """Gap elements and links (nc); term k of contact c at ``width·c + k``, the left side's terms in the first
+    half of a row, the right side's in the second (:mod:`.kinematics`)."""
 
-    floors: np.ndarray      #: (nc·SIDE_TERMS,) int, floor of each term (an absent term: floor 0, weight 0)
-    weights: np.ndarray     #: (nc·SIDE_TERMS,) its weight (left ≥ 0, right ≤ 0)
+    floors: np.ndarray      #: (nc·width,) int, floor of each term (an absent term: floor 0, weight 0)
+    weights: np.ndarray     #: (nc·width,) its weight (left ≥ 0, right ≤ 0)
+    width: tuple            #: terms per contact, as its type: NARROW_TERMS or SIDE_TERMS (:func:`.kinematics.row_width`)
     gap: np.ndarray         #: (nc,) m
     law: np.ndarray         #: (nc,) int, kernel branch (pounding.contact)
     parameters: np.ndarray  #: (nc, N_PARAMETERS)
@@ -128,12 +131,13 @@ class ContactState(NamedTuple):
 
 
 class StoreyTerms(NamedTuple):
-    """A plan model's storey elements, its planes (R rows): row p's drift is ``Σ_k weights[4p + k]·u[floors[4p + k]]``
-    (the plane's weight vector a: u and θ of the floors above and below, docs/plan-models.md) and its
+    """A plan model's storey elements, its planes (R rows): row p's drift is ``Σ_k weights[w·p + k]·u[floors[w·p + k]]``
+    (w terms per row; the plane's weight vector a: u and θ of the floors above and below, docs/plan-models.md) and its
     shear F enters the floors as ``weights·F`` (virtual work).  Absent terms: floor 0, weight 0."""
 
-    floors: np.ndarray     #: (R·SIDE_TERMS,) int
-    weights: np.ndarray    #: (R·SIDE_TERMS,) float
+    floors: np.ndarray     #: (R·w,) int
+    weights: np.ndarray    #: (R·w,) float
+    width: tuple           #: w, as its type (:func:`.kinematics.row_width`)
     stiffness: np.ndarray  #: (R,) N/m, the plane's elastic stiffness (the dense stiffness block carries k·Δ)
 
 
@@ -160,14 +164,15 @@ class Storeys(NamedTuple):
 class Friction(NamedTuple):
     """Coulomb friction faces of a plan model (the solver's *friction* argument; nf faces).
 
-    A face's tangential slip rate is ``v_t = Σ_k weights[4f + k]·v[floors[4f + k]]`` (the low side's
+    A face's tangential slip rate is ``v_t = Σ_k weights[w·f + k]·v[floors[w·f + k]]`` (w terms per face; the low side's
     material point on its face minus the high side's, along +tangent); its friction λ (N, positive
     resisting +v_t) enters the floors as ``weights·λ`` (virtual work), like a contact force.  Its normal
     force N is the sum of its points' forces (contacts ``first_point … first_point + point_count − 1``).
     """
 
-    floors: np.ndarray       #: (nf·SIDE_TERMS,) int, slip terms (an absent term: floor 0, weight 0)
-    weights: np.ndarray      #: (nf·SIDE_TERMS,) float
+    floors: np.ndarray       #: (nf·w,) int, slip terms (an absent term: floor 0, weight 0)
+    weights: np.ndarray      #: (nf·w,) float
+    width: tuple             #: w, as its type (:func:`.kinematics.row_width`)
     coefficient: np.ndarray  #: (nf,) μ
     first_point: np.ndarray  #: (nf,) int, the face's first contact point
     point_count: np.ndarray  #: (nf,) int, its number of points

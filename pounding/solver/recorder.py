@@ -296,23 +296,23 @@ def record_floor_peaks(work, h, n, below, peaks) -> None:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
-def record_plane_peaks(work, h, n, floors, weights, peaks) -> None:
+def record_plane_peaks(work, h, n, floors, weights, width, peaks) -> None:
     """Peak |drift| of every plane of a plan model over an accepted step of *h* s (none: no planes).
 
-    A plane's drift ``Σ_k w_k·u[f_k]`` (*floors*, *weights*: ``Structure.plane_floors`` and
-    ``plane_weights``) as a storey's in :func:`record_floor_peaks`: its value at the step's end, and
+    A plane's drift ``Σ_k w_k·u[f_k]`` (*floors*, *weights*, *width*: ``Structure.plane_floors``,
+    ``plane_weights`` and ``plane_width``) as a storey's in :func:`record_floor_peaks`: its value at the step's end, and
     the extremum of its Hermite cubic inside the step when its rate changes sign.
     """
     y, ynew, peak = work.y, work.ynew, peaks.plane
     for p in range(peak.size):
-        d1 = combo(ynew, 0, floors, weights, p)
+        d1 = combo(ynew, 0, floors, weights, width, p)
         v = abs(d1)
         if v > peak[p]:
             peak[p] = v
-        r0 = combo(y, n, floors, weights, p)
-        r1 = combo(ynew, n, floors, weights, p)
+        r0 = combo(y, n, floors, weights, width, p)
+        r1 = combo(ynew, n, floors, weights, width, p)
         if r0 * r1 < 0.0:
-            v = extremum_in_step(combo(y, 0, floors, weights, p), r0, d1, r1, h)
+            v = extremum_in_step(combo(y, 0, floors, weights, width, p), r0, d1, r1, h)
             if v > peak[p]:
                 peak[p] = v
 
@@ -337,14 +337,14 @@ def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, t
     y, ynew, K, forces_end = work.y, work.ynew, work.K, work.forces_end
     k1, k7 = K[0], K[6]
     n, iq = lay.n_floors, lay.internal
-    cf, cw, cgap, claw, cprm = contacts
+    cf, cw, width, cgap, claw, cprm = contacts
     closed, cconst, cmode, open_imp = cstate.closed, cstate.constant, cstate.mode, cstate.open_row
     peak_force, fractions, deltas, values = peaks.force, peaks.fractions, peaks.deltas, peaks.values
     zero = n - n
     for c in range(lay.n_contacts):
         if kernels.is_permanent(claw[c]):
             # A link: peak |F| on the step's interpolant (no trace: it is engaged at every step).
-            e_d0, e_r0, e_d1, e_r1, e_a0, e_a1, _ = step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground)
+            e_d0, e_r0, e_d1, e_r1, e_a0, e_a1, _ = step_kinematics(y, ynew, k1, k7, n, cf, cw, width, c, ground)
             closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
                                    (e_d0, e_r0, e_d1, e_r1, e_a0, e_a1), (y[iq + c], k1[iq + c], ynew[iq + c],
                                                                           k7[iq + c]), h, fractions, deltas, values)
@@ -359,7 +359,7 @@ def record_contacts(work, h, t, lay, contacts, cstate, ground, peaks, impacts, t
             if row >= 0 and fpk > impacts[row, IMP_PEAK_FORCE]:
                 impacts[row, IMP_PEAK_FORCE] = fpk
         elif closed[c]:
-            e_d0, e_r0, e_d1, e_r1, e_a0, e_a1, _ = step_kinematics(y, ynew, k1, k7, n, cf, cw, c, ground)
+            e_d0, e_r0, e_d1, e_r1, e_a0, e_a1, _ = step_kinematics(y, ynew, k1, k7, n, cf, cw, width, c, ground)
             fpk = closed_contact_samples(claw[c], cprm[c], cconst[c], cmode[c], cgap[c],
                                          (e_d0, e_r0, e_d1, e_r1, e_a0, e_a1),
                                          (y[iq + c], k1[iq + c], ynew[iq + c], k7[iq + c]), h, fractions, deltas,

@@ -20,8 +20,8 @@ from pounding.solver import kernels
 from pounding.solver import storeys
 from pounding.solver.dense import interpolate
 from pounding.solver.friction_forces import friction_forces
-from pounding.solver.kinematics import (SIDE_TERMS, compliance, contact_sums, drift, fill_grounds, ground_at, ground_offset,
-                                        ground_weight, push, storey_drift, storey_push, storey_stiffness)
+from pounding.solver.kinematics import (compliance, contact_sums, drift, fill_grounds, ground_at, ground_offset,
+                                        ground_share, ground_weight, push, storey_drift, storey_push, storey_stiffness)
 
 __all__ = ["stuck_constraints", "rhs", "rhs_called", "rates_within_step", "storey_forces"]
 
@@ -38,7 +38,8 @@ def stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground):
     so δ̈ = Σ_k w_k·(−fbuf_k/m_k) + a_g,L·(1 − W_L) − a_g,R·(1 + W_R) with W_L, W_R
     the sums of the left and right floor weights.  Kept out of :func:`rhs` (rarely needed).
     """
-    cf, cw = contacts.floors, contacts.weights
+    cf, cw, width = contacts.floors, contacts.weights, contacts.width
+    stride = len(width)
     closed, cmode = cstate.closed, cstate.mode
     nc = forces.size
     for _ in range(100):
@@ -48,16 +49,16 @@ def stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground):
             if closed[c] and cmode[c] == kernels.MODE_STUCK:
                 # δ̈ = Σ_k cw·(−fbuf/m − a_g) over the floor terms
                 if ground is None:
-                    relative = -ag_t * ground_weight(cf, cw, c)
+                    relative = -ag_t * ground_weight(cw, width, c)
                 else:
                     gnow = ground.now
-                    relative = (gnow[0, ground.left_row[c]] * (1.0 - cw[SIDE_TERMS * c] - cw[SIDE_TERMS * c + 1])
-                                - gnow[0, ground.right_row[c]] * (1.0 + cw[SIDE_TERMS * c + 2] + cw[SIDE_TERMS * c + 3]))
-                for k in range(SIDE_TERMS):
-                    relative -= cw[SIDE_TERMS * c + k] * (fbuf[cf[SIDE_TERMS * c + k]] / mass[cf[SIDE_TERMS * c + k]])
-                change = relative / compliance(mass, cf, cw, c)
+                    relative = (gnow[0, ground.left_row[c]] * ground_share(cw, width, c, 1.0)
+                                - gnow[0, ground.right_row[c]] * ground_share(cw, width, c, -1.0))
+                for k in range(stride * c, stride * c + stride):
+                    relative -= cw[k] * (fbuf[cf[k]] / mass[cf[k]])
+                change = relative / compliance(mass, cf, cw, width, c)
                 forces[c] += change
-                push(fbuf, cf, cw, c, change)
+                push(fbuf, cf, cw, width, c, change)
                 largest = max(largest, abs(change))
                 scale = max(scale, abs(forces[c]))
         if largest <= 1e-13 * scale:
@@ -86,7 +87,8 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
     dstart, dsize, doff = structure.dense_start, structure.dense_size, structure.dense_offset
     dvals = structure.dense_values
     dband, dstiff = structure.dense_band, structure.dense_stiffness
-    cf, cw, cgap, claw, cprm = contacts
+    cf, cw, cwidth, cgap, claw, cprm = contacts
+    stride = len(cwidth)
     closed, cconst, cmode = cstate.closed, cstate.constant, cstate.mode
     n = mass.size
     nc = cgap.size
@@ -152,7 +154,7 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
         out[work + c] = 0.0  # δ̇ of a closed contact for now; its power F·δ̇ below
         if closed[c]:
             # Summed from 0 term by term, the gap last: a floor pair's δ is u_L − u_R − gap to the bit.
-            delta, rate = contact_sums(y, n, cf, cw, c)
+            delta, rate = contact_sums(y, n, cf, cw, cwidth, c)
             if ground is not None:
                 delta += ground_offset(ground, ground.now, c, 2)
                 rate += ground_offset(ground, ground.now, c, 1)
@@ -172,7 +174,7 @@ def rhs(y, ag_t, lay, structure, contacts, cstate, out, fbuf, forces, storey, gr
             # law's force) waits, so it is the loop's value at δ = 0 when the faces meet again
         forces[c] = f
         if f != 0.0:
-            for k in range(SIDE_TERMS * c, SIDE_TERMS * c + SIDE_TERMS):
+            for k in range(stride * c, stride * c + stride):
                 fbuf[cf[k]] += cw[k] * f
     if n_stuck > 0:
         stuck_constraints(ag_t, mass, contacts, cstate, fbuf, forces, ground)

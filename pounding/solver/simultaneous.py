@@ -27,7 +27,6 @@ from __future__ import annotations
 from numba import njit
 
 from pounding.solver import jit
-from pounding.solver.kinematics import SIDE_TERMS
 
 __all__ = ["delassus", "solve_lcp", "LCP_SWEEPS"]
 
@@ -36,7 +35,7 @@ LCP_SWEEPS = 500
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def delassus(mass, cf, cw, active, na, G) -> None:
+def delassus(mass, cf, cw, width, active, na, G) -> None:
     """``G[i, j] = Σ_k Σ_l w_k·w_l / m_f`` over the floor terms k of contact active[i] and l of
     active[j] on the same floor f (1/kg), for i, j < *na*: the change of contact i's δ̇ per unit
     impulse of j."""
@@ -45,10 +44,10 @@ def delassus(mass, cf, cw, active, na, G) -> None:
         for j in range(na):
             cj = active[j]
             total = 0.0
-            for k in range(SIDE_TERMS * ci, SIDE_TERMS * ci + SIDE_TERMS):
+            for k in range(len(width) * ci, len(width) * ci + len(width)):
                 if cw[k] == 0.0:
                     continue
-                for m in range(SIDE_TERMS * cj, SIDE_TERMS * cj + SIDE_TERMS):
+                for m in range(len(width) * cj, len(width) * cj + len(width)):
                     if cw[m] != 0.0 and cf[m] == cf[k]:
                         total += cw[k] * cw[m] / mass[cf[k]]
             G[i, j] = total
