@@ -58,3 +58,23 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         reporter.write_line(f"CI: {skipped} test(s) skipped; under CI a skip is a failure "
                             "(see the skip reasons above for what to install)", red=True)
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """{file name: matplotlib figure} of every figure drawn while the test runs, laid out as
+    :func:`pounding.results.plots.save_figure` lays it out (nothing is written)."""
+    from pathlib import Path
+
+    from pounding.results import plots
+
+    drawn = {}
+
+    def keep(fig, path):
+        plots.lay_out(fig)
+        drawn[Path(path).name] = fig
+        return Path(path)
+
+    monkeypatch.setattr(plots, "save_figure", keep)
+    yield drawn
+    plots.pyplot().close("all")

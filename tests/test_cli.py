@@ -74,6 +74,7 @@ def test_info_and_rerun(tmp_path, capsys):
     assert "displacement('time', 'floor') [m]" in text
     again = tmp_path / "again.nc"
     assert main(["rerun", str(out), "-o", str(again)]) == 0
+    assert f"rerun reproduces {out}: all" in capsys.readouterr().out   # as a plan run's rerun: one path
     assert open_run(again).peak_drift_ratio.equals(open_run(out).peak_drift_ratio)
 
 

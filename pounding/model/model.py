@@ -107,6 +107,10 @@ def _trusted(cls: type, **values: Any) -> Any:
 # --------------------------------------------------------------------------- #
 
 
+#: The side of the building a wall stands beside, by the contact's normal and the wall's side of the gap element.
+_WALL_SIDES = {("x", "right"): "east", ("x", "left"): "west", ("y", "right"): "north", ("y", "left"): "south"}
+
+
 @dataclass(frozen=True)
 class GapElement:
     """One contact point between floor ``level_left`` of building ``left`` (the low side along the
@@ -167,6 +171,8 @@ class GapElement:
         """``A:3`` (floor), ``A:s4@0.5`` (storey 4's column at half its height) or ``wall``."""
         building, level, at = ((self.left, self.level_left, self.at_left) if side == "left"
                                else (self.right, self.level_right, self.at_right))
+        if building == WALL and self.point is not None:   # in plan: the wall's side of the building
+            return f"{schema.WALL_NAME}:{_WALL_SIDES[(self.normal, side)]}"
         if building == WALL:
             return schema.WALL_NAME
         return f"{names[building]}:{level}" if at is None else f"{names[building]}:s{level}@{at:g}"

@@ -1074,7 +1074,10 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
              "solver_rtol": float(model.solver.rtol), "solver_atol": float(model.solver.atol),
              "solver_output_dt": float(model.solver.output_dt), "solver_steps": int(raw.n_steps),
              "solver_rejected_steps": int(raw.n_rejected),
-             "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings})}
+             "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
+             "hysteresis": json.dumps({b.name: [None if p.hysteresis is None else p.hysteresis.describe()
+                                                for _, _, p in b.planes()] for b in model.buildings if b.is_inelastic}),
+             "p_delta": ", ".join(b.name for b in model.buildings if b.p_delta)}
     attrs.update({k: v for k, v in status.items() if v != "" and not (isinstance(v, float) and np.isnan(v))})
     if model.contacts_held_open:
         attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
@@ -1174,6 +1177,13 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
         "impact_velocity": _var(("impact",), raw.impact_velocity, "m/s", "approach velocity at the point at onset"),
         "impact_peak_force": _var(("impact",), raw.impact_peak_force, "N", "peak force of the impact"),
         "impact_impulse": _var(("impact",), raw.impact_impulse, "N s", "impulse of the impact"),
+        "impact_duration": _var(("impact",), raw.impact_end_time - raw.impact_time, "s",
+                                "contact duration (nan if still in contact at the end)"),
+        "impact_dissipated_energy": _var(("impact",), raw.impact_work, "J",
+                                         "energy dissipated by the contact during the impact "
+                                         "(work of the contact force; partial if still in contact at the end)"),
+        **_trace_variables(raw),
+        **_plane_yielding(assembly, raw),
     }
     data.update(_friction_variables(assembly, raw))
     data.update(_plane_link_variables(model, assembly, raw, supports))
@@ -1190,6 +1200,40 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
     status = plane_status(model, assembly, raw)
     ds = xr.Dataset(data, coords=coords, attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time,
                                                                wall_time=wall_time, status=status))
+    labels = np.asarray(ds.contact.values, dtype=object)
+    ds = ds.set_coords(["impact_time", "trace_time"]).assign_coords(
+        impact_contact_label=("impact", labels[raw.impact_contact] if labels.size else np.zeros(0, dtype=object),
+                              {"long_name": "contact point of the impact (label of impact_contact)"}),
+        trace_contact_label=("trace", labels[raw.trace_contact] if labels.size else np.zeros(0, dtype=object),
+                             {"long_name": "contact point of the sample (label of trace_contact)"}))
     ds.attrs["energy_closure"] = plane_energy_closure(ds)
     ds.attrs["energy_closure_error"] = ds.attrs["energy_closure"]
+    ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"
     return ds
+
+
+def _trace_variables(raw: RawSolution) -> dict[str, tuple]:
+    """Full-resolution samples of every closed contact (every solver step, on its interpolant)."""
+    return {"trace_time": _var(("trace",), raw.trace_time, "s", "time of a full-resolution sample of a closed contact"),
+            "trace_contact": _var(("trace",), raw.trace_contact.astype(np.int32), "1",
+                                  "index of the contact point along the contact dimension"),
+            "trace_penetration": _var(("trace",), raw.trace_penetration, "m",
+                                      "penetration at the full-resolution sample"),
+            "trace_force": _var(("trace",), raw.trace_force, "N", "contact force at the full-resolution sample")}
+
+
+def _plane_yielding(assembly: Assembly, raw: RawSolution) -> dict[str, tuple]:
+    """Each plane's yield drift and force and its peak ductility (NaN for an elastic plane; {} without yielding
+    planes)."""
+    system = assembly.system
+    if system.storey_floors is None or not np.any(system.storey_state >= 0):
+        return {}
+    yielding = system.storey_state >= 0
+    yield_drift = np.where(yielding, system.storey_parameters[:, 0], np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ductility = raw.peak_plane_drift / yield_drift
+    return {"plane_yield_drift": _var(("plane",), yield_drift, "m", "yield drift of the plane (NaN: elastic)"),
+            "plane_yield_force": _var(("plane",), yield_drift * assembly.plane_stiffness, "N",
+                                      "yield force of the plane (NaN: elastic)"),
+            "peak_plane_ductility": _var(("plane",), ductility, "1",
+                                         "peak |drift| of the plane over its yield drift (NaN: elastic)")}

@@ -9,14 +9,27 @@ from __future__ import annotations
 
 import json
 
-__all__ = ["record_event", "scale_text", "run_title", "describe_plan"]
+__all__ = ["record_event", "scale_text", "run_title"]
+
+
+def _two_components(ds) -> bool:
+    """Whether a pair of components shook the run: its ground acceleration along x and along y are both
+    non-zero."""
+    import numpy as np
+
+    ground = ds.variables.get("ground_acceleration") if hasattr(ds, "variables") else None
+    return ground is not None and "direction" in ground.dims and bool(np.all(np.abs(ground.values).max(axis=0) > 0))
 
 
 def record_event(ds) -> str:
-    """The record's event, year, station and component from a run archive's metadata (``""`` if none)."""
+    """The record's event, year, station and component from a run archive's metadata (``""`` if none); of a
+    pair of components, the event, year and station."""
     from pounding.records.record import event_text
 
-    return event_text(json.loads(ds.attrs.get("record_metadata", "{}") or "{}"))
+    metadata = json.loads(ds.attrs.get("record_metadata", "{}") or "{}")
+    if _two_components(ds):
+        metadata = {k: v for k, v in metadata.items() if k != "component"}
+    return event_text(metadata)
 
 
 def scale_text(scale: float, method: str = "factor", description: str = "") -> str:
@@ -49,32 +62,3 @@ def run_title(ds) -> str:
     if str(attrs.get("contacts", "")).startswith("held open"):   # pounding run --no-contacts
         text += ", contacts held open"
     return text
-
-
-def describe_plan(ds) -> str:
-    """What a plan-run archive holds, in words: the ground motion and the run's options, then per building its
-    floors, outline and planes, and the contact points per face (the peaks are :func:`plan_summary`'s)."""
-    import numpy as np
-
-    attrs = ds.attrs
-    record = attrs.get("record_name", "its ground motion")
-    intensity = scale_text(float(attrs.get("record_scale", 1.0)), str(attrs.get("record_scale_method", "factor")),
-                           str(attrs.get("record_scale_description", "")))
-    held = "; every contact held open" if str(attrs.get("contacts", "")).startswith("held open") else ""
-    lines = [f"plan model '{attrs.get('model', '')}' under {record}, {intensity}, "
-             f"angle {float(attrs.get('angle', 0.0)):g} deg, {float(ds.time[-1]):.2f} s{held}"]
-    lines.append("buildings (floors, outline m, planes per direction):")
-    for name in dict.fromkeys(ds.building.values):
-        floors = np.flatnonzero(ds.building.values == name)
-        xs, ys = ds.corner_x.values[floors[0]], ds.corner_y.values[floors[0]]
-        mine = ds.plane_building.values == name
-        directions = ds.plane_direction.values[mine]
-        lines.append(f"  {name}: {floors.size} floor{'s' if floors.size > 1 else ''}, [[{xs.min():g}, {ys.min():g}], [{xs.max():g}, {ys.max():g}]], "
-                     f"{int((directions == 'x').sum())} along x and {int((directions == 'y').sum())} along y")
-    if ds.sizes.get("contact", 0):
-        lines.append("contact points (floors: location m, normal, impacts, peak normal force):")
-        for p in range(ds.sizes["contact"]):
-            lines.append(f"  {ds.point_between.values[p]}: ({float(ds.point_x[p]):g}, {float(ds.point_y[p]):g}), "
-                         f"{ds.point_normal.values[p]}, {int(ds.impact_count[p])} impacts, "
-                         f"{float(ds.peak_contact_force[p]) / 1e3:.4g} kN")
-    return "\n".join(lines)

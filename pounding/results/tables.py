@@ -20,7 +20,7 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["header", "long_table", "run_tables", "plan_tables", "plan_history_table", "sweep_tables", "scenario_dims", "write_csv", "csv_paths",
+__all__ = ["header", "long_table", "run_tables", "sweep_tables", "scenario_dims", "write_csv", "csv_paths",
            "format_tables"]
 
 
@@ -72,54 +72,38 @@ def _present(ds, names: Sequence[str]) -> list[str]:
 
 
 def run_tables(ds) -> dict:
-    """Tables of a run archive: ``storeys`` (peak drifts, and yielding results when present), ``contacts``
-    (gap, law, impacts, peak force) and, for a model with links, ``links``."""
+    """Tables of a run archive, of any model, those its dimensions call for.
+
+    ``storeys`` (the main table: peak drift ratio, and drift, residual drift, ductility and hysteretic energy
+    where the archive has them), ``planes`` where storeys are made of planes (peak drift and drift ratio per
+    plane), ``floors``, ``rotations`` and ``corners`` where floors move in plan (peak displacement per floor and
+    direction, peak rotation per floor, peak corner displacement per floor, corner and direction),
+    ``contacts`` (gap, law, impacts, peak force; a contact point's location and normal) and ``links``.
+    Floors and storeys are labelled ``A:1`` with their building and 1-based level.
+    """
     storey = _present(ds, ["peak_drift_ratio", "peak_storey_drift", "residual_drift_ratio", "peak_ductility",
                            "storey_hysteretic_energy"])
     if "peak_ductility" in ds and not bool(np.isfinite(ds.peak_ductility.values).any()):
         storey = [n for n in storey if n not in ("residual_drift_ratio", "peak_ductility",
                                                  "storey_hysteretic_energy")]
     tables = {"storeys": long_table(ds, storey, extra=_present(ds, ["storey_building", "storey_level", "height"]))}
+    if ds.sizes.get("plane", 0):
+        tables["planes"] = long_table(ds, ["peak_plane_drift_ratio", "peak_plane_drift"], extra=_present(
+            ds, ["plane_building", "plane_storey", "plane_direction", "plane_at", "plane_height", "plane_stiffness"]))
+    if "direction" in ds.peak_displacement.dims:
+        floor = _present(ds, ["building", "level"])
+        tables["floors"] = long_table(ds, ["peak_displacement"], extra=floor)
+        tables["rotations"] = long_table(ds, ["peak_rotation"], extra=floor)
+        tables["corners"] = long_table(ds, ["peak_corner_displacement"], extra=floor + _present(
+            ds, ["corner_x", "corner_y", "peak_corner_displacement_magnitude"]))
     if ds.sizes.get("contact", 0):
         tables["contacts"] = long_table(ds, ["impact_count", "peak_contact_force"], extra=_present(
-            ds, ["building_left", "level_left", "building_right", "level_right", "gap", "law", "xi_formula"]))
+            ds, ["building_left", "level_left", "building_right", "level_right", "gap", "law", "xi_formula",
+                 "point_x", "point_y", "point_normal"]))
     if ds.sizes.get("link", 0):
         tables["links"] = long_table(ds, ["peak_link_force", "link_dissipated_energy"],
                                      extra=_present(ds, ["link_law"]))
     return tables
-
-
-def plan_tables(ds) -> dict:
-    """Peak tables of a plan-run archive (:mod:`pounding.results.plan_dataset`): ``floors`` (peak
-    displacement of the centre of mass per floor and direction), ``rotations`` (peak rotation per floor),
-    ``corners`` (peak corner displacement per floor, corner and direction, with its magnitude), ``planes``
-    (peak drift per plane) and ``points`` (impacts and peak normal force per contact point)."""
-    floor = ["building", "level"]
-    tables = {"floors": long_table(ds, ["peak_displacement"], extra=floor),
-              "rotations": long_table(ds, ["peak_rotation"], extra=floor),
-              "corners": long_table(ds, ["peak_corner_displacement"],
-                                    extra=floor + ["corner_x", "corner_y", "peak_corner_displacement_magnitude"]),
-              "planes": long_table(ds, ["peak_plane_drift"], extra=["plane_building", "plane_storey",
-                                                                    "plane_direction", "plane_at", "plane_stiffness"])}
-    if ds.sizes.get("contact", 0):
-        tables["points"] = long_table(ds, ["impact_count", "peak_contact_force"],
-                                      extra=["point_between", "point_normal", "point_x", "point_y"])
-    return tables
-
-
-def plan_history_table(ds):
-    """A plan run's floor histories as one wide table: ``time [s]``, then per floor ``B:L x [m]``,
-    ``B:L y [m]`` and ``B:L theta [rad]`` (building B, floor L; the centre of mass's displacement and
-    the floor's rotation)."""
-    import pandas as pd
-
-    columns: dict[str, np.ndarray] = {header(ds, "time"): ds.time.values}
-    u, theta = ds.displacement.values, ds.rotation.values
-    for f, (name, level) in enumerate(zip(ds.building.values, ds.level.values)):
-        columns[f"{name}:{level} x [{ds.displacement.attrs['units']}]"] = u[:, f, 0]
-        columns[f"{name}:{level} y [{ds.displacement.attrs['units']}]"] = u[:, f, 1]
-        columns[f"{name}:{level} theta [{ds.rotation.attrs['units']}]"] = theta[:, f]
-    return pd.DataFrame(columns)
 
 
 def scenario_dims(ds) -> tuple[str, ...]:
