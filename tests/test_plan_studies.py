@@ -230,7 +230,7 @@ def test_cli_gap_and_compare_on_a_plan_model(tmp_path, capsys):
     out = tmp_path / "g.nc"
     assert main(["gap", str(model), "--workers", "1", "--no-progress", "-o", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "A:1-wall@(20,0)" in printed and "enough for 0 of 1" in printed
+    assert "A:1-wall:east@(20,0)" in printed and "enough for 0 of 1" in printed
     with xr.open_dataset(out) as ds:
         assert ds.required_gap.dims == ("record", "contact") and ds.required_gap.attrs["units"] == "m"
         assert float(ds.required_gap.max()) > 0.01 and list(ds.building_right.values) == ["wall", "wall"]
