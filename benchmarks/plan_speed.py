@@ -46,8 +46,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import pounding  # noqa: E402
-from pounding.export.opensees import allow_tension  # noqa: E402
-from pounding.export.opensees_plan import allow_plan_tension, peak_corner_displacement, run_opensees_plan  # noqa: E402
+from pounding.export.opensees import allow_tension, run_opensees  # noqa: E402
 from pounding.model.model import model_from_text  # noqa: E402
 from pounding.model.model import load_model  # noqa: E402
 from pounding.simulation import simulate  # noqa: E402
@@ -68,8 +67,8 @@ def _relative(values, reference) -> float:
     return float(out.max()) if out.size else 0.0
 
 
-def _peaks_ours(model, ds) -> dict:
-    return {"drift": ds.peak_plane_drift.values, "corner": peak_corner_displacement(model, ds),
+def _peaks_ours(ds) -> dict:
+    return {"drift": ds.peak_plane_drift.values, "corner": ds.peak_corner_displacement.values.reshape(-1, 2),
             "force": ds.peak_contact_force.values, "impacts": ds.impact_count.values}
 
 
@@ -98,7 +97,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     folder = out_dir(args, "plan_speed")
 
-    plan = allow_plan_tension(load_model(ROOT / "models" / "corner_pair.yaml"))
+    plan = allow_tension(load_model(ROOT / "models" / "corner_pair.yaml"))
     planar = allow_tension(model_from_text(ISSUE_PAIR, name="issue_pair"))
     if args.duration:
         planar = planar.with_ground_motion(duration=args.duration)
@@ -109,11 +108,11 @@ def main(argv=None) -> int:
 
     tight = dataclasses.replace(plan, solver=dataclasses.replace(plan.solver, **REFERENCE))
     reference = simulate(tight, duration=args.duration, output_dt=CORNER_OUTPUT_DT)
-    ref = _peaks_ours(plan, reference)
-    ours = _peaks_ours(plan, simulate(plan, duration=args.duration, output_dt=CORNER_OUTPUT_DT))
+    ref = _peaks_ours(reference)
+    ours = _peaks_ours(simulate(plan, duration=args.duration, output_dt=CORNER_OUTPUT_DT))
     rows = [{"simulator": "ours", "setting": f"rtol {DEFAULT_RTOL:g}", "time": t_plan, "errors": errors(ours, ref)}]
     for dt in (float(x) for x in args.dts.split(",")):
-        peer = run_opensees_plan(plan, dt=dt, duration=args.duration)
+        peer = run_opensees(plan, dt=dt, duration=args.duration)
         rows.append({"simulator": "OpenSeesPy", "setting": f"dt {dt:g}", "dt": dt, "time": peer["wall_time"],
                      "converged": peer["converged"], "errors": errors(_peaks_peer(peer), ref)})
     print(f"\nconverged solution: rtol {REFERENCE['rtol']:g}, {int(reference.impact_count.sum())} impacts, "

@@ -27,6 +27,7 @@ import pounding
 from pounding.errors import ModelError, PoundingError
 from pounding.records.record import Record
 from pounding.simulation import assemble, record_for
+from pounding.solver.assembly import GroundRows
 from pounding.solver.integrator import integrate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -221,8 +222,8 @@ def test_the_multi_ground_kernel_path_with_identical_grounds_equals_the_one_grou
     record = record_for(model)
     ground = np.r_[record.acceleration, 0.0]
     settings = dict(rtol=1e-9, atol=1e-12, atol_velocity=1e-11, output_dt=0.01)
-    one = integrate(assemble(model), ground, DT, DURATION, **settings)
-    two = integrate(assemble(model, (0, 1)), np.vstack([ground, ground]), DT, DURATION, **settings)
+    one = integrate(assemble(model).system, ground, DT, DURATION, **settings)
+    two = integrate(assemble(model, GroundRows((0, 1))).system, np.vstack([ground, ground]), DT, DURATION, **settings)
     np.testing.assert_array_equal(two.state, one.state)
     np.testing.assert_array_equal(two.impact_time, one.impact_time)
     assert np.all(two.state[:, -1] == 0.0)   # no ground work on one common ground

