@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 from pounding.studies.engine.execution import start_client  # noqa: E402
 from pounding.studies.ida import build_ida_plan, ida_study, run_ida_scenario  # noqa: E402
-from pounding.studies.ida.plan import Hunt  # noqa: E402
+from pounding.studies.ida.schedule import Hunt  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402

@@ -12,7 +12,7 @@ import pytest
 import pounding
 from pounding.errors import PoundingError
 from pounding.studies import fragility
-from pounding.studies.ida.plan import collapse_drifts, with_collapse_drift
+from pounding.studies.ida.schedule import collapse_drifts, with_collapse_drift
 
 PAIR = """\
 name: weak-beside-strong

@@ -227,7 +227,7 @@ def test_a_hunt_never_repeats_a_level_and_stays_within_its_estimate():
     import itertools
 
     from pounding.studies.ida.hunt import next_hunt_level
-    from pounding.studies.ida.plan import Hunt
+    from pounding.studies.ida.schedule import Hunt
 
     for start, step, increment, tolerance, runs, ceiling, collapse in itertools.product(
             [0.1, 1.0], [1e-6, 0.01, 0.37], [0.0, 1e-6, 0.05], [2e-6, 0.05], [1, 12], [1.0, 5.0],

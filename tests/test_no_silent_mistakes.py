@@ -171,7 +171,7 @@ def test_the_registry_lookup_is_the_one_place_names_are_matched():
 
 
 def test_levels_take_the_units_mce_takes():
-    from pounding.studies.ida.plan import parse_intensity, parse_levels
+    from pounding.studies.ida.schedule import parse_intensity, parse_levels
 
     np.testing.assert_array_equal(parse_levels("0.1g:0.3g:0.1g"), [0.1, 0.2, 0.3])
     np.testing.assert_allclose(parse_levels("98.0665 gal, 1.96133 m/s2, 0.3"), [0.1, 0.2, 0.3], rtol=1e-12)

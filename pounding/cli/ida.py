@@ -14,19 +14,12 @@ __all__ = ["register_cli", "add_hunt_options"]
 
 
 def _cmd_ida(args: argparse.Namespace) -> int:
-    from pounding.studies.ida import Hunt, build_ida_plan, build_pair_ida_plan, ida_study, ida_summary, ida_table, \
-        parse_intensity, plot_ida
-    from pounding.model.model import is_plan_file, load_model
+    from pounding.studies.ida import Hunt, build_ida_plan, ida_study, ida_summary, ida_table, parse_intensity, plot_ida
+    from pounding.model.model import load_model
     from pounding.results.checks import model_warnings, print_warnings
 
     check_study_options(args)
-    plan_model = is_plan_file(args.model)
-    if plan_model:
-        from pounding.cli.plan_studies import refuse_options
-
-        refuse_options(args, "ida", ("--csv",))
-    else:
-        check_csv(args, [args.model])
+    check_csv(args, [args.model])
     hunt = None
     if args.hunt:
         hunt = Hunt(start=args.hunt_start, step=args.hunt_step, increment=args.hunt_increment,
@@ -35,20 +28,15 @@ def _cmd_ida(args: argparse.Namespace) -> int:
         raise PoundingError("give --levels START:STOP:STEP (fixed stripes, in g, e.g. 0.1:3.0:0.1) or --hunt "
                             "(hunt-and-fill)")
     mce = None if args.mce is None else parse_intensity(args.mce, "--mce")
-    build = build_pair_ida_plan if plan_model else build_ida_plan
-    plan = build(args.model, args.records, im=args.im, building=args.building, levels=args.levels,
-                 hunt=hunt, without_contacts=args.without_contacts, limits=args.limits,
-                 collapse_drift=args.collapse_drift, mce=mce, scaling=args.scaling, duration=args.duration)
+    plan = build_ida_plan(args.model, args.records, im=args.im, building=args.building, levels=args.levels,
+                          hunt=hunt, without_contacts=args.without_contacts, limits=args.limits,
+                          collapse_drift=args.collapse_drift, mce=mce, scaling=args.scaling, duration=args.duration)
     print(f"IDA of '{plan.model_name}': {len(plan.records)} records x "
           + (f"{len(plan.levels)} levels" if hunt is None else "hunt-and-fill")
           + f" x {len(plan.variants)} variant(s) = {'up to ' if hunt is not None else ''}{plan.planned_runs()} runs; "
           f"IM {plan.im.describe()}", file=sys.stderr)
-    if plan_model:
-        from pounding.model.plan_model import load_plan_model
-
-        print_warnings(load_plan_model(args.model).warnings)
-    else:
-        print_warnings(model_warnings(load_model(args.model)).values())   # its runs are not checked one by one
+    model = load_model(args.model)   # its runs are not checked one by one: the buildings' and the gaps' warnings once
+    print_warnings([*model.warnings, *model_warnings(model).values()])
     try:
         ds = ida_study(plan, args.output, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)
@@ -127,7 +115,8 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--without-contacts", action="store_true",
                         help="run every scenario again with the contacts held open (the effect of pounding)")
     parser.add_argument("--limits", metavar="LIST",
-                        help="peak storey drift ratio limits, e.g. 0.005,0.015,0.025 (the default)")
+                        help="peak storey drift ratio limits, e.g. 0.005,0.015,0.025 (the default); in plan a "
+                             "storey's drift ratio is its planes' largest")
     parser.add_argument("--collapse-drift", type=float, metavar="RATIO",
                         help="every building's collapse drift ratio in this study, over the model's collapse: "
                              "{drift_ratio} and solver.stop_drift_ratio (the runs end there; default: the model's, "

@@ -323,7 +323,7 @@ class Building:
         """
         n = self.n_dof
         copies = 8 if self.damping.kind == "modal" else 5
-        check_memory(8.0 * copies * n * n, what=f"building {self.name}: the modes of its {n} degrees of freedom "
+        check_memory(8.0 * copies * n * n, what=f"building {self.name}: the modes of its {self.n_floors} storeys "
                                                 f"(dense {n} x {n} matrices)",
                      fix="model the building with fewer storeys (lump several storeys into one) or run it on a "
                          "machine with more memory")

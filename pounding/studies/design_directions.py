@@ -561,7 +561,9 @@ def _building_summary(building, found: dict[str, Any], code: str) -> dict[str, A
 def _simulated(ds, rows: list[dict[str, Any]], name: str, use_max: bool) -> None:
     """Each row's simulated requirement (mean, max over the records that ran) at intensity *name*, in place."""
     ok = ds.status.values == "ok"
-    labels = [str(p) for p in ds.point.values]
+    # a contact point of the gap study's archive: its face (YAML order) and place, as the rows name it
+    labels = [f"{face}@({float(x):g},{float(y):g})" for face, x, y in
+              zip(ds.point_face.values, ds.point_x.values, ds.point_y.values)]
     for row in rows:
         values = ds.required_gap.values[ok, labels.index(row["contact"])] if ok.any() else np.full(1, np.nan)
         mean, largest = float(np.mean(values)), float(np.max(values))
@@ -577,7 +579,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
     The pairs (default: the model's own) are scaled by one factor per intensity
     (:func:`pounding.studies.design.suite_scale_factor` on :func:`pair_set_spectra`, periods
     0.2 T_min to 2 T_max of the buildings' principal periods along x and y) and run with no
-    contacts (:func:`pounding.studies.plan.gap.plan_gap_study`).
+    contacts held open (:func:`pounding.studies.gap.gap_study`).
 
     Returns
     -------
@@ -587,7 +589,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
     """
     from pounding.model.model import load_model
     from pounding.studies.common import pair_values
-    from pounding.studies.plan.gap import plan_gap_study
+    from pounding.studies.gap import gap_study
 
     model = load_model(model_path)
     if not model.faces:
@@ -603,7 +605,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
     intensities = []
     for intensity in found["intensities"]:
         factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
-        ds = plan_gap_study(model_path, pairs, scale=factor, duration=duration, **run_options)
+        ds = gap_study(model_path, pairs, scale=factor, duration=duration, **run_options)
         ok = ds.status.values == "ok"
         use_max = code == "ec8" and int(ok.sum()) < EC8_MEAN_RECORDS
         _simulated(ds, rows, intensity.name, use_max)

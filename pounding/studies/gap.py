@@ -1,38 +1,48 @@
 """How far apart must two buildings be? The separation that avoids pounding, by simulation and by the code rules.
 
-For every contact (level pair) of a model and every record, the model is run
-with its contacts held open, and the **required separation** is the largest
-relative approach of the two floors::
+For every contact of a model and every record, the model is run with its
+contacts held open, and the **required separation** is the largest relative
+approach of the contact's two sides along its normal::
 
     required = max(0, max over t of (u_left(t) − u_right(t)))
 
-(``u_left`` the floor of the left building, ``u_right`` that of its right
-neighbour, relative to the ground, positive to the right.)  A gap larger than
-this never closes under that record; a smaller one closes at least once — the
-motion of a model is the same with or without contacts until the first
-closure.
+(``u_left`` the displacement of the low side's floor at the contact along the
+normal, ``u_right`` that of the high side's, relative to the ground.)  A
+contact is a gap element (:class:`pounding.model.model.GapElement`): in a
+planar row a level pair, whose floors move alike everywhere; between floors in
+plan a contact point of a face (the two ends of the facing edges' overlap),
+where a floor moves by ``u + θ ẑ × (p − c)``, so the approach is ``w · q`` with
+the point's penetration weights (:func:`side_vectors`).  A gap larger than the
+requirement never closes under that record; a smaller one closes at least once
+— the motion of a model is the same with or without contacts until the first
+closure.  A face needs the larger of its points' requirements (the approach is
+linear along the face).  Floors in plan are shaken by record pairs, both
+components at once.
 
 Beside it, the **combination rules** of the codes applied to the same run's
-peak floor displacements u₁ = max |u_left|, u₂ = max |u_right| (a registry
-keyed by name, like the ξ formulas; each entry cites its source):
+peak displacements of the two sides at the contact along the normal,
+u₁ = max |u_left|, u₂ = max |u_right| (0 for a wall; a registry keyed by
+name, like the ξ formulas; each entry cites its source):
 
 ``abs``   u₁ + u₂ (the absolute sum; never unconservative);
 ``srss``  √(u₁² + u₂²) (ASCE 7-22 §12.12.2, δ_MT — §12.12.3 in ASCE 7-16; Eurocode 8 §4.4.2.7);
 ``ddc``   √(u₁² + u₂² − 2ρ u₁ u₂), the double difference combination
           (Jeng, Kasai & Maison 1992; Penzien 1997), with ρ the correlation of
-          the two responses taken as the CQC coefficient of the buildings'
-          first modes (:func:`cqc_correlation`, Der Kiureghian 1981).
+          the two responses taken as the CQC coefficient of the two buildings'
+          modes of largest effective mass along the normal (:func:`normal_mode`,
+          :func:`cqc_correlation`, Der Kiureghian 1981; ρ = 0 against a wall).
 
 Over a record set: the median, 84th percentile and maximum of each, the
 fraction of records for which each rule is unconservative (rule < required),
 and the verdict against the model's own gap ("enough for N of M records").
 
 The exact maximum of u_left − u_right is taken on the cubic Hermite
-interpolant of the stored samples (displacement difference and its rate at
-every ``output_dt``), not on the samples alone: with the default
+interpolant of the stored samples (the approach and its rate at every
+``output_dt``), not on the samples alone: with the default
 ``output_dt = 0.01 s`` the interpolation error is below 1e-6 m for the
 shipped models (O(Δt⁴ ω⁴ u)), far below the 1 mm a separation is quoted to.
-See ``docs/gap.md``.
+A side's peak is the run's own (full resolution) where it is one degree of
+freedom (a planar floor), else the same interpolant's.  See ``docs/gap.md``.
 """
 
 from __future__ import annotations
@@ -51,11 +61,11 @@ from pounding.errors import PoundingError
 from pounding.registry import add_unique
 
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "gap_attrs",
-           "required_separations", "run_gap_scenario", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
+           "normal_mode", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
            "gap_summary", "gap_table", "gap_tables", "plot_gap"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
-GAP_PART = "gap-1"
+GAP_PART = "gap-2"
 
 
 # --------------------------------------------------------------------------- #
@@ -181,42 +191,154 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     return best
 
 
-def required_separations(ds) -> dict[str, np.ndarray]:
-    """Required separation and peak floor displacements per contact of a contact-free run.
+def normal_mode(building, normal: str = "x") -> tuple[float, float]:
+    """``(period s, damping ratio)`` of *building*'s mode of largest effective mass along *normal* (``x`` or ``y``).
+
+    A planar building's floors move along x only: its translational mode of largest effective mass
+    (the first mode of a regular shear building); a building in plan: its 3-D mode (translation and
+    torsion coupled) that moves the most mass along the face's normal.
+    """
+    omega, phi = building.modes
+    r = np.zeros(building.n_dof)
+    r[building.dof_names.index(normal)::building.dofs_per_floor] = 1.0
+    gamma = phi.T @ (building.mass_matrix() @ r)
+    i = int(np.argmax(gamma * gamma))
+    return float(building.periods[i]), float(building.modal_damping_ratios[i])
+
+
+def side_vectors(model) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray | None]]:
+    """Per gap element of *model*: ``(w, a_left, a_right)``, each over the model's degrees of freedom.
+
+    ``w · q`` is the approach of the two sides at the contact point along its normal (m, positive
+    closing: the penetration ``δ = w · q − gap``); ``a_left · q`` and ``a_right · q`` are each side's own
+    displacement there along the normal (m; None for a fixed wall).  A floor of one degree of freedom
+    moves alike everywhere (``a`` picks its u_x); a floor in plan moves at a point p by
+    ``u + θ ẑ × (p − c)`` (its centre of mass c), the point's penetration weights
+    (:meth:`pounding.model.model.Model.penetration_vectors`).
+    """
+    from pounding.model.model import WALL
+
+    def unit(building: int, level: int) -> np.ndarray | None:
+        if building == WALL:
+            return None
+        a = np.zeros(model.n_dof)
+        a[model.floor_slice(building, level).start] = 1.0
+        return a
+
+    points = iter(model.penetration_vectors())
+    out = []
+    for g in model.gaps:
+        if g.face is None:
+            left, right = unit(g.left, g.level_left), unit(g.right, g.level_right)
+            w = np.zeros(model.n_dof)
+            for a, sign in ((left, 1.0), (right, -1.0)):
+                if a is not None:
+                    w += sign * a
+            out.append((w, left, right))
+            continue
+        face, point, w = next(points)
+        first = model.scatter(face, np.vstack([point.weights[0], np.zeros(3)]))
+        second = None if face.second == WALL else model.scatter(face, np.vstack([np.zeros(3), point.weights[1]]))
+        out.append((w, first, second) if face.face.first_low else (w, second, first))
+    return out
+
+
+def _side_peak(time: np.ndarray, q: np.ndarray, qd: np.ndarray, a: np.ndarray | None,
+               peak_of: Callable[[int], float]) -> float:
+    """Peak |a · q| (m): the run's own full-resolution peak where *a* is one degree of freedom, else the largest
+    of the cubic Hermite interpolant of the stored samples (:func:`max_hermite`); 0 for a wall (None)."""
+    if a is None:
+        return 0.0
+    nonzero = np.flatnonzero(a)
+    if nonzero.size == 1 and abs(a[nonzero[0]]) == 1.0:
+        return peak_of(int(nonzero[0]))
+    value, rate = q @ a, qd @ a
+    return max(max_hermite(time, value, rate), max_hermite(time, -value, -rate))
+
+
+def required_separations(model, ds) -> dict[str, np.ndarray]:
+    """Required separation, the sides' peak displacements and their correlation per contact of a contact-free run.
 
     Parameters
     ----------
+    model : pounding.model.model.Model
+        The model (its contact points, their sides and the buildings' modes).
     ds : xarray.Dataset
-        Results of :func:`pounding.simulation.simulate` on a model with its contacts held open
+        Results of :func:`pounding.simulation.simulate` on *model* with its contacts held open
         (:meth:`pounding.model.model.Model.with_contacts_open`).
 
     Returns
     -------
     dict
-        ``required`` (m, ≥ 0), ``peak_left``, ``peak_right`` (m): arrays along ``ds.contact``.
+        Arrays along the gap elements (``ds.contact``): ``required`` (m, ≥ 0: the largest approach
+        ``w · q`` of the two sides along the normal, on the cubic Hermite interpolant), ``peak_left``,
+        ``peak_right`` (m: each side's peak displacement at the point along the normal, 0 for a wall),
+        ``correlation`` (1: the CQC coefficient of the two buildings' modes of largest effective mass along
+        the normal, :func:`normal_mode`; 0 against a wall, where every rule gives the building's own).
     """
-    floors = {str(f): i for i, f in enumerate(ds.floor.values)}
-    u = ds.displacement.values
-    v = ds.velocity.values
+    from pounding.model.model import WALL
+    from pounding.studies.common import dof_peaks, floor_states
+
+    q, qd = floor_states(ds)
     t = ds.time.values
-    peak = ds.peak_displacement.values
-    required, peak_left, peak_right = [], [], []
-    for bl, ll, br, lr in zip(ds.building_left.values, ds.level_left.values, ds.building_right.values,
-                              ds.level_right.values):
-        i, j = floors[f"{bl}:{int(ll)}"], floors[f"{br}:{int(lr)}"]
-        approach = max_hermite(t, u[:, i] - u[:, j], v[:, i] - v[:, j])
-        required.append(max(0.0, approach))
-        peak_left.append(float(peak[i]))
-        peak_right.append(float(peak[j]))
-    return {"required": np.array(required), "peak_left": np.array(peak_left), "peak_right": np.array(peak_right)}
+    found: dict[str, np.ndarray] = {}
+
+    def peak_of(k: int) -> float:   # the run's full-resolution peaks, read when a side is one degree of freedom
+        if "peaks" not in found:
+            found["peaks"] = dof_peaks(ds)
+        return float(found["peaks"][k])
+
+    out: dict[str, list[float]] = {k: [] for k in ("required", "peak_left", "peak_right", "correlation")}
+    for g, (w, left, right) in zip(model.gaps, side_vectors(model)):
+        out["required"].append(max(0.0, max_hermite(t, q @ w, qd @ w)))
+        out["peak_left"].append(_side_peak(t, q, qd, left, peak_of))
+        out["peak_right"].append(_side_peak(t, q, qd, right, peak_of))
+        if WALL in (g.left, g.right):
+            out["correlation"].append(0.0)
+        else:
+            modes = [normal_mode(model.buildings[b], g.normal) for b in (g.left, g.right)]
+            out["correlation"].append(cqc_correlation(modes[0][0], modes[1][0], modes[0][1], modes[1][1]))
+    return {k: np.array(v, dtype=float) for k, v in out.items()}
 
 
-def _first_mode(building) -> tuple[float, float]:
-    return float(building.periods[0]), float(building.modal_damping_ratios[0])
+def _contact_info(model, ds) -> dict[str, list]:
+    """Per gap element: its label and sides (from the run's ``contact`` coordinates), the model's gap, the sides'
+    elevations and modes; for points in plan their place (``point_x``, ``point_y``, ``point_normal``,
+    ``point_face``: the face ``A:1-B:1``)."""
+    from pounding.model.model import WALL
+
+    names = [b.name for b in model.buildings]
+
+    def side(building: int, level: int, other: int, other_level: int, normal: str) -> tuple[float, float, float]:
+        if building == WALL:   # a wall faces the floor on the other side: its elevation, no mode
+            return float(model.buildings[other].elevation[other_level - 1]), math.nan, math.nan
+        period, damping = normal_mode(model.buildings[building], normal)
+        return float(model.buildings[building].elevation[level - 1]), period, damping
+
+    info: dict[str, list] = {k: [] for k in ("elevation_left", "elevation_right", "period_left", "period_right",
+                                             "damping_left", "damping_right")}
+    for g in model.gaps:
+        for name, values in (("left", side(g.left, g.level_left, g.right, g.level_right, g.normal)),
+                             ("right", side(g.right, g.level_right, g.left, g.level_left, g.normal))):
+            for key, value in zip(("elevation", "period", "damping"), values):
+                info[f"{key}_{name}"].append(value)
+    info.update({
+        "contact": [str(c) for c in ds.contact.values],
+        "building_left": [str(x) for x in ds.building_left.values],
+        "building_right": [str(x) for x in ds.building_right.values],
+        "level_left": [int(x) for x in ds.level_left.values],
+        "level_right": [int(x) for x in ds.level_right.values],
+        "gap": [float(g.gap) for g in model.gaps]})
+    if "point_x" in ds.coords:
+        info.update({"point_x": [float(x) for x in ds.point_x.values], "point_y": [float(y) for y in ds.point_y.values],
+                     "point_normal": [str(n) for n in ds.point_normal.values],
+                     "point_face": [model.faces[g.face].label(names) for g in model.gaps]})
+    return info
 
 
 def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
-    """One record of a gap study, on a worker: the contact-free run and its separations (plain data).
+    """One record (a record pair for floors in plan) of a gap study, on a worker: the contact-free run and each
+    contact's separations (plain data).
 
     Never raises for a problem of the scenario: the result then has
     ``status = "error"`` and the message.
@@ -224,7 +346,8 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     from pounding.model.model import model_from_text
     from pounding.results.checks import run_warnings
     from pounding.results.dataset import record_pga
-    from pounding.simulation import simulate
+    from pounding.simulation import component_records, simulate
+    from pounding.studies.common import ground_pga
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
 
@@ -240,28 +363,19 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
             raise PoundingError(f"{ds.attrs.get('status_message', ds.attrs['status'])}; no separation is derived "
                                 "from a run that did not reach the record's end (lower --scale, or check the "
                                 "model's strength)")
-        found = required_separations(ds)
-        names = [b.name for b in model.buildings]
-        modes = {b.name: _first_mode(b) for b in model.buildings}
+        found = required_separations(model, ds)
+        # One record: its PGA as the archive has it; a pair: the geometric mean of its components' PGAs.
+        intensity = ground_pga([r for r in component_records(model) if r is not None]) \
+            if model.ground_motion.two_components else record_pga(ds)[1]
+        result.update(_contact_info(model, ds))
         result.update({
             "status": "ok",
-            "contact": [str(c) for c in ds.contact.values],
-            "building_left": [str(x) for x in ds.building_left.values],
-            "building_right": [str(x) for x in ds.building_right.values],
-            "level_left": [int(x) for x in ds.level_left.values],
-            "level_right": [int(x) for x in ds.level_right.values],
-            "gap": [float(g.gap) for g in model.gaps],
-            "elevation_left": [float(model.buildings[g.left].elevation[g.level_left - 1]) for g in model.gaps],
-            "elevation_right": [float(model.buildings[g.right].elevation[g.level_right - 1]) for g in model.gaps],
-            "period_left": [modes[names[g.left]][0] for g in model.gaps],
-            "period_right": [modes[names[g.right]][0] for g in model.gaps],
-            "damping_left": [modes[names[g.left]][1] for g in model.gaps],
-            "damping_right": [modes[names[g.right]][1] for g in model.gaps],
             "required": found["required"].tolist(),
             "peak_left": found["peak_left"].tolist(),
             "peak_right": found["peak_right"].tolist(),
+            "correlation": found["correlation"].tolist(),
             "scale_factor": float(ds.attrs.get("record_scale", 1.0)),
-            "intensity": record_pga(ds)[1],
+            "intensity": intensity,
             "warnings": run_warnings(ds, gaps=[g.gap for g in model.gaps]),
             "solver_wall_time": float(ds.attrs["wall_time"]),
         })
@@ -278,43 +392,42 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
 
 def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = None, *,
                     scale: Any = None, duration: float | None = None):
-    """The sweep behind ``pounding gap``: one scenario per record.
+    """The sweep behind ``pounding gap``: one scenario per record (a record pair for floors in plan).
 
     Parameters
     ----------
     model : path-like
         YAML model with at least one contact.
     records : str or list of str, optional
-        A set (``fema-p695:farfield``) or a comma-separated list; default: the model's record.
+        A set (``fema-p695:farfield``: its 44 records, or its 22 pairs for floors in plan) or a
+        comma-separated list; default: the model's record (pair).
     scale : float or mapping, optional
-        ``ground_motion.scale`` for every record (a factor, or ``{pga: 0.4g}``...).
+        ``ground_motion.scale`` for every record (a factor, or ``{pga: 0.4g}``...; a pair's target applies
+        to its geometric mean).
     duration : float, optional
         Simulated time, s.
     """
     from pounding.model.model import load_model
-    from pounding.studies.common import check_duration, record_values, study_sweep
+    from pounding.studies.common import check_duration, record_sweep
 
     base = load_model(model)  # the model's own errors, with its file name
     base.refuse_building_records("the gap study (it runs the model under one record at a time)")
     names = [b.name for b in base.buildings]
     for g in base.gaps:
-        if g.has_wall or g.has_column_point:
-            what = "a fixed wall" if g.has_wall else "a point of a column between floors"
-            raise PoundingError(f"{os.fspath(model)}: contacts[{g.contact}] ({g.label(names)}) joins {what}; the gap "
-                                "study's separation rules compare the floors of two buildings: keep only "
-                                "floor-to-floor level pairs between buildings in the model you study")
+        if g.has_column_point:
+            raise PoundingError(f"{os.fspath(model)}: contacts[{g.contact}] ({g.label(names)}) joins a point of a "
+                                "column between floors; the gap study's separation rules compare floors: keep only "
+                                "floor-to-floor level pairs (or a floor and a wall) in the model you study")
     if not base.gaps:
-        raise PoundingError(f"{os.fspath(model)}: the model has no contacts; list the level pairs to check in "
-                            "'contacts' (gap: 0 is fine: only the levels and buildings are used)")
-    path = os.path.abspath(os.fspath(model))
+        raise PoundingError(f"{os.fspath(model)}: the model has no contacts; list the level pairs (or faces) to "
+                            "check in 'contacts' (gap: 0 is fine: only the levels and buildings are used; the "
+                            "outlines give a face's gap)")
     settings: dict[str, Any] = {"name": f"{base.name} (gap study)"}
     if scale is not None:
         settings["scale"] = scale
     if check_duration(duration) is not None:
         settings["ground_motion.duration"] = float(duration)
-    document: dict[str, Any] = {"name": f"gap-{Path(path).stem}", "model": path, "set": settings,
-                                "axes": {"records": record_values(records, base)}}
-    return study_sweep(document, f"<gap {os.fspath(model)}>")
+    return record_sweep(model, base, "gap", settings, records, f"<gap {os.fspath(model)}>")
 
 
 def over_records(values: np.ndarray, ok: np.ndarray) -> dict[str, np.ndarray]:
@@ -339,12 +452,12 @@ def over_records(values: np.ndarray, ok: np.ndarray) -> dict[str, np.ndarray]:
     return {"median": np.median(good, axis=-2), "p84": np.percentile(good, 84.0, axis=-2), "max": good.max(axis=-2)}
 
 
-def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float, kind: str | None = None) -> dict:
-    """The global attributes of a gap study's dataset, planar and plan.
+def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float) -> dict:
+    """The global attributes of a gap study's dataset.
 
     Parameters
     ----------
-    sweep : Sweep or PlanSweep
+    sweep : Sweep
         The study's sweep (its heading, model name and path).
     title : str
         The title's opening, followed by ``of`` and the sweep's heading.
@@ -354,16 +467,12 @@ def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float, ki
         Records run by this call.
     elapsed : float
         Wall time of this call, s.
-    kind : str, optional
-        The dataset's ``kind`` attribute (a plan study's ``plan_gap``), after ``study``.
     """
     from pounding import __version__
     from pounding.studies.common import sweep_heading
 
     attrs: dict[str, Any] = {"title": f"{title} of {sweep_heading(sweep)}", "model_name": sweep.model_name,
                              "source": f"pounding {__version__}", "study": "gap"}
-    if kind is not None:
-        attrs["kind"] = kind
     attrs.update({"model_path": sweep.model_path or "",
                   "rules": "; ".join(f"{r.key}: {r.title} ({r.reference})" for r in RULES.values()),
                   "n_records": len(ok), "n_failed": int((~ok).sum()), "n_run": ran, "elapsed_time": elapsed,
@@ -371,9 +480,69 @@ def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float, ki
     return attrs
 
 
+#: Coordinates of a contact point in plan (the run archive's), with their attributes.
+POINT_COORDS = {
+    "point_x": (float, {"units": "m", "long_name": "x of the contact point at rest"}),
+    "point_y": (float, {"units": "m", "long_name": "y of the contact point at rest"}),
+    "point_normal": (object, {"long_name": "normal direction of the point's face"}),
+    "point_face": (object, {"long_name": "the face of the point: the two floors (building:floor)"}),
+}
+
+
+def _records_layout(parts: list[dict[str, Any]], nc: int) -> dict[str, np.ndarray]:
+    """Per record × contact ``required``, ``peak_left``, ``peak_right`` (m) and per record ``scale_factor``,
+    ``intensity`` of the records that ran (NaN elsewhere), ``status`` and ``error``."""
+    nr = len(parts)
+    out = {k: np.full((nr, nc), np.nan) for k in ("required", "peak_left", "peak_right")}
+    out.update({k: np.full(nr, np.nan) for k in ("scale_factor", "intensity")})
+    for r, part in enumerate(parts):
+        if part.get("status") != "ok":
+            continue
+        for key in ("required", "peak_left", "peak_right"):
+            out[key][r] = part[key]
+        out["scale_factor"][r] = part.get("scale_factor", np.nan)
+        out["intensity"][r] = part.get("intensity", np.nan)
+    out["status"] = np.array([p.get("status", "error") for p in parts], dtype=object)
+    out["error"] = np.array([p.get("error", "") or "" for p in parts], dtype=object)
+    return out
+
+
+def _gap_coords(records: list[str], first: dict[str, Any] | None, rules: list[str]) -> dict[str, tuple]:
+    """The gap dataset's coordinates: record, contact (its sides, elevations, modes; the point in plan), rule."""
+    def info(name: str, dtype=float):
+        return np.array(first[name] if first else [], dtype=dtype)
+
+    def side(key: str, dtype, units: str | None, words: str) -> dict[str, tuple]:
+        return {f"{key}_{s}": ("contact", info(f"{key}_{s}", dtype),
+                               {**({"units": units} if units else {}), "long_name": words.format(side=s)})
+                for s in ("left", "right")}
+
+    coords = {
+        "record": ("record", np.array(records, dtype=object), {"long_name": "record specification (a record pair "
+                                                                         "for floors in plan)"}),
+        "contact": ("contact", np.array(first["contact"] if first else [], dtype=object),
+                    {"long_name": "gap element label (a point in plan: @(x,y))"}),
+        "rule": ("rule", np.array(rules, dtype=object), {"long_name": "separation rule"}),
+        "gap": ("contact", info("gap"), {"units": "m", "long_name": "the model's gap at rest"}),
+        **side("building", object, None, "{side} building ('wall' for a fixed wall)"),
+        **side("level", np.int32, "1", "{side} floor (0 for a wall)"),
+        **side("elevation", float, "m", "{side} floor elevation (a wall: the floor it faces)"),
+        **side("period", float, "s", "{side} building's period of largest effective mass along the normal "
+                                     "(NaN for a wall)"),
+        **side("damping", float, "1", "{side} building's damping ratio of that mode (NaN for a wall)"),
+    }
+    if first and "point_x" in first:
+        coords.update({name: ("contact", info(name, dtype), attrs) for name, (dtype, attrs) in POINT_COORDS.items()})
+    return coords
+
+
 def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: float = float("nan"),
                          ran: int = 0):
-    """The gap study's NetCDF layout (dims ``record`` × ``contact``, and ``rule``) from per-record results."""
+    """The gap study's NetCDF layout (dims ``record`` × ``contact``, and ``rule``) from per-record results.
+
+    One layout for every model: a contact is a gap element (a contact point of a face in plan, with the
+    coordinates ``point_x``, ``point_y``, ``point_normal``, ``point_face``).
+    """
     import xarray as xr
 
     from pounding.studies.common import study_parts
@@ -384,42 +553,24 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     parts = study_parts(scenarios, results, GAP_PART)
     records = [str(s.coords["record"]) for s in scenarios]
     first = next((p for p in parts if p.get("status") == "ok"), None)
-    contacts = first["contact"] if first else []
-    nr, nc = len(records), len(contacts)
-    required = np.full((nr, nc), np.nan)
-    peak_left = np.full((nr, nc), np.nan)
-    peak_right = np.full((nr, nc), np.nan)
-    scale_factor = np.full(nr, np.nan)
-    intensity = np.full(nr, np.nan)
-    status = np.array([p.get("status", "error") for p in parts], dtype=object)
-    error = np.array([p.get("error", "") or "" for p in parts], dtype=object)
-    for r, part in enumerate(parts):
-        if part.get("status") != "ok":
-            continue
-        required[r] = part["required"]
-        peak_left[r] = part["peak_left"]
-        peak_right[r] = part["peak_right"]
-        scale_factor[r] = part.get("scale_factor", np.nan)
-        intensity[r] = part.get("intensity", np.nan)
-
-    def info(name: str, dtype=float):
-        return np.array(first[name] if first else [], dtype=dtype)
-
-    rho = np.array([cqc_correlation(ta, tb, za, zb) for ta, tb, za, zb in
-                    zip(info("period_left"), info("period_right"), info("damping_left"), info("damping_right"))])
+    nc = len(first["contact"]) if first else 0
+    layout = _records_layout(parts, nc)
+    required, peak_left, peak_right = layout["required"], layout["peak_left"], layout["peak_right"]
+    rho = np.array(first["correlation"] if first else [], dtype=float)
     rules = list(RULES)
     separation = np.stack([RULES[k].function(peak_left, peak_right, rho[None, :]) for k in rules]) \
-        if nc else np.zeros((len(rules), nr, 0))
+        if nc else np.zeros((len(rules), len(records), 0))
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = separation / required[None, :, :]
-    ok = status == "ok"
-    gap = info("gap")
+    ok = layout["status"] == "ok"
+    gap = np.array(first["gap"] if first else [], dtype=float)
 
     req = over_records(required, ok)
     sep = over_records(separation, ok)
     unconservative = (separation[:, ok] < required[None, ok]).mean(axis=1) if ok.any() \
         else np.full((len(rules), nc), np.nan)
     enough = (gap[None, :] >= required[ok]).sum(axis=0).astype(np.int32) if nc else np.zeros(0, np.int32)
+    pair = bool(first and "point_x" in first)
 
     def var(dims, data, units, long_name, **extra):
         return (dims, data, {"units": units, "long_name": long_name, **extra})
@@ -427,11 +578,14 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     ds = xr.Dataset(
         {
             "required_gap": var(("record", "contact"), required, "m",
-                                "separation needed to avoid pounding: max over t of u_left - u_right, floored at 0"),
+                                "separation needed to avoid pounding: max over t of the approach of the two sides "
+                                "along the normal (u_left - u_right), floored at 0"),
             "peak_displacement_left": var(("record", "contact"), peak_left, "m",
-                                          "peak absolute displacement of the left floor (contact-free run)"),
+                                          "peak absolute displacement of the left floor along the normal at the "
+                                          "contact (contact-free run)"),
             "peak_displacement_right": var(("record", "contact"), peak_right, "m",
-                                           "peak absolute displacement of the right floor (contact-free run)"),
+                                           "peak absolute displacement of the right floor along the normal at the "
+                                           "contact (contact-free run; 0 for a wall)"),
             "rule_gap": var(("rule", "record", "contact"), separation, "m", "separation by the combination rule"),
             "rule_ratio": var(("rule", "record", "contact"), ratio, "1",
                               "rule separation / required separation (< 1: unconservative)"),
@@ -447,29 +601,16 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
             "records_enough": var(("contact",), enough, "1",
                                   "number of records for which the model's gap is at least the required separation"),
             "correlation": var(("contact",), rho, "1",
-                               "CQC correlation of the two buildings' first modes (Der Kiureghian 1981)"),
-            "scale_factor": var(("record",), scale_factor, "1", "factor applied to the record"),
-            "intensity": var(("record",), intensity, "m s-2", PGA_LONG_NAME),
-            "status": (("record",), status, {"long_name": "ok, or error (see variable error)"}),
-            "error": (("record",), error, {"long_name": "error message of a failed record"}),
+                               "CQC correlation of the two buildings' modes of largest effective mass along the "
+                               "normal (Der Kiureghian 1981; 0 against a wall)"),
+            "scale_factor": var(("record",), layout["scale_factor"], "1",
+                                "factor applied to the record" + (" (both components of the pair)" if pair else "")),
+            "intensity": var(("record",), layout["intensity"], "m s-2",
+                             PGA_LONG_NAME + ("; a pair: the geometric mean of its two components'" if pair else "")),
+            "status": (("record",), layout["status"], {"long_name": "ok, or error (see variable error)"}),
+            "error": (("record",), layout["error"], {"long_name": "error message of a failed record"}),
         },
-        coords={
-            "record": ("record", np.array(records, dtype=object), {"long_name": "record specification"}),
-            "contact": ("contact", np.array(contacts, dtype=object), {"long_name": "gap element label"}),
-            "rule": ("rule", np.array(rules, dtype=object), {"long_name": "separation rule"}),
-            "gap": ("contact", gap, {"units": "m", "long_name": "the model's gap at rest"}),
-            "building_left": ("contact", info("building_left", object), {"long_name": "left building"}),
-            "building_right": ("contact", info("building_right", object), {"long_name": "right building"}),
-            "level_left": ("contact", info("level_left", np.int32), {"units": "1", "long_name": "left floor"}),
-            "level_right": ("contact", info("level_right", np.int32), {"units": "1", "long_name": "right floor"}),
-            "elevation_left": ("contact", info("elevation_left"), {"units": "m", "long_name": "left floor elevation"}),
-            "elevation_right": ("contact", info("elevation_right"),
-                                {"units": "m", "long_name": "right floor elevation"}),
-            "period_left": ("contact", info("period_left"), {"units": "s", "long_name": "left building T1"}),
-            "period_right": ("contact", info("period_right"), {"units": "s", "long_name": "right building T1"}),
-            "damping_left": ("contact", info("damping_left"), {"units": "1", "long_name": "left building zeta1"}),
-            "damping_right": ("contact", info("damping_right"), {"units": "1", "long_name": "right building zeta1"}),
-        },
+        coords=_gap_coords(records, first, rules),
         attrs=gap_attrs(sweep, "pounding gap study", ok, ran=ran, elapsed=elapsed),
     )
     warnings = study_warnings(p.get("warnings") for p in parts if p.get("status") == "ok")
@@ -498,7 +639,8 @@ def gap_study(model: str | os.PathLike, records: str | list[str] | None = None, 
 
 
 def gap_summary(ds, model: str = "") -> dict[str, Any]:
-    """The study as one JSON-ready document (SI units, metres)."""
+    """The study as one JSON-ready document (SI units, metres); a contact point in plan adds its ``point``
+    (x, y, normal, face)."""
     from pounding.studies.common import finite_or_none
 
     ok = ds.status.values == "ok"
@@ -522,6 +664,9 @@ def gap_summary(ds, model: str = "") -> dict[str, Any]:
             "records_enough": int(ds.records_enough.values[c]),
             "records_ok": int(ok.sum()),
         }
+        if "point_x" in ds.coords:
+            entry["point"] = {"x": float(ds.point_x.values[c]), "y": float(ds.point_y.values[c]),
+                              "normal": str(ds.point_normal.values[c]), "face": str(ds.point_face.values[c])}
         out["contacts"][str(label)] = entry
     failed = {rec: str(err) for rec, err, good in zip(records, ds.error.values, ok) if not good}
     if failed:
@@ -534,17 +679,18 @@ def _mm(value: float) -> str:
 
 
 def gap_table(ds) -> str:
-    """The study as a printed table (millimetres)."""
+    """The study as a printed table (millimetres): a row per contact (per contact point in plan)."""
     ok = ds.status.values == "ok"
     n_ok = int(ok.sum())
     rules = [str(r) for r in ds.rule.values]
+    width = max([14] + [len(str(label)) for label in ds.contact.values])
     lines = [f"required separation over {n_ok} record{'s' if n_ok != 1 else ''} (mm; contact-free runs), "
              "and the code rules on the same runs"]
-    head = f"{'contact':<14} {'gap':>7} {'median':>7} {'p84':>7} {'max':>7}  " + \
+    head = f"{'contact':<{width}} {'gap':>7} {'median':>7} {'p84':>7} {'max':>7}  " + \
            "  ".join(f"{r + ' p84':>9} {'unsafe':>6}" for r in rules) + "  verdict"
     lines.append(head)
     for c, label in enumerate(ds.contact.values):
-        row = (f"{str(label):<14} {_mm(float(ds.gap.values[c])):>7} {_mm(float(ds.required_gap_median.values[c])):>7} "
+        row = (f"{str(label):<{width}} {_mm(float(ds.gap.values[c])):>7} {_mm(float(ds.required_gap_median.values[c])):>7} "
                f"{_mm(float(ds.required_gap_p84.values[c])):>7} {_mm(float(ds.required_gap_max.values[c])):>7}  ")
         cells = []
         for k in range(len(rules)):
@@ -555,30 +701,49 @@ def gap_table(ds) -> str:
         row += "  ".join(cells) + f"  enough for {enough} of {n_ok}"
         lines.append(row)
     lines.append("unsafe: fraction of records for which the rule is below the required separation; "
-                 f"ddc uses rho = CQC of the first modes ({', '.join(f'{x:.3f}' for x in ds.correlation.values)})")
+                 "ddc uses rho = CQC of the modes of largest effective mass along the normal "
+                 f"({', '.join(f'{x:.3f}' for x in ds.correlation.values)})")
+    if "point_x" in ds.coords:
+        lines.append("a contact point's separation is along its face's normal; a face needs the larger of its "
+                     "points' (the approach is linear along the face)")
     return "\n".join(lines)
 
 
 def gap_tables(ds) -> dict:
     """Tables of a gap archive (metres): ``contacts`` (the model's gap, the required separation's median,
-    84th percentile and maximum, the records it suffices for), ``rules`` (each rule's separation and how
-    often it is unconservative), ``records`` (per record and contact: the required separation and the
-    peak displacements it came from) and ``rule_records`` (each rule per record and contact)."""
+    84th percentile and maximum, the records it suffices for; a point in plan with its place and face),
+    ``rules`` (each rule's separation and how often it is unconservative), ``records`` (per record and
+    contact: the required separation and the peak displacements it came from) and ``rule_records`` (each
+    rule per record and contact)."""
     from pounding.results.tables import long_table
 
     place = ["building_left", "level_left", "elevation_left", "building_right", "level_right", "elevation_right"]
+    place += [name for name in POINT_COORDS if name in ds.coords]
     return {
         "contacts": long_table(ds, ["gap", "required_gap_median", "required_gap_p84", "required_gap_max",
                                     "records_enough", "correlation"], extra=place),
         "rules": long_table(ds, ["rule_gap_median", "rule_gap_p84", "rule_gap_max", "unconservative_fraction"]),
         "records": long_table(ds, ["required_gap", "peak_displacement_left", "peak_displacement_right"],
-                              extra=["status", "scale_factor", "gap"]),
+                              extra=["status", "scale_factor", "intensity", "gap"]),
         "rule_records": long_table(ds, ["rule_gap", "rule_ratio"], extra=["status"]),
     }
 
 
+def _face_envelope(ds, chosen: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The contacts *chosen* grouped by their floors (a face's points in plan; one contact each otherwise),
+    bottom up: ``(elevations m, gaps m, the index groups)``; a group's value is the largest of its contacts'."""
+    keys = [(int(ds.level_left.values[c]), int(ds.level_right.values[c])) for c in chosen]
+    groups = [chosen[[k == key for k in keys]] for key in dict.fromkeys(keys)]
+    z = np.array([max(float(ds.elevation_left.values[g[0]]), float(ds.elevation_right.values[g[0]]))
+                  for g in groups])
+    order = np.argsort(z, kind="stable")
+    groups = [groups[i] for i in order]
+    return z[order], np.array([float(ds.gap.values[g].min()) for g in groups]), groups
+
+
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
-    """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap."""
+    """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap, one
+    panel per pair of buildings (contact points in plan: each face's largest, the face's requirement)."""
     from pounding.results.plots import finish_profile_panel, plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
@@ -586,21 +751,25 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     pairs = sorted({(str(a), str(b)) for a, b in zip(ds.building_left.values, ds.building_right.values)})
     fig, axes = plt.subplots(1, len(pairs), figsize=(5.2 * len(pairs), 4.6), squeeze=False)
     ok = ds.status.values == "ok"
+
+    def largest(values: np.ndarray, groups: list[np.ndarray]) -> np.ndarray:
+        return np.array([np.max(values[..., g], axis=-1) for g in groups]).T
+
     for ax, (left, right) in zip(axes[0], pairs):
         sel = np.flatnonzero((ds.building_left.values == left) & (ds.building_right.values == right))
-        order = sel[np.argsort(ds.elevation_left.values[sel])]
-        z = np.maximum(ds.elevation_left.values[order], ds.elevation_right.values[order])
+        z, gaps, groups = _face_envelope(ds, sel)
         for r in np.flatnonzero(ok):
-            ax.plot(1000 * ds.required_gap.values[r, order], z, color="0.75", lw=0.8, marker=".", ms=3,
+            ax.plot(1000 * largest(ds.required_gap.values[r], groups), z, color="0.75", lw=0.8, marker=".", ms=3,
                     label="required, one record" if r == np.flatnonzero(ok)[0] else None)
-        ax.plot(1000 * ds.required_gap_median.values[order], z, color="k", lw=2, marker="o", ms=4,
+        ax.plot(1000 * largest(ds.required_gap_median.values, groups), z, color="k", lw=2, marker="o", ms=4,
                 label="required, median")
-        ax.plot(1000 * ds.required_gap_p84.values[order], z, color="k", lw=1.2, ls="--", label="required, 84th pct")
+        ax.plot(1000 * largest(ds.required_gap_p84.values, groups), z, color="k", lw=1.2, ls="--",
+                label="required, 84th pct")
         for k, rule in enumerate(ds.rule.values):
-            ax.plot(1000 * ds.rule_gap_p84.values[k, order], z, lw=1.4, marker="s", ms=3, color=f"C{k}",
+            ax.plot(1000 * largest(ds.rule_gap_p84.values[k], groups), z, lw=1.4, marker="s", ms=3, color=f"C{k}",
                     label=f"{rule} (84th pct)")
-        ax.plot(1000 * ds.gap.values[order], z, color="C3", lw=2.2, ls=":", label="model gap")
-        rho = float(np.mean(ds.correlation.values[order]))
+        ax.plot(1000 * gaps, z, color="C3", lw=2.2, ls=":", label="model gap")
+        rho = float(np.mean(ds.correlation.values[sel]))
         finish_profile_panel(ax, "separation (mm)", "elevation of the contact (m)",
                              f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", title_size=9)
     suptitle(fig, f"separation needed to avoid pounding, {int(ok.sum())} record(s) run\n{ds.attrs.get('title', '')}",

@@ -62,8 +62,16 @@ Fragility (:mod:`pounding.studies.fragility`)
     collapse (FEMA P695 §7.2).  A fit whose median is not inside the data is
     "not determinable": no θ, β or CMR (docs/ida.md).
 
+Record pairs
+    A model shaken by two components (floors in plan) runs record pairs,
+    each in both orientations (FEMA P695's three-dimensional analyses; a
+    pair's IM the geometric mean of its components'): see
+    :mod:`pounding.studies.ida.schedule`.  Its storeys' drift ratios are their
+    planes' largest; the archive adds each plane's (``plane``) and the pair's
+    ``pair``, ``orientation`` and components.
+
 Modules
-    ``plan``     inputs (IM, levels, limits, hunt settings) and the plan of every run
+    ``schedule`` inputs (IM, levels, limits, hunt settings) and the schedule of every run
     ``runs``     one run on a worker, and its outcome
     ``hunt``     hunt-and-fill: the next level of a record, the hunt on the study engine
     ``dataset``  the NetCDF layout and the fragility fitted on it
@@ -76,10 +84,9 @@ import os
 
 from pounding.studies.ida.dataset import MAX_BETA, assemble_ida_dataset, exceeds, ida_fragility
 from pounding.studies.ida.hunt import HuntTasks, next_hunt_level, run_hunt
-from pounding.studies.ida.plan import (DEFAULT_LIMITS, IM_NAMES, MAX_LEVELS, SA_DAMPING, SCALINGS, VARIANTS, Hunt,
-                                       IdaPlan, IntensityMeasure, build_ida_plan, limit_label, parse_intensity,
-                                       parse_levels, parse_limits)
-from pounding.studies.ida.pairs import ORIENTATIONS, build_pair_ida_plan, ida_runner, run_pair_ida_scenario
+from pounding.studies.ida.schedule import (DEFAULT_LIMITS, IM_NAMES, MAX_LEVELS, ORIENTATIONS, SA_DAMPING, SCALINGS,
+                                           VARIANTS, Hunt, IdaPlan, IntensityMeasure, build_ida_plan, limit_label,
+                                           parse_intensity, parse_levels, parse_limits)
 from pounding.studies.ida.report import ida_summary, ida_table, ida_tables, plot_ida
 from pounding.studies.ida.runs import IDA_PART, building_drifts, collapsed_in, run_ida_scenario, run_outcome
 
@@ -87,8 +94,7 @@ __all__ = ["IDA_PART", "VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MA
            "IntensityMeasure", "Hunt", "IdaPlan", "parse_levels", "parse_limits", "build_ida_plan",
            "run_ida_scenario", "next_hunt_level", "HuntTasks", "run_hunt", "ida_study", "assemble_ida_dataset", "ida_fragility",
            "ida_summary", "ida_table", "ida_tables", "plot_ida", "run_outcome", "parse_intensity", "limit_label", "exceeds",
-           "building_drifts", "collapsed_in", "ORIENTATIONS", "build_pair_ida_plan", "ida_runner",
-           "run_pair_ida_scenario"]
+           "building_drifts", "collapsed_in", "ORIENTATIONS"]
 
 
 def ida_study(plan: IdaPlan, output: str | os.PathLike | None = None, **run_options):
@@ -109,5 +115,5 @@ def ida_study(plan: IdaPlan, output: str | os.PathLike | None = None, **run_opti
     def assemble(_sweep, results, *, elapsed=float("nan"), ran=0):
         return assemble_ida_dataset(plan, results, entries, elapsed=elapsed, ran=ran)
 
-    tasks = sweep_tasks(plan.sweep, runner=ida_runner(plan), assemble=assemble, scenarios=scenarios)
+    tasks = sweep_tasks(plan.sweep, runner=run_ida_scenario, assemble=assemble, scenarios=scenarios)
     return run_study(tasks, output, **run_options)

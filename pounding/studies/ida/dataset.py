@@ -10,7 +10,7 @@ import numpy as np
 
 from pounding.errors import PoundingError
 from pounding.studies.common import records_text
-from pounding.studies.ida.plan import SA_DAMPING, IdaPlan, limit_label
+from pounding.studies.ida.schedule import SA_DAMPING, IdaPlan, limit_label
 from pounding.studies.ida.runs import building_drifts, collapse_building_of, run_collapses, run_outcome
 from pounding.units import STANDARD_GRAVITY
 
@@ -62,7 +62,8 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
                                   for c in p["contacts"]["contact"]))
     contact_index = {c: k for k, c in enumerate(contacts)}
     ns, nc = len(storeys), len(contacts)
-    extra = {name: np.full((nv, nr, nl, nb), np.nan) for name in (first or {}).get("building_peaks", {})}
+    planes = (first or {}).get("planes")   # floors in plan: each plane of each storey
+    plane_drift = np.full((nv, nr, nl, len(planes["plane"]) if planes else 0), np.nan)
 
     level_value = np.full((nv, nr, nl), np.nan)
     intensity = np.full((nv, nr, nl), np.nan)
@@ -106,8 +107,8 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
             impacts[i, r, j], force[i, r, j] = 0, 0.0
         impacts[i, r, j, at] = part["contacts"]["impact_count"]
         force[i, r, j, at] = part["contacts"]["peak_contact_force"]
-        for name, values in part.get("building_peaks", {}).items():
-            extra[name][i, r, j] = values
+        if planes:
+            plane_drift[i, r, j] = part["planes"]["peak_drift_ratio"]
         collapse_time[i, r, j] = np.nan if part.get("collapse_time") is None else part["collapse_time"]
         collapse_storey[i, r, j] = part.get("collapse_storey", "")
     status[status == ""] = "not run"
@@ -126,10 +127,12 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "intensity": var(im_dims, intensity_data, "m s-2",
                          f"{plan.im.describe()} of the scaled record (the IM value reached)"),
         "scale_factor": var(im_dims, factor_data, "1",
-                            "factor applied to the record as stored (catalogue or file), after processing"),
+                            "factor applied to the record as stored (catalogue or file), after processing (both "
+                            "components of a record pair)"),
         "max_drift_ratio": var(run + ("building",), max_drift, "1",
                                "largest peak storey drift ratio of the building"),
-        "peak_drift_ratio": var(run + ("storey",), peak_drift, "1", "peak absolute storey drift ratio"),
+        "peak_drift_ratio": var(run + ("storey",), peak_drift, "1", "peak absolute storey drift ratio (floors in plan: "
+                                "the largest of the storey's planes')"),
         "residual_drift_ratio": var(run + ("storey",), residual, "1",
                                     "residual storey drift ratio at the end of the run (signed; NaN if the run "
                                     "does not report it)"),
@@ -150,18 +153,18 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "status": (run, status, {"long_name": "completed, collapsed, failed (or not run)"}),
         "error": (run, error, {"long_name": "error message of a failed run"}),
         "collapse_time": var(run, collapse_time, "s", "time at which the solver stopped the run at collapse"),
-        "collapse_storey": (run, collapse_storey, {"long_name": "storey that collapsed ('' if none)"}),
+        "collapse_storey": (run, collapse_storey, {"long_name": "storey that collapsed (in plan: of the plane past its "
+                                                                 "collapse drift ratio; '' if none)"}),
         "solver_wall_time": var(run, wall, "s", "solver wall time of the run"),
         "im_stored": var(("record",), plan.im_stored, "m s-2",
                          f"{plan.im.describe()} of the record as stored, after processing"),
         "normalisation_factor": var(("record",), plan.normalisation, "1",
                                     "FEMA P695 normalisation factor NM (1 with per-record scaling)"),
     }
-    if extra:
-        from pounding.studies.ida.pairs import BUILDING_PEAKS
-
-        for name, values in extra.items():
-            data_vars[name] = var(run + ("building",), values, *BUILDING_PEAKS[name])
+    if planes:
+        data_vars["peak_plane_drift_ratio"] = var(run + ("plane",), plane_drift, "1",
+                                                  "peak absolute drift ratio of the plane (a frame or wall line of "
+                                                  "the storey; drift / storey height)")
     if not stripes:
         data_vars["level_value"] = var(run, level_value, "m s-2", "the level of each run (the record's own "
                                        "IM with per-record scaling; the set's median with FEMA P695 scaling)")
@@ -182,9 +185,17 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "contact": ("contact", np.array(contacts, dtype=object), {"long_name": "gap element label"}),
         "limit": ("limit", np.array(plan.limits, dtype=float), {"units": "1",
                                                                 "long_name": "peak storey drift ratio limit"}),
+        **_pair_coords(plan),
     }
+    if planes:
+        coords["plane"] = ("plane", np.array(planes["plane"], dtype=object),
+                           {"long_name": "plane label building:storey:direction@at (a frame or wall line)"})
+        coords["plane_building"] = ("plane", np.array(planes["building"], dtype=object),
+                                    {"long_name": "building of the plane"})
+    under = f"record pairs in both orientations, {records_text(plan.records)}" if plan.pairs else \
+        records_text(plan.records)
     ds = xr.Dataset(data_vars, coords=coords, attrs={
-        "title": f"pounding IDA of model '{plan.model_name}' under {records_text(plan.records)}, "
+        "title": f"pounding IDA of model '{plan.model_name}' under {under}, "
                  f"{plan.im.describe()} {plan.describe_levels()}",
         "model_name": plan.model_name,
         "source": f"pounding {__version__}",
@@ -231,10 +242,27 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
     ds["fragility_note"] = (("variant", "building", "fragility_limit"), notes,
                             {"long_name": "why a fragility could not be fitted, or how"})
     if plan.pairs:
-        from pounding.studies.ida.pairs import pair_layout
-
-        ds = pair_layout(ds, plan)
+        ds.attrs["angle"] = float((plan.documents[0].get("ground_motion") or {}).get("angle", 0.0))
     return ds
+
+
+def _pair_coords(plan: IdaPlan) -> dict[str, tuple]:
+    """The ``record`` coordinates of record pairs (each in one orientation): ``pair``, ``orientation``,
+    ``component_x``, ``component_y``; none when each record is one component."""
+    if not plan.pairs:
+        return {}
+    pair, orientation = zip(*(r.rsplit(" ", 1) for r in plan.records))
+    angle = float((plan.documents[0].get("ground_motion") or {}).get("angle", 0.0))
+    return {
+        "pair": ("record", np.array(pair, dtype=object), {"long_name": "record pair (components a and b)"}),
+        "orientation": ("record", np.array(orientation, dtype=object),
+                        {"long_name": f"ab: component a along the model's angle ({angle:g} deg from +x), b 90 deg "
+                                      "further; ba: b along the angle, a 90 deg further"}),
+        "component_x": ("record", np.array([p[0] for p in plan.pairs], dtype=object),
+                        {"long_name": "the component acting along the model's angle (ground_motion x)"}),
+        "component_y": ("record", np.array([p[1] for p in plan.pairs], dtype=object),
+                        {"long_name": "the component acting 90 deg further (ground_motion y)"}),
+    }
 
 
 # --------------------------------------------------------------------------- #

@@ -21,9 +21,8 @@ import numpy as np
 
 from pounding.studies.engine.tasks import Scenario, TaskSource
 from pounding.studies.ida.dataset import assemble_ida_dataset
-from pounding.studies.ida.plan import LEVEL_DECIMALS, Hunt, IdaPlan
-from pounding.studies.ida.pairs import ida_runner
-from pounding.studies.ida.runs import run_collapses
+from pounding.studies.ida.schedule import LEVEL_DECIMALS, Hunt, IdaPlan
+from pounding.studies.ida.runs import run_collapses, run_ida_scenario
 
 __all__ = ["next_hunt_level", "HuntTasks", "run_hunt"]
 
@@ -82,7 +81,7 @@ class HuntTasks(TaskSource):
 
         self.plan = plan
         self.name, self.label, self.model_name = plan.sweep.name, plan.sweep.label, plan.model_name
-        self.runner = ida_runner(plan)
+        self.runner = run_ida_scenario
         self.inputs = sweep_inputs(plan.sweep)
         self.chains = [(v, r) for v in plan.variants for r in range(len(plan.records))]
         self.runs: dict[tuple[str, int], list[tuple[float, Scenario]]] = {c: [] for c in self.chains}

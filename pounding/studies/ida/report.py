@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from pounding.studies.ida.dataset import exceeds
-from pounding.studies.ida.plan import SA_DAMPING
+from pounding.studies.ida.schedule import SA_DAMPING
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ida_summary", "ida_table", "ida_tables", "plot_ida"]
@@ -18,8 +18,9 @@ __all__ = ["ida_summary", "ida_table", "ida_tables", "plot_ida"]
 
 
 def _drift_of(ds) -> str:
-    """What drifts in the IDA's buildings: ``storey``, or ``plane`` in a plan model's IDA (docs/ida.md)."""
-    return "plane" if ds.attrs.get("model_kind") == "plan" else "storey"
+    """What reaches a collapse drift ratio in the IDA's buildings: a ``storey``, or a ``plane`` of a storey for
+    floors in plan (their archive has the ``plane`` dimension; docs/ida.md)."""
+    return "plane" if "plane" in ds.dims else "storey"
 
 def ida_summary(ds) -> dict[str, Any]:
     """The study as one JSON-ready document: ``{"im", "fragility", "cmr"}`` (θ and IMs in g)."""

@@ -1,4 +1,9 @@
-"""One IDA run on a worker: the scaled model simulated for its peaks, and the run's outcome."""
+"""One IDA run on a worker: the scaled model simulated for its peaks, and the run's outcome.
+
+One runner for every model: the peaks of :func:`pounding.simulation.simulate_peaks` (a storey's drift
+ratio is, for floors in plan, the largest of its planes'; a contact is a gap element, a contact point in
+plan), and for floors in plan each plane's peak drift ratio beside them.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from pounding.studies.ida.plan import IdaPlan
+from pounding.studies.ida.schedule import IdaPlan
 
 __all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in", "collapse_building_of",
            "run_collapses"]
@@ -109,6 +114,10 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "scale_factor": peaks["record_scale"],
             "solver_wall_time": peaks["wall_time"],
         })
+        if "plane" in peaks:   # floors in plan: each plane (a frame or wall line) of each storey
+            result["planes"] = {"plane": list(peaks["plane"]),
+                                "building": [label.rsplit(":", 2)[0] for label in peaks["plane"]],
+                                "peak_drift_ratio": [float(x) for x in peaks["peak_plane_drift_ratio"]]}
     except Exception as exc:  # noqa: BLE001 - a failing run is a result, not a crash
         result["error"] = f"{task.get('where', 'scenario')}: {one_line(exc)}"
     result["wall_time"] = time.perf_counter() - started

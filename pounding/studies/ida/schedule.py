@@ -1,9 +1,23 @@
-"""An IDA's inputs and plan: intensity measure, levels, limits, hunt settings; every record's IM and factor.
+"""An IDA's inputs and schedule: intensity measure, levels, limits, hunt settings; every record's IM and factor.
 
-The plan resolves, before any run, the IM of every record as the model uses
-it and the factor that takes it to a level (``record`` or ``fema-p695``
-scaling, see :mod:`pounding.studies.ida`), and makes the scenario of any
-(variant, record, level).
+The schedule (:class:`IdaPlan`) resolves, before any run, the IM of every
+record as the model uses it and the factor that takes it to a level
+(``record`` or ``fema-p695`` scaling, see :mod:`pounding.studies.ida`), and
+makes the scenario of any (variant, record, level).
+
+A model shaken by two components (floors in plan) runs record *pairs*, each in
+both orientations, as FEMA P695 runs its pairs in three-dimensional analyses:
+
+``ab``  component a along the model's ``angle``, b 90° further;
+``ba``  the components swapped: b along ``angle``, a 90° further.
+
+Each orientation is a record of the IDA (``PAIR ab`` / ``PAIR ba``; its own
+chain of a hunt); both components are scaled by one factor, so the pair keeps
+its shape.  A pair's IM is the geometric mean of its components' IMs
+(:meth:`IntensityMeasure.of_records`: for Sa(T1) the pair's geometric-mean
+spectrum at T1, as FEMA P695 §A.8 normalises and scales record pairs; it does
+not depend on the orientation); its FEMA P695 normalisation factor NM is the
+pair's (Table A-4C: one per pair, both components carry it).
 """
 
 from __future__ import annotations
@@ -12,7 +26,6 @@ import copy
 import math
 import os
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,7 +39,7 @@ __all__ = ["VARIANTS", "DEFAULT_LIMITS", "IM_NAMES", "SCALINGS", "MAX_LEVELS", "
            "LEVEL_RESOLUTION", "MAX_IDA_RUNS", "IntensityMeasure",
            "Hunt", "IdaPlan", "parse_levels", "parse_limits", "limit_label", "build_ida_plan", "parse_intensity",
            "collapse_drifts", "with_collapse_drift", "check_ida_inputs", "resolve_scaling", "check_run_count",
-           "ida_measure", "finish_ida_plan"]
+           "ida_measure", "finish_ida_plan", "ORIENTATIONS", "oriented_document", "ground_records", "normalisation_of"]
 
 #: The two variants of every scenario: the model as given, and with its contacts held open.
 VARIANTS = ("with_contacts", "without_contacts")
@@ -46,6 +59,8 @@ LEVEL_RESOLUTION = 10.0 ** -LEVEL_DECIMALS
 #: Most runs an IDA may plan (records x variants x runs per record); ~0.1-1 s each on one core,
 #: 1e5 runs is a day of a small cluster.
 MAX_IDA_RUNS = 100_000
+#: The two orientations of a record pair: which component acts along the model's ``angle`` (ground_motion x).
+ORIENTATIONS = ("ab", "ba")
 
 
 # --------------------------------------------------------------------------- #
@@ -67,8 +82,8 @@ class IntensityMeasure:
     period : float
         T1, s (NaN for ``pga``).
     pair : bool
-        True for the record pairs of a plan model: a pair's IM is the geometric mean of its two components' IMs
-        (:meth:`of_pair`).
+        True for record pairs (a model shaken by two components): a pair's IM is the geometric mean of its two
+        components' IMs (:meth:`of_records`).
     """
 
     name: str
@@ -84,10 +99,13 @@ class IntensityMeasure:
 
         return spectral_acceleration(record, period=self.period, damping=SA_DAMPING)
 
-    def of_pair(self, first, second) -> float:
-        """The IM of a record pair, m/s²: the geometric mean √(IM_a · IM_b) of its two components'
-        (for ``sa-t1`` the pair's geometric-mean spectrum at T1, as FEMA P695 §A.8 normalises pairs)."""
-        return math.sqrt(self.of(first) * self.of(second))
+    def of_records(self, records) -> float:
+        """The IM of a ground motion, m/s²: of one record, its own (:meth:`of`); of a record pair, the geometric
+        mean √(IM_a · IM_b) of its two components' (for ``sa-t1`` the pair's geometric-mean spectrum at T1, as
+        FEMA P695 §A.8 normalises pairs)."""
+        if len(records) == 1:
+            return self.of(records[0])
+        return math.sqrt(self.of(records[0]) * self.of(records[1]))
 
     def describe(self) -> str:
         mean = ", geometric mean of the pair" if self.pair else ""
@@ -281,8 +299,8 @@ class IdaPlan:
     #: Per building: its collapse drift ratio in this study (:func:`collapse_drifts`) and where it comes from.
     collapse_drifts: tuple[float, ...] = ()
     collapse_sources: tuple[str, ...] = ()
-    #: Plan models only: per record (a pair in one orientation) its two components, the one along the model's
-    #: ``angle`` first (ground_motion x) and the one 90° further (y); empty for a planar IDA.
+    #: Record pairs only: per record (a pair in one orientation) its two components, the one along the model's
+    #: ``angle`` first (ground_motion x) and the one 90° further (y); empty when each record is one component.
     pairs: tuple[tuple[str, str], ...] = ()
     _cache: dict = field(default_factory=dict, repr=False)
 
@@ -345,9 +363,8 @@ class IdaPlan:
         scenario key hashes it), but built from one dump per variant and record with the factor
         written in: a dump takes milliseconds, which over the thousands of runs of an IDA was
         seconds of serial work on the client before the first run.  The documents share everything but their
-        ``ground_motion`` mapping; nothing changes a scenario's data after it is made.  A plan model's
-        pair is written as components ``x`` and ``y``, each with the factor as its ``scale``; without contacts
-        it has no ``contacts`` (its outlines fix every gap, so they cannot be held open by a gap).
+        ``ground_motion`` mapping; nothing changes a scenario's data after it is made.  A record pair is
+        written as components ``x`` and ``y``, each with the factor as its ``scale`` (:func:`_scaled_ground`).
         """
         from pounding.model.model import hold_contacts_open
 
@@ -355,18 +372,15 @@ class IdaPlan:
         if template is None:
             base = copy.deepcopy(self.documents[record])
             if variant == "without_contacts":
-                if self.pairs:
-                    base["contacts"] = []
-                else:
-                    hold_contacts_open(base)
-            base["ground_motion"] = _scaled_ground(base["ground_motion"], _SCALE_PLACEHOLDER, bool(self.pairs))
+                hold_contacts_open(base)
+            base["ground_motion"] = _scaled_ground(base["ground_motion"], _SCALE_PLACEHOLDER)
             pieces = dump_document(base).split(_yaml_scalar(_SCALE_PLACEHOLDER))
             template = (base, pieces)
             self._cache[("template", variant, record)] = template
         base, pieces = template
         document = dict(base)
-        document["ground_motion"] = _scaled_ground(base["ground_motion"], factor, bool(self.pairs))
-        if len(pieces) != (3 if self.pairs else 2):   # the placeholder is not where the scale goes: dump it all
+        document["ground_motion"] = _scaled_ground(base["ground_motion"], factor)
+        if len(pieces) != 1 + len(_scaled_parts(base["ground_motion"])):   # the placeholder is elsewhere: dump it all
             return document, dump_document(document)
         return document, _yaml_scalar(factor).join(pieces)
 
@@ -381,12 +395,18 @@ class IdaPlan:
                 for level in self.levels]
 
 
-def _scaled_ground(ground: dict, factor: float, pair: bool) -> dict:
-    """A copy of a ``ground_motion`` mapping with its record scaled by *factor*: ``scale``, or with *pair*
-    the ``scale`` of both components ``x`` and ``y`` (a plan model's pair, both scaled alike)."""
-    if not pair:
+def _scaled_parts(ground: dict) -> list[str]:
+    """Where a ``ground_motion`` mapping's factor goes: its components ``x`` and ``y`` (a record pair given one
+    by one: both scaled alike), else its ``scale``."""
+    return [k for k in ("x", "y") if isinstance(ground.get(k), dict)] or ["scale"]
+
+
+def _scaled_ground(ground: dict, factor: float) -> dict:
+    """A copy of a ``ground_motion`` mapping with its record (or both components of its pair) scaled by *factor*."""
+    parts = _scaled_parts(ground)
+    if parts == ["scale"]:
         return dict(ground, scale=factor)
-    return dict(ground, x=dict(ground["x"], scale=factor), y=dict(ground["y"], scale=factor))
+    return dict(ground, **{k: dict(ground[k], scale=factor) for k in parts})
 
 
 def check_ida_inputs(im: str, scaling: str, levels: Any, hunt: Hunt | None, limits: Any,
@@ -493,9 +513,8 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     duration : float, optional
         Simulated time of every run, s.
     """
-    from pounding.model.model import load_model, model_from_data
-    from pounding.simulation import record_for
-    from pounding.studies.common import record_values, study_sweep
+    from pounding.model.model import load_model
+    from pounding.studies.common import record_sweep
 
     override = collapse_drift
     levels, drift_limits, collapse_drift = check_ida_inputs(im, scaling, levels, hunt, limits, collapse_drift, mce,
@@ -503,44 +522,98 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
 
     base = load_model(model)   # the model's own errors, with its file name
     base.refuse_building_records("pounding ida (it scales one record)")
-    measure = ida_measure(base, im, building)
+    pair = base.ground_motion.two_components
+    measure = ida_measure(base, im, building, pair=pair)
     if without_contacts and not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: --without-contacts needs a model with contacts")
+    if pair and records is None and base.ground_motion.record is None:
+        raise PoundingError(f"{os.fspath(model)}: its ground motion is given as components x and y; pounding ida "
+                            "runs record pairs, each in both orientations: give --records fema-p695:farfield (or "
+                            "pairs such as fema-p695:farfield/1,fema-p695:farfield/2)")
 
-    path = os.path.abspath(os.fspath(model))
     settings: dict[str, Any] = {"name": f"{base.name} (IDA)", "ground_motion.scale": 1.0}
     if duration is not None:
         settings["ground_motion.duration"] = float(duration)
-    document = {"name": f"ida-{Path(path).stem}", "model": path, "set": settings,
-                "axes": {"records": record_values(records, base)}}
-    sweep = study_sweep(document, f"<ida {os.fspath(model)}>")
+    sweep = record_sweep(model, base, "ida", settings, records, f"<ida {os.fspath(model)}>")
     scenarios = sweep.scenarios()
     if not scenarios:
         raise PoundingError("--records: the record set is empty")
-    recs = [str(s.coords["record"]) for s in scenarios]
-    documents, stored, norm, errors = [], [], [], []
+    labels, documents, components, stored, norm, errors = [], [], [], [], [], []
     for s in scenarios:
-        documents.append(s.data if override is None else with_collapse_drift(s.data, float(override)))
-        try:
-            if s.error is not None:
-                raise PoundingError(s.error)
-            one = model_from_data(s.data, name=base.name, source=s.document, base_dir=s.base_dir)
-            rec = record_for(one)
-            value = measure.of(rec)
-            if not value > 0:
-                raise PoundingError(f"record {s.coords['record']}: its {measure.describe()} is 0; it cannot be "
-                                    "scaled")
+        record = str(s.coords["record"])
+        value, nm, error = _record_measure(s, record, base.name, measure, sweep.label)
+        for orientation in (ORIENTATIONS if pair else (None,)):
+            document = s.data if orientation is None else oriented_document(s.data, record, orientation)
+            documents.append(document if override is None else with_collapse_drift(document, float(override)))
+            labels.append(record if orientation is None else f"{record} {orientation}")
+            if orientation is not None:
+                components.append((document["ground_motion"]["x"]["record"], document["ground_motion"]["y"]["record"]))
             stored.append(value)
-            nm = rec.metadata.get("normalization_factor")
-            norm.append(float(nm) if isinstance(nm, (int, float)) and nm > 0 else float("nan"))
-            errors.append(None)
-        except PoundingError as exc:
-            stored.append(float("nan"))
-            norm.append(float("nan"))
-            errors.append(f"{sweep.label}: record {s.coords['record']}: {' '.join(str(exc).split())}")
-    return finish_ida_plan(base, sweep, recs, documents, measure, stored, norm, errors, scaling=scaling,
+            norm.append(nm)
+            errors.append(error)
+    return finish_ida_plan(base, sweep, labels, documents, measure, stored, norm, errors, scaling=scaling,
                            without_contacts=without_contacts, limits=drift_limits, collapse_drift=collapse_drift,
-                           override=override, levels=levels, hunt=hunt, mce=mce, path=path)
+                           override=override, levels=levels, hunt=hunt, mce=mce, path=os.path.abspath(os.fspath(model)),
+                           pairs=tuple(components))
+
+
+def oriented_document(document: dict, pair: str, orientation: str) -> dict:
+    """A copy of a model *document* shaken by the record *pair* in *orientation*: components ``x`` (along the
+    model's ``angle``) and ``y`` (90° further), each at scale 1 (the IDA writes its factor into both)."""
+    from pounding.model.ground import pair_components
+
+    out = copy.deepcopy(document)
+    ground = out.setdefault("ground_motion", {})
+    a, b = pair_components(pair)
+    first, second = (a, b) if orientation == "ab" else (b, a)
+    for key in ("record", "scale", "x", "y", "units", "dt"):
+        ground.pop(key, None)
+    ground["x"] = {"record": first, "scale": 1.0}
+    ground["y"] = {"record": second, "scale": 1.0}
+    return out
+
+
+def ground_records(model) -> list:
+    """The record(s) of *model*'s ground motion as it runs them: one record read and processed
+    (:func:`pounding.simulation.record_for`), or a pair's two components (:func:`pounding.simulation.component_records`)."""
+    from pounding.simulation import component_records, record_for
+
+    if model.ground_motion.two_components:
+        return [r for r in component_records(model) if r is not None]
+    return [record_for(model)]
+
+
+def normalisation_of(records: list) -> float:
+    """The FEMA P695 normalisation factor NM of a ground motion: its record's, or its pair's (both components
+    carry the pair's, FEMA P695 Table A-4C); NaN if there is none (not FEMA P695 records)."""
+    values = [r.metadata.get("normalization_factor") for r in records]
+    if all(isinstance(x, (int, float)) and x > 0 for x in values) and len(set(values)) == 1:
+        return float(values[0])
+    return float("nan")
+
+
+def _record_measure(scenario, record: str, name: str, measure: IntensityMeasure,
+                    label: str) -> tuple[float, float, str | None]:
+    """``(IM as stored m/s², NM, error)`` of one record (pair) of the IDA's sweep (an error: NaN, NaN, the line)."""
+    from pounding.model.model import model_from_data, model_from_text
+    from pounding.model.document import dump_document
+
+    what = "record pair" if measure.pair else "record"
+    try:
+        if scenario.error is not None:
+            raise PoundingError(scenario.error)
+        if measure.pair:   # the orientation does not change the pair's IM (a geometric mean) nor its NM
+            one = model_from_text(dump_document(oriented_document(scenario.data, record, "ab")), name=name,
+                                  base_dir=scenario.base_dir)
+        else:
+            one = model_from_data(scenario.data, name=name, source=scenario.document, base_dir=scenario.base_dir)
+        records = ground_records(one)
+        value = measure.of_records(records)
+        if not value > 0:
+            raise PoundingError(f"{what} {record}: its {measure.describe()} is 0; it cannot be scaled")
+        return value, normalisation_of(records), None
+    except PoundingError as exc:
+        return float("nan"), float("nan"), f"{label}: {what} {record}: {' '.join(str(exc).split())}"
 
 
 def finish_ida_plan(base, sweep, records: list[str], documents: list[dict], measure: IntensityMeasure,
