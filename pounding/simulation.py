@@ -417,6 +417,14 @@ def _pair_spec_changes(record: str, where: str) -> dict:
 
 def _record_spec_changes(record: str, record_units: str | None, record_dt: float | None, where: str) -> dict:
     """The ``ground_motion`` keys a record spec given to :func:`simulate` sets (one-line errors for a bad file)."""
+    from pounding.model.ground import pair_components
+
+    components = pair_components(record)
+    if components is not None:
+        option = "--record" if where == "cli" else "record="
+        raise PoundingError(f"{option} {record} is a record pair (components a and b), but this model's floors move "
+                            f"along x only (no plan:) and take one component: give {components[0]} or "
+                            f"{components[1]}, or give the buildings plan: to run both")
     spec = record_path(record)
     if os.path.isabs(spec) and not Path(spec).exists():
         here = "the command line" if where == "cli" else "the Python API"

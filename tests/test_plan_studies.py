@@ -393,7 +393,8 @@ def test_pounding_table_plot_and_info_read_plan_compare_and_sweep_archives(plan_
 
 @pytest.mark.parametrize("axes, message", [
     ("  eccentricity: {building: A, direction: x, values: [0, 1]}\n", "eccentricity applies to a building with plan"),
-    ("  angle: [0, 90]\n", "unknown key 'angle' in ground_motion"),
+    ("  angle: [0, 90]\n", "there is no second component to turn"),
+    ("  friction: [0, 0.3]\n", "there is no slip for friction to resist"),
 ])
 def test_plan_axes_on_a_planar_model_are_refused_in_one_line(axes, message):
     with pytest.raises(ModelError) as caught:

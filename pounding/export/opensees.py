@@ -110,7 +110,7 @@ def export_refusal(model) -> str | None:
     if friction is not None:
         return (f"contact {friction.label(names)}: the OpenSees export does not write friction (OpenSees' frictional "
                 "contact elements take their normal force from their own penalty spring, not from the Hertz "
-                "material beside them); export the model without friction:")
+                "material beside them); export the model without friction")
     column = next((g for g in model.gaps if g.has_column_point), None)
     if column is not None:
         return (f"contact {column.label(names)} strikes a column between floors: a column point moves as a weighted "

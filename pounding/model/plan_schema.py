@@ -372,7 +372,8 @@ def _plan_between(index: int, value: Any, buildings: list, section: str = "conta
             planar = next(names[i] for i, is_plan in kinds.items() if not is_plan)
             other = next(names[i] for i, is_plan in kinds.items() if is_plan)
             raise problem(f"joins plan building {other} to planar building {planar}; give {planar} a plan: (outline "
-                          "and planes) too", kind="error", at=at)
+                          "and planes) too: a contact in plan acts at points of the two outlines' facing edges, "
+                          f"and {planar} has no outline", kind="error", at=at)
     return indices[0], indices[1]
 
 
@@ -390,7 +391,7 @@ def _pair_processing(value: Any) -> Any:
     """``processing`` of a record pair: baseline correction only (each component corrected on its own)."""
     processing = processing_value(value)
     if processing is not None and processing.trim is not None:
-        raise problem("trim applies to one record: trimming each component of a pair to its own significant "
+        raise problem("applies to one record: trimming each component of a pair to its own significant "
                       "duration would shift one against the other in time; trim the pair's records beforehand "
                       "(keep baseline: true here)", kind="error", at=("trim",), line="key", colon=False)
     return processing
@@ -432,7 +433,8 @@ class PlanGroundMotionEntry(SchemaEntry):
                               at=("record",), line="key")
             if pair_components(self.record) is None:
                 raise problem("must be a catalogue pair such as fema-p695:farfield/1 (components a and b) in a plan "
-                              "model; for single records write x: {record: ...} and y: {record: ...}",
+                              "model, whose ground moves along x and y; for single records write x: {record: ...} "
+                              "and y: {record: ...}",
                               at=("record",))
         return self
 
@@ -485,7 +487,9 @@ class PlanModelEntry(ModelEntry):
         for i, b in enumerate(self.buildings):
             if not isinstance(b, PlanBuildingEntry):
                 raise problem(f"has no plan: but building {names[0]} has one; in a plan model every building needs "
-                              "plan: (outline) and storeys with planes", kind="error", at=("buildings", i),
+                              "plan: (outline) and storeys with planes, since the buildings share one plan frame "
+                              "where contacts act at points of the outlines and the ground moves along x and y",
+                              kind="error", at=("buildings", i),
                               line="key", colon=False)
         return self
 

@@ -1290,6 +1290,22 @@ def _order(full: Location, kind: str) -> tuple:
     return tuple(key)
 
 
+_ALONG_X = "floors without plan: move along x only, under one record"
+
+#: Keys of a model in plan written in a planar one (its entry class, the key) and why they do not apply there.
+PLAN_KEYS: dict[tuple[type, str], str] = {
+    (ContactEntry, "friction"): "Coulomb friction acts on the slip of two floors along a contact face, and "
+                                "floors without plan: move along x only, across the face",
+    (ContactEntry, "face"): "a wall's face is a side of a building's outline, and a building without plan: has none",
+    (GroundMotionEntry, "angle"): f"it turns a record pair's components in plan, and {_ALONG_X}",
+    (GroundMotionEntry, "x"): f"components x and y shake buildings in plan, and {_ALONG_X}",
+    (GroundMotionEntry, "y"): f"components x and y shake buildings in plan, and {_ALONG_X}",
+    **{(storey, key): "a storey without plan: is one spring along x (its stiffness), with no planes placed in "
+                      "plan and no rotation"
+       for storey in (StoreyEntry, StoreyShorthand) for key in ("planes", "centre_of_mass", "radius_of_gyration")},
+}
+
+
 def translate(exc: ValidationError, cls: type[BaseModel], source: Document, root: Location = ()) -> ModelError:
     """The first problem of *exc* (in reading order) as one :class:`ModelError` line.
 
@@ -1347,6 +1363,7 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
             text += f" for law {owner.name}"
         return source.error(loc[:-1], text, line=source.key_line(loc[:-1])), loc, rank
     if kind == "extra_forbidden":
+        entry = owner
         if owner is not None and issubclass(owner, (ContactLaw, LinkLaw)):
             entry = ContactEntry if issubclass(owner, ContactLaw) else LinkEntry
             found = _owner(cls, raw[:-2])      # the entry holding the law's parameters (a plan contact's own keys)
@@ -1354,6 +1371,10 @@ def _translate(error: dict, cls: type[BaseModel], source: Document, root: Locati
             choices = list(entry.KEYS) + [k for k in owner.model_fields if k != "law"]
         else:
             choices = list(getattr(owner, "ALLOWED", None) or (owner.model_fields if owner else []))
+        reason = PLAN_KEYS.get((entry, key))
+        if reason is not None:   # a key of a model in plan written in a planar one: why it does not apply
+            return source.error(loc[:-1], f"'{key}' applies to buildings in plan only: {reason}; give the buildings "
+                                          "plan: (docs/plan-models.md)", line=source.key_line(loc)), loc, rank
         hint = did_you_mean(str(key), choices) or f"; allowed keys: {', '.join(choices)}"
         what = "unknown key" if loc[:-1] else "unknown top-level key"
         return source.error(loc[:-1], f"{what} '{key}'{hint}", line=source.key_line(loc)), loc, rank

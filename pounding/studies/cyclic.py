@@ -212,6 +212,11 @@ def hysteresis_test(model, storey: str, protocol: str, amplitude: float | None =
 
     loaded = load_model(model) if isinstance(model, (str, Path)) else model
     building, level = _storey(loaded, storey)
+    if building.in_plan:
+        raise PoundingError(f"storey {storey} is in plan: it resists through "
+                            f"{len(building.storeys[level - 1].planes)} planes, each a spring with its own stiffness "
+                            "and law, and pounding hysteresis drives one storey spring; test a plane's law as the "
+                            "storey of a planar building (the plane's stiffness, the storey height, its hysteresis)")
     k, h = float(building.stiffness[level - 1]), float(building.height[level - 1])
     law = building.hysteresis[level - 1]
     if protocol in PROTOCOLS:

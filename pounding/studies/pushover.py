@@ -174,6 +174,12 @@ def pushover(model, *, pattern: str = "first-mode", building: str | None = None,
     if building is not None and building not in names:
         raise PoundingError(f"no building '{building}' in the model (buildings: {', '.join(names)})")
     chosen = [b for b in loaded.buildings if building is None or b.name == building]
+    plan = next((b for b in chosen if b.in_plan), None)
+    if plan is not None:
+        raise PoundingError(f"building {plan.name} is in plan: its storeys resist through planes and its floors "
+                            "move along x, y and a rotation, while pounding pushover pushes one storey spring per "
+                            "storey along one direction; pounding p695 pushes it along x and along y as torsion-free "
+                            "shear chains (its mu_T per axis)")
     # Each building to its own collapse drift ratio (collapse: {drift_ratio}, else solver.stop_drift_ratio).
     limits = dict(zip(names, loaded.collapse_drift_ratios()))
     curves = [pushover_building(b, pattern, steps=steps, drift_limit_ratio=float(limits[b.name] or DEFAULT_DRIFT_LIMIT))

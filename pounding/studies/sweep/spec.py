@@ -920,6 +920,11 @@ def _check_gap_path(doc: Document, loc: tuple, steps: tuple[Step, ...], document
 
 def _axis_kind(doc: Document, loc: tuple, key: str, base: _Base) -> tuple[str, tuple[Step, ...]]:
     """The kind of axis *key* (module docstring) and, for a path, its steps (aliases resolved)."""
+    if key in ALIASES and not base.model.in_plan:
+        what = ("under one record, so there is no second component to turn" if key == "angle" else
+                "across the contact faces, so there is no slip for friction to resist")
+        raise doc.error(loc, f"the base model has no plan: its floors move along x only, {what}; {key} applies to a "
+                             "model in plan", line=doc.key_line(loc))
     kind = {"records": "record", "record": "record", "scale": "scale", "xi": "xi",
             "pounding": "contacts"}.get(key, "eccentricity" if key.startswith("eccentricity") else "path")
     steps: tuple[Step, ...] = ()
