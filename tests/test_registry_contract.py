@@ -30,7 +30,7 @@ from numba import njit
 from pounding import hysteresis
 from pounding.contact import laws, links, xi
 from pounding.errors import PoundingError
-from pounding.export import opensees
+from pounding.export import opensees, opensees_materials
 from pounding.solver import kernels, storeys
 from pounding.studies.verify import RIGID_MASS, RTOL, contact_phase
 
@@ -165,9 +165,9 @@ def one_line_refusal(call, name: str) -> None:
 def test_opensees_exports_or_refuses_contact_law_by_name(name):
     law = law_of(name)
     try:
-        material, notes = opensees.contact_material(law, 0.01)
+        material, notes = opensees_materials.contact_material(law, 0.01)
     except PoundingError:
-        one_line_refusal(lambda: opensees.contact_material(law, 0.01), name)
+        one_line_refusal(lambda: opensees_materials.contact_material(law, 0.01), name)
         return
     assert isinstance(material[0], str) and all(isinstance(x, float) for x in material[1:])
 
@@ -175,7 +175,7 @@ def test_opensees_exports_or_refuses_contact_law_by_name(name):
 @pytest.mark.parametrize("key", list(xi.FORMULAS))
 def test_opensees_exports_every_xi_formula(key):
     law = laws.HertzDamp(kh=2.0e9, restitution=0.5, xi=key, tension="allow")
-    material, _ = opensees.contact_material(law, 0.01)
+    material, _ = opensees_materials.contact_material(law, 0.01)
     assert material == ["Hertzdamp", 2.0e9, xi.FORMULAS[key](0.5), -0.01]
 
 
@@ -183,9 +183,9 @@ def test_opensees_exports_every_xi_formula(key):
 def test_opensees_exports_or_refuses_link_by_name(name):
     link = link_of(name)
     try:
-        parts = opensees.link_materials(link, 1)
+        parts = opensees_materials.link_materials(link, 1)
     except PoundingError:
-        one_line_refusal(lambda: opensees.link_materials(link, 1), name)
+        one_line_refusal(lambda: opensees_materials.link_materials(link, 1), name)
         return
     assert parts and all(isinstance(p[1], str) for p in parts)
 
