@@ -176,8 +176,13 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     a = 6.0 * y0 + 3.0 * m0 - 6.0 * y1 + 3.0 * m1
     b = -6.0 * y0 - 4.0 * m0 + 6.0 * y1 - 2.0 * m1
     c = m0
-    # Only intervals whose ends bracket a maximum can hold an interior one above both ends.
-    candidates = np.flatnonzero((m0 > 0.0) | (m1 < 0.0))
+    # Only intervals whose ends bracket a maximum can hold an interior one above both ends, and only those whose
+    # interpolant can rise above the largest sample: y(s) <= max(y0, y1) + 4/27 (|m0| + |m1|) on [0, 1] (the
+    # Hermite basis: h00 + h01 = 1, both in [0, 1]; |h10|, |h11| <= 4/27), so the others cannot change the
+    # maximum (the bound is padded for round-off: a skipped interval lies below the largest sample).
+    rise = np.maximum(y0, y1) + (4.0 / 27.0) * (np.abs(m0) + np.abs(m1))
+    pad = 1e-12 * (abs(best) + float(np.max(np.abs(rise), initial=0.0)))
+    candidates = np.flatnonzero(((m0 > 0.0) | (m1 < 0.0)) & (rise >= best - pad))
     for k in candidates:
         roots = np.roots([a[k], b[k], c[k]]) if a[k] != 0.0 or b[k] != 0.0 else np.empty(0)
         for s in roots:
