@@ -147,6 +147,21 @@ class GroundMotionSpec:
         return self.angle is not None
 
     @property
+    def one_component(self) -> str | None:
+        """``x`` or ``y``: the one component a ground motion of two components names (the other absent), which a
+        study's single records are written into; None otherwise (one record along x, a pair, or both given)."""
+        if not self.two_components or self.record is not None or (self.x is None) == (self.y is None):
+            return None
+        return "x" if self.x is not None else "y"
+
+    @property
+    def record_pairs(self) -> bool:
+        """True if a study runs this ground motion under record *pairs* (``fema-p695:farfield`` = its 22 pairs):
+        two components, both named.  One component (along x, or one of x and y alone in plan) runs single
+        records (``fema-p695:farfield`` = its 44 components), each written where the model's own record is."""
+        return self.two_components and self.one_component is None
+
+    @property
     def is_catalogue(self) -> bool:
         """True if ``record`` is a catalogue reference or name rather than a file."""
         return self.record is not None and is_catalogued(self.record)

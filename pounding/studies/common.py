@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from pounding.errors import PoundingError
+from pounding.records.catalogue import is_catalogued
 
 __all__ = ["study_parts", "record_list", "record_values", "pair_values", "study_document", "study_sweep",
            "check_duration", "finite_or_none", "records_text", "scale_spec_text", "sweep_heading", "record_sweep",
@@ -55,7 +56,8 @@ def record_values(records: str | list[str] | None, model: Any = None, *, pairs: 
         Whose record is the default; without it, None when *records* is None.
     pairs : bool
         The records are pairs (a ground motion of two components); *model*'s own is its pair (None when it gives
-        its components one by one: the study runs them as they are).
+        its components one by one: the study runs them as they are).  A ground motion in plan that names one
+        component (x or y alone) takes single records (*pairs* False), its own being that component's record.
     """
     listed = record_list(records, pairs=pairs)
     if listed is not None:
@@ -63,6 +65,12 @@ def record_values(records: str | list[str] | None, model: Any = None, *, pairs: 
     if model is None:
         return None
     motion = model.ground_motion
+    side = motion.one_component
+    if side is not None:
+        record = getattr(motion, side).record
+        if is_catalogued(record) or os.path.isabs(record) or motion.base_dir is None:
+            return [record]
+        return [os.path.normpath(os.path.join(motion.base_dir, record))]
     if motion.two_components:
         return None if motion.record is None else [motion.record]
     return [motion.record if motion.is_catalogue else str(motion.record_path)]
@@ -217,7 +225,7 @@ def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dic
         Where an error is said to be (``<gap models/pair.yaml>``).
     """
     path = os.path.abspath(os.fspath(model))
-    pairs = bool(base.ground_motion.two_components)
+    pairs = bool(base.ground_motion.record_pairs)
     values = record_values(records, base, pairs=pairs)
     document: dict[str, Any] = {"name": f"{prefix}-{Path(path).stem}", "model": path, "set": settings,
                                 "axes": {} if values is None else {"records": values}}

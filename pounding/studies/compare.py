@@ -124,7 +124,7 @@ def build_sweep(model: str | os.PathLike, formulas: str | list[str] | None = Non
     base = load_model(model)                # the model's own errors, with its file name
     base.refuse_building_records("pounding compare (it runs the model under one record at a time)")
     axes = compared_axis(model, [g.law for g in base.gaps], formulas, contacts, reference)
-    listed = record_values(records, pairs=base.ground_motion.two_components)
+    listed = record_values(records, pairs=base.ground_motion.record_pairs)
     document = study_document(model, "compare", axes, listed, duration, scale)
     return study_sweep(document, f"<compare {os.fspath(model)}>")
 

@@ -54,7 +54,8 @@ def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any]:
     ground_motion = data.get("ground_motion") if isinstance(data, dict) else None
     scale = ground_motion.get("scale") if isinstance(ground_motion, dict) else None
     name = task.get("name", "model")
-    if not isinstance(scale, (int, float)) or isinstance(scale, bool):
+    if not isinstance(scale, (int, float)) or isinstance(scale, bool) or "x" in ground_motion or "y" in ground_motion:
+        # a target, or components given one by one (scaled in their own ``scale``): the model loads its own
         return model_from_data(data, name=name, source=task["document"], base_dir=task.get("base_dir")), None
     key = repr((dict(data, ground_motion=dict(ground_motion, scale=None)), task.get("base_dir"), name))
     with _TEMPLATES_LOCK:

@@ -522,7 +522,7 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
 
     base = load_model(model)   # the model's own errors, with its file name
     base.refuse_building_records("pounding ida (it scales one record)")
-    pair = base.ground_motion.two_components
+    pair = base.ground_motion.record_pairs
     measure = ida_measure(base, im, building, pair=pair)
     if without_contacts and not base.gaps:
         raise PoundingError(f"{os.fspath(model)}: --without-contacts needs a model with contacts")

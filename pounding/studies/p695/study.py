@@ -292,7 +292,7 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
         "s_m1": spectrum.s_m1 * g, "quality": str(inputs.quality), "records_spec": inputs.records,
         "pattern": inputs.pattern, "group": ",".join(inputs.group),
         "analysis": ("three-dimensional: record pairs, both components at once, each pair in both orientations"
-                     if base.ground_motion.two_components else "two-dimensional: each record one component"),
+                     if base.ground_motion.record_pairs else "two-dimensional: each record one component"),
         "hunt": str(idas[names[0]].attrs.get("hunt", "")),
         "collapse_drift": float(idas[names[0]].attrs.get("collapse_drift", float("nan"))),
         "n_run": int(sum(int(d.attrs.get("n_run", 0)) for d in idas.values())),

