@@ -65,12 +65,7 @@ REFUSED = {
 }
 #: Study and model pairs where the product does not give the planar archive yet (strict xfail: it fails once
 #: fixed, to be taken off this list).
-KNOWN_GAPS = {
-    ("pounding", "isolated_moat"): "a wall beside the west or south face in plan labels its contact points at the "
-                                   "wall's place (wall:west-iso:1@(-0.15,0)), which moves with the gap: the compare's "
-                                   "'without' runs (gap 1e6) label them anew, so the archive holds 6 contacts, "
-                                   "-1 impacts where a run had no such label (models/isolated_moat_plan.yaml alike)",
-}
+KNOWN_GAPS: dict[tuple[str, str], str] = {}
 #: A side's peak displacement in a gap study: a planar floor's is the run's own (full resolution), a contact
 #: point in plan's (u + θ ẑ × (p − c), not one degree of freedom) the largest of the cubic Hermite interpolant of
 #: the stored samples (pounding/studies/gap.py); they differ by that interpolant's error, below 1e-6 m for the

@@ -222,6 +222,14 @@ def test_a_building_in_a_moat_with_four_walls():
     model = build(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()), walls))
     assert [(c.face.normal, c.face.first_low) for c in model.faces] == [("x", True), ("x", False), ("y", True),
                                                                           ("y", False)]
+    # every point on the building's own edge, whatever the gap: the labels of a run without contacts (gap 1e6)
+    # are those of the run with them
+    edges = {"x": (0.0, 20.0), "y": (0.0, 10.0)}
+    for c in model.faces:
+        axis = 0 if c.face.normal == "x" else 1
+        assert all(p.location[axis] in edges[c.face.normal] for p in c.points), c.face
+    far = build(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()), walls.replace("gap: 0.3", "gap: 1.0e6")))
+    assert [p.location for c in far.faces for p in c.points] == [p.location for c in model.faces for p in c.points]
     twice = walls + walls.splitlines(keepends=True)[0]
     assert "already joined by contacts[0]" in error_of(plan_text(building("A", "[[0, 0], [20, 10]]", one_storey()),
                                                                  twice))

@@ -72,7 +72,7 @@ class ContactPoint:
     Attributes
     ----------
     location : (float, float)
-        The point on the tangent line at rest (its normal coordinate is the low side's face), m.
+        The point at rest: at the end of the overlap along the tangent, on the low side's edge (a building's own edge at a wall), m.
     weights : (2, 3) ndarray
         Penetration weights over (u_x, u_y, θ) of the first side's floor (row 0) and the second's (row 1;
         zeros for a wall): ``δ = weights[0]·q_first + weights[1]·q_second − gap``.
@@ -186,8 +186,14 @@ def slip_weights(face: Face, centre_first: tuple[float, float], centre_second: t
 
 def face_points(face: Face, centre_first: tuple[float, float],
                 centre_second: tuple[float, float] | None) -> tuple[ContactPoint, ContactPoint]:
-    """The face's two contact points (the ends of the overlap), with their penetration and slip weights."""
+    """The face's two contact points (the ends of the overlap), with their penetration and slip weights.
+
+    A point lies on the low side's edge between two buildings, and on the building's own edge at a wall, so it
+    stays where it is when the gap changes (a wall 1e6 m away in a run without contacts).  Along the normal its
+    coordinate does not enter the weights (a rigid floor moves alike along a line normal to the face).
+    """
     slip = slip_weights(face, centre_first, centre_second)
-    return tuple(ContactPoint(_on_tangent(face, s, face.face_low),
+    edge = face.face_low if centre_second is not None or face.first_low else face.face_high
+    return tuple(ContactPoint(_on_tangent(face, s, edge),
                               penetration_weights(face, s, centre_first, centre_second), slip)
                  for s in face.span)   # type: ignore[return-value]
