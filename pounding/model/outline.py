@@ -72,7 +72,8 @@ class ContactPoint:
     Attributes
     ----------
     location : (float, float)
-        The point at rest: at the end of the overlap along the tangent, on the low side's edge (a building's own edge at a wall), m.
+        The point at rest: at an end of the overlap along the tangent, on the low side's edge (on the
+        building's own edge at a wall), m.
     weights : (2, 3) ndarray
         Penetration weights over (u_x, u_y, θ) of the first side's floor (row 0) and the second's (row 1;
         zeros for a wall): ``δ = weights[0]·q_first + weights[1]·q_second − gap``.
