@@ -29,8 +29,8 @@ from _output import add_output_arguments, out_dir  # noqa: E402
 MODELS = ["pair", "pair_inelastic", "pair_collapse", "isolated_moat", "pair_bumper", "pair_column", "pair_links",
           "pair_wave_passage", "row_of_three", "corner_pair", "isolated_moat_plan"]
 
-#: The worker: one model name per input line, one solver wall time (s) per output line (a plan
-#: model through its own loader and ``simulate_plan``).
+#: The worker: one model name per input line, one solver wall time (s) per output line (in a tree
+#: from before the one structure model, a plan model through its own loader and ``simulate_plan``).
 WORKER = """
 import sys
 import time
@@ -52,9 +52,12 @@ for line in sys.stdin:
     name = line.strip()
     if name not in models:
         path = f"models/{name}.yaml"
-        if is_plan_file(path):
+        try:   # a tree before one structure model: plan models had their own loader and simulate
             from pounding.model.plan_model import load_plan_model
             from pounding.simulation import simulate_plan
+        except ImportError:
+            load_plan_model = None
+        if is_plan_file(path) and load_plan_model is not None:
             models[name] = (simulate_plan, load_plan_model(path))
         else:
             models[name] = (simulate, pounding.load_model(path))
