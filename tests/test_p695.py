@@ -287,7 +287,8 @@ def test_planes_that_cannot_make_one_storey_spring_are_refused_in_one_line():
 @pytest.fixture
 def plan_p695(in_process, tmp_path, capsys):
     out = tmp_path / "p695.nc"
-    code = main(["p695", CORNER, "--system", "other", "-o", str(out), "--plot", str(tmp_path)] + PLAN_SMALL)
+    code = main(["p695", CORNER, "--system", "other", "-o", str(out), "--plot", str(tmp_path), "--csv",
+                 str(tmp_path / "verdict.csv")] + PLAN_SMALL)
     text = capsys.readouterr().out
     assert code == 0, text
     return out, text
@@ -322,5 +323,15 @@ def test_a_small_plan_p695_gives_the_verdict_table_with_both_variants(plan_p695,
                                    (levels * ida.im_stored.values[None, :, None])[ran], rtol=1e-12)
         t1 = float(model.buildings[[b.name for b in model.buildings].index(name)].periods[0])
         assert float(ds.period_t1.sel(building=name)) == t1 == ida.attrs["im_period"]
+    import pandas as pd
+
+    verdict = pd.read_csv(out.parent / "verdict.csv")     # --csv: the verdict table, a row per variant and building
+    assert len(verdict) == 4 and "acmr [-]" in verdict.columns and "pushover_axis" in verdict.columns
+    got = verdict.set_index(["variant", "building"])["acmr [-]"]
+    for variant in ds.variant.values:
+        for name in ("A", "B"):
+            want = float(ds.acmr.sel(variant=variant, building=name))
+            assert (np.isnan(want) and np.isnan(got[(variant, name)])) or got[(variant, name)] == pytest.approx(
+                want, rel=1e-6)   # the CSV's printed digits
     assert main(["table", str(out)]) == 0 and "pushover_axis" in capsys.readouterr().out
     assert main(["plot", str(out), "-o", str(out.parent / "again")]) == 0

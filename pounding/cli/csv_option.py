@@ -1,4 +1,4 @@
-"""The ``--csv FILE`` option of run, compare, gap, sweep and ida, and the tables of each archive kind.
+"""The ``--csv FILE`` option of run, compare, gap, sweep, ida and p695, and the tables of each archive kind.
 
 One table-building function per archive kind (:func:`archive_tables`), so
 that ``pounding table`` on an archive (:mod:`pounding.cli.table`) and

@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 
+from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
 from pounding.cli.ida import add_hunt_options
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
 
@@ -24,6 +25,7 @@ def _cmd_p695(args: argparse.Namespace) -> int:
                                        parse_quality, parse_systems, plot_p695)
 
     check_study_options(args)
+    check_csv(args, [args.model])
     names = [b.name for b in load_model(args.model).buildings]
     groups = tuple(x.strip() for x in args.group.split(",") if x.strip()) if args.group else ()
     inputs = P695Inputs(systems=parse_systems(args.system, names),
@@ -43,6 +45,7 @@ def _cmd_p695(args: argparse.Namespace) -> int:
     print(f"ran {ds.attrs['n_run']} runs" + (f" ({reused} more done before)" if reused else ""), file=out)
     if args.output:
         print(f"wrote {args.output} (each building's IDA in {ida_folder(args.output)}/)", file=out)
+    write_csv_option(args, "p695", ds, out)
     if args.plot:
         for png in plot_p695(ds, args.plot):
             print(f"wrote {png}", file=out)
@@ -78,6 +81,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                         help="max storey drift ratio taken as collapse (as `pounding ida --collapse-drift`)")
     add_hunt_options(parser)
     parser.add_argument("--duration", type=float, help="simulated time of every run, s (default: the model's)")
+    add_csv_option(parser)
     parser.add_argument("-o", "--output", metavar="P695.nc",
                         help="write the verdict (NetCDF); resumable: each building's IDA is kept in P695.nc.ida/")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
