@@ -902,17 +902,6 @@ def _plane_shear(assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> np.
     return shear
 
 
-def plan_energy_closure(ds: xr.Dataset) -> float:
-    """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of a plan archive (dimensionless)."""
-    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
-             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0)
-             + ds.get("energy_link_dissipated", 0.0) + ds.get("energy_link_strain", 0.0))
-    initial = float(parts[0])
-    supplied = initial + ds.energy_input + ds.get("energy_ground_work", 0.0)
-    scale = float(np.abs(supplied).max())
-    return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
-
-
 def plane_energy_closure(ds: xr.Dataset) -> float:
     """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of an archive with plane rows (dimensionless)."""
     parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
