@@ -111,3 +111,25 @@ def test_a_building_without_design_factors_is_refused(tmp_path, capsys):
     assert main(["gap", str(path), "--code", "asce7-22", "--sds", "1", "--sd1", "0.6"] + FAST) == 2
     err = capsys.readouterr().err
     assert "buildings[1] (B) has no design.asce7_22" in err and err.count("\n") == 1
+
+
+def test_a_requirement_no_record_met_is_not_determined_and_small_values_keep_their_digits():
+    """At an intensity where every record failed there is nothing to compare: the row says so (not "ok"); a
+    code separation of 0.04 mm below a requirement of 0.05 mm is printed with the digits that show it."""
+    from pounding.studies.design import Separation, code_gap_table, simulated_requirement
+
+    none = simulated_requirement(np.zeros(0), 0.02, use_max=False)
+    assert none["unconservative"] is None and math.isnan(none["used"])
+    small = simulated_requirement(np.array([4.0e-5, 6.0e-5]), 4.0e-5, use_max=False)
+    assert small["unconservative"] and small["used"] == pytest.approx(5.0e-5)
+    result = {"code": "asce7-22", "rule": "rule", "buildings": {},
+              "intensities": [{"name": n, "factor": 1.0, "period_range": (0.1, 2.0), "target": "t", "why": "w",
+                               "records_ok": k, "statistic": "mean", "failed": {}}
+                              for n, k in (("design", 0), ("MCE_R", 2))],
+              "contacts": [{"contact": "A:1-B:1", "left": 4.0e-5, "right": 0.0,
+                            "separation": Separation(4.0e-5, 4.0e-5, 0.0),
+                            "simulated": {"design": none, "MCE_R": small}}]}
+    table = code_gap_table(result)
+    row = next(line for line in table.splitlines() if line.startswith("A:1-B:1"))
+    assert "0.04" in row and "0.05/0.06" in row
+    assert "UNCONSERVATIVE at MCE_R" in row and "not determined at design (no record ran)" in row

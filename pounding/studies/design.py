@@ -54,7 +54,7 @@ __all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION", "d
            "nzs1170_5_separation", "NTC_2004_HEIGHT", "NTC_2004_SIMPLIFIED", "NTC_2004_MINIMUM", "ntc2004_setback",
            "ntc2004_separation", "SUITE_FRACTION", "SUITE_PERIODS", "EC8_MEAN_RECORDS", "ASCE_RECORDS",
            "suite_scale_factor", "Intensity", "record_set_spectra", "code_setup", "code_displacements",
-           "pair_separation", "code_separations",
+           "pair_separation", "code_separations", "simulated_requirement",
            "code_gap_study", "code_gap_table", "code_gap_summary"]
 
 #: Participating mass the modes of a response-spectrum analysis must reach (ASCE 7-22 §12.9.1.1, EC8 §4.3.3.3.1).
@@ -602,6 +602,21 @@ def code_separations(model, code: str, displacement: dict[str, np.ndarray], *,
     return rows
 
 
+def simulated_requirement(required: Any, separation: float, use_max: bool) -> dict[str, Any]:
+    """A contact's simulated requirement over the records that ran (m) beside the code's *separation* (m).
+
+    ``mean``, ``max``, ``used`` (the max where *use_max*, else the mean) and ``unconservative``: True
+    where the code's separation is below the requirement used, None where no record ran (nothing to
+    compare: not "ok").
+    """
+    values = np.asarray(required, dtype=float)
+    if values.size == 0:
+        return {"mean": math.nan, "max": math.nan, "used": math.nan, "unconservative": None}
+    mean, largest = float(np.mean(values)), float(np.max(values))
+    used = largest if use_max else mean
+    return {"mean": mean, "max": largest, "used": used, "unconservative": bool(separation < used)}
+
+
 def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], records: Any = None, *,
                    duration: float | None = None, **run_options) -> dict[str, Any]:
     """Each code separation per level pair beside the simulated requirement of records scaled to the code's spectrum.
@@ -647,12 +662,8 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
                             "failed": {str(r): str(e) for r, e, good in zip(ds.record.values, ds.error.values, ok)
                                        if not good}})
         for c, row in enumerate(rows):
-            values = required[:, c] if n_ok else np.full(1, np.nan)
-            mean, largest = float(np.mean(values)), float(np.max(values))
-            used = largest if use_max else mean
-            row.setdefault("simulated", {})[intensity.name] = {
-                "mean": mean, "max": largest, "used": used,
-                "unconservative": bool(row["separation"].same_property < used)}
+            row.setdefault("simulated", {})[intensity.name] = simulated_requirement(
+                required[:, c], row["separation"].same_property, use_max)
     return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
             "records": specs, "intensities": intensities, "contacts": rows,
             "buildings": {name: {"modes": r.n_modes, "mass_fraction": r.mass_fraction,
@@ -670,7 +681,10 @@ def code_gap_table(result: dict[str, Any]) -> str:
     each building's analysis in its own ``description``.
     """
     def mm(value: float) -> str:
-        return "-" if not math.isfinite(value) else f"{1000 * value:.1f}"
+        # three significant figures below 1 mm: a flag never compares two values printed alike as 0.0
+        if not math.isfinite(value):
+            return "-"
+        return f"{1000 * value:.1f}" if abs(value) >= 1e-3 or value == 0.0 else f"{1000 * value:.3g}"
 
     first, second = result.get("sides", ("left", "right"))
     short = {"left": "L", "right": "R", "first": "1", "second": "2"}
@@ -702,7 +716,9 @@ def code_gap_table(result: dict[str, Any]) -> str:
         sep = row["separation"]
         cells = "  ".join(f"{mm(row['simulated'][n]['mean']) + '/' + mm(row['simulated'][n]['max']):>22}" for n in names)
         unsafe = [n for n in names if row["simulated"][n]["unconservative"]]
-        flag = ("UNCONSERVATIVE at " + ", ".join(unsafe)) if unsafe else "ok"
+        unknown = [n for n in names if row["simulated"][n]["unconservative"] is None]
+        flag = "; ".join(([f"UNCONSERVATIVE at {', '.join(unsafe)}"] if unsafe else [])
+                         + ([f"not determined at {', '.join(unknown)} (no record ran)"] if unknown else [])) or "ok"
         lines.append(f"{row['contact']:<{width}} " + (f"{mm(row['gap']):>6} " if gap else "")
                      + f"{mm(row[first]):>7} {mm(row[second]):>7} {mm(sep.same_property):>9} "
                      f"{mm(sep.property_lines):>10}  {cells}  {flag}")

@@ -83,7 +83,8 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.studies.design import (EC8_MEAN_RECORDS, SUITE_PERIODS, ModalResponse, Separation,
                                      code_setup, dof_per_floor, ground_influence, modal_response, modes_for_mass,
-                                     pair_separation, response_directions, suite_scale_factor)
+                                     pair_separation, response_directions, simulated_requirement,
+                                     suite_scale_factor)
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ACCIDENTAL_ECCENTRICITY", "ORTHOGONAL_FRACTION", "TORSIONAL_IRREGULARITY", "EXTREME_TORSIONAL_IRREGULARITY",
@@ -565,11 +566,8 @@ def _simulated(ds, rows: list[dict[str, Any]], name: str, use_max: bool) -> None
     labels = [f"{face}@({float(x):g},{float(y):g})" for face, x, y in
               zip(ds.point_face.values, ds.point_x.values, ds.point_y.values)]
     for row in rows:
-        values = ds.required_gap.values[ok, labels.index(row["contact"])] if ok.any() else np.full(1, np.nan)
-        mean, largest = float(np.mean(values)), float(np.max(values))
-        used = largest if use_max else mean
-        row.setdefault("simulated", {})[name] = {"mean": mean, "max": largest, "used": used,
-                                                 "unconservative": bool(row["separation"].same_property < used)}
+        row.setdefault("simulated", {})[name] = simulated_requirement(
+            ds.required_gap.values[ok, labels.index(row["contact"])], row["separation"].same_property, use_max)
 
 
 def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_options: dict[str, Any],
