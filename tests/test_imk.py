@@ -366,3 +366,30 @@ def test_event_driven_kernel_equals_the_drift_driven_material(name, seed):
         end = lost[lost > 0][0] if (lost > 0).any() else ours.size
         errors.append(np.abs(ours[:end] - theirs[:end]).max() / np.abs(theirs).max())
     assert errors[2] < 1e-7 and errors[2] < 0.05 * errors[0], errors
+
+
+def _one_reversal(name: str, rate: float) -> hysteresis.ImkStorey:
+    """Λ_s = 0.065 (E_t = 0.23 MJ), the other modes off: one excursion to 3 % spends β_s ≈ 0.8 of it."""
+    deterioration = dict(VARIANTS[name]["deterioration"], lambda_s=0.065, lambda_c=0.0, lambda_k=0.0)
+    if "lambda_a" in deterioration:
+        deterioration["lambda_a"] = 0.0
+    return imk(name, deterioration=deterioration, deterioration_rate=rate, negative=dict(deterioration_rate=rate))
+
+
+@pytest.mark.parametrize("name", list(VARIANTS))
+def test_a_deterioration_rate_that_would_turn_the_strength_negative_fails_the_storey(name):
+    """D = 1.5 (OpenSees takes any D) and an excursion with β_s ≈ 0.8 > 1/D: (1 − β_s D) < 0 would make the
+    yield force negative, a storey that pushes as it is pushed; it fails at the reversal instead, as where
+    β > 1, in the drift-driven rules (the hysteresis command) and in the building solver's event-driven ones.
+    The same history with D = 0.5 deteriorates (its reloading force is lower than the first cycle's) and
+    goes on."""
+    drifts = np.concatenate([np.linspace(0.0, 0.03 * H, 300), np.linspace(0.03 * H, -0.03 * H, 600)[1:]])
+    material = ImkMaterial(_one_reversal(name, 1.5), K, H)
+    forces = np.asarray(material.run(drifts))
+    assert material.failed and forces[-1] == 0.0 and forces.min() >= 0.0   # failed before pushing back
+    solver = event_driven(_one_reversal(name, 1.5), drifts)
+    assert solver[-1] == 0.0 and solver.min() >= 0.0
+    gentle = ImkMaterial(_one_reversal(name, 0.5), K, H)
+    reloaded = np.asarray(gentle.run(drifts))
+    assert not gentle.failed and -reloaded.min() < reloaded.max()
+    assert np.all(event_driven(_one_reversal(name, 0.5), drifts)[-100:] < 0.0)

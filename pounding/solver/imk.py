@@ -134,11 +134,15 @@ def _deteriorate(st, o, work, use_accelerated):
         beta_a, fail_a = beta(e_i, st[EA], work, st[CA])
     st[ELAST] = work
     intercept = st[o + FCAP] - st[o + KPC] * st[o + UCAP]
-    st[o + FY] *= 1.0 - beta_s * st[o + RATE]
-    st[o + KP] *= 1.0 - beta_s * st[o + RATE]
+    strength = 1.0 - beta_s * st[o + RATE]
+    capping = 1.0 - beta_c * st[o + RATE]
+    # D > 1 and β near 1 would turn the strength negative: the capacity is exhausted, as where β > 1
+    exhausted = strength <= 0.0 or capping <= 0.0
+    st[o + FY] *= max(strength, 0.0)
+    st[o + KP] *= max(strength, 0.0)
     st[o + UGLO] *= 1.0 + beta_a * st[o + RATE]
     st[o + UY] = st[o + FY] / st[KE]
-    return intercept * (1.0 - beta_c * st[o + RATE]), fail_s or fail_c or fail_a
+    return intercept * max(capping, 0.0), fail_s or fail_c or fail_a or exhausted
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)

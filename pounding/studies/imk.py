@@ -55,6 +55,8 @@ class Backbone:
     f_local: float
     u_global: float
     f_global: float
+    #: The last excursion's (1 − β D) reached zero: the strength is spent (the storey fails).
+    exhausted: bool = False
 
     @classmethod
     def initial(cls, ke: float, fy: float, up: float, upc: float, uu: float, fcap_ratio: float,
@@ -80,11 +82,15 @@ class Backbone:
         capping point is then :meth:`place_capping_point`'s.
         """
         intercept_pc = self.fcap - self.kpc * self.ucap
-        self.fy *= 1.0 - beta_s * self.rate
-        self.kp *= 1.0 - beta_s * self.rate
+        strength, capping = 1.0 - beta_s * self.rate, 1.0 - beta_c * self.rate
+        # D > 1 and β near 1 would turn the strength negative (a storey giving energy back): the capacity is
+        # exhausted, as where β > 1 (Ibarra et al. 2005); the caller fails the storey.
+        self.exhausted = strength <= 0.0 or capping <= 0.0
+        self.fy *= max(strength, 0.0)
+        self.kp *= max(strength, 0.0)
         self.u_global *= 1.0 + beta_a * self.rate
         self.uy = self.fy / ke
-        return intercept_pc * (1.0 - beta_c * self.rate)
+        return intercept_pc * max(capping, 0.0)
 
     def place_capping_point(self, intercept_pc: float) -> None:
         """Capping point where the hardening line meets the post-capping line of intercept *intercept_pc* (N)."""
@@ -222,6 +228,7 @@ class ImkMaterial:
         beta_s, beta_c, beta_a, fail = self._excursion_betas()
         b = self.sides[sigma]
         b.place_capping_point(b.deteriorate(self.ke, beta_s, beta_c, beta_a))
+        fail = fail or b.exhausted
         b.f_global = b.force_at(self.ke, b.u_global)
         b.ures = (b.fres - b.fcap + b.kpc * b.ucap) / b.kpc
         u0 = sigma * (u_prev - f_prev / self.k_unload)  # zero-force drift, this direction's coordinates
@@ -324,8 +331,8 @@ class ImkMaterial:
         b = self.sides[sigma]
         if not self.on_backbone and f_prev * f <= 0.0 and self.yielded:
             beta_s, beta_c, _, fail_e = self._excursion_betas()
-            fail = fail or fail_e
             intercept_pc = b.deteriorate(self.ke, beta_s, beta_c, 0.0)
+            fail = fail or fail_e or b.exhausted
             # The post-capping slope shrinks with the yield force's excess over the residual (IMKBilin).
             b.kpc = 0.0 if b.fy < b.fres else b.kpc0 * (b.fy - b.fres) / (b.fy0 - b.fres)
             b.place_capping_point(intercept_pc)
