@@ -133,3 +133,19 @@ def test_a_requirement_no_record_met_is_not_determined_and_small_values_keep_the
     row = next(line for line in table.splitlines() if line.startswith("A:1-B:1"))
     assert "0.04" in row and "0.05/0.06" in row
     assert "UNCONSERVATIVE at MCE_R" in row and "not determined at design (no record ran)" in row
+
+
+@pytest.mark.parametrize("factor, where", [("{q: 0.8}", "design.ec8.q must be >= 1"),
+                                           ("{q: 3.9, qd: 0.5}", "design.ec8.qd must be >= 1")])
+def test_a_behaviour_factor_below_one_is_refused_in_the_model_and_in_spectrum(tmp_path, capsys, factor, where):
+    """EN 1998-1 §3.2.2.5: q = 1 is the elastic design; a q below 1 (typed as a fraction, or q_d for 1/q)
+    would raise the design forces and shrink nothing: refused in one line, in the model and on the CLI."""
+    path = tmp_path / "low_q.yaml"
+    path.write_text(MODEL.replace("ec8: {q: 3.9}", f"ec8: {factor}"), encoding="utf-8")
+    assert main(["gap", str(path), "--code", "ec8", "--ag", "0.25"] + FAST) == 2
+    err = capsys.readouterr().err
+    assert where in err and ("§3.2.2.5" in err or "§4.4.2.7" in err)
+    assert err.count("\n") == 1
+    assert main(["spectrum", "ec8", "--ag", "0.3", "--q", "0.5"]) == 2
+    err = capsys.readouterr().err
+    assert "the behaviour factor q must be >= 1 (got 0.5)" in err and err.count("\n") == 1

@@ -290,6 +290,14 @@ StopDriftRatio = Annotated[
     AfterValidator(located(_optional(_bound(lambda v: v >= MIN_STOP_DRIFT_RATIO,
                                               f"must be >= {MIN_STOP_DRIFT_RATIO:g} (0.01 %; collapse is a drift "
                                               "ratio of several per cent, e.g. 0.1)"))))]
+#: A behaviour factor (EN 1998-1 §3.2.2.5: q ≥ 1; q = 1 is an elastic design, q < 1 would amplify it).
+BehaviourFactor = Annotated[float, BeforeValidator(located(as_number)),
+                            AfterValidator(located(_bound(lambda v: v >= 1, "must be >= 1 (EN 1998-1 §3.2.2.5: "
+                                                          "q = 1 is elastic; a q below 1 would raise the forces)")))]
+OptionalBehaviourFactor = Annotated[
+    float | None, BeforeValidator(located(_optional(as_number))),
+    AfterValidator(located(_optional(_bound(lambda v: v >= 1, "must be >= 1 (EN 1998-1 §4.4.2.7: q_d, as q, "
+                                                              "is at least 1)"))))]
 Rtol = Annotated[float, BeforeValidator(located(as_number)),
                  AfterValidator(located(_bound(lambda v: v >= MIN_RTOL, f"must be >= {MIN_RTOL:g}")))]
 
@@ -513,8 +521,9 @@ class Ec8DesignEntry(SchemaEntry):
 
     WHAT: ClassVar[str] = "a mapping {q}, e.g. {q: 3.9}"
 
-    q: PositiveNumber = Field(description="behaviour factor q (EN 1998-1 §3.2.2.5, §5.2.2.2)")
-    qd: OptionalPositiveNumber = Field(None, description="displacement behaviour factor q_d of (4.23), default q")
+    q: BehaviourFactor = Field(description="behaviour factor q >= 1 (EN 1998-1 §3.2.2.5, §5.2.2.2)")
+    qd: OptionalBehaviourFactor = Field(None, description="displacement behaviour factor q_d >= 1 of (4.23), "
+                                                           "default q")
 
 
 class DesignEntry(SchemaEntry):

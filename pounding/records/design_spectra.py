@@ -275,6 +275,9 @@ def ec8_spectrum(spectrum_type: int, ground: str, ag: float, *, q: float | None 
             clause="EN 1998-1 §3.2.2.2 (elastic horizontal spectrum, (3.2)-(3.6))",
             function=lambda t: ec8_elastic(t, ag, soil, tb, tc, td, eta), damping=zeta, corners=corners)
     q = _positive("the behaviour factor q", q)
+    if q < 1.0:
+        raise PoundingError(f"the behaviour factor q must be >= 1 (got {q:g}): EN 1998-1 §3.2.2.5's design spectrum "
+                            "divides the elastic one by q, and q = 1 is elastic; a q below 1 would raise the forces")
     if abs(zeta - 0.05) > 1e-12:
         raise PoundingError("the Eurocode 8 design spectrum (§3.2.2.5) has no damping correction; give --damping "
                             "only for the elastic spectrum (without --q)")
