@@ -124,6 +124,8 @@ def test_pushover_command_writes_table_archive_and_plot(model_file, tmp_path, ca
     for argv, message in ((["--building", "C"], "no building 'C'"), (["--steps", "0"], "--steps must be at least 1"),
                           # one step once landed past the strength loss: V_max 0 N, exit 0
                           (["--steps", "1"], "--steps must be at least 10 (got 1)"),
+                          # no bound once: a billion steps ran for hours
+                          (["--steps", "1000000000"], "--steps must be at most 20000 (got 1000000000)"),
                           (["--design-cs", "-1"], "--design-cs must be a number > 0")):
         assert main(["pushover", str(model_file), *argv]) == 2
         err = capsys.readouterr().err.strip()

@@ -40,7 +40,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("model", help="YAML model, e.g. models/pair_inelastic.yaml")
     parser.add_argument("--pattern", choices=PATTERNS, default="first-mode", help="lateral load pattern")
     parser.add_argument("--building", help="push only this building")
-    parser.add_argument("--steps", type=int, default=400, help="drift steps of the control storey (at least 10, default 400)")
+    parser.add_argument("--steps", type=int, default=400, help="drift steps of the control storey (10 to 20000, default 400)")
     parser.add_argument("--period", type=float, metavar="T",
                         help="the period T of FEMA P695 eq. 6-7 (C_u·T_a), s; max(T, T1) is used (default T1)")
     parser.add_argument("--design-cs", type=float, metavar="C_S",
