@@ -249,6 +249,10 @@ def _two_component_supports(model: Model, where: str) -> SupportMotions:
     requested = [spec.lag(name) for name in names]
     lags = [round(lag / step) * step for lag in requested]
     end = spec.duration or max(r.time_step * r.acceleration.size for r in present) + max(lags)
+    # the grid spans the whole duration (a one-component record is padded in the solver instead): its memory
+    # is checked before it is allocated, as a run's (at most two rows per building and the zero row)
+    check_memory(estimate_memory(model, end, step, model.solver.output_dt) * (2 * len(names) + 1),
+                 what=f"{_where(model)}this run", fix="shorten ground_motion.duration or raise solver.output_dt")
     time = np.arange(int(math.ceil(end / step + 1e-9)) + 1) * step
     zero = (np.zeros(2), 1.0)
     series = []

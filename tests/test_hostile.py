@@ -303,6 +303,11 @@ def test_memory_is_estimated_before_allocating(case):
 
     with pytest.raises(PoundingError, match=r"would need about .* of memory, more than 50% .*; shorten"):
         simulate(load_model(case / "model.yaml"), duration=1e9)
+    # a model in plan, whose two components are laid on one grid over the whole duration (was a numpy
+    # MemoryError traceback: 745 GiB of sample times)
+    corner = Path(__file__).resolve().parents[1] / "models" / "corner_pair.yaml"
+    with pytest.raises(PoundingError, match=r"corner_pair.yaml: this run would need about .*; shorten"):
+        simulate(load_model(corner), duration=1e9)
 
 
 def test_a_huge_sweep_is_refused_before_expanding(tmp_path):
