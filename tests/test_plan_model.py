@@ -6,6 +6,7 @@ Hand computations are written out beside each check (docs/plan-models.md).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -368,3 +369,27 @@ def test_a_gap_between_outlines_is_the_decimal_gap_written():
     face = facing(((0.0, 0.0), (20.0, 10.0)), ((20.05, 2.0), (30.0, 8.0)))
     assert face is not None and face.gap == 0.05 and face.normal == "x"
     assert abs(face.gap - (20.05 - 20.0)) < 1e-15
+
+
+def test_a_model_in_site_coordinates_runs_as_at_the_origin():
+    """corner_pair moved to a UTM-like site (easting 500 km, northing 4100 km): not refused as singular (the
+    rank test took plane moments about the origin, 1e5 times the lever arms), its points labelled with every
+    digit, and the same physics. 1e-8: the coordinates' round-off (4e6 m x 1e-16 = 4e-10 m on lever arms of
+    metres) carried through the run, far below any modelling difference (1e-3)."""
+    import re
+
+    from pounding.simulation import simulate
+
+    text = (Path(__file__).resolve().parents[1] / "models" / "corner_pair.yaml").read_text()
+    east, north = 500000.0, 4100000.0
+    moved = text.replace("outline: [[0, 0], [24, 16]]", f"outline: [[{east}, {north}], [{east + 24}, {north + 16}]]")
+    moved = moved.replace("outline: [[24.05, 10], [40.05, 26]]",
+                          f"outline: [[{east + 24.05}, {north + 10}], [{east + 40.05}, {north + 26}]]")
+    moved = re.sub(r"\{direction: (x|y), at: ([0-9.]+)",
+                   lambda m: f"{{direction: {m[1]}, at: {float(m[2]) + (north if m[1] == 'x' else east)!r}", moved)
+    site, origin = (simulate(model_from_text(t, name="corner"), duration=6.0) for t in (moved, text))
+    assert list(site.contact.values)[:2] == ["A:1-B:1@(500024,4100010)", "A:1-B:1@(500024,4100016)"]
+    assert int(site.impact_count.sum()) == int(origin.impact_count.sum()) > 0
+    for name in ("peak_drift_ratio", "peak_plane_drift_ratio", "peak_contact_force"):
+        a, b = site[name].values, origin[name].values
+        assert np.max(np.abs(a - b)) <= 1e-8 * np.max(np.abs(b)), name

@@ -348,7 +348,7 @@ def storey_stiffness_defect(planes: list[Plane] | tuple[Plane, ...], length: flo
     """Why a storey's planes leave it without stiffness in some motion, or None if they resist every one.
 
     The storey's relative motion (Δx, Δy, Δθ) of the floor above the floor below is
-    resisted by ``Σ k a aᵀ`` (a about the plan origin); it is singular when every plane
+    resisted by ``Σ k a aᵀ`` (a about the planes' mean position); it is singular when every plane
     runs along one direction, or when every plane passes through one point (a twist
     about it is free).  *length* (m, e.g. the outline's diagonal) makes the rotation
     column commensurate for the rank test.
@@ -358,9 +358,14 @@ def storey_stiffness_defect(planes: list[Plane] | tuple[Plane, ...], length: flo
         other = "y" if directions == {"x"} else "x"
         return f"every plane runs along {next(iter(directions), 'x')}: nothing resists drift along {other}; " \
                f"add a plane along {other}"
+    # moments about the planes' mean position: about the plan origin, outlines in site coordinates (a UTM
+    # easting of 500 km) make the rotation column 1e5 times the others and the rank test call it singular
+    x0 = float(np.mean([p.at for p in planes if p.direction == "y"]))
+    y0 = float(np.mean([p.at for p in planes if p.direction == "x"]))
     k = np.zeros((3, 3))
     for p in planes:
-        a = np.array([1.0, 0.0, -p.at / length]) if p.direction == "x" else np.array([0.0, 1.0, p.at / length])
+        a = (np.array([1.0, 0.0, -(p.at - y0) / length]) if p.direction == "x"
+             else np.array([0.0, 1.0, (p.at - x0) / length]))
         k += float(p.stiffness) * np.outer(a, a)
     eigenvalues = np.linalg.eigvalsh(k)
     if eigenvalues[0] > 1e-10 * eigenvalues[-1]:

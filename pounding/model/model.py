@@ -181,7 +181,7 @@ class GapElement:
     def label(self, names: list[str]) -> str:
         """Gap element label, e.g. ``A:3-B:3``, ``A:1-wall``, ``A:3-B:s4@0.5``; a point in plan adds its place,
         ``A:3-B:3@(24,10)``."""
-        where = "" if self.point is None else f"@({self.point[0]:g},{self.point[1]:g})"
+        where = "" if self.point is None else f"@{outline.place_label(self.point)}"
         return f"{self.side_label(names, 'left')}-{self.side_label(names, 'right')}{where}"
 
     def level_document(self, side: str) -> Any:
@@ -281,7 +281,7 @@ class Link:
 
     def label(self, names: list[str]) -> str:
         """``A:4-B:4`` (a point in plan adds its place, ``A:4-B:4@(24,13)``)."""
-        where = "" if self.point is None else f"@({self.point[0]:g},{self.point[1]:g})"
+        where = "" if self.point is None else f"@{outline.place_label(self.point)}"
         return f"{names[self.left]}:{self.level_left}-{names[self.right]}:{self.level_right}{where}"
 
 

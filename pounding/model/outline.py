@@ -27,7 +27,7 @@ import numpy as np
 
 from pounding.model.floors import Outline, point_weights
 
-__all__ = ["Face", "ContactPoint", "WALL_FACES", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face", "wall_side",
+__all__ = ["Face", "ContactPoint", "WALL_FACES", "place_label", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face", "wall_side",
            "penetration_weights", "slip_weights"]
 
 #: A wall's face of a building: (normal direction, True if the building is on the low side).
@@ -103,6 +103,19 @@ def overlap_at_rest(first: Outline, second: Outline) -> bool:
 
 #: Decimal places (m) a gap between two outlines is rounded to: the picometre.
 GAP_DECIMALS = 12
+
+
+def place_label(point: tuple[float, float]) -> str:
+    """``(24,10)``, ``(24.05,10)``: a point in plan (m) to the millimetre, trailing zeros dropped.
+
+    Site coordinates keep every digit (``(500024,4100016)``), where ``:g`` would print
+    ``4.10002e+06`` and give two points 4 m apart one label.
+    """
+    def metres(value: float) -> str:
+        text = f"{value:.3f}".rstrip("0").rstrip(".")
+        return "0" if text in ("-0", "") else text
+
+    return f"({metres(point[0])},{metres(point[1])})"
 
 
 def edge_distance(low: float, high: float) -> float:

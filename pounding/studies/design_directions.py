@@ -81,6 +81,7 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import PoundingError
+from pounding.model.outline import place_label
 from pounding.studies.design import (EC8_MEAN_RECORDS, SUITE_PERIODS, ModalResponse, Separation,
                                      code_setup, dof_per_floor, ground_influence, modal_response, modes_for_mass,
                                      pair_separation, response_directions, simulated_requirement,
@@ -413,7 +414,7 @@ def plan_code_separations(model, code: str, found: dict[str, Any], *, tolerance:
             d1, d2 = one["design"], (0.0 if wall else two["design"])
             same = (not wall) and abs(z1 - z2) <= tolerance + 1e-9
             separation = Separation(d1, d1, 0.0) if wall else pair_separation(code, d1, d2, same_levels=same)
-            rows.append({"contact": f"{face}@({x:g},{y:g})", "face": face, "normal": contact.face.normal,
+            rows.append({"contact": f"{face}@{place_label((x, y))}", "face": face, "normal": contact.face.normal,
                          "location": [float(x), float(y)], "gap": float(contact.gap), "first": d1, "second": d2,
                          "first_parts": one, "second_parts": two, "elevation": max(z1, z2), "same_levels": same,
                          "separation": separation})
@@ -563,7 +564,7 @@ def _simulated(ds, rows: list[dict[str, Any]], name: str, use_max: bool) -> None
     """Each row's simulated requirement (mean, max over the records that ran) at intensity *name*, in place."""
     ok = ds.status.values == "ok"
     # a contact point of the gap study's archive: its face (YAML order) and place, as the rows name it
-    labels = [f"{face}@({float(x):g},{float(y):g})" for face, x, y in
+    labels = [f"{face}@{place_label((float(x), float(y)))}" for face, x, y in
               zip(ds.point_face.values, ds.point_x.values, ds.point_y.values)]
     for row in rows:
         row.setdefault("simulated", {})[name] = simulated_requirement(
