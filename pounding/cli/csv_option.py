@@ -68,12 +68,13 @@ def add_csv_option(parser: argparse.ArgumentParser) -> None:
 def check_csv(args: argparse.Namespace, inputs: list | tuple = ()) -> None:
     """Before anything runs: ``--csv`` is not a folder and not one of the command's *inputs*."""
     from pounding.errors import PoundingError
-    from pounding.results.archive import check_not_input
+    from pounding.results.archive import check_not_input, check_output_place
 
     if getattr(args, "csv", None):
         if Path(args.csv).is_dir():
             raise PoundingError(f"--csv {args.csv} is a directory; give a file name such as "
                                 f"{Path(args.csv) / 'results.csv'}")
+        check_output_place(args.csv, "--csv", folder=False)
         check_not_input(args.csv, [*inputs, getattr(args, "output", None)])
 
 

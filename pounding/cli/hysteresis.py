@@ -8,13 +8,16 @@ __all__ = ["register_cli"]
 
 
 def _cmd_hysteresis(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_not_input, check_writable, save_run
+    from pounding.results.archive import check_not_input, check_output_place, check_writable, save_run
     from pounding.studies.cyclic import PROTOCOLS, hysteresis_test, plot_hysteresis, write_csv
 
     inputs = [args.model] + ([] if args.protocol in PROTOCOLS else [args.protocol])
     check_writable(args.output, overwrite=args.overwrite, inputs=inputs)
     if args.csv:
+        check_output_place(args.csv, "--csv", folder=False)
         check_not_input(args.csv, inputs + [args.output])
+    if args.plot:
+        check_output_place(args.plot, "--plot", folder=True)
     ds = hysteresis_test(args.model, args.storey, args.protocol, args.amplitude)
     save_run(ds, args.output, overwrite=args.overwrite)
     print(f"wrote {args.output} ({ds.sizes['step']} steps; peak |shear| {abs(ds.storey_shear).max().item():.6g} N "

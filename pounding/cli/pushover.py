@@ -12,11 +12,13 @@ PATTERNS = ("first-mode", "triangular", "uniform")
 
 
 def _cmd_pushover(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable, save_run
+    from pounding.results.archive import check_output_place, check_writable, save_run
     from pounding.studies.pushover import plot_pushover, pushover, pushover_table
 
     if args.output:
         check_writable(args.output, overwrite=args.overwrite, inputs=[args.model])
+    if args.plot:
+        check_output_place(args.plot, "--plot", folder=True)
     ds = pushover(args.model, pattern=args.pattern, building=args.building, steps=args.steps, period=args.period,
                   design_cs=args.design_cs)
     print(pushover_table(ds))

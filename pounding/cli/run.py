@@ -94,19 +94,9 @@ def _damaged_if_garbled(source):
 
 def _check_plot_dir(directory: str) -> None:
     """Fail before any computation if --plot DIR cannot be created or written."""
-    import os
+    from pounding.results.archive import check_output_place
 
-    from pounding.errors import PoundingError
-    from pounding.results.archive import nearest_existing
-
-    target = Path(directory)
-    if target.exists() and not target.is_dir():
-        raise PoundingError(f"{target} is a file; --plot needs a directory")
-    probe = nearest_existing(target)
-    if probe.exists() and not probe.is_dir():
-        raise PoundingError(f"--plot {target}: {probe} is a file, not a directory")
-    if not os.access(probe, os.W_OK | os.X_OK):
-        raise PoundingError(f"--plot {target}: {probe} is not writable; choose another folder")
+    check_output_place(directory, "--plot", folder=True)
 
 
 # --------------------------------------------------------------------------- #

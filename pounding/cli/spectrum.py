@@ -91,6 +91,11 @@ def _periods(text: str | None, spectrum) -> np.ndarray:
 def _cmd_spectrum(args: argparse.Namespace) -> int:
     from pounding.units import STANDARD_GRAVITY
 
+    from pounding.results.archive import check_output_place
+
+    for option in ("--csv", "--plot"):   # both are files
+        if getattr(args, option[2:]):
+            check_output_place(getattr(args, option[2:]), option, folder=False)
     spectrum = spectrum_from_args(args)
     periods = _periods(args.periods, spectrum)
     print(spectrum_table(spectrum, periods))

@@ -38,8 +38,10 @@ def check_study_options(args: argparse.Namespace) -> None:
         raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
     if args.output:
         check_writable(args.output, overwrite=args.overwrite)
-    if args.plot and Path(args.plot).exists() and not Path(args.plot).is_dir():
-        raise PoundingError(f"{args.plot} is a file; --plot needs a directory")
+    if args.plot:
+        from pounding.results.archive import check_output_place
+
+        check_output_place(args.plot, "--plot", folder=True)
 
 
 def summary_lines(ds) -> list[str]:

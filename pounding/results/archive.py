@@ -30,7 +30,8 @@ import xarray as xr
 
 from pounding.errors import ArchiveError
 
-__all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing", "atomic_path", "check_not_input", "check_regular_file",
+__all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing",
+           "check_output_place", "atomic_path", "check_not_input", "check_regular_file",
            "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
            "REQUIRED_VARIABLES", "REQUIRED_PLANE_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
@@ -55,6 +56,29 @@ def nearest_existing(path: str | os.PathLike) -> Path:
             break
         probe = probe.parent
     return probe
+
+
+def check_output_place(path: str | os.PathLike, option: str, *, folder: bool) -> None:
+    """Before any computation: *path* (a folder if *folder*, else a file) can be made where it is asked.
+
+    One line naming *option* (``--plot``, ``--csv``) where the path is a file but a folder is asked (or a
+    folder but a file is), where an ancestor is a file, or where the closest existing folder is not
+    writable: found after the work, each was a traceback with the results lost.
+
+    Raises
+    ------
+    ArchiveError
+    """
+    target = Path(path)
+    if folder and target.exists() and not target.is_dir():
+        raise ArchiveError(f"{option} {target}: it is a file; {option} needs a directory")
+    if not folder and target.is_dir():
+        raise ArchiveError(f"{option} {target}: it is a directory; give a file name such as {target / 'results'}")
+    probe = nearest_existing(target if folder else target.parent)
+    if probe.exists() and not probe.is_dir():
+        raise ArchiveError(f"{option} {target}: {probe} is a file, not a directory; choose another path")
+    if probe.exists() and not os.access(probe, os.W_OK | os.X_OK):
+        raise ArchiveError(f"{option} {target}: {probe} is not writable; choose another folder")
 
 
 def make_folder(folder: str | os.PathLike, *, what: str) -> Path:
