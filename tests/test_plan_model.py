@@ -393,3 +393,24 @@ def test_a_model_in_site_coordinates_runs_as_at_the_origin():
     for name in ("peak_drift_ratio", "peak_plane_drift_ratio", "peak_contact_force"):
         a, b = site[name].values, origin[name].values
         assert np.max(np.abs(a - b)) <= 1e-8 * np.max(np.abs(b)), name
+
+
+def test_a_wall_inside_the_neighbouring_building_is_refused():
+    """A 0.15 m gap to a wall east of A, where B stands 0.05 m east of A: the wall would stand inside B (it was
+    accepted, and A struck a wall inside its neighbour). Up to B's edge (0.05 m), on the other sides, and held
+    open (1e6: a run without contacts), the wall is accepted."""
+    planes_b = PLANES_SYMMETRIC.replace("direction: y, at: 0,", "direction: y, at: 20.05,").replace(
+        "direction: y, at: 20,", "direction: y, at: 30,")
+    buildings = (building("A", "[[0, 0], [20, 10]]", one_storey())
+                 + building("B", "[[20.05, 0], [30, 10]]", one_storey(planes_b)))
+
+    def text(gap, face="east"):
+        return plan_text(buildings, f"  - {{between: [A, wall], face: {face}, gap: {gap}, levels: [1], "
+                                    "law: hertz-damp, kh: 1.0e9, restitution: 0.6}\n")
+
+    message = error_of(text(0.15))
+    assert "contacts[0].gap puts the wall on A's east side inside building B" in message and "\n" not in message
+    for gap in ("0.05", "1.0e6"):
+        assert build(text(gap)).faces[0].gap == float(gap)
+    for face in ("west", "north", "south"):
+        assert build(text(0.15, face)).faces[0].face.normal in ("x", "y")

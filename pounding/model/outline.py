@@ -27,7 +27,7 @@ import numpy as np
 
 from pounding.model.floors import Outline, point_weights
 
-__all__ = ["Face", "ContactPoint", "WALL_FACES", "place_label", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face", "wall_side",
+__all__ = ["Face", "ContactPoint", "WALL_FACES", "place_label", "facing", "edge_distance", "GAP_DECIMALS", "overlap_at_rest", "face_points", "wall_face", "wall_side", "wall_blocked_by",
            "penetration_weights", "slip_weights"]
 
 #: A wall's face of a building: (normal direction, True if the building is on the low side).
@@ -155,6 +155,25 @@ def wall_face(outline: Outline, side: str, gap: float) -> Face:
     edge = low_edge if building_low else high_edge
     face_low, face_high = (edge, edge + gap) if building_low else (edge - gap, edge)
     return Face(normal, building_low, float(gap), face_low, face_high, span)
+
+
+def wall_blocked_by(face: Face, outlines: list[Outline]) -> int | None:
+    """The index of the first of *outlines* standing between a building's edge and its wall's *face* (or
+    beyond the wall, over the face's span), None if the strip is open ground.
+
+    The strip runs from the building's edge to the wall along the normal (``face_low``..``face_high``)
+    and over ``face.span`` along the tangent; an outline overlapping it by a positive area blocks it.
+    """
+    axis = 0 if face.normal == "x" else 1
+    for index, outline in enumerate(outlines):
+        ranges = _intervals(outline)
+        along, across = ranges[axis], ranges[1 - axis]
+        if _overlap(across, face.span) <= 0.0:
+            continue
+        beyond = along[0] >= face.face_high if face.first_low else along[1] <= face.face_low
+        if not beyond and _overlap(along, (face.face_low, face.face_high)) > 0.0:
+            return index
+    return None
 
 
 def wall_side(face: Face) -> str:

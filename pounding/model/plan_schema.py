@@ -293,16 +293,26 @@ class PlanContactEntry(ContactEntry):
                           line="key", colon=False)
         self._pairs = tuple((a[0], b[0]) for a, b in levels)
         self._points = tuple((a[1], b[1]) for a, b in levels)
-        self._face = self._wall_face(index, first) if second is None else self._geometry_face(index, first, second)
+        self._face = (self._wall_face(index, first, buildings) if second is None
+                      else self._geometry_face(index, first, second))
 
-    def _wall_face(self, index: int, building: PlanBuildingEntry) -> plan_contacts.Face:
+    def _wall_face(self, index: int, building: PlanBuildingEntry, buildings: list) -> plan_contacts.Face:
         if self.face is None:
             raise problem(f"a wall contact of a plan model needs face: the side of {building.name} the wall "
                           "stands beside (east, west, north or south)", kind="error", at=(index, "between"))
         if self.gap is None:
             raise problem("a wall contact needs gap: its distance from the building's face at rest, m",
                           kind="error", at=(index,), line="key")
-        return plan_contacts.wall_face(building.plan.outline, self.face, self.gap)
+        face = plan_contacts.wall_face(building.plan.outline, self.face, self.gap)
+        others = [b for b in buildings if b is not building]
+        blocked = None if self.gap >= OPEN_GAP else plan_contacts.wall_blocked_by(face, [b.plan.outline for b in others])
+        if blocked is not None:
+            other = others[blocked]
+            raise problem(f"puts the wall on {building.name}'s {self.face} side inside building {other.name} "
+                          f"({_outline_text(other)}): a wall stands on open ground beside the building; shorten the "
+                          f"gap, or join {building.name} and {other.name} by a contact", kind="error",
+                          at=(index, "gap"), colon=False)
+        return face
 
     def _geometry_face(self, index: int, first: PlanBuildingEntry, second: PlanBuildingEntry) -> plan_contacts.Face:
         if self.face is not None:
