@@ -304,7 +304,7 @@ class PlanContactEntry(ContactEntry):
             raise problem("a wall contact needs gap: its distance from the building's face at rest, m",
                           kind="error", at=(index,), line="key")
         face = plan_contacts.wall_face(building.plan.outline, self.face, self.gap)
-        others = [b for b in buildings if b is not building]
+        others = [b for b in buildings if b is not building and getattr(b, "plan", None) is not None]
         blocked = None if self.gap >= OPEN_GAP else plan_contacts.wall_blocked_by(face, [b.plan.outline for b in others])
         if blocked is not None:
             other = others[blocked]
