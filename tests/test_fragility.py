@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -12,7 +13,8 @@ from scipy.optimize import minimize
 from scipy.stats import norm
 
 from pounding.errors import PoundingError
-from pounding.studies.fragility import collapse_margin_ratio, fit_intensities, fit_stripes
+from pounding.studies.fragility import (collapse_margin_ratio, fit_intensities, fit_stripes, kaplan_meier,
+                                        kaplan_meier_median)
 
 
 def _independent_mle(x, n, z):
@@ -85,3 +87,68 @@ def test_collapse_margin_ratio():
     assert collapse_margin_ratio(2.4, 1.5) == pytest.approx(1.6)
     with pytest.raises(PoundingError):
         collapse_margin_ratio(2.4, 0.0)
+
+
+# --------------------------------------------------------------------------- #
+# The Kaplan-Meier estimate and its median (S_CT of pounding p695)
+# --------------------------------------------------------------------------- #
+
+@pytest.mark.parametrize("values, expected", [
+    # No censoring: the ceil(n/2)-th smallest collapse intensity (FEMA P695: half the records collapse).
+    ([3.0, 1.0, 2.0], 2.0),                          # n = 3: the 2nd
+    ([1.0, 2.0, 3.0, 4.0, 5.0], 3.0),                # n = 5: the 3rd
+    ([4.0, 1.0, 3.0, 2.0], 2.0),                     # n = 4: the 2nd, not the average 2.5 of the 2nd and 3rd
+    ([1.0, 2.0, math.inf, math.inf], 2.0),           # 4 records, 2 collapses: the 2nd collapse, a number
+    ([1.0, math.inf, math.inf, math.inf], math.nan),  # 1 of 4 collapsed: half never reached
+    ([1.0, 1.0, 2.0, 3.0], 1.0),                     # ties collapse together: 2 of 4 at 1.0
+    ([2.0, 1.0, 1.0, 1.0, 5.0, 6.0], 1.0),           # 3 of 6 at 1.0
+    ([2.0, 2.0, 1.0, 5.0, 6.0], 2.0),                # 1 of 5 at 1.0, 3 of 5 at 2.0 (ceil(5/2) = 3rd value)
+])
+def test_the_kaplan_meier_median_without_censoring_is_the_order_statistic(values, expected):
+    x = np.array(values)
+    got = kaplan_meier_median(x, np.isfinite(x))
+    assert (math.isnan(got) and math.isnan(expected)) or got == expected
+
+
+def test_the_kaplan_meier_estimate_of_kaplan_and_meier_1958():
+    """The example of Kaplan & Meier (1958): N = 8 items, deaths at 0.8, 3.1, 5.4, 9.2, losses (censored)
+    at 1.0, 2.7, 7.0, 12.1.  By hand, P(t) just after each death: 7/8; 7/8 x 4/5 = 0.7 (1.0 and 2.7 lost,
+    5 at risk at 3.1); 0.7 x 3/4 = 0.525 (4 at risk at 5.4); 0.525 x 1/2 = 0.2625 (7.0 lost, 2 at risk at
+    9.2).  The fraction dead first reaches 1/2 at 9.2 (at 5.4 it is 0.475)."""
+    deaths, losses = [0.8, 3.1, 5.4, 9.2], [1.0, 2.7, 7.0, 12.1]
+    x = np.array(deaths + losses)
+    reached = np.array([True] * 4 + [False] * 4)
+    times, fraction = kaplan_meier(x, reached)
+    np.testing.assert_array_equal(times, deaths)
+    assert fraction == [Fraction(1, 8), Fraction(3, 10), Fraction(19, 40), Fraction(59, 80)]
+    assert kaplan_meier_median(x, reached) == 9.2
+
+
+def test_the_kaplan_meier_estimate_of_the_6mp_leukaemia_data():
+    """Klein & Moeschberger (2003), "Survival Analysis", 2nd ed., Table 4.1A: the 6-MP group of the leukaemia
+    remission data (Freireich et al. 1963; 21 patients, weeks, + censored): 6, 6, 6, 6+, 7, 9+, 10, 10+,
+    11+, 13, 16, 17+, 19+, 20+, 22, 23, 25+, 32+, 32+, 34+, 35+.  The table's S(t): 0.857, 0.807, 0.753,
+    0.690, 0.627, 0.538, 0.448 at 6, 7, 10, 13, 16, 22, 23 (three decimals: the tolerance), median 23 weeks.
+    The censoring at 6 (6+) and at 10 (10+) share a death time: they are at risk there (n = 21 and 15)."""
+    events = [6, 6, 6, 7, 10, 13, 16, 22, 23]
+    censored = [6, 9, 10, 11, 17, 19, 20, 25, 32, 32, 34, 35]
+    x = np.array(events + censored, dtype=float)
+    reached = np.array([True] * len(events) + [False] * len(censored))
+    times, fraction = kaplan_meier(x, reached)
+    np.testing.assert_array_equal(times, [6, 7, 10, 13, 16, 22, 23])
+    survival = [1 - float(f) for f in fraction]
+    np.testing.assert_allclose(survival, [0.857, 0.807, 0.753, 0.690, 0.627, 0.538, 0.448], atol=5e-4)
+    assert kaplan_meier_median(x, reached) == 23.0
+
+
+def test_a_record_censored_low_leaves_the_median_to_the_others_and_too_much_censoring_gives_none():
+    # Censored at 0 (never seen standing): it leaves every risk set; the other 4 give their 2nd value.
+    assert kaplan_meier_median(np.array([0.0, 1.0, 2.0, 3.0, 4.0]), np.array([False] + [True] * 4)) == 2.0
+    # 2 collapses at 1 and 2 among 5, 3 censored at 1.5: F(1) = 1/5, F(2) = 1 - 4/5 x 0/1 = 1 -> 2.0
+    x, hit = np.array([1.0, 2.0, 1.5, 1.5, 1.5]), np.array([True, True, False, False, False])
+    assert kaplan_meier(x, hit)[1] == [Fraction(1, 5), Fraction(1)]
+    assert kaplan_meier_median(x, hit) == 2.0
+    # 1 collapse among 5, the other 4 censored above it: F = 1/5 only, not determinable
+    assert math.isnan(kaplan_meier_median(np.array([1.0, 2.0, 2.0, 3.0, 3.0]), np.array([True] + [False] * 4)))
+    with pytest.raises(PoundingError, match="one value"):
+        kaplan_meier(np.array([1.0, math.nan]), np.array([True, True]))

@@ -38,6 +38,12 @@ record counts in the denominators and never as reaching the limit: its own
 outcome was hidden, so it may lie on either side of the median.  Otherwise the
 fit is "not determinable", with the counts, never a number.
 
+The median of a right-censored sample without a distribution (:func:`kaplan_meier`,
+:func:`kaplan_meier_median`): the product-limit estimator of Kaplan & Meier (1958), "Nonparametric
+estimation from incomplete observations", J. Amer. Statist. Assoc. 53 457–481, of the fraction of records
+that reached the limit by intensity x, F(x) = 1 − Π_{x_j ≤ x} (1 − d_j / n_j) (d_j records reaching it at
+x_j, n_j records still observed there), and the smallest x_j at which F reaches 1/2.
+
 And :func:`collapse_margin_ratio`, the FEMA P695 (2009) CMR = Ŝ_CT / S_MT.
 """
 
@@ -45,6 +51,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 from scipy.special import log_ndtr, ndtr, ndtri
@@ -52,7 +59,8 @@ from scipy.special import log_ndtr, ndtr, ndtri
 from pounding.errors import PoundingError
 
 __all__ = ["Fragility", "fit_stripes", "fit_intensities", "fit_censored_intensities", "collapse_margin_ratio",
-           "probability", "median_observed", "median_observed_stripes", "MIN_DISTINCT_OBSERVATIONS"]
+           "probability", "median_observed", "median_observed_stripes", "MIN_DISTINCT_OBSERVATIONS", "kaplan_meier",
+           "kaplan_meier_median"]
 
 #: Distinct observed intensities (or stripes with observed runs) a two-parameter fit needs: one gives
 #: no dispersion (β = 0 or undefined).
@@ -258,6 +266,56 @@ def median_observed_stripes(n_exceed: np.ndarray, n_ran: np.ndarray) -> bool:
     z = np.asarray(n_exceed, dtype=float)
     n = np.asarray(n_ran, dtype=float)
     return bool(np.sum(n > 0) >= MIN_DISTINCT_OBSERVATIONS and np.any((n > 0) & (2 * z >= n)))
+
+
+def kaplan_meier(values: np.ndarray, reached: np.ndarray) -> tuple[np.ndarray, list[Fraction]]:
+    """The Kaplan–Meier (1958) product-limit estimate of the fraction of records that reached a limit.
+
+    Parameters
+    ----------
+    values : (n,) array
+        Each record's intensity at the limit (*reached* True), or the highest intensity at which it was seen
+        not to reach it (*reached* False: right-censored; +inf for a record never seen to reach it), any units.
+    reached : (n,) array of bool
+
+    Returns
+    -------
+    intensities : (m,) array
+        The distinct intensities at which records reached the limit, ascending (the units of *values*).
+    fraction : list of Fraction
+        The estimate of the fraction reached at and just above each, F(x_j) = 1 − Π_{i ≤ j} (n_i − d_i) / n_i:
+        d_i records reached the limit at x_i, n_i records had values ≥ x_i (were still observed there).
+
+    Records that reach the limit at equal intensities reach it together (one factor, d_i > 1); a record
+    censored at an intensity where others reach the limit is still observed there (the convention of
+    Kaplan & Meier 1958: losses at a death time follow the deaths; Klein & Moeschberger 2003, "Survival
+    Analysis", 2nd ed., §4.2).  Exact (fractions of counts): without
+    censoring F(x_k) is exactly k/n, so no round-off decides a comparison with 1/2.
+    """
+    x = np.asarray(values, dtype=float)
+    hit = np.asarray(reached, dtype=bool)
+    if x.shape != hit.shape or np.any(np.isnan(x)):
+        raise PoundingError("Kaplan-Meier: needs one value (not NaN) and one flag per record")
+    intensities = np.unique(x[hit])
+    surviving, fraction = Fraction(1), []
+    for value in intensities:
+        at_risk = int(np.sum(x >= value))
+        surviving *= Fraction(at_risk - int(np.sum(hit & (x == value))), at_risk)
+        fraction.append(1 - surviving)
+    return intensities, fraction
+
+
+def kaplan_meier_median(values: np.ndarray, reached: np.ndarray) -> float:
+    """The smallest intensity at which the Kaplan–Meier fraction reached (:func:`kaplan_meier`) is at least 1/2;
+    NaN where it never is (too many records censored, or too few reached the limit).
+
+    Without censoring (every record reached the limit, or was never seen to: +inf) this is the k-th smallest
+    value with k = ⌈n/2⌉ of the n records: with an even n the (n/2)-th, not an average with the next.
+    """
+    for value, fraction in zip(*kaplan_meier(values, reached)):
+        if 2 * fraction >= 1:
+            return float(value)
+    return float("nan")
 
 
 def collapse_margin_ratio(median_collapse_intensity: float, mce_intensity: float) -> float:

@@ -145,7 +145,9 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
                         "1 if another building's collapse ended the run before this one collapsed: its outcome "
                         "at this intensity is unknown (right-censored)"),
         "collapse_building": (run, collapse_building, {"long_name": "building whose collapse ended the run "
-                                                                     "('' if none)"}),
+                                                                     "('' if none; buildings that ran alone, "
+                                                                     "without contacts: every one that collapsed, "
+                                                                     "comma-separated)"}),
         "collapse_drift_ratio": var(("building",), np.array(plan.collapse_drifts or (plan.collapse_drift,) * nb,
                                                             dtype=float), "1",
                                     "the building's collapse drift ratio in this study",

@@ -105,13 +105,17 @@ class HuntTasks(TaskSource):
         return observed, censored_at
 
     def _next_level(self, chain: tuple[str, int]) -> float | None:
-        """The chain's next level: the first building whose hunt (:func:`next_hunt_level` on the runs that
-        observed it) asks for a level below its censoring and not yet run; None when every hunt is done."""
+        """The chain's next level: the first building (of ``plan.hunted``, default all) whose hunt
+        (:func:`next_hunt_level` on the runs that observed it) asks for a level below its censoring and not
+        yet run; None when every hunt is done."""
         found = self._histories(chain)
         if found is None:
             return None
         ran = {level for level, _ in self.runs[chain]}
-        for history, ceiling in zip(*found):
+        hunted = self.plan.hunted or self.plan.buildings
+        for name, history, ceiling in zip(self.plan.buildings, *found):
+            if name not in hunted:
+                continue
             level = next_hunt_level(self.plan.hunt, history)
             if level is not None and level < ceiling and level not in ran:
                 return level
@@ -149,6 +153,8 @@ class HuntTasks(TaskSource):
                    for level, scenario in self.runs[chain]]
         ds = assemble_ida_dataset(self.plan, results, entries, elapsed=elapsed, ran=ran)
         ds.attrs["n_lost"] = lost
+        if self.plan.hunted:   # only these buildings' collapses are bracketed (the others' fragilities: as seen)
+            ds.attrs["hunted_buildings"] = ",".join(self.plan.hunted)
         return ds
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from pounding.studies.ida.schedule import IdaPlan
 
 __all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in", "collapse_building_of",
-           "run_collapses"]
+           "run_collapses", "buildings_alone"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 IDA_PART = "ida-1"
@@ -91,8 +91,12 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
                               "format": PARTS_FORMAT}
     try:
         model, record = _model_and_record(task)
-        peaks = simulate_peaks(model, record)   # the peaks of simulate(model), without histories or dataset
-        refuse_failed_run(peaks["status"], peaks["status_message"])   # energy_inconsistent: failed
+        alone = buildings_alone(task["data"], model)
+        if alone is None:
+            peaks = simulate_peaks(model, record)   # the peaks of simulate(model), without histories or dataset
+            refuse_failed_run(peaks["status"], peaks["status_message"])   # energy_inconsistent: failed
+        else:   # buildings that cannot act on each other: each its own run, so no collapse ends another's
+            peaks = _separate_peaks(task, alone, record)
         result.update({
             "status": "ok",
             # A storey that lost its lateral resistance (unstable) is a sidesway collapse of the building.
@@ -101,6 +105,7 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "collapse_time": _plain(peaks["collapse_time"]),
             "collapse_storey": peaks["collapse_storey"],
             "collapse_building": peaks["collapse_building"],
+            **({"collapse_buildings": peaks["collapse_buildings"]} if alone is not None else {}),
             "storeys": {
                 "storey": list(peaks["storey"]),
                 "building": list(peaks["storey_building"]),
@@ -125,6 +130,55 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     return result
 
 
+def buildings_alone(document: dict[str, Any], model) -> list[dict[str, Any]] | None:
+    """One model document per building of *model* (its *document*, plain data) when its buildings cannot act
+    on each other, else None.
+
+    They cannot when the model has more than one building, no links, no contact that can close (none, or
+    every one held open: the variant without contacts) and one ground motion that reaches every building at
+    once (no wave passage, no per-building records).  Each document then keeps one building and everything
+    else of the model but its contacts: the run of that building alone is its run in the model, and a
+    neighbour's collapse can no longer end it (docs/ida.md "Collapse of each building").
+    """
+    if (len(model.buildings) < 2 or model.links or (model.gaps and not model.contacts_held_open)
+            or model.is_multi_support):
+        return None
+    rest = {k: v for k, v in document.items() if k not in ("buildings", "contacts", "links")}
+    return [dict(rest, buildings=[building]) for building in document["buildings"]]
+
+
+def _separate_peaks(task: dict[str, Any], documents: list[dict[str, Any]], record) -> dict[str, Any]:
+    """The peaks of one run of independent buildings (:func:`buildings_alone`): each building run alone on the
+    same scaled *record* (None: each model loads its own), merged in the model's order.
+
+    Every building that collapsed is in ``collapse_buildings``; ``collapse_building``, ``collapse_time`` and
+    ``collapse_storey`` are the first collapse's; the wall time is the sum.  A failed run of any building
+    (energy_inconsistent) fails the whole run, as it would the model's.
+    """
+    from pounding.simulation import refuse_failed_run, simulate_peaks
+
+    runs = []
+    for document in documents:
+        model, own = _model_and_record(dict(task, data=document))
+        peaks = simulate_peaks(model, own if record is None else record)
+        refuse_failed_run(peaks["status"], peaks["status_message"])
+        runs.append(peaks)
+    fallen = [p for p in runs if p["collapse_building"]]
+    first = min(fallen, key=lambda p: p["collapse_time"]) if fallen else runs[0]
+    merged = {key: first[key] for key in ("status", "status_message", "collapse_time", "collapse_storey",
+                                          "collapse_building", "record_scale")}
+    merged["collapse_buildings"] = [p["collapse_building"] for p in fallen]
+    merged["wall_time"] = float(sum(p["wall_time"] for p in runs))
+    for key in ("storey", "storey_building", "contact", "plane"):
+        if key in first:
+            merged[key] = [label for p in runs for label in p[key]]
+    for key in ("peak_drift_ratio", "residual_drift_ratio", "impact_count", "peak_contact_force",
+                "peak_plane_drift_ratio"):
+        if key in first:
+            merged[key] = np.concatenate([np.asarray(p[key]) for p in runs])
+    return merged
+
+
 def run_outcome(part: dict[str, Any] | None) -> str:
     """``completed``, ``collapsed`` or ``failed`` (no result, or an error) of one run's part."""
     if not part or part.get("status") != "ok" or part.get("study") != IDA_PART:
@@ -141,10 +195,13 @@ def building_drifts(part: dict[str, Any], buildings: list[str]) -> np.ndarray:
 
 
 def collapse_building_of(part: dict[str, Any]) -> str:
-    """The building whose collapse ended a run ("" if none; a part stored before parts named it: the
+    """The building whose collapse ended a run ("" if none; buildings that ran alone: every one that collapsed,
+    comma-separated; a part stored before parts named it: the
     building of its ``collapse_storey``)."""
     if part.get("outcome") != "collapsed":
         return ""
+    if "collapse_buildings" in part:   # buildings that ran alone: every one that collapsed
+        return ",".join(part["collapse_buildings"])
     if part.get("collapse_building"):
         return str(part["collapse_building"])
     storeys = part["storeys"]
@@ -159,14 +216,18 @@ def run_collapses(part: dict[str, Any] | None, plan: IdaPlan) -> tuple[np.ndarra
     IMK storey at zero strength, or a loss of resistance to P-Delta) or when its largest peak storey
     drift ratio reached its collapse drift in the study (``plan.collapse_drifts``).  It is censored when
     another building's collapse ended the run before it collapsed: its outcome at this intensity is
-    unknown (docs/ida.md "Collapse of each building").
+    unknown (docs/ida.md "Collapse of each building").  In a run of buildings that ran alone
+    (``collapse_buildings``, :func:`buildings_alone`) no building is censored.
     """
     if run_outcome(part) == "failed":
         return None
     names = np.array(plan.buildings, dtype=object)
     limits = np.array(plan.collapse_drifts or (plan.collapse_drift,) * names.size, dtype=float)
+    drifts = building_drifts(part, plan.buildings)
+    if "collapse_buildings" in part:   # each building ran alone: none was stopped by another's collapse
+        return np.isin(names, part["collapse_buildings"]) | (drifts >= limits), np.zeros(names.size, bool)
     stopper = collapse_building_of(part)
-    collapsed = (names == stopper) | (building_drifts(part, plan.buildings) >= limits)
+    collapsed = (names == stopper) | (drifts >= limits)
     stopped = part.get("outcome") == "collapsed"
     if stopped and not stopper:   # the collapse of a building not named: every building, as parts before
         collapsed[:] = True

@@ -302,6 +302,9 @@ class IdaPlan:
     #: Record pairs only: per record (a pair in one orientation) its two components, the one along the model's
     #: ``angle`` first (ground_motion x) and the one 90° further (y); empty when each record is one component.
     pairs: tuple[tuple[str, str], ...] = ()
+    #: The buildings whose collapse a hunt brackets, in model order (empty: every building); ``pounding p695``
+    #: hunts only the building of each IDA.
+    hunted: tuple[str, ...] = ()
     _cache: dict = field(default_factory=dict, repr=False)
 
     def describe_levels(self) -> str:

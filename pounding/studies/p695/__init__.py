@@ -12,13 +12,14 @@ Modules
 from __future__ import annotations
 
 from pounding.studies.p695.report import VERDICT_WORDS, p695_summary, p695_table, plot_p695, pounding_effect
-from pounding.studies.p695.study import (DEFAULT_RECORDS, P695Inputs, collapse_intensities, ida_folder,
-                                         median_collapse, p695_study, parse_systems)
+from pounding.studies.p695.study import (DEFAULT_RECORDS, OUTCOMES, P695Inputs, collapse_intensities, ida_folder,
+                                         median_collapse, outcome_counts, p695_study, parse_systems)
 from pounding.studies.p695.tables import SDCS, SYSTEMS
 from pounding.studies.p695.verdict import (Quality, Spectrum, Verdict, design_period, group_verdict, mce_spectrum,
                                            parse_quality, total_uncertainty, verdict)
 
 __all__ = ["SDCS", "SYSTEMS", "DEFAULT_RECORDS", "VERDICT_WORDS", "P695Inputs", "Quality", "Spectrum", "Verdict",
            "parse_quality", "parse_systems", "mce_spectrum", "design_period", "total_uncertainty", "verdict",
-           "group_verdict", "collapse_intensities", "median_collapse", "ida_folder", "p695_study", "p695_summary",
+           "group_verdict", "OUTCOMES", "collapse_intensities", "outcome_counts", "median_collapse", "ida_folder",
+           "p695_study", "p695_summary",
            "p695_table", "plot_p695", "pounding_effect"]

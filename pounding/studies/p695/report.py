@@ -42,7 +42,8 @@ def p695_summary(ds) -> dict:
             v = b.sel(variant=variant)
             entry["variants"][str(variant)] = {"S_CT_g": _g(float(v.s_ct)), "CMR": _plain(float(v.cmr)),
                                                "ACMR": _plain(float(v.acmr)),
-                                               "verdict": VERDICT_WORDS[int(v.passes)], "note": str(v.note.values)}
+                                               "verdict": VERDICT_WORDS[int(v.passes)], "note": str(v.note.values),
+                                               **({"records": _counts(v)} if "records_collapsed" in v else {})}
         out["buildings"][str(name)] = entry
     if "group_passes" in ds:
         out["group"] = {"buildings": ds.attrs["group"].split(","), "variants": {
@@ -51,6 +52,12 @@ def p695_summary(ds) -> dict:
                      "verdict": "PASS" if int(ds.group_passes.sel(variant=v)) else "FAIL"}
             for v in ds.variant.values}}
     return out
+
+
+def _counts(v) -> dict[str, int]:
+    """A building's records in one variant: collapsed, censored by another building's collapse, no collapse."""
+    return {"collapsed": int(v.records_collapsed), "censored": int(v.records_censored),
+            "no_collapse": int(v.records_not_collapsed)}
 
 
 def pounding_effect(ds) -> list[str]:
@@ -63,7 +70,10 @@ def pounding_effect(ds) -> list[str]:
         o = int(ds.passes.sel(variant="without_contacts", building=name))
         acmr = [float(ds.acmr.sel(variant=v, building=name)) for v in ("without_contacts", "with_contacts")]
         change = f" (ACMR {acmr[0]:.2f} -> {acmr[1]:.2f})" if all(map(math.isfinite, acmr)) else ""
-        if o == 1 and w == 0:
+        if -1 in (w, o):
+            where = " and ".join(_VARIANT[v] for v, p in (("with_contacts", w), ("without_contacts", o)) if p == -1)
+            lines.append(f"{name}: S_CT not determinable {where}; the verdicts are not compared")
+        elif o == 1 and w == 0:
             lines.append(f"{name}: pounding turns it from PASS into FAIL{change}")
         elif o == 0 and w == 1:
             lines.append(f"{name}: pounding turns it from FAIL into PASS{change}")
@@ -90,13 +100,17 @@ def p695_table(ds) -> str:
     if str(ds.attrs.get("analysis", "")).startswith("three"):
         lines.append(f"{ds.attrs['analysis']}; mu_T: the smaller of the pushovers along x and y (torsion-free "
                      "chains): " + ", ".join(f"{b} {a}" for b, a in zip(ds.building.values, ds.pushover_axis.values)))
-    lines.append(f"{'building':<10}{'variant':<18}{'S_CT g':>8}{'CMR':>7}{'ACMR':>7}  verdict (ACMR >= ACMR20)")
+    counted = "records_collapsed" in ds
+    lines.append(f"{'building':<10}{'variant':<18}{'S_CT g':>8}{'CMR':>7}{'ACMR':>7}"
+                 + (f"{'collapsed':>10}{'censored':>9}{'no coll.':>9}" if counted else "")
+                 + "  verdict (ACMR >= ACMR20)")
     for name in ds.building.values:
         for variant in ds.variant.values:
             v = ds.sel(building=name, variant=variant)
             note = str(v.note.values)
+            records = "".join(f"{n:>{w}}" for n, w in zip(_counts(v).values(), (10, 9, 9))) if counted else ""
             lines.append(f"{str(name):<10}{_VARIANT.get(str(variant), str(variant)):<18}{float(v.s_ct) / g:8.3f}"
-                         f"{float(v.cmr):7.2f}{float(v.acmr):7.2f}  {VERDICT_WORDS[int(v.passes)]}"
+                         f"{float(v.cmr):7.2f}{float(v.acmr):7.2f}{records}  {VERDICT_WORDS[int(v.passes)]}"
                          + (f" ({note})" if note else ""))
     if "group_passes" in ds:
         for variant in ds.variant.values:
@@ -116,13 +130,32 @@ def p695_tables(ds) -> dict:
 
     beside = [n for n in ("system", "period", "period_t1", "period_based_ductility", "pushover_axis", "s_mt", "ssf",
                           "beta_tot", "acmr_10", "acmr_20") if n in ds.variables]
-    verdict_table = long_table(ds, ["s_ct", "cmr", "acmr", "passes", "note"], extra=beside)
-    return {"verdict": verdict_table, "records": long_table(ds, ["collapse_intensity"])}
+    counts = [n for n in ("records_collapsed", "records_censored", "records_not_collapsed") if n in ds.variables]
+    verdict_table = long_table(ds, ["s_ct", "cmr", "acmr", "passes", "note"] + counts, extra=beside)
+    per_record = ["collapse_intensity"] + (["record_outcome"] if "record_outcome" in ds.variables else [])
+    return {"verdict": verdict_table, "records": long_table(ds, per_record)}
+
+
+def _fraction_collapsed(v) -> tuple[np.ndarray | None, np.ndarray]:
+    """The Kaplan-Meier fraction of records collapsed of one building and variant: (intensities m/s², fraction),
+    (None, []) if no record ran (an archive without ``record_outcome``: finite values collapses, inf none)."""
+    from pounding.studies.fragility import kaplan_meier
+
+    values = v.collapse_intensity.values
+    if "record_outcome" in v:
+        outcome = v.record_outcome.values
+    else:
+        outcome = np.where(np.isnan(values), "failed", np.where(np.isinf(values), "no collapse", "collapsed"))
+    ran = outcome != "failed"
+    if not ran.any():
+        return None, np.zeros(0)
+    at, fraction = kaplan_meier(values[ran], outcome[ran] == "collapsed")
+    return at, np.array([float(f) for f in fraction])
 
 
 def plot_p695(ds, directory: str | os.PathLike) -> list[Path]:
-    """``p695.png``: per building, the records' collapse intensities as an empirical fraction collapsed against
-    the set's median Sa(T), per variant, with S_MT and S_CT marked."""
+    """``p695.png``: per building, the Kaplan-Meier fraction of records collapsed (censored records counted
+    while observed) against the set's median Sa(T), per variant, with S_MT and S_CT marked."""
     from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
@@ -133,13 +166,10 @@ def plot_p695(ds, directory: str | os.PathLike) -> list[Path]:
     for ax, name in zip(axes[0], buildings):
         b = ds.sel(building=name)
         for variant, style in zip(ds.variant.values, ("-", "--")):
-            values = b.collapse_intensity.sel(variant=variant).values / g
-            values = np.sort(values[~np.isnan(values)])
-            if values.size == 0:
+            at, fraction = _fraction_collapsed(b.sel(variant=variant))
+            if at is None:
                 continue
-            fraction = np.arange(1, values.size + 1) / values.size
-            shown = np.isfinite(values)
-            ax.step(np.r_[0.0, values[shown]], np.r_[0.0, fraction[shown]], style, where="post",
+            ax.step(np.r_[0.0, at / g], np.r_[0.0, fraction], style, where="post",
                     label=f"{_VARIANT.get(str(variant), str(variant))}: ACMR {float(b.acmr.sel(variant=variant)):.2f} "
                           f"({VERDICT_WORDS[int(b.passes.sel(variant=variant))]})")
         ax.axvline(float(b.s_mt) / g, color="k", lw=0.8, ls=":", label=f"S_MT {float(b.s_mt) / g:.2f} g")

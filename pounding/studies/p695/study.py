@@ -19,7 +19,7 @@ import math
 import os
 import shutil
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -30,8 +30,8 @@ from pounding.studies.p695.tables import SYSTEMS
 from pounding.studies.p695.verdict import Quality, Spectrum, beta_rtr, design_period, group_verdict, verdict
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["DEFAULT_RECORDS", "P695Inputs", "parse_systems", "collapse_intensities", "median_collapse",
-           "ida_folder", "p695_study"]
+__all__ = ["DEFAULT_RECORDS", "OUTCOMES", "P695Inputs", "parse_systems", "collapse_intensities", "outcome_counts",
+           "median_collapse", "ida_folder", "p695_study"]
 
 #: The methodology's set for the collapse evaluation (§A.9: the far-field set, 22 pairs, 44 components; a
 #: model in plan runs its 22 pairs, each in both orientations).
@@ -81,51 +81,90 @@ class P695Inputs:
     pattern: str = "first-mode"
 
 
-def collapse_intensities(ida, building: str) -> np.ndarray:
-    """(variant, record): each record's collapse level (m/s², the set's median IM) of a hunt-and-fill IDA.
+#: A record's outcome for one building and variant (the archive's ``record_outcome``).
+OUTCOMES = ("collapsed", "censored", "no collapse", "failed")
 
-    The middle of the final bracket (the lowest collapsing level and the highest non-collapsing one below
-    it, or 0); +inf for a record that did not collapse up to the hunt's ceiling (censored); NaN for a record
-    with a failed run.
+
+def collapse_intensities(ida, building: str) -> tuple[np.ndarray, np.ndarray]:
+    """(variant, record): each record's intensity (m/s², the set's median IM) and outcome (:data:`OUTCOMES`)
+    for *building* in a hunt-and-fill IDA.
+
+    ``collapsed``: the middle of the final bracket (the lowest level where the building collapsed and the
+    highest level below it where it was seen not to, or 0).  ``censored``: another building's collapse ended
+    a run of the record before this one collapsed, and it was never seen to collapse: its collapse
+    intensity is above the highest level at which it was seen not to collapse (the value; 0 if none), and
+    unknown beyond.  ``no collapse``: seen not to collapse up to the hunt's ceiling, +inf (above every
+    collapse intensity of the study).  ``failed``: a run failed, NaN.  A censored run is neither a collapse
+    nor a survival of this building.
     """
     b = [str(x) for x in ida.building.values].index(building)
     levels = ida.level_value.values
-    # A run that another building's collapse ended (censored, issue 27 §3) counts as this building's
-    # collapse here, as it did before censoring existed: S_CT then stays a lower bound (conservative).
-    collapsed = (ida.collapsed.values[..., b] == 1) | (ida.censored.values[..., b] == 1 if "censored" in ida else False)
+    collapsed = ida.collapsed.values[..., b] == 1
+    censored = ida.censored.values[..., b] == 1 if "censored" in ida else np.zeros_like(collapsed)
     failed = ida.status.values == "failed"
     out = np.full(levels.shape[:2], np.nan)
+    outcome = np.full(levels.shape[:2], "failed", dtype=object)
     for i in range(levels.shape[0]):
         for r in range(levels.shape[1]):
             ran = np.isfinite(levels[i, r])
             if failed[i, r].any() or not ran.any():
                 continue
+            standing = levels[i, r][ran & ~collapsed[i, r] & ~censored[i, r]]
             hits = levels[i, r][ran & collapsed[i, r]]
-            if hits.size == 0:
+            if hits.size:
+                high = float(hits.min())
+                below = standing[standing < high]
+                out[i, r] = 0.5 * (high + (float(below.max()) if below.size else 0.0))
+                outcome[i, r] = "collapsed"
+            elif (ran & censored[i, r]).any():
+                out[i, r] = float(standing.max()) if standing.size else 0.0
+                outcome[i, r] = "censored"
+            else:
                 out[i, r] = math.inf
-                continue
-            high = float(hits.min())
-            below = levels[i, r][ran & ~collapsed[i, r] & (levels[i, r] < high)]
-            out[i, r] = 0.5 * (high + (float(below.max()) if below.size else 0.0))
-    return out
+                outcome[i, r] = "no collapse"
+    return out, outcome
 
 
-def median_collapse(values: np.ndarray) -> tuple[float, str]:
-    """S_CT, the median of the records' collapse intensities (FEMA P695 §6.3: half the records collapse),
-    and a note; NaN when half or more of the records did not collapse (censored) or none ran."""
-    finite_or_censored = values[~np.isnan(values)]
-    failed = int(np.isnan(values).sum())
-    notes = [f"{failed} record(s) with a failed run left out"] if failed else []
-    if finite_or_censored.size == 0:
+def outcome_counts(outcomes: np.ndarray) -> dict[str, int]:
+    """How many records had each outcome of :data:`OUTCOMES`."""
+    return {k: int(np.sum(np.asarray(outcomes) == k)) for k in OUTCOMES}
+
+
+def median_collapse(values: np.ndarray, outcomes: np.ndarray | None = None) -> tuple[float, str]:
+    """S_CT and a note: the intensity at which half the records have collapsed (FEMA P695 §6.4), from the
+    Kaplan–Meier estimate of the fraction collapsed (:func:`pounding.studies.fragility.kaplan_meier_median`).
+
+    *values* and *outcomes* as :func:`collapse_intensities` gives them (*outcomes* None: every finite value a
+    collapse, +inf no collapse, NaN a failed run).  A censored record counts while it is observed (below
+    its value) and a record with no collapse up to the ceiling at every collapse intensity; without
+    censoring S_CT is the ⌈n/2⌉-th smallest collapse intensity of the n records that ran.  NaN with the
+    reason where the estimate never reaches one half, or no record ran.
+    """
+    from pounding.studies.fragility import kaplan_meier, kaplan_meier_median
+
+    values = np.asarray(values, dtype=float)
+    if outcomes is None:
+        outcomes = np.where(np.isnan(values), "failed", np.where(np.isinf(values), "no collapse", "collapsed"))
+    counts = outcome_counts(outcomes)
+    ran = np.asarray(outcomes) != "failed"
+    n = int(ran.sum())
+    notes = [f"{counts['failed']} record(s) with a failed run left out"] if counts["failed"] else []
+    if counts["censored"]:
+        notes.append(f"{counts['censored']} of {n} records censored by another building's collapse")
+    if counts["no collapse"]:
+        notes.append(f"{counts['no collapse']} of {n} records did not collapse up to the hunt's ceiling")
+    if n == 0:
         return float("nan"), "; ".join(notes + ["no record ran"])
-    censored = int(np.isinf(finite_or_censored).sum())
-    median = float(np.median(finite_or_censored))
-    if censored:
-        notes.append(f"{censored} of {finite_or_censored.size} records did not collapse up to the hunt's ceiling")
-    if not math.isfinite(median):
-        notes.append("S_CT not determinable: at least half the records did not collapse (raise --hunt-ceiling)")
-        return float("nan"), "; ".join(notes)
-    return median, "; ".join(notes)
+    hit = np.asarray(outcomes)[ran] == "collapsed"
+    s_ct = kaplan_meier_median(values[ran], hit)
+    if math.isnan(s_ct):
+        fraction = kaplan_meier(values[ran], hit)[1]
+        reached = float(fraction[-1]) if fraction else 0.0
+        why = ("too many records censored by another building's collapse" if counts["censored"] else
+               "raise --hunt-ceiling")
+        notes.append(f"S_CT not determinable: the estimated fraction collapsed reaches only {reached:.2f}, "
+                     f"not 1/2 ({why})")
+    return s_ct, "; ".join(notes)
 
 
 def _sa_ratio(plan, period: float) -> float:
@@ -175,9 +214,10 @@ def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.Pa
     spectrum = inputs.spectrum
     heights = {b.name: float(np.sum(b.height)) for b in base.buildings}
     periods = {n: design_period(inputs.systems[n], heights[n], spectrum.s_d1) for n in names}
-    plans = {n: build_ida_plan(model, inputs.records, im="sa-t1", building=n, hunt=inputs.hunt,
-                               without_contacts=bool(base.gaps), collapse_drift=inputs.collapse_drift,
-                               scaling="auto", duration=inputs.duration) for n in names}
+    # Each building's IDA hunts that building's collapse only (hunted): another's hunt is not needed for its S_CT.
+    plans = {n: replace(build_ida_plan(model, inputs.records, im="sa-t1", building=n, hunt=inputs.hunt,
+                                       without_contacts=bool(base.gaps), collapse_drift=inputs.collapse_drift,
+                                       scaling="auto", duration=inputs.duration), hunted=(n,)) for n in names}
     if any(p.scaling != "fema-p695" for p in plans.values()):
         raise PoundingError(f"--records {inputs.records!r}: pounding p695 scales the FEMA P695 records by their "
                             "normalisation factors (§A.8); give fema-p695:farfield (the default) or some of its "
@@ -199,8 +239,9 @@ def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.Pa
         ida = ida_study(plans[n], path, overwrite=True, keep_parts=True, **run_options)
         idas[n] = ida
         ratio = _sa_ratio(plans[n], periods[n].period)
-        values = collapse_intensities(ida, n) * ratio
-        rows[n] = {"mu": mu, "bound": bound, "axis": found.axis, "ratio": ratio, "values": values,
+        values, outcomes = collapse_intensities(ida, n)
+        rows[n] = {"mu": mu, "bound": bound, "axis": found.axis, "ratio": ratio, "values": values * ratio,
+                   "outcomes": outcomes,
                    "t1": float(plans[n].im.period), "variants": [str(v) for v in ida.variant.values]}
     ds = _assemble(base, inputs, periods, heights, rows, idas, model)
     if target is not None:
@@ -228,14 +269,18 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
     passes = np.zeros((nv, nb), np.int8)
     notes = np.full((nv, nb), "", dtype=object)
     values = np.full((nv, nb, len(records)), np.nan)
+    outcomes = np.full((nv, nb, len(records)), "failed", dtype=object)
+    counts = {k: np.zeros((nv, nb), np.int32) for k in OUTCOMES}
     fixed = {k: np.full(nb, np.nan) for k in ("s_mt", "ssf", "beta_tot", "acmr_10", "acmr_20", "beta_rtr")}
     for b, n in enumerate(names):
         row, period = rows[n], periods[n].period
         s_mt = spectrum.s_mt(period)
         fixed["beta_rtr"][b] = beta_rtr(row["mu"])
         for i in range(nv):
-            values[i, b] = row["values"][i]
-            s_ct, note = median_collapse(row["values"][i] / g)
+            values[i, b], outcomes[i, b] = row["values"][i], row["outcomes"][i]
+            for k, count in outcome_counts(row["outcomes"][i]).items():
+                counts[k][i, b] = count
+            s_ct, note = median_collapse(row["values"][i] / g, row["outcomes"][i])
             v = verdict(s_ct, s_mt, period, row["mu"], spectrum.sdc, inputs.quality)
             per["s_ct"][i, b], per["cmr"][i, b], per["acmr"][i, b] = v.s_ct * g, v.cmr, v.acmr
             passes[i, b] = -1 if not math.isfinite(v.acmr) else (1 if v.passes else 0)
@@ -280,8 +325,17 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
                         "median NM Sa(T) / median NM Sa(T1) of the normalised set (converts the IDA's levels)"),
         "collapse_intensity": var(vb + ("record",), values, "m s-2",
                                   "the normalised set's median Sa(T, 5 %) at the record's collapse (middle of the "
-                                  "final hunt bracket; inf: no collapse up to the ceiling; NaN: a run failed)"),
-        "s_ct": var(vb, per["s_ct"], "m s-2", "median collapse intensity S_CT (half the records collapse)"),
+                                  "final hunt bracket); censored: the highest at which it was seen not to "
+                                  "collapse; inf: no collapse up to the ceiling; NaN: a run failed"),
+        "record_outcome": (vb + ("record",), outcomes, {"long_name": "collapsed, censored (another building's "
+                                                        "collapse ended its runs first), no collapse (up to the "
+                                                        "hunt's ceiling) or failed"}),
+        "records_collapsed": var(vb, counts["collapsed"], "1", "records in which the building collapsed"),
+        "records_censored": var(vb, counts["censored"], "1", "records censored by another building's collapse"),
+        "records_not_collapsed": var(vb, counts["no collapse"], "1",
+                                     "records with no collapse up to the hunt's ceiling"),
+        "s_ct": var(vb, per["s_ct"], "m s-2", "median collapse intensity S_CT: where the Kaplan-Meier fraction of "
+                                              "records collapsed reaches 1/2"),
         "cmr": var(vb, per["cmr"], "1", "collapse margin ratio CMR = S_CT / S_MT (§7.2)"),
         "acmr": var(vb, per["acmr"], "1", "adjusted collapse margin ratio ACMR = SSF CMR (eq. 7-1)"),
         "passes": var(vb, passes, "1", "1 if ACMR >= ACMR_20% (an individual building, §7.5), 0 if not, -1 if not "
