@@ -179,10 +179,14 @@ def test_without_contacts_nothing_impacts_and_with_contacts_something_does(strip
     assert (ds.impact_count.sel(variant="without_contacts").values == 0).all()
     assert (ds.peak_contact_force.sel(variant="without_contacts").values == 0).all()
     assert ds.impact_count.sel(variant="with_contacts").values.sum() > 0
-    # at the lowest level the floors may not reach each other; both variants then coincide exactly
+    # at the lowest level the floors may not reach each other; both variants then give the same response,
+    # integrated differently (without contacts each building runs alone, with its own adaptive steps): equal to
+    # 100 x the solver's rtol 1e-6 (the global error of an adaptive integration is a small multiple of it)
     with_, without = (ds.sel(variant=v) for v in ("with_contacts", "without_contacts"))
     quiet = with_.impact_count.sum("contact").values == 0
-    np.testing.assert_array_equal(with_.peak_drift_ratio.values[quiet], without.peak_drift_ratio.values[quiet])
+    assert quiet.any()
+    np.testing.assert_allclose(with_.peak_drift_ratio.values[quiet], without.peak_drift_ratio.values[quiet],
+                               rtol=1e-4)
 
 
 def test_the_json_has_the_shape_of_the_issue(in_process, tmp_path, capsys):
@@ -408,7 +412,12 @@ def test_an_ida_run_keeps_exactly_the_peaks_and_collapse_of_the_full_simulation(
     task = plan.scenario(variant, 0, level).task(sweep_label="test", name="pair_inelastic")
     part = ida.run_ida_scenario(task)
     assert part["status"] == "ok", part["error"]
-    model = model_from_data(task["data"], name="m", source=task["document"], base_dir=task.get("base_dir"))
+    data = task["data"]
+    if variant == "without_contacts":   # the buildings cannot touch: each runs alone; A (8 storeys) collapses
+        data = dict(data, buildings=data["buildings"][:1], contacts=[])
+        part["storeys"] = {k: v[:8] for k, v in part["storeys"].items()}
+        part["contacts"] = {k: [] for k in part["contacts"]}
+    model = model_from_data(data, name="m", source=task["document"], base_dir=task.get("base_dir"))
     full = simulate(model)
     assert part["run_status"] == full.attrs["status"]
     assert part["run_status"] == ("collapsed" if variant == "without_contacts" else "completed")
@@ -485,14 +494,16 @@ def test_runs_of_one_template_reuse_its_model_and_record_and_give_the_fresh_runs
         task = plan.scenario(variant, record, level).task(sweep_label="test", name="pair")
         part = ida.run_ida_scenario(task)
         assert part["status"] == "ok", part["error"]
-        assert len(validated) - before == (1 if afresh else 0)
-        fresh = simulate_peaks(fresh_model(task["data"], name="pair", source=task["document"],
-                                           base_dir=task.get("base_dir")))
-        np.testing.assert_array_equal(part["storeys"]["peak_drift_ratio"], fresh["peak_drift_ratio"])
-        np.testing.assert_array_equal(part["storeys"]["residual_drift_ratio"], fresh["residual_drift_ratio"])
-        np.testing.assert_array_equal(part["contacts"]["impact_count"], fresh["impact_count"])
-        np.testing.assert_array_equal(part["contacts"]["peak_contact_force"], fresh["peak_contact_force"])
-        assert part["scale_factor"] == fresh["record_scale"] == task["data"]["ground_motion"]["scale"]
+        alone = variant == "without_contacts"   # the buildings cannot touch: the model and each building alone
+        assert len(validated) - before == ((3 if alone else 1) if afresh else 0)
+        data = task["data"]
+        documents = [dict(data, buildings=[b], contacts=[]) for b in data["buildings"]] if alone else [data]
+        fresh = [simulate_peaks(fresh_model(d, name="pair", source=task["document"], base_dir=task.get("base_dir")))
+                 for d in documents]
+        for key, where in (("peak_drift_ratio", "storeys"), ("residual_drift_ratio", "storeys"),
+                           ("impact_count", "contacts"), ("peak_contact_force", "contacts")):
+            np.testing.assert_array_equal(part[where][key], np.concatenate([f[key] for f in fresh]))
+        assert part["scale_factor"] == fresh[0]["record_scale"] == task["data"]["ground_motion"]["scale"]
     # A record that cannot be read: the run fails with the loader's message, every time.
     task = plan.scenario(plan.variants[0], 0, 0.2).task(sweep_label="test", name="pair")
     broken = dict(task, data=dict(task["data"], ground_motion=dict(task["data"]["ground_motion"],

@@ -132,9 +132,8 @@ def test_both_components_are_scaled_by_one_factor_to_the_pairs_geometric_mean_sa
 # --------------------------------------------------------------------------- #
 
 
-def _reference(orientation: str, factor: float, contacts: bool = True):
-    """corner_pair run on its own by simulate: the pair shorthand (ab) or components swapped (ba); without
-    contacts: held open, as the planar IDA holds them."""
+def _reference_document(orientation: str, factor: float) -> dict:
+    """corner_pair's document shaken as the IDA's run (orientation, factor), plain data."""
     document = yaml.safe_load(Path(CORNER).read_text())
     angle = document["ground_motion"]["angle"]
     if orientation == "ab":
@@ -143,18 +142,44 @@ def _reference(orientation: str, factor: float, contacts: bool = True):
         document["ground_motion"] = {"x": {"record": f"{PAIR}b", "scale": factor},
                                      "y": {"record": f"{PAIR}a", "scale": factor}, "angle": angle,
                                      "duration": DURATION}
+    return document
+
+
+def _reference(orientation: str, factor: float, contacts: bool = True):
+    """corner_pair run on its own by simulate: the pair shorthand (ab) or components swapped (ba); without
+    contacts: held open, as the planar IDA holds them."""
+    document = _reference_document(orientation, factor)
     model = model_from_text(yaml.safe_dump(document, sort_keys=False), name="corner_pair")
     return model, simulate(model if contacts else model.with_contacts_open())
+
+
+def _alone_reference(orientation: str, factor: float) -> dict[str, np.ndarray]:
+    """corner_pair without contacts as its IDA runs it: each building on its own (the other building and the
+    contacts left out, the buildings cannot touch), by simulate, the peaks joined in the model's order."""
+    document = _reference_document(orientation, factor)
+    runs = []
+    for building in document["buildings"]:
+        one = dict(document, buildings=[building], contacts=[])
+        runs.append(simulate(model_from_text(yaml.safe_dump(one, sort_keys=False), name="corner_pair")))
+    return {k: np.concatenate([ds[k].values for ds in runs])
+            for k in ("storey", "peak_drift_ratio", "plane", "peak_plane_drift_ratio")}
 
 
 @pytest.mark.parametrize("orientation", ["ab", "ba"])
 def test_every_run_equals_a_separate_simulate_at_its_scale(stripes, orientation):
     """Bit-identical peaks: a run of the IDA is simulate_peaks of the model at the run's factor, whose peaks are
-    simulate's (the solver tracks them at every step, whatever the output sampling)."""
+    simulate's (the solver tracks them at every step, whatever the output sampling); without contacts, of each
+    building alone."""
     r = list(stripes.orientation.values).index(orientation)
     for j in range(stripes.level.size):
         factor = float(stripes.scale_factor.values[r, j])
-        for v, contacts in ((0, True), (1, False)):
+        alone = _alone_reference(orientation, factor)
+        assert list(stripes.storey.values) == list(alone["storey"])
+        np.testing.assert_array_equal(stripes.peak_drift_ratio.values[1, r, j], alone["peak_drift_ratio"])
+        assert list(stripes.plane.values) == list(alone["plane"])
+        np.testing.assert_array_equal(stripes.peak_plane_drift_ratio.values[1, r, j], alone["peak_plane_drift_ratio"])
+        assert (stripes.impact_count.values[1, r, j] == 0).all()
+        for v, contacts in ((0, True),):
             _, ds = _reference(orientation, factor, contacts)
             assert list(stripes.storey.values) == list(ds.storey.values)
             np.testing.assert_array_equal(stripes.peak_drift_ratio.values[v, r, j], ds.peak_drift_ratio.values)

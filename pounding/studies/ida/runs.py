@@ -18,7 +18,7 @@ import numpy as np
 from pounding.studies.ida.schedule import IdaPlan
 
 __all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in", "collapse_building_of",
-           "run_collapses", "buildings_alone"]
+           "run_collapses", "buildings_alone", "separate_peaks"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 IDA_PART = "ida-1"
@@ -37,8 +37,9 @@ _TEMPLATES_KEPT = 8
 _TEMPLATES_LOCK = threading.Lock()
 
 
-def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any]:
-    """The run's model and its scaled record (None: the model loads its own), reusing its template's.
+def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any, list | None]:
+    """The run's model, its scaled record (None: the model loads its own) and its buildings alone (one model
+    each, :func:`buildings_alone`; None: they run together), reusing its template's.
 
     A run is keyed by its document data with the scale left out (``repr`` of plain data: exact
     for floats), its base folder and name; a scaled record is
@@ -56,7 +57,8 @@ def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any]:
     name = task.get("name", "model")
     if not isinstance(scale, (int, float)) or isinstance(scale, bool) or "x" in ground_motion or "y" in ground_motion:
         # a target, or components given one by one (scaled in their own ``scale``): the model loads its own
-        return model_from_data(data, name=name, source=task["document"], base_dir=task.get("base_dir")), None
+        model = model_from_data(data, name=name, source=task["document"], base_dir=task.get("base_dir"))
+        return model, None, _alone_models(task, model)
     key = repr((dict(data, ground_motion=dict(ground_motion, scale=None)), task.get("base_dir"), name))
     with _TEMPLATES_LOCK:
         template = _TEMPLATES.get(key)
@@ -65,14 +67,25 @@ def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any]:
     if template is None:
         model = model_from_data(data, name=name, source=task["document"], base_dir=task.get("base_dir"))
         if model.has_building_records:
-            return model, None
-        template = (model, processed_record_for(model, where="yaml"))
+            return model, None, None
+        template = (model, processed_record_for(model, where="yaml"), _alone_models(task, model))
         with _TEMPLATES_LOCK:
             _TEMPLATES[key] = template
             while len(_TEMPLATES) > _TEMPLATES_KEPT:
                 _TEMPLATES.popitem(last=False)
-    model, processed = template
-    return model, scale_record(processed, float(scale))
+    model, processed, alone = template
+    return model, scale_record(processed, float(scale)), alone
+
+
+def _alone_models(task: dict[str, Any], model) -> list | None:
+    """Each building of the run's *model* alone, validated (:func:`buildings_alone`), or None."""
+    from pounding.model.model import model_from_data
+
+    documents = buildings_alone(task["data"], model)
+    if documents is None:
+        return None
+    return [model_from_data(d, name=task.get("name", "model"), source=task["document"], base_dir=task.get("base_dir"))
+            for d in documents]
 
 
 def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
@@ -90,13 +103,12 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": IDA_PART,
                               "format": PARTS_FORMAT}
     try:
-        model, record = _model_and_record(task)
-        alone = buildings_alone(task["data"], model)
+        model, record, alone = _model_and_record(task)
         if alone is None:
             peaks = simulate_peaks(model, record)   # the peaks of simulate(model), without histories or dataset
             refuse_failed_run(peaks["status"], peaks["status_message"])   # energy_inconsistent: failed
         else:   # buildings that cannot act on each other: each its own run, so no collapse ends another's
-            peaks = _separate_peaks(task, alone, record)
+            peaks = separate_peaks(alone, record)
         result.update({
             "status": "ok",
             # A storey that lost its lateral resistance (unstable) is a sidesway collapse of the building.
@@ -147,9 +159,9 @@ def buildings_alone(document: dict[str, Any], model) -> list[dict[str, Any]] | N
     return [dict(rest, buildings=[building]) for building in document["buildings"]]
 
 
-def _separate_peaks(task: dict[str, Any], documents: list[dict[str, Any]], record) -> dict[str, Any]:
-    """The peaks of one run of independent buildings (:func:`buildings_alone`): each building run alone on the
-    same scaled *record* (None: each model loads its own), merged in the model's order.
+def separate_peaks(models: list, record) -> dict[str, Any]:
+    """The peaks of one run of independent buildings: each building's model alone (:func:`buildings_alone`)
+    run on the same scaled *record* (None: each model loads its own), merged in the model's order.
 
     Every building that collapsed is in ``collapse_buildings``; ``collapse_building``, ``collapse_time`` and
     ``collapse_storey`` are the first collapse's; the wall time is the sum.  A failed run of any building
@@ -158,9 +170,8 @@ def _separate_peaks(task: dict[str, Any], documents: list[dict[str, Any]], recor
     from pounding.simulation import refuse_failed_run, simulate_peaks
 
     runs = []
-    for document in documents:
-        model, own = _model_and_record(dict(task, data=document))
-        peaks = simulate_peaks(model, own if record is None else record)
+    for model in models:
+        peaks = simulate_peaks(model, record)
         refuse_failed_run(peaks["status"], peaks["status_message"])
         runs.append(peaks)
     fallen = [p for p in runs if p["collapse_building"]]
