@@ -32,7 +32,7 @@ import xarray as xr
 from pounding.errors import ArchiveError
 
 __all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing",
-           "check_output_place", "atomic_path", "write_error", "check_not_input", "check_regular_file",
+           "check_output_place", "atomic_path", "write_error", "write_reason", "check_not_input", "check_regular_file",
            "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
            "REQUIRED_VARIABLES", "REQUIRED_PLANE_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
@@ -383,13 +383,13 @@ def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True)
         descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.pounding-{os.getpid()}-", suffix=".tmp",
                                                  dir=folder)
     except OSError as exc:
-        raise write_error(target, exc) from None
+        raise write_error(target, exc) from exc
     os.close(descriptor)
     try:
         try:
             yield temporary
         except OSError as exc:   # the writer failed: a full disk, a file too large, an I/O error
-            raise write_error(target, exc) from None
+            raise write_error(target, exc) from exc
         try:
             with open(temporary, "rb+") as handle:
                 os.fsync(handle.fileno())
@@ -404,7 +404,7 @@ def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True)
                                f"replaced and this run's archive is kept as {kept} (rename it, or pass "
                                "--overwrite to replace)") from None
         except OSError as exc:
-            raise write_error(target, exc) from None
+            raise write_error(target, exc) from exc
     except BaseException:
         if os.path.exists(temporary):
             os.unlink(temporary)
@@ -415,13 +415,19 @@ def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True)
 _FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
 
 
-def write_error(target: str | os.PathLike, exc: OSError) -> ArchiveError:
-    """The one line of a write of *target* that failed with *exc* (the file written atomically, so the
-    old one is kept): ``cannot write T: No space left on device (the disk is full); the old file...``."""
+def write_reason(exc: OSError) -> str:
+    """Why a write failed, in words: ``No space left on device (the disk is full)``."""
     reason = exc.strerror or str(exc)
     if exc.errno in _FULL:
         reason += " (the disk is full)" if exc.errno != errno.EFBIG else " (the file is larger than allowed)"
-    return ArchiveError(f"cannot write {target}: {reason}; the old file, if any, is unchanged")
+    return reason
+
+
+def write_error(target: str | os.PathLike, exc: OSError) -> ArchiveError:
+    """The one line of a write of *target* that failed with *exc* (the file written atomically, so the
+    old one is kept): ``cannot write T: No space left on device (the disk is full); the old file...``.
+    Raised ``from exc``: the cause stays readable (``__cause__``) and the command line prints this line."""
+    return ArchiveError(f"cannot write {target}: {write_reason(exc)}; the old file, if any, is unchanged")
 
 
 def _umask() -> int:
