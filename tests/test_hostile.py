@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -636,3 +637,81 @@ def test_a_full_disk_under_the_parts_folder_names_it_and_keeps_the_parts(own_cas
     assert any("1 of 2 scenarios already done" in note for note in notes), notes   # resumed from the kept part
     assert all((parts / name).read_bytes() == data for name, data in kept.items())
     assert len(list(parts.glob("*.json"))) == 2
+
+
+def _solver_cache_folder(numba_cache: Path) -> Path:
+    """The folder numba caches the solver's kernels in under ``NUMBA_CACHE_DIR=numba_cache``."""
+    code = "import pounding.solver.kernels; from pounding.solver import jit; print(jit.cache_folders()[0])"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(numba_cache)))
+    return Path(done.stdout.strip())
+
+
+def test_a_damaged_numba_cache_is_a_miss_and_is_replaced(own_case, tmp_path_factory):
+    # numba's cache holding the solver (the prebuilt kernels copied in: the same files numba writes), then a
+    # garbage index for the integrator and a truncated data file of a kernel it calls.  Before, every run
+    # failed with an UnpicklingError until the cache was deleted.  POUNDING_PREBUILT=0: the kernels come
+    # from numba's cache or are compiled (one compilation of the integrator here, ~15 s of CPU).
+    import pickle
+
+    cache = tmp_path_factory.mktemp("numba")
+    folder = _solver_cache_folder(cache)
+    folder.mkdir(parents=True, exist_ok=True)
+    for file in (ROOT / "pounding" / "solver" / "prebuilt").iterdir():
+        shutil.copy(file, folder / file.name)
+    index = next(folder.glob("integrator._integrate-*.nbi"))
+    index.write_bytes(os.urandom(300))
+    data = next(folder.glob("recorder.grown-*.nbc"))
+    data.write_bytes(data.read_bytes()[:1000])
+    env = {"NUMBA_CACHE_DIR": str(cache), "POUNDING_PREBUILT": "0"}
+    for attempt in ("damaged", "repaired"):
+        status, out, err = pounding(["run", "model.yaml", "-o", f"{attempt}.nc"], own_case, limit=600, env=env)
+        assert status == 0 and "Traceback" not in err, err[-2000:]
+    with open(index, "rb") as handle:   # both replaced by numba's next save: they read again
+        pickle.load(handle)
+        assert isinstance(pickle.loads(handle.read())[1], dict)
+    pickle.loads(data.read_bytes())
+    first, second = (xr.open_dataset(own_case / f"{a}.nc") for a in ("damaged", "repaired"))
+    np.testing.assert_array_equal(first.displacement.values, second.displacement.values)   # same kernels
+
+
+def _package_copy(tmp_path: Path) -> Path:
+    """A copy of the package (with its prebuilt kernels) to damage or make read-only; its parent to import from."""
+    root = tmp_path / "site-packages"
+    shutil.copytree(ROOT / "pounding", root / "pounding", ignore=shutil.ignore_patterns("__pycache__"))
+    return root
+
+
+def test_prebuild_status_names_damaged_files(tmp_path):
+    root = _package_copy(tmp_path)
+    prebuilt = root / "pounding" / "solver" / "prebuilt"
+    index, data = sorted(prebuilt.glob("*.nbi"))[0], sorted(prebuilt.glob("*.nbc"))[-1]
+    index.write_bytes(os.urandom(300))   # the first index: the one the status read, with a traceback
+    data.write_bytes(data.read_bytes()[:100])
+    done = subprocess.run([sys.executable, "-m", "pounding.prebuild", "--status"], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(root)))
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert f"2 of {len(list(prebuilt.iterdir()))} prebuilt kernel files" in done.stdout
+    assert index.name in done.stdout and data.name in done.stdout
+
+
+def test_a_read_only_install_with_a_read_only_home_runs(tmp_path):
+    # The tests run as root, for whom chmod does not stop a write: "not writable" is simulated by paths
+    # under a regular file (the package's solver/__pycache__ is a file, HOME is a file, NUMBA_CACHE_DIR is
+    # under a file), which no user can create.  Before, the solver's first kernel failed at import
+    # ("cannot cache function ...: no locator available").  The temporary folder is the writable fallback.
+    root = _package_copy(tmp_path)
+    (root / "pounding" / "solver" / "__pycache__").write_text("read-only stand-in")
+    home = tmp_path / "home"
+    home.write_text("a file, not a folder")
+    (tmp_path / "tmp").mkdir()
+    env = {key: value for key, value in os.environ.items() if key not in ("XDG_CACHE_HOME", "NUMBA_CACHE_DIR")}
+    env.update(PYTHONPATH=str(root), HOME=str(home), NUMBA_CACHE_DIR=str(home / "numba"), TMPDIR=str(tmp_path / "tmp"),
+               PYTHONDONTWRITEBYTECODE="1")
+    done = subprocess.run([sys.executable, "-m", "pounding", "run", str(ROOT / "models" / "pair.yaml"), "-o",
+                           str(tmp_path / "pair.nc"), "--duration", "2"], capture_output=True, text=True,
+                          timeout=600, cwd=tmp_path, env=env)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr[-2000:]
+    warnings = [line for line in done.stderr.splitlines() if line.startswith("pounding: warning: ")]
+    assert len(warnings) == 1 and f"NUMBA_CACHE_DIR={home / 'numba'} cannot be written" in warnings[0], warnings
+    assert (tmp_path / "tmp" / f"pounding-numba-{os.getuid()}").is_dir()
