@@ -159,10 +159,8 @@ def tolerate_damaged_files() -> None:
 
 def prepare() -> None:
     """Before the solver's first kernel is defined: a writable (or no) cache, damaged files as misses."""
-    import pounding
-
     tolerate_damaged_files()
-    use_writable_cache(Path(pounding.__file__).resolve().parent / "solver" / "kernels.py")
+    use_writable_cache(Path(__file__).resolve().parent / "solver" / "kernels.py")   # this package's solver
 
 
 class _BeforeSolver(importlib.abc.MetaPathFinder):
