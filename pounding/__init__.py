@@ -29,6 +29,9 @@ from __future__ import annotations
 __version__ = "0.1.0"
 
 from pounding.errors import PoundingError  # noqa: E402
+from pounding.numba_cache import install as _install_numba_cache  # noqa: E402
+
+_install_numba_cache()   # numba's cache folder is chosen before the solver's kernels are defined
 
 __all__ = ["__version__", "PoundingError", "load_model", "simulate", "open_run", "save_run", "rerun", "drop_ragged",
            "load_record"]

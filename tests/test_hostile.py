@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -502,3 +503,215 @@ def test_stale_temporaries_of_dead_writers_are_removed(case, tmp_path):
         p.write_bytes(b"x")
     save_run(xr.open_dataset(case / "run.nc").load(), tmp_path / "run.nc")
     assert not stale.exists() and live.exists() and other.exists()
+
+
+# --------------------------------------------------------------------------- #
+# Fourth audit: outputs onto inputs, writes that are not atomic, numba's cache
+# --------------------------------------------------------------------------- #
+
+
+@pytest.fixture
+def own_case(tmp_path):
+    """A case of its own (a failing test may destroy its files): the small model, its record, its archive,
+    a folder ``sub`` (for ``sub/..`` spellings) and links ``link.txt`` → the record, ``link.nc`` → the archive."""
+    path = _write_case(tmp_path, base_model())
+    assert main(["run", str(path), "-o", str(tmp_path / "run.nc")]) == 0
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "link.txt").symlink_to("quake.txt")
+    (tmp_path / "link.nc").symlink_to("run.nc")
+    (tmp_path / "spec.txt").write_text("0 1.0\n1 0.5\n2 0.2\n")
+    return tmp_path
+
+
+#: Commands whose output (-o, --csv, or a table --csv writes beside it) is one of the files they read, spelled
+#: through a link or ``sub/..``; each was run to the end and replaced the input (or the link to it) before.
+OUTPUTS_ONTO_INPUTS = {
+    "run --csv onto a link to the record": ["run", "model.yaml", "-o", "o.nc", "--csv", "link.txt"],
+    "run --csv whose contacts table lands on the record": ["run", "model.yaml", "-o", "o.nc", "--csv", "sub/../quake"],
+    "rerun -o onto the record it reads again": ["rerun", "run.nc", "-o", "sub/../quake.txt", "--overwrite"],
+    "table --csv onto the archive": ["table", "run.nc", "--csv", "link.nc"],
+    "export -o onto a link to the record": ["export", "opensees", "model.yaml", "-o", "link.txt", "--overwrite"],
+    "spectrum --csv onto its own input": ["spectrum", "user", "spec.txt", "--csv", "sub/../spec.txt"],
+    "hysteresis --csv onto a link to the record": ["hysteresis", "model.yaml", "--storey", "A:1", "--protocol",
+                                                   "fema461", "--amplitude", "0.01", "-o", "h.nc", "--csv",
+                                                   "link.txt"],
+    "pushover -o onto the record": ["pushover", "model.yaml", "-o", "quake.txt", "--overwrite"],
+    "gap --csv onto the record": ["gap", "model.yaml", "-o", "g.nc", "--workers", "1", "--csv", "./quake.txt"],
+    "ida --csv onto the record": ["ida", "model.yaml", "--levels", "0.1:0.2:0.1", "-o", "i.nc", "--workers", "1",
+                                  "--csv", "link.txt"],
+}
+
+
+@pytest.mark.parametrize("label", list(OUTPUTS_ONTO_INPUTS))
+def test_an_output_onto_an_input_is_refused_before_any_work(own_case, capsys, monkeypatch, label):
+    monkeypatch.chdir(own_case)
+    if "contacts table" in label:   # the record named as the table --csv quake writes beside it
+        (own_case / "quake.txt").rename(own_case / "quake.contacts.csv")
+        (own_case / "model.yaml").write_text((own_case / "model.yaml").read_text().replace("quake.txt",
+                                                                                          "quake.contacts.csv"))
+    before = {p.name: p.read_bytes() for p in own_case.iterdir() if p.is_file()}
+    links = {p.name for p in own_case.iterdir() if p.is_symlink()}
+    assert main(OUTPUTS_ONTO_INPUTS[label]) == 2
+    assert "is an input of this command" in _error(capsys)
+    after = {p.name: p.read_bytes() for p in own_case.iterdir() if p.is_file()}
+    assert after == before   # every input intact, and nothing written: refused before the work
+    assert {p.name for p in own_case.iterdir() if p.is_symlink()} == links
+
+
+def _full_disk_at(limit: int) -> None:   # runs in the child before exec: writes beyond *limit* bytes fail
+    import resource
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)   # EFBIG instead of a killed process
+    resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+
+@pytest.mark.parametrize("command", ["export", "spectrum"])
+def test_a_write_that_fails_midway_keeps_the_old_file(own_case, command):
+    # A file-size limit makes the write of the new file fail part-way (EFBIG), as a full disk does (ENOSPC):
+    # before, the exported script was written in place (truncated to the limit), and the spectrum's CSV
+    # failure was reported as "is standard output a full disk".  The limit is above anything the command
+    # writes besides (compiled-Python caches) and below the new file (the script ~20 kB, the CSV ~150 kB).
+    old = b"the old, good file\n"
+    target = own_case / ("model_opensees.py" if command == "export" else "spectrum.csv")
+    target.write_bytes(old)
+    args = (["export", "opensees", "model.yaml", "-o", target.name, "--overwrite"] if command == "export" else
+            ["spectrum", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--periods", "0:4:0.001", "--csv", target.name])
+    environ = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONDONTWRITEBYTECODE="1")
+    done = subprocess.run([sys.executable, "-m", "pounding", *args], cwd=own_case, capture_output=True, text=True,
+                          timeout=120, env=environ, preexec_fn=lambda: _full_disk_at(8192))
+    errors = [line for line in done.stderr.splitlines() if line.startswith("pounding: error: ")]
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert len(errors) == 1 and f"cannot write {target.name}" in errors[0] and "is unchanged" in errors[0], errors
+    assert target.read_bytes() == old
+    assert not [p.name for p in own_case.iterdir() if ".pounding-" in p.name]   # no temporary left
+
+
+def test_a_full_disk_while_writing_tables_keeps_the_old_tables(own_case, capsys, monkeypatch):
+    import errno
+
+    import pandas as pd
+
+    target = own_case / "peaks.csv"
+    target.write_text("old\n")
+    original = pd.DataFrame.to_csv
+
+    def half_then_full(self, path, *args, **kwargs):   # half of the table written, then ENOSPC
+        original(self.iloc[: len(self) // 2], path, *args, **kwargs)
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(pd.DataFrame, "to_csv", half_then_full)
+    assert main(["table", str(own_case / "run.nc"), "--csv", str(target)]) == 2
+    error = _error(capsys)
+    assert f"cannot write {target}" in error and "disk is full" in error and "standard output" not in error
+    assert target.read_text() == "old\n"
+    assert not [p.name for p in own_case.iterdir() if ".pounding-" in p.name]
+
+
+def test_a_full_disk_under_the_parts_folder_names_it_and_keeps_the_parts(own_case, in_process_client, monkeypatch):
+    import errno
+
+    from pounding.studies.sweep import load_sweep, run_sweep
+
+    (own_case / "s.yaml").write_text("model: model.yaml\naxes:\n  contacts[*].gap: [0.01, 0.02]\n")
+    output, parts = own_case / "out.nc", own_case / "out.nc.parts"
+    original, calls = Path.write_bytes, []
+
+    def full_after_one(self, data):   # the first part is stored, the second meets a full disk half-way
+        if ".pounding-" in self.name and self.parent == parts:
+            calls.append(self)
+            if len(calls) > 1:
+                original(self, data[: len(data) // 2])
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return original(self, data)
+
+    monkeypatch.setattr(Path, "write_bytes", full_after_one)
+    with pytest.raises(PoundingError, match=r"parts folder .*out\.nc\.parts: No space left on device \(the disk "
+                                            r"is full\).*run the same command again to resume"):
+        run_sweep(load_sweep(own_case / "s.yaml"), output, client=in_process_client, progress=False)
+    kept = {p.name: p.read_bytes() for p in parts.iterdir()}
+    assert len(kept) == 1 and all(name.endswith(".json") for name in kept)   # the stored part, no temporary
+    monkeypatch.setattr(Path, "write_bytes", original)
+    notes: list[str] = []
+    run_sweep(load_sweep(own_case / "s.yaml"), output, client=in_process_client, progress=False, keep_parts=True,
+              log=notes.append)
+    assert any("1 of 2 scenarios already done" in note for note in notes), notes   # resumed from the kept part
+    assert all((parts / name).read_bytes() == data for name, data in kept.items())
+    assert len(list(parts.glob("*.json"))) == 2
+
+
+def _solver_cache_folder(numba_cache: Path) -> Path:
+    """The folder numba caches the solver's kernels in under ``NUMBA_CACHE_DIR=numba_cache``."""
+    code = "import pounding.solver.kernels; from pounding.solver import jit; print(jit.cache_folders()[0])"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(numba_cache)))
+    return Path(done.stdout.strip())
+
+
+def test_a_damaged_numba_cache_is_a_miss_and_is_replaced(own_case, tmp_path_factory):
+    # numba's cache holding the solver (the prebuilt kernels copied in: the same files numba writes), then a
+    # garbage index for the integrator and a truncated data file of a kernel it calls.  Before, every run
+    # failed with an UnpicklingError until the cache was deleted.  POUNDING_PREBUILT=0: the kernels come
+    # from numba's cache or are compiled (one compilation of the integrator here, ~15 s of CPU).
+    import pickle
+
+    cache = tmp_path_factory.mktemp("numba")
+    folder = _solver_cache_folder(cache)
+    folder.mkdir(parents=True, exist_ok=True)
+    for file in (ROOT / "pounding" / "solver" / "prebuilt").iterdir():
+        shutil.copy(file, folder / file.name)
+    index = next(folder.glob("integrator._integrate-*.nbi"))
+    index.write_bytes(os.urandom(300))
+    data = next(folder.glob("recorder.grown-*.nbc"))
+    data.write_bytes(data.read_bytes()[:1000])
+    env = {"NUMBA_CACHE_DIR": str(cache), "POUNDING_PREBUILT": "0"}
+    for attempt in ("damaged", "repaired"):
+        status, out, err = pounding(["run", "model.yaml", "-o", f"{attempt}.nc"], own_case, limit=600, env=env)
+        assert status == 0 and "Traceback" not in err, err[-2000:]
+    with open(index, "rb") as handle:   # both replaced by numba's next save: they read again
+        pickle.load(handle)
+        assert isinstance(pickle.loads(handle.read())[1], dict)
+    pickle.loads(data.read_bytes())
+    first, second = (xr.open_dataset(own_case / f"{a}.nc") for a in ("damaged", "repaired"))
+    np.testing.assert_array_equal(first.displacement.values, second.displacement.values)   # same kernels
+
+
+def _package_copy(tmp_path: Path) -> Path:
+    """A copy of the package (with its prebuilt kernels) to damage or make read-only; its parent to import from."""
+    root = tmp_path / "site-packages"
+    shutil.copytree(ROOT / "pounding", root / "pounding", ignore=shutil.ignore_patterns("__pycache__"))
+    return root
+
+
+def test_prebuild_status_names_damaged_files(tmp_path):
+    root = _package_copy(tmp_path)
+    prebuilt = root / "pounding" / "solver" / "prebuilt"
+    index, data = sorted(prebuilt.glob("*.nbi"))[0], sorted(prebuilt.glob("*.nbc"))[-1]
+    index.write_bytes(os.urandom(300))   # the first index: the one the status read, with a traceback
+    data.write_bytes(data.read_bytes()[:100])
+    done = subprocess.run([sys.executable, "-m", "pounding.prebuild", "--status"], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(root)))
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    assert f"2 of {len(list(prebuilt.iterdir()))} prebuilt kernel files" in done.stdout
+    assert index.name in done.stdout and data.name in done.stdout
+
+
+def test_a_read_only_install_with_a_read_only_home_runs(tmp_path):
+    # The tests run as root, for whom chmod does not stop a write: "not writable" is simulated by paths
+    # under a regular file (the package's solver/__pycache__ is a file, HOME is a file, NUMBA_CACHE_DIR is
+    # under a file), which no user can create.  Before, the solver's first kernel failed at import
+    # ("cannot cache function ...: no locator available").  The temporary folder is the writable fallback.
+    root = _package_copy(tmp_path)
+    (root / "pounding" / "solver" / "__pycache__").write_text("read-only stand-in")
+    home = tmp_path / "home"
+    home.write_text("a file, not a folder")
+    (tmp_path / "tmp").mkdir()
+    env = {key: value for key, value in os.environ.items() if key not in ("XDG_CACHE_HOME", "NUMBA_CACHE_DIR")}
+    env.update(PYTHONPATH=str(root), HOME=str(home), NUMBA_CACHE_DIR=str(home / "numba"), TMPDIR=str(tmp_path / "tmp"),
+               PYTHONDONTWRITEBYTECODE="1")
+    done = subprocess.run([sys.executable, "-m", "pounding", "run", str(ROOT / "models" / "pair.yaml"), "-o",
+                           str(tmp_path / "pair.nc"), "--duration", "2"], capture_output=True, text=True,
+                          timeout=600, cwd=tmp_path, env=env)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr[-2000:]
+    warnings = [line for line in done.stderr.splitlines() if line.startswith("pounding: warning: ")]
+    assert len(warnings) == 1 and f"NUMBA_CACHE_DIR={home / 'numba'} cannot be written" in warnings[0], warnings
+    assert (tmp_path / "tmp" / f"pounding-numba-{os.getuid()}").is_dir()

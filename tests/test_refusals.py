@@ -171,6 +171,8 @@ CASES: dict[str, Case] = {
     "compare, gap, ida, p695 of a record per building": Case(
         "(it runs the model under one record at a time) needs one model-level ground_motion",
         {"MODEL.yaml": PER_BUILDING}, ("--duration", "1") + STUDY),
+    "an output that is an input (-o, --csv and the tables beside it, export opensees -o, spectrum --csv)": Case(
+        "is an input of this command", extra=("--duration", "1")),
 }
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
+from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.cli.run import SCALE_HELP, parse_scale_option
 from pounding.cli.sweep import add_cluster_options, check_study_options, print_study_warnings, raise_if_all_failed
 from pounding.studies.compare import DEFAULT_FORMULAS, REFERENCE, compare, comparison_table, plot_comparison
@@ -17,7 +17,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
-    check_csv(args, [args.model])
+    check_outputs(args, [args.model])
     scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
         ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,

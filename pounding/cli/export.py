@@ -12,24 +12,26 @@ __all__ = ["register_cli"]
 
 
 def _cmd_export_opensees(args: argparse.Namespace) -> int:
+    from pounding.cli.csv_option import check_outputs
     from pounding.export.opensees import DEFAULT_DT, opensees_script_and_notes
     from pounding.model.model import load_model
-    from pounding.results.archive import check_not_input
-    from pounding.simulation import model_inputs, record_path
+    from pounding.results.archive import atomic_path, check_output_place
+    from pounding.simulation import record_path
 
     dt = DEFAULT_DT if args.dt is None else args.dt
+    output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
+    check_outputs(argparse.Namespace(**{**vars(args), "output": str(output)}))   # the default name too
+    check_output_place(output, "-o", folder=False)
+    if (output.exists() or output.is_symlink()) and not args.overwrite:
+        raise PoundingError(f"{output} exists; pass --overwrite to replace it")
     model = load_model(args.model)
     record = None if args.record is None else record_path(args.record)   # relative to the current directory
-    output = Path(args.output) if args.output else Path(Path(args.model).stem + "_opensees.py")
-    check_not_input(output, [args.model] + model_inputs(model) + ([str(record)] if record is not None else []))
     source, notes = opensees_script_and_notes(model, record, dt=dt, xi=args.xi, duration=args.duration,
                                               where="cli")
-    if output.exists() and not args.overwrite:
-        raise PoundingError(f"{output} exists; pass --overwrite to replace it")
-    try:
-        output.write_text(source, encoding="utf-8")
-    except OSError as exc:
-        raise PoundingError(f"cannot write {output}: {exc.strerror}") from None
+    if output.parent != Path("."):
+        output.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(output) as temporary:   # a full disk keeps the old script
+        Path(temporary).write_text(source, encoding="utf-8")
     for note in notes:
         print(f"pounding: note: {note}", file=sys.stderr)
     print(f"wrote {output} (run: python {output} [--dt DT] [-o peaks.json])")

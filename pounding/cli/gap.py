@@ -9,7 +9,7 @@ import sys
 from pounding.cli.run import SCALE_HELP, parse_scale_option
 from pounding.cli.spectrum import add_spectrum_options
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted, print_study_warnings
-from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
+from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.errors import PoundingError
 
 __all__ = ["register_cli"]
@@ -71,7 +71,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
 
         if is_plan_file(args.model):
             return _cmd_code_gap(args, plan=True)
-    check_csv(args, [args.model])
+    check_outputs(args, [args.model])
     if args.code:
         return _cmd_code_gap(args)
     _refuse_spectrum_without_code(args)

@@ -8,14 +8,13 @@ __all__ = ["register_cli"]
 
 
 def _cmd_hysteresis(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_not_input, check_output_place, check_writable, save_run
+    from pounding.cli.csv_option import check_outputs
+    from pounding.results.archive import check_output_place, check_writable, save_run
     from pounding.studies.cyclic import PROTOCOLS, hysteresis_test, plot_hysteresis, write_csv
 
     inputs = [args.model] + ([] if args.protocol in PROTOCOLS else [args.protocol])
     check_writable(args.output, overwrite=args.overwrite, inputs=inputs)
-    if args.csv:
-        check_output_place(args.csv, "--csv", folder=False)
-        check_not_input(args.csv, inputs + [args.output])
+    check_outputs(args)   # -o and --csv: not the model, its records or the protocol file
     if args.plot:
         check_output_place(args.plot, "--plot", folder=True)
     ds = hysteresis_test(args.model, args.storey, args.protocol, args.amplitude)

@@ -7,7 +7,7 @@ import json
 import sys
 
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
-from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
+from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.errors import PoundingError
 
 __all__ = ["register_cli", "add_hunt_options"]
@@ -19,7 +19,7 @@ def _cmd_ida(args: argparse.Namespace) -> int:
     from pounding.results.checks import model_warnings, print_warnings
 
     check_study_options(args)
-    check_csv(args, [args.model])
+    check_outputs(args, [args.model])
     hunt = None
     if args.hunt:
         hunt = Hunt(start=args.hunt_start, step=args.hunt_step, increment=args.hunt_increment,

@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
+from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.cli.ida import add_hunt_options
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
 
@@ -25,7 +25,7 @@ def _cmd_p695(args: argparse.Namespace) -> int:
                                        parse_quality, parse_systems, plot_p695)
 
     check_study_options(args)
-    check_csv(args, [args.model])
+    check_outputs(args, [args.model])
     names = [b.name for b in load_model(args.model).buildings]
     groups = tuple(x.strip() for x in args.group.split(",") if x.strip()) if args.group else ()
     inputs = P695Inputs(systems=parse_systems(args.system, names),

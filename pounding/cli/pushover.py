@@ -12,11 +12,13 @@ PATTERNS = ("first-mode", "triangular", "uniform")
 
 
 def _cmd_pushover(args: argparse.Namespace) -> int:
+    from pounding.cli.csv_option import check_outputs
     from pounding.results.archive import check_output_place, check_writable, save_run
     from pounding.studies.pushover import plot_pushover, pushover, pushover_table
 
     if args.output:
         check_writable(args.output, overwrite=args.overwrite, inputs=[args.model])
+        check_outputs(args)   # nor the model's record files
     if args.plot:
         check_output_place(args.plot, "--plot", folder=True)
     ds = pushover(args.model, pattern=args.pattern, building=args.building, steps=args.steps, period=args.period,

@@ -7,7 +7,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from pounding.cli.csv_option import add_csv_option, check_csv, write_csv_option
+from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 
 __all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options", "outcome_status",
            "UNTRUSTED_RUN_STATUS"]
@@ -112,7 +112,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
     if args.plot:
         _check_plot_dir(args.plot)
-    check_csv(args, [args.model])
+    check_outputs(args, [args.model])
     with output_lock(output):   # a second run onto the same name refuses here, before computing
         return _run_locked(args, output, started)
 
@@ -189,6 +189,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
     from pounding.simulation import rerun
 
     check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
+    check_outputs(args)   # nor the records the rerun reads again
     with output_lock(args.output, writer="pounding rerun"):
         check_writable(args.output, overwrite=args.overwrite, inputs=[args.run])
         before = open_run(args.run)

@@ -91,11 +91,12 @@ def _periods(text: str | None, spectrum) -> np.ndarray:
 def _cmd_spectrum(args: argparse.Namespace) -> int:
     from pounding.units import STANDARD_GRAVITY
 
+    from pounding.cli.csv_option import check_outputs
     from pounding.results.archive import check_output_place
 
-    for option in ("--csv", "--plot"):   # both are files
-        if getattr(args, option[2:]):
-            check_output_place(getattr(args, option[2:]), option, folder=False)
+    check_outputs(args)   # --csv: not the user spectrum's own file
+    if args.plot:   # a file
+        check_output_place(args.plot, "--plot", folder=False, inputs=[getattr(args, "spectrum_file", None)])
     spectrum = spectrum_from_args(args)
     periods = _periods(args.periods, spectrum)
     print(spectrum_table(spectrum, periods))

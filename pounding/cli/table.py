@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from pounding.cli.csv_option import archive_tables, check_csv, write_csv_option
+from pounding.cli.csv_option import archive_tables, check_outputs, write_csv_option
 
 __all__ = ["register_cli"]
 
@@ -13,7 +13,7 @@ def _cmd_table(args: argparse.Namespace) -> int:
     from pounding.cli.run import open_archive
     from pounding.results.tables import format_tables
 
-    check_csv(args, [args.archive])
+    check_outputs(args, [args.archive])
     kind, ds = open_archive(args.archive)
     if args.csv:
         write_csv_option(args, kind, ds)

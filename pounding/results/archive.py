@@ -14,6 +14,7 @@ never leaves a truncated archive; an existing file is never replaced unless
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import signal
@@ -31,7 +32,7 @@ import xarray as xr
 from pounding.errors import ArchiveError
 
 __all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing",
-           "check_output_place", "atomic_path", "check_not_input", "check_regular_file",
+           "check_output_place", "atomic_path", "write_error", "write_reason", "check_not_input", "check_regular_file",
            "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
            "REQUIRED_VARIABLES", "REQUIRED_PLANE_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
@@ -58,18 +59,22 @@ def nearest_existing(path: str | os.PathLike) -> Path:
     return probe
 
 
-def check_output_place(path: str | os.PathLike, option: str, *, folder: bool) -> None:
-    """Before any computation: *path* (a folder if *folder*, else a file) can be made where it is asked.
+def check_output_place(path: str | os.PathLike, option: str, *, folder: bool, inputs: tuple | list = ()) -> None:
+    """Before any computation: *path* (a folder if *folder*, else a file) can be made where it is asked,
+    and a file is none of the command's *inputs*.
 
-    One line naming *option* (``--plot``, ``--csv``) where the path is a file but a folder is asked (or a
-    folder but a file is), where an ancestor is a file, or where the closest existing folder is not
-    writable: found after the work, each was a traceback with the results lost.
+    One line naming *option* (``--plot``, ``--csv``, ``-o``) where the path is a file but a folder is asked
+    (or a folder but a file is), where an ancestor is a file, where the closest existing folder is not
+    writable, or where the file is one of *inputs* (:func:`check_not_input`: after resolving links and
+    ``..``): found after the work, each was a traceback with the results lost, or an input destroyed.
 
     Raises
     ------
     ArchiveError
     """
     target = Path(path)
+    if not folder:
+        check_not_input(target, inputs, option)
     if folder and target.exists() and not target.is_dir():
         raise ArchiveError(f"{option} {target}: it is a file; {option} needs a directory")
     if not folder and target.is_dir():
@@ -155,8 +160,11 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
     return target
 
 
-def check_not_input(output: str | os.PathLike, inputs: tuple | list = ()) -> None:
-    """Refuse an *output* that is the same file as one of *inputs* (after resolving links and ``..``).
+def check_not_input(output: str | os.PathLike, inputs: tuple | list = (), option: str = "") -> None:
+    """Refuse an *output* that is the same file as one of *inputs*: the same path after resolving links
+    and ``..`` (either may be a link), or the same file under another name (a hard link).
+
+    *option* (``--csv``) names the output in the message.
 
     Raises
     ------
@@ -174,7 +182,8 @@ def check_not_input(output: str | os.PathLike, inputs: tuple | list = ()) -> Non
         except (OSError, RuntimeError):
             same = False
         if same:
-            raise ArchiveError(f"{out} is an input of this command ({item}); writing there would destroy it: "
+            shown = f"{option} {out}" if option else str(out)
+            raise ArchiveError(f"{shown} is an input of this command ({item}); writing there would destroy it: "
                                "choose another output file")
 
 
@@ -353,7 +362,10 @@ def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True)
 
     On success the file is flushed to disk and renamed over *target* (an
     atomic replacement on POSIX); on any failure, including KeyboardInterrupt,
-    it is removed and *target* is left as it was.  The temporary name carries
+    it is removed and *target* is left as it was.  Every file pounding writes
+    goes through here (archives, CSV tables, parts, exported scripts); a
+    writer's ``OSError`` (a full disk) is re-raised as the one line of
+    :func:`write_error`.  The temporary name carries
     the writer's pid (``.NAME.pounding-PID-XXXX.tmp``) so that temporaries of
     writers that were killed are removed by the next writer in that folder
     (*clean_stale*; a writer of many files in one folder, such as a sweep's
@@ -371,10 +383,13 @@ def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True)
         descriptor, temporary = tempfile.mkstemp(prefix=f".{target.name}.pounding-{os.getpid()}-", suffix=".tmp",
                                                  dir=folder)
     except OSError as exc:
-        raise ArchiveError(f"cannot write {target}: {exc.strerror or exc}") from None
+        raise write_error(target, exc) from exc
     os.close(descriptor)
     try:
-        yield temporary
+        try:
+            yield temporary
+        except OSError as exc:   # the writer failed: a full disk, a file too large, an I/O error
+            raise write_error(target, exc) from exc
         try:
             with open(temporary, "rb+") as handle:
                 os.fsync(handle.fileno())
@@ -389,12 +404,30 @@ def atomic_path(target: Path, *, clean_stale: bool = True, replace: bool = True)
                                f"replaced and this run's archive is kept as {kept} (rename it, or pass "
                                "--overwrite to replace)") from None
         except OSError as exc:
-            raise ArchiveError(f"cannot write {target}: {exc.strerror or exc}; the old file, if any, is "
-                               "unchanged") from None
+            raise write_error(target, exc) from exc
     except BaseException:
         if os.path.exists(temporary):
             os.unlink(temporary)
         raise
+
+
+#: errno of a write that failed for want of space.
+_FULL = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+
+
+def write_reason(exc: OSError) -> str:
+    """Why a write failed, in words: ``No space left on device (the disk is full)``."""
+    reason = exc.strerror or str(exc)
+    if exc.errno in _FULL:
+        reason += " (the disk is full)" if exc.errno != errno.EFBIG else " (the file is larger than allowed)"
+    return reason
+
+
+def write_error(target: str | os.PathLike, exc: OSError) -> ArchiveError:
+    """The one line of a write of *target* that failed with *exc* (the file written atomically, so the
+    old one is kept): ``cannot write T: No space left on device (the disk is full); the old file...``.
+    Raised ``from exc``: the cause stays readable (``__cause__``) and the command line prints this line."""
+    return ArchiveError(f"cannot write {target}: {write_reason(exc)}; the old file, if any, is unchanged")
 
 
 def _umask() -> int:

@@ -268,9 +268,14 @@ def _storey(model, storey: str):
 
 def write_csv(ds: xr.Dataset, path: str | Path) -> Path:
     """``storey_drift_m,storey_shear_N``, one row per step."""
+    from pounding.results.archive import atomic_path
+
     path = Path(path)
     rows = np.column_stack([ds.storey_drift.values, ds.storey_shear.values])
-    np.savetxt(path, rows, delimiter=",", header="storey_drift_m,storey_shear_N", comments="", fmt="%.17g")
+    if str(path.parent):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as temporary:   # a full disk keeps the old file
+        np.savetxt(temporary, rows, delimiter=",", header="storey_drift_m,storey_shear_N", comments="", fmt="%.17g")
     return path
 
 

@@ -34,11 +34,19 @@ def parts_dir(output: str | os.PathLike) -> Path:
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
-    from pounding.results.archive import atomic_path
+    """Write one part; a failure (a full disk) is one line naming the parts folder, whose parts are kept."""
+    from pounding.errors import ArchiveError
+    from pounding.results.archive import atomic_path, write_reason
 
-    # The parts folder is cleaned of killed writers' temporaries once, by prepare_store.
-    with atomic_path(path, clean_stale=False) as temporary:
-        Path(temporary).write_bytes(data)
+    try:
+        # The parts folder is cleaned of killed writers' temporaries once, by prepare_store.
+        with atomic_path(path, clean_stale=False) as temporary:
+            Path(temporary).write_bytes(data)
+    except ArchiveError as exc:
+        reason = write_reason(exc.__cause__) if isinstance(exc.__cause__, OSError) else str(exc)
+        raise PoundingError(f"cannot store a finished scenario in the parts folder {path.parent}: {reason}; the "
+                            "scenarios stored there so far are kept: free some space (or choose another output) and "
+                            "run the same command again to resume") from None
 
 
 def _fsync_dir(path: Path) -> None:
