@@ -34,7 +34,11 @@ name, like the ξ formulas; each entry cites its source):
 
 Over a record set: the median, 84th percentile and maximum of each, the
 fraction of records for which each rule is unconservative (rule < required),
-and the verdict against the model's own gap ("enough for N of M records").
+and the verdict against the model's own gap ("enough for N of M records").  A
+record on which a building collapses stays in: its need is +inf (unbounded),
+the statistics are order statistics over every record that ran
+(:func:`order_statistic`), and one that falls on a collapsed record is "not
+bounded" (:data:`NOT_BOUNDED`).
 
 The exact maximum of u_left − u_right is taken on the cubic Hermite
 interpolant of the stored samples (the approach and its rate at every
