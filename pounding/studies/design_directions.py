@@ -561,8 +561,11 @@ def _building_summary(building, found: dict[str, Any], code: str) -> dict[str, A
 
 
 def _simulated(ds, rows: list[dict[str, Any]], name: str, use_max: bool) -> None:
-    """Each row's simulated requirement (mean, max over the records that ran) at intensity *name*, in place."""
-    ok = ds.status.values == "ok"
+    """Each row's simulated requirement (mean, max over the records that ran, a collapsed one's +inf) at
+    intensity *name*, in place."""
+    from pounding.studies.gap import records_ran
+
+    ok = records_ran(ds)
     # a contact point of the gap study's archive: its face (YAML order) and place, as the rows name it
     labels = [f"{face}@{place_label((float(x), float(y)))}" for face, x, y in
               zip(ds.point_face.values, ds.point_x.values, ds.point_y.values)]
@@ -588,7 +591,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
     """
     from pounding.model.model import load_model
     from pounding.studies.common import pair_values
-    from pounding.studies.gap import gap_study
+    from pounding.studies.gap import gap_study, record_outcomes, records_ran
 
     model = load_model(model_path)
     if not model.faces:
@@ -605,7 +608,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
     for intensity in found["intensities"]:
         factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
         ds = gap_study(model_path, pairs, scale=factor, duration=duration, **run_options)
-        ok = ds.status.values == "ok"
+        ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
         use_max = code == "ec8" and int(ok.sum()) < EC8_MEAN_RECORDS
         _simulated(ds, rows, intensity.name, use_max)
         intensities.append({"name": intensity.name, "why": intensity.why, "target": intensity.spectrum.name,
@@ -613,8 +616,7 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
                             "spectrum_kind": "RotD100 spectrum of the pairs" if code == "asce7-22"
                             else "spectrum of the components",
                             "records_ok": int(ok.sum()), "statistic": "max" if use_max else "mean",
-                            "failed": {str(r): str(e) for r, e, good in zip(ds.record.values, ds.error.values, ok)
-                                       if not good}})
+                            **record_outcomes(ds)})
     return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
             "records": pairs, "intensities": intensities, "contacts": rows, "sides": ("first", "second"),
             "buildings": {b.name: _building_summary(b, found, code) for b in model.buildings}}

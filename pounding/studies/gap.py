@@ -34,7 +34,11 @@ name, like the ξ formulas; each entry cites its source):
 
 Over a record set: the median, 84th percentile and maximum of each, the
 fraction of records for which each rule is unconservative (rule < required),
-and the verdict against the model's own gap ("enough for N of M records").
+and the verdict against the model's own gap ("enough for N of M records").  A
+record on which a building collapses stays in: its need is +inf (unbounded),
+the statistics are order statistics over every record that ran
+(:func:`order_statistic`), and one that falls on a collapsed record is "not
+bounded" (:data:`NOT_BOUNDED`).
 
 The exact maximum of u_left − u_right is taken on the cubic Hermite
 interpolant of the stored samples (the approach and its rate at every
@@ -60,12 +64,17 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.registry import add_unique
 
-__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "gap_attrs",
+__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "order_statistic",
+           "records_ran", "record_outcomes", "bounded_value", "NOT_BOUNDED", "COLLAPSE_STATUSES", "gap_attrs",
            "normal_mode", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
            "gap_summary", "gap_table", "gap_tables", "plot_gap"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 GAP_PART = "gap-2"
+#: Run statuses that end a contact-free run early because a building collapsed or lost its lateral resistance.
+COLLAPSE_STATUSES = ("collapsed", "unstable")
+#: How a statistic that falls on a collapsed record (+inf in the archive) is written in text, CSV and JSON.
+NOT_BOUNDED = "not bounded"
 
 
 # --------------------------------------------------------------------------- #
@@ -351,7 +360,7 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     from pounding.model.model import model_from_text
     from pounding.results.checks import run_warnings
     from pounding.results.dataset import record_pga
-    from pounding.simulation import component_records, simulate
+    from pounding.simulation import component_records, refuse_failed_run, simulate
     from pounding.studies.common import ground_pga
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
@@ -362,12 +371,13 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
         ds = simulate(model.with_contacts_open())
-        if ds.attrs.get("status", "completed") != "completed":
-            # A building that collapsed or lost its resistance stops the run: the peaks of a truncated
-            # history are no separation (they would understate it), so the record is an error.
-            raise PoundingError(f"{ds.attrs.get('status_message', ds.attrs['status'])}; no separation is derived "
-                                "from a run that did not reach the record's end (lower --scale, or check the "
-                                "model's strength)")
+        status = ds.attrs.get("status", "completed")
+        message = str(ds.attrs.get("status_message", status))
+        refuse_failed_run(status, message)   # energy_inconsistent: no answer, an error
+        if status not in ("completed", *COLLAPSE_STATUSES):
+            raise PoundingError(f"{message}; the contact-free run did not reach the record's end")
+        # A building that collapsed or lost its resistance stops the run: its need is at least what the
+        # truncated history reached and unbounded after; the statistics count it as +inf (over_records).
         found = required_separations(model, ds)
         # One record: its PGA as the archive has it; a pair: the geometric mean of its components' PGAs.
         intensity = ground_pga([r for r in component_records(model) if r is not None]) \
@@ -375,6 +385,8 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
         result.update(_contact_info(model, ds))
         result.update({
             "status": "ok",
+            "outcome": "collapsed" if status in COLLAPSE_STATUSES else "completed",
+            "collapse": message if status in COLLAPSE_STATUSES else "",
             "required": found["required"].tolist(),
             "peak_left": found["peak_left"].tolist(),
             "peak_right": found["peak_right"].tolist(),
@@ -435,29 +447,87 @@ def build_gap_sweep(model: str | os.PathLike, records: str | list[str] | None = 
     return record_sweep(model, base, "gap", settings, records, f"<gap {os.fspath(model)}>")
 
 
-def over_records(values: np.ndarray, ok: np.ndarray) -> dict[str, np.ndarray]:
-    """Median, 84th percentile (linear interpolation) and maximum over the records of the *ok* ones.
+def order_statistic(values: np.ndarray, percent: float) -> np.ndarray:
+    """The *percent* percentile over axis −2 by linear interpolation between order statistics, +inf where it is
+    not bounded.
+
+    With the n values sorted, x₍₀₎ ≤ … ≤ x₍ₙ₋₁₎ (+inf last), and h = (n − 1)·p::
+
+        Q(p) = x₍⌊h⌋₎ + (h − ⌊h⌋) (x₍⌊h⌋+1₎ − x₍⌊h⌋₎)
+
+    (Hyndman & Fan 1996, definition 7; numpy's ``linear``; the median is Q(0.5)).  Where the highest order
+    statistic it uses, x₍⌈h⌉₎, is +inf (a collapsed record's requirement), Q is +inf: not bounded.  Otherwise
+    it is numpy's value on the finite order statistics (an +inf is replaced by the largest finite value,
+    which keeps every order statistic used).
 
     Parameters
     ----------
     values : ndarray
-        Per record along axis −2 (``record`` × contact or point, or ``rule`` × ``record`` × ...), in m.
-    ok : ndarray of bool
-        Which records ran.
+        Records along axis −2 (n ≥ 1), m; +inf for a collapsed record, no NaN.
+    percent : float
+        p in percent (50: the median, 84).
+
+    Returns
+    -------
+    ndarray
+        *values* without axis −2, m (+inf: not bounded).
+    """
+    n = values.shape[-2]
+    used = math.ceil((n - 1) * (percent / 100.0))   # the highest order statistic the interpolation reaches
+    infinite = np.isposinf(values)
+    top = np.max(np.where(infinite, -np.inf, values), axis=-2, keepdims=True)
+    finite = np.where(infinite, np.where(np.isfinite(top), top, 0.0), values)
+    value = np.median(finite, axis=-2) if percent == 50.0 else np.percentile(finite, percent, axis=-2)
+    return np.where(n - infinite.sum(axis=-2) <= used, np.inf, value)
+
+
+def over_records(values: np.ndarray, ran: np.ndarray) -> dict[str, np.ndarray]:
+    """Median, 84th percentile and maximum over the records that *ran* (:func:`order_statistic`).
+
+    Parameters
+    ----------
+    values : ndarray
+        Per record along axis −2 (``record`` × contact or point, or ``rule`` × ``record`` × ...), in m; +inf
+        for a record on which a building collapsed (its need is unbounded).
+    ran : ndarray of bool
+        Which records ran (completed or collapsed; a failed record is left out).
 
     Returns
     -------
     dict
-        ``median``, ``p84`` and ``max``: *values* without the record axis (nan where no record ran), in m.
+        ``median``, ``p84`` and ``max``: *values* without the record axis, in m (+inf: the statistic falls
+        on a collapsed record, not bounded; NaN where no record ran).
     """
-    good = values[..., ok, :]
+    good = values[..., ran, :]
     if good.shape[-2] == 0:
         nan = np.full(good.shape[:-2] + good.shape[-1:], np.nan)
         return {"median": nan, "p84": nan, "max": nan}
-    return {"median": np.median(good, axis=-2), "p84": np.percentile(good, 84.0, axis=-2), "max": good.max(axis=-2)}
+    return {"median": order_statistic(good, 50.0), "p84": order_statistic(good, 84.0), "max": good.max(axis=-2)}
 
 
-def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float) -> dict:
+def records_ran(ds) -> np.ndarray:
+    """Which records of a gap archive ran (``status`` ok or collapsed): those its statistics are over."""
+    return np.isin(ds.status.values, ("ok", "collapsed"))
+
+
+def record_outcomes(ds) -> dict[str, dict[str, str]]:
+    """The records of a gap archive that did not complete: ``failed`` (record: its error) and ``collapsed``
+    (record: what stopped its run)."""
+    out: dict[str, dict[str, str]] = {"failed": {}, "collapsed": {}}
+    for record, message, status in zip(ds.record.values, ds.error.values, ds.status.values):
+        if status in ("error", "collapsed"):
+            out["failed" if status == "error" else "collapsed"][str(record)] = str(message)
+    return out
+
+
+def bounded_value(value: Any) -> float | str | None:
+    """A statistic for JSON: a float, :data:`NOT_BOUNDED` for +inf (it falls on a collapsed record), None for
+    NaN (no record ran)."""
+    number = float(value)
+    return NOT_BOUNDED if number == math.inf else number if math.isfinite(number) else None
+
+
+def gap_attrs(sweep, title: str, status: np.ndarray, *, ran: int, elapsed: float) -> dict:
     """The global attributes of a gap study's dataset.
 
     Parameters
@@ -466,8 +536,8 @@ def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float) ->
         The study's sweep (its heading, model name and path).
     title : str
         The title's opening, followed by ``of`` and the sweep's heading.
-    ok : ndarray of bool
-        Which records ran (``n_records``, ``n_failed``).
+    status : ndarray of str
+        Per record ``ok``, ``collapsed`` or ``error`` (``n_records``, ``n_collapsed``, ``n_failed``).
     ran : int
         Records run by this call.
     elapsed : float
@@ -480,7 +550,8 @@ def gap_attrs(sweep, title: str, ok: np.ndarray, *, ran: int, elapsed: float) ->
                              "source": f"pounding {__version__}", "study": "gap"}
     attrs.update({"model_path": sweep.model_path or "",
                   "rules": "; ".join(f"{r.key}: {r.title} ({r.reference})" for r in RULES.values()),
-                  "n_records": len(ok), "n_failed": int((~ok).sum()), "n_run": ran, "elapsed_time": elapsed,
+                  "n_records": len(status), "n_collapsed": int((status == "collapsed").sum()),
+                  "n_failed": int((status == "error").sum()), "n_run": ran, "elapsed_time": elapsed,
                   "Conventions": "CF-1.8"})
     return attrs
 
@@ -495,21 +566,42 @@ POINT_COORDS = {
 
 
 def _records_layout(parts: list[dict[str, Any]], nc: int) -> dict[str, np.ndarray]:
-    """Per record × contact ``required``, ``peak_left``, ``peak_right`` (m) and per record ``scale_factor``,
-    ``intensity`` of the records that ran (NaN elsewhere), ``status`` and ``error``."""
+    """Per record × contact ``required`` (+inf for a collapsed record), ``reached`` (the largest approach the
+    run reached), ``peak_left``, ``peak_right`` (m) and per record ``scale_factor``, ``intensity`` of the
+    records that ran (NaN elsewhere), ``status`` (``ok``, ``collapsed``, ``error``) and ``error`` (a collapsed
+    record's: what stopped its run)."""
     nr = len(parts)
-    out = {k: np.full((nr, nc), np.nan) for k in ("required", "peak_left", "peak_right")}
+    out = {k: np.full((nr, nc), np.nan) for k in ("required", "reached", "peak_left", "peak_right")}
     out.update({k: np.full(nr, np.nan) for k in ("scale_factor", "intensity")})
+    status, error = [], []
     for r, part in enumerate(parts):
+        collapsed = part.get("status") == "ok" and part.get("outcome") == "collapsed"
+        status.append("collapsed" if collapsed else part.get("status", "error"))
+        error.append(str(part.get("collapse", "") if collapsed else part.get("error", "") or ""))
         if part.get("status") != "ok":
             continue
-        for key in ("required", "peak_left", "peak_right"):
-            out[key][r] = part[key]
+        for key, name in (("reached", "required"), ("peak_left", "peak_left"), ("peak_right", "peak_right")):
+            out[key][r] = part[name]
+        out["required"][r] = np.inf if collapsed else out["reached"][r]
         out["scale_factor"][r] = part.get("scale_factor", np.nan)
         out["intensity"][r] = part.get("intensity", np.nan)
-    out["status"] = np.array([p.get("status", "error") for p in parts], dtype=object)
-    out["error"] = np.array([p.get("error", "") or "" for p in parts], dtype=object)
+    out["status"] = np.array(status, dtype=object)
+    out["error"] = np.array(error, dtype=object)
     return out
+
+
+def _statistics(layout: dict[str, np.ndarray], separation: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
+    """The study's statistics over records: of the requirement and each rule's separation (+inf on a collapsed
+    record: :func:`over_records`), each rule's unconservative fraction (over the records that completed: on a
+    collapsed one both are unbounded) and the records the model's *gap* suffices for (a collapsed one: none)."""
+    status, required = layout["status"], layout["required"]
+    ran, done = status != "error", status == "ok"
+    separation = np.where((status == "collapsed")[None, :, None], np.inf, separation)
+    unconservative = (separation[:, done] < required[None, done]).mean(axis=1) if done.any() \
+        else np.full(separation.shape[::2], np.nan)
+    enough = (gap[None, :] >= required[ran]).sum(axis=0).astype(np.int32)
+    return {"required": over_records(required, ran), "rules": over_records(separation, ran),
+            "separation": separation, "unconservative": unconservative, "enough": enough}
 
 
 def _gap_coords(records: list[str], first: dict[str, Any] | None, rules: list[str]) -> dict[str, tuple]:
@@ -563,19 +655,14 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
     required, peak_left, peak_right = layout["required"], layout["peak_left"], layout["peak_right"]
     rho = np.array(first["correlation"] if first else [], dtype=float)
     rules = list(RULES)
-    separation = np.stack([RULES[k].function(peak_left, peak_right, rho[None, :]) for k in rules]) \
-        if nc else np.zeros((len(rules), len(records), 0))
+    gap = np.array(first["gap"] if first else [], dtype=float)
+    found = _statistics(layout, np.stack([RULES[k].function(peak_left, peak_right, rho[None, :]) for k in rules])
+                        if nc else np.zeros((len(rules), len(records), 0)), gap)
+    separation, req, sep = found["separation"], found["required"], found["rules"]
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = separation / required[None, :, :]
-    ok = layout["status"] == "ok"
-    gap = np.array(first["gap"] if first else [], dtype=float)
-
-    req = over_records(required, ok)
-    sep = over_records(separation, ok)
-    unconservative = (separation[:, ok] < required[None, ok]).mean(axis=1) if ok.any() \
-        else np.full((len(rules), nc), np.nan)
-    enough = (gap[None, :] >= required[ok]).sum(axis=0).astype(np.int32) if nc else np.zeros(0, np.int32)
     pair = bool(first and "point_x" in first)
+    unbounded = "; +inf: not bounded (it falls on a record on which a building collapsed)"
 
     def var(dims, data, units, long_name, **extra):
         return (dims, data, {"units": units, "long_name": long_name, **extra})
@@ -584,27 +671,40 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
         {
             "required_gap": var(("record", "contact"), required, "m",
                                 "separation needed to avoid pounding: max over t of the approach of the two sides "
-                                "along the normal (u_left - u_right), floored at 0"),
+                                "along the normal (u_left - u_right), floored at 0; +inf for a record on which a "
+                                "building collapsed (unbounded)"),
+            "required_gap_reached": var(("record", "contact"), layout["reached"], "m",
+                                        "largest approach of the two sides reached by the run (a collapsed "
+                                        "record's: before its run stopped, a lower bound of its need)"),
             "peak_displacement_left": var(("record", "contact"), peak_left, "m",
                                           "peak absolute displacement of the left floor along the normal at the "
                                           "contact (contact-free run)"),
             "peak_displacement_right": var(("record", "contact"), peak_right, "m",
                                            "peak absolute displacement of the right floor along the normal at the "
                                            "contact (contact-free run; 0 for a wall)"),
-            "rule_gap": var(("rule", "record", "contact"), separation, "m", "separation by the combination rule"),
+            "rule_gap": var(("rule", "record", "contact"), separation, "m",
+                            "separation by the combination rule (+inf for a collapsed record: its peaks are unbounded)"),
             "rule_ratio": var(("rule", "record", "contact"), ratio, "1",
-                              "rule separation / required separation (< 1: unconservative)"),
-            "required_gap_median": var(("contact",), req["median"], "m", "median required separation over records"),
+                              "rule separation / required separation (< 1: unconservative; NaN for a collapsed record)"),
+            "required_gap_median": var(("contact",), req["median"], "m",
+                                       "median required separation over the records that ran" + unbounded),
             "required_gap_p84": var(("contact",), req["p84"], "m",
-                                    "84th percentile of the required separation over records (linear interpolation)"),
-            "required_gap_max": var(("contact",), req["max"], "m", "largest required separation over records"),
-            "rule_gap_median": var(("rule", "contact"), sep["median"], "m", "median rule separation over records"),
-            "rule_gap_p84": var(("rule", "contact"), sep["p84"], "m", "84th percentile of the rule separation"),
-            "rule_gap_max": var(("rule", "contact"), sep["max"], "m", "largest rule separation over records"),
-            "unconservative_fraction": var(("rule", "contact"), unconservative, "1",
-                                           "fraction of records for which the rule is below the required separation"),
-            "records_enough": var(("contact",), enough, "1",
-                                  "number of records for which the model's gap is at least the required separation"),
+                                    "84th percentile of the required separation over the records that ran (linear "
+                                    "interpolation between order statistics)" + unbounded),
+            "required_gap_max": var(("contact",), req["max"], "m", "largest required separation over records"
+                                    + unbounded),
+            "rule_gap_median": var(("rule", "contact"), sep["median"], "m", "median rule separation over records"
+                                   + unbounded),
+            "rule_gap_p84": var(("rule", "contact"), sep["p84"], "m", "84th percentile of the rule separation"
+                                + unbounded),
+            "rule_gap_max": var(("rule", "contact"), sep["max"], "m", "largest rule separation over records"
+                                + unbounded),
+            "unconservative_fraction": var(("rule", "contact"), found["unconservative"], "1",
+                                           "fraction of the records that completed for which the rule is below the "
+                                           "required separation"),
+            "records_enough": var(("contact",), found["enough"], "1",
+                                  "number of records for which the model's gap is at least the required separation "
+                                  "(a collapsed record: never)"),
             "correlation": var(("contact",), rho, "1",
                                "CQC correlation of the two buildings' modes of largest effective mass along the "
                                "normal (Der Kiureghian 1981; 0 against a wall)"),
@@ -612,11 +712,14 @@ def assemble_gap_dataset(sweep, results: dict[str, dict[str, Any]], *, elapsed: 
                                 "factor applied to the record" + (" (both components of the pair)" if pair else "")),
             "intensity": var(("record",), layout["intensity"], "m s-2",
                              PGA_LONG_NAME + ("; a pair: the geometric mean of its two components'" if pair else "")),
-            "status": (("record",), layout["status"], {"long_name": "ok, or error (see variable error)"}),
-            "error": (("record",), layout["error"], {"long_name": "error message of a failed record"}),
+            "status": (("record",), layout["status"], {"long_name": "ok, collapsed (a building collapsed in the "
+                                                                    "contact-free run: its need is unbounded), or "
+                                                                    "error (see variable error)"}),
+            "error": (("record",), layout["error"], {"long_name": "error message of a failed record; what stopped "
+                                                                  "the run of a collapsed one"}),
         },
         coords=_gap_coords(records, first, rules),
-        attrs=gap_attrs(sweep, "pounding gap study", ok, ran=ran, elapsed=elapsed),
+        attrs=gap_attrs(sweep, "pounding gap study", layout["status"], ran=ran, elapsed=elapsed),
     )
     warnings = study_warnings(p.get("warnings") for p in parts if p.get("status") == "ok")
     if warnings:   # each kind once for the study (pounding.results.checks)
@@ -645,16 +748,19 @@ def gap_study(model: str | os.PathLike, records: str | list[str] | None = None, 
 
 def gap_summary(ds, model: str = "") -> dict[str, Any]:
     """The study as one JSON-ready document (SI units, metres); a contact point in plan adds its ``point``
-    (x, y, normal, face)."""
+    (x, y, normal, face).  A value that is not bounded (a collapsed record's requirement, a statistic that
+    falls on one) is the words :data:`NOT_BOUNDED`; ``collapsed`` names the records on which a building
+    collapsed, with what stopped the run."""
     from pounding.studies.common import finite_or_none
 
-    ok = ds.status.values == "ok"
+    status = ds.status.values
+    ran = records_ran(ds)
     records = [str(r) for r in ds.record.values]
     out: dict[str, Any] = {"model": model or ds.attrs.get("model_name", ds.attrs.get("title", "")), "records": records, "contacts": {}}
     for c, label in enumerate(ds.contact.values):
         def shape(values: np.ndarray, median: Any, p84: Any, largest: Any) -> dict[str, Any]:
-            return {"per_record": {rec: finite_or_none(v) for rec, v, good in zip(records, values, ok) if good},
-                    "median": finite_or_none(median), "p84": finite_or_none(p84), "max": finite_or_none(largest)}
+            return {"per_record": {rec: bounded_value(v) for rec, v, good in zip(records, values, ran) if good},
+                    "median": bounded_value(median), "p84": bounded_value(p84), "max": bounded_value(largest)}
 
         entry = {
             "gap": float(ds.gap.values[c]),
@@ -667,71 +773,99 @@ def gap_summary(ds, model: str = "") -> dict[str, Any]:
                                         for k, rule in enumerate(ds.rule.values)},
             "correlation": finite_or_none(ds.correlation.values[c]),
             "records_enough": int(ds.records_enough.values[c]),
-            "records_ok": int(ok.sum()),
+            "records_ok": int((status == "ok").sum()),
+            "records_collapsed": int((status == "collapsed").sum()),
         }
         if "point_x" in ds.coords:
             entry["point"] = {"x": float(ds.point_x.values[c]), "y": float(ds.point_y.values[c]),
                               "normal": str(ds.point_normal.values[c]), "face": str(ds.point_face.values[c])}
         out["contacts"][str(label)] = entry
-    failed = {rec: str(err) for rec, err, good in zip(records, ds.error.values, ok) if not good}
-    if failed:
-        out["failed"] = failed
+    out.update({key: listed for key, listed in record_outcomes(ds).items() if listed})
     return out
 
 
 def _mm(value: float) -> str:
-    return "-" if not math.isfinite(value) else f"{1000 * value:.1f}"
+    return NOT_BOUNDED if value == math.inf else "-" if not math.isfinite(value) else f"{1000 * value:.1f}"
+
+
+def _collapsed_line(ds) -> list[str]:
+    """The line that names the records on which a building collapsed (none: no line)."""
+    collapsed = [str(r) for r, s in zip(ds.record.values, ds.status.values) if s == "collapsed"]
+    if not collapsed:
+        return []
+    return [f"collapsed ({len(collapsed)}: {', '.join(collapsed[:3])}{', ...' if len(collapsed) > 3 else ''}): a "
+            "building collapsed in the contact-free run, so its need is unbounded; it counts as exceeding every "
+            f"separation, and a statistic that falls on it is '{NOT_BOUNDED}'"]
 
 
 def gap_table(ds) -> str:
     """The study as a printed table (millimetres): a row per contact (per contact point in plan)."""
-    ok = ds.status.values == "ok"
-    n_ok = int(ok.sum())
+    status = ds.status.values
+    n_ran, n_collapsed = int(records_ran(ds).sum()), int((status == "collapsed").sum())
     rules = [str(r) for r in ds.rule.values]
     width = max([14] + [len(str(label)) for label in ds.contact.values])
-    lines = [f"required separation over {n_ok} record{'s' if n_ok != 1 else ''} (mm; contact-free runs), "
-             "and the code rules on the same runs"]
-    head = f"{'contact':<{width}} {'gap':>7} {'median':>7} {'p84':>7} {'max':>7}  " + \
-           "  ".join(f"{r + ' p84':>9} {'unsafe':>6}" for r in rules) + "  verdict"
-    lines.append(head)
+    rows = []
     for c, label in enumerate(ds.contact.values):
-        row = (f"{str(label):<{width}} {_mm(float(ds.gap.values[c])):>7} {_mm(float(ds.required_gap_median.values[c])):>7} "
-               f"{_mm(float(ds.required_gap_p84.values[c])):>7} {_mm(float(ds.required_gap_max.values[c])):>7}  ")
-        cells = []
+        cells = [_mm(float(ds.gap.values[c]))] + [_mm(float(ds[f"required_gap_{s}"].values[c]))
+                                                   for s in ("median", "p84", "max")]
         for k in range(len(rules)):
             fraction = float(ds.unconservative_fraction.values[k, c])
-            cells.append(f"{_mm(float(ds.rule_gap_p84.values[k, c])):>9} "
-                         f"{('-' if not math.isfinite(fraction) else f'{100 * fraction:.0f}%'):>6}")
-        enough = int(ds.records_enough.values[c])
-        row += "  ".join(cells) + f"  enough for {enough} of {n_ok}"
-        lines.append(row)
-    lines.append("unsafe: fraction of records for which the rule is below the required separation; "
-                 "ddc uses rho = CQC of the modes of largest effective mass along the normal "
+            cells += [_mm(float(ds.rule_gap_p84.values[k, c])),
+                      "-" if not math.isfinite(fraction) else f"{100 * fraction:.0f}%"]
+        rows.append((str(label), cells, f"enough for {int(ds.records_enough.values[c])} of {n_ran}"))
+    heads = ["gap", "median", "p84", "max"] + [h for r in rules for h in (r + " p84", "unsafe")]
+    least = [7] * 4 + [9, 6] * len(rules)
+    widths = [max([least[k], len(h)] + [len(row[1][k]) for row in rows]) for k, h in enumerate(heads)]
+
+    def line(first: str, cells: list[str], last: str) -> str:
+        body = " ".join(f"{cell:>{w}}" for cell, w in zip(cells[:4], widths[:4])) + "  " + "  ".join(
+            f"{cells[k]:>{widths[k]}} {cells[k + 1]:>{widths[k + 1]}}" for k in range(4, len(cells), 2))
+        return f"{first:<{width}} {body}  {last}"
+
+    lines = [f"required separation over {n_ran} record{'s' if n_ran != 1 else ''} (mm; contact-free runs"
+             + (f"; {n_collapsed} collapsed" if n_collapsed else "") + "), and the code rules on the same runs",
+             line("contact", heads, "verdict")]
+    lines += [line(*row) for row in rows]
+    lines.append("unsafe: fraction of the records that completed for which the rule is below the required "
+                 "separation; ddc uses rho = CQC of the modes of largest effective mass along the normal "
                  f"({', '.join(f'{x:.3f}' for x in ds.correlation.values)})")
+    lines += _collapsed_line(ds)
     if "point_x" in ds.coords:
         lines.append("a contact point's separation is along its face's normal; a face needs the larger of its "
                      "points' (the approach is linear along the face)")
     return "\n".join(lines)
 
 
+def _not_bounded_words(frame):
+    """*frame* with every +inf written :data:`NOT_BOUNDED` (its columns then hold text beside numbers)."""
+    for column in frame.columns:
+        values = frame[column].to_numpy()
+        if values.dtype.kind == "f" and np.isposinf(values).any():
+            frame[column] = np.where(np.isposinf(values), NOT_BOUNDED, values.astype(object))
+    return frame
+
+
 def gap_tables(ds) -> dict:
     """Tables of a gap archive (metres): ``contacts`` (the model's gap, the required separation's median,
     84th percentile and maximum, the records it suffices for; a point in plan with its place and face),
     ``rules`` (each rule's separation and how often it is unconservative), ``records`` (per record and
-    contact: the required separation and the peak displacements it came from) and ``rule_records`` (each
-    rule per record and contact)."""
+    contact: the required separation, the approach the run reached and the peak displacements it came from)
+    and ``rule_records`` (each rule per record and contact).  A value that is not bounded (+inf in the
+    archive) is written :data:`NOT_BOUNDED`."""
     from pounding.results.tables import long_table
 
     place = ["building_left", "level_left", "elevation_left", "building_right", "level_right", "elevation_right"]
     place += [name for name in POINT_COORDS if name in ds.coords]
-    return {
+    reached = ["required_gap_reached"] if "required_gap_reached" in ds else []
+    tables = {
         "contacts": long_table(ds, ["gap", "required_gap_median", "required_gap_p84", "required_gap_max",
                                     "records_enough", "correlation"], extra=place),
         "rules": long_table(ds, ["rule_gap_median", "rule_gap_p84", "rule_gap_max", "unconservative_fraction"]),
-        "records": long_table(ds, ["required_gap", "peak_displacement_left", "peak_displacement_right"],
+        "records": long_table(ds, ["required_gap", *reached, "peak_displacement_left", "peak_displacement_right"],
                               extra=["status", "scale_factor", "intensity", "gap"]),
         "rule_records": long_table(ds, ["rule_gap", "rule_ratio"], extra=["status"]),
     }
+    return {name: _not_bounded_words(frame) for name, frame in tables.items()}
 
 
 def _face_envelope(ds, chosen: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
@@ -748,7 +882,8 @@ def _face_envelope(ds, chosen: np.ndarray) -> tuple[np.ndarray, np.ndarray, list
 
 def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
     """``gap_profile.png``: required separation against elevation per record, the rules and the model's gap, one
-    panel per pair of buildings (contact points in plan: each face's largest, the face's requirement)."""
+    panel per pair of buildings (contact points in plan: each face's largest, the face's requirement).  A record
+    on which a building collapsed has no line, and a statistic that is not bounded (+inf) is not drawn."""
     from pounding.results.plots import finish_profile_panel, plot_directory, pyplot, save_figure, suptitle
 
     plt = pyplot()
@@ -777,8 +912,10 @@ def plot_gap(ds, directory: str | os.PathLike) -> list[Path]:
         rho = float(np.mean(ds.correlation.values[sel]))
         finish_profile_panel(ax, "separation (mm)", "elevation of the contact (m)",
                              f"{left} | {right}   (ddc with rho = {rho:.3f}; rho near 0: ddc = srss)", title_size=9)
-    suptitle(fig, f"separation needed to avoid pounding, {int(ok.sum())} record(s) run\n{ds.attrs.get('title', '')}",
-                 9)
+    collapsed = int((ds.status.values == "collapsed").sum())
+    suptitle(fig, f"separation needed to avoid pounding, {int(records_ran(ds).sum())} record(s) run"
+             + (f", {collapsed} collapsed (a statistic that falls on one is {NOT_BOUNDED}: not drawn)" if collapsed
+                else "") + f"\n{ds.attrs.get('title', '')}", 9)
     path = out / "gap_profile.png"
     save_figure(fig, path)
     return [path]
