@@ -334,7 +334,7 @@ def test_a_period_out_of_any_buildings_range_is_warned_of_once_per_study(tmp_pat
     assert _warnings(capsys.readouterr().err) == [f"pounding: warning: {warned} (2 of 2 runs)"]
 
 
-def test_a_plan_building_in_tonnes_is_warned_of_and_a_stiff_single_storey_is_not(tmp_path):
+def test_a_plan_building_in_tonnes_is_warned_of_and_a_stiff_single_storey_is_not(tmp_path, capsys):
     from pounding.model.model import load_model
 
     shipped = load_model(ROOT / "models" / "corner_pair.yaml")
@@ -344,9 +344,12 @@ def test_a_plan_building_in_tonnes_is_warned_of_and_a_stiff_single_storey_is_not
     path.write_text(text.replace("mass: 3.5e5", "mass: 350"))
     # masses and (by the default radius of gyration) rotational inertias / 1000: every period / sqrt(1000)
     period = float(max(shipped.periods["A"])) / np.sqrt(1000.0)
-    assert checks.model_warnings(load_model(path)) == {
-        "period": f"building A (6 storeys) has a fundamental period of {period:.3g} s (less than 0.05 s): are its "
-                  "floor masses in tonnes instead of kg?"}
+    warned = (f"building A (6 storeys) has a fundamental period of {period:.3g} s (less than 0.05 s): are its floor "
+              "masses in tonnes instead of kg?")
+    assert checks.model_warnings(load_model(path)) == {"period": warned}
+    # and a run in plan says so, as a planar run does
+    assert main(["run", str(path), "--no-contacts", "--duration", "0.2", "-o", str(tmp_path / "x.nc")]) == 0
+    assert _warnings(capsys.readouterr().err) == [f"pounding: warning: {warned}"]
     # a single storey may be that stiff (a one-storey wall building); two storeys at 0.049 s may not
     assert checks.period_warnings({"A": 0.02}, {"A": 1}) == {}
     assert "period" in checks.period_warnings({"A": 0.049}, {"A": 2})
