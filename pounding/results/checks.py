@@ -59,8 +59,9 @@ G_RECORD_STRONG_G = 1.5
 #: Own PGA (g) below which a record declared in m/s² or cm/s² is flagged: a record of 0.1-0.49 g in g read as m/s²
 #: has 0.01-0.05 g, weaker than the motions a pounding study is run for.
 SI_RECORD_FLOOR_G = 0.05
-#: A design spectrum's parameter (S_DS, S_D1, S_MS, S_M1, a_g; g) above which it is flagged: the value in m/s² is
-#: 9.81 times, in % of g 100 times the value in g, so most such mistakes land above it.
+#: A design spectrum's parameter (S_DS, S_D1, S_MS, S_M1, a_g; g) above which it is flagged: twice the S_MS of
+#: FEMA P695's highest design category (Dmax, 1.5 g; FEMA P695 2009, Table 5-1A); the value in m/s² is 9.81 times,
+#: in % of g 100 times the value in g, so most such mistakes land above it.
 SPECTRAL_LIMIT_G = 3.0
 #: Fundamental period (s) below which a building of more than one storey is flagged: floor masses in tonnes read as
 #: kg divide the periods by 31.6 (sqrt 1000); a single storey may be that stiff (a one-storey wall building).
