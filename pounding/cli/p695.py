@@ -20,13 +20,15 @@ SYSTEMS = ("steel-moment", "rc-moment", "steel-ebf", "steel-brbf", "other")
 
 def _cmd_p695(args: argparse.Namespace) -> int:
     from pounding.model.model import load_model
+    from pounding.results.checks import model_warnings, print_warnings, spectrum_warnings
     from pounding.studies.ida import Hunt
     from pounding.studies.p695 import (P695Inputs, ida_folder, mce_spectrum, p695_study, p695_summary, p695_table,
                                        parse_quality, parse_systems, plot_p695)
 
     check_study_options(args)
     check_outputs(args, [args.model])
-    names = [b.name for b in load_model(args.model).buildings]
+    model = load_model(args.model)
+    names = [b.name for b in model.buildings]
     groups = tuple(x.strip() for x in args.group.split(",") if x.strip()) if args.group else ()
     inputs = P695Inputs(systems=parse_systems(args.system, names),
                         spectrum=mce_spectrum(args.sdc, args.sms, args.sm1), quality=parse_quality(args.quality),
@@ -34,6 +36,10 @@ def _cmd_p695(args: argparse.Namespace) -> int:
                         hunt=Hunt(start=args.hunt_start, step=args.hunt_step, increment=args.hunt_increment,
                                   tolerance=args.tolerance, runs=args.runs_per_record, ceiling=args.hunt_ceiling),
                         collapse_drift=args.collapse_drift, duration=args.duration, pattern=args.pattern)
+    # its runs are not checked one by one (an IDA's): the model and the spectrum once; its records are the
+    # FEMA P695 far-field set, in g (a record of another set is refused)
+    print_warnings([*model_warnings(model).values(),
+                    *spectrum_warnings({"S_MS": args.sms, "S_M1": args.sm1}).values()])
     try:
         ds = p695_study(args.model, inputs, args.output, overwrite=args.overwrite, keep_parts=args.keep_parts,
                         workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)

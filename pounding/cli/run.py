@@ -149,8 +149,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     print(summary(ds))
     for warning in model.warnings:
         print(f"warning: {warning}")
-    if not model.in_plan:   # the checks read storeys' hysteresis attributes, which a plan archive lacks
-        print_warnings(run_warnings(ds).values())
+    print_warnings(run_warnings(ds).values())
     print(f"wrote {path}")
     write_csv_option(args, "run", ds)
     if args.plot:

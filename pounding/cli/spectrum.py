@@ -10,7 +10,7 @@ import numpy as np
 
 from pounding.errors import PoundingError
 
-__all__ = ["register_cli", "spectrum_from_args", "add_spectrum_options", "spectrum_table"]
+__all__ = ["register_cli", "spectrum_from_args", "add_spectrum_options", "spectrum_table", "warn_of_parameters"]
 
 
 def spectrum_from_args(args: argparse.Namespace, *, code: str | None = None):
@@ -36,6 +36,15 @@ def spectrum_from_args(args: argparse.Namespace, *, code: str | None = None):
             raise PoundingError("a user spectrum needs a file of two columns, period (s) and Sa (g)")
         return ds.read_user_spectrum(args.spectrum_file)
     raise PoundingError(f"unknown code {code!r}; choose asce7-22, ec8 or user")  # pragma: no cover
+
+
+def warn_of_parameters(args: argparse.Namespace, code: str) -> None:
+    """The ``spectrum`` warning (:func:`pounding.results.checks.spectrum_warnings`) of the parsed options of *code*'s
+    spectrum (``asce7-22``: S_DS, S_D1; ``ec8``: a_g), on stderr."""
+    from pounding.results.checks import print_warnings, spectrum_warnings
+
+    given = {"asce7-22": {"S_DS": "sds", "S_D1": "sd1"}, "ec8": {"a_g": "ag"}}.get(code, {})
+    print_warnings(spectrum_warnings({name: getattr(args, key, None) for name, key in given.items()}).values())
 
 
 def add_spectrum_options(parser: argparse.ArgumentParser, code: str, *, q: bool = True) -> None:
@@ -98,6 +107,7 @@ def _cmd_spectrum(args: argparse.Namespace) -> int:
     if args.plot:   # a file
         check_output_place(args.plot, "--plot", folder=False, inputs=[getattr(args, "spectrum_file", None)])
     spectrum = spectrum_from_args(args)
+    warn_of_parameters(args, args.code)
     periods = _periods(args.periods, spectrum)
     print(spectrum_table(spectrum, periods))
     if args.csv:   # the headers and the atomic writing of every pounding CSV (pounding.results.tables)

@@ -62,7 +62,7 @@ from pounding.solver.storeys import recoverable_energy
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
-           "RAGGED_DIMS"]
+           "RAGGED_DIMS", "loaded_record_pga"]
 
 #: Dimensions whose length depends on the run (impacts, full-resolution contact samples).
 RAGGED_DIMS = ("impact", "trace")
@@ -699,7 +699,7 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
     return ds
 
 
-def _record_pga(record: Record) -> tuple[float, float]:
+def loaded_record_pga(record: Record) -> tuple[float, float]:
     """A record's PGA, m/s²: as recorded (the file's own ``pga_g``, else the samples over the factor) and as run."""
     return _pga_pair(record.metadata.get("pga_g"), float(record.scale),
                      lambda: float(np.max(np.abs(record.acceleration))) if record.acceleration.size else 0.0)
@@ -722,7 +722,7 @@ def _grounds(model: Model, record: Record, system: System, raw: RawSolution, sup
     else:
         _, vel, disp = kinematics.ground_state_at(rows, step, raw.time)
     return {"record": np.array([r.name for r in records], dtype=object),
-            "pga": [_record_pga(r) for r in records],
+            "pga": [loaded_record_pga(r) for r in records],
             "source": np.array([r.source for r in records], dtype=object),
             "scale": np.array([float(r.scale) for r in records]),
             "sha256": [str(r.metadata.get("sha256", "")) for r in records],

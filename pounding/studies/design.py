@@ -53,7 +53,7 @@ __all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION", "d
            "EC8_SAME_LEVELS_FACTOR", "ec8_design_displacement", "ec8_separation", "is1893_separation",
            "nzs1170_5_separation", "NTC_2004_HEIGHT", "NTC_2004_SIMPLIFIED", "NTC_2004_MINIMUM", "ntc2004_setback",
            "ntc2004_separation", "SUITE_FRACTION", "SUITE_PERIODS", "EC8_MEAN_RECORDS", "ASCE_RECORDS",
-           "suite_scale_factor", "Intensity", "record_set_spectra", "code_setup", "code_displacements",
+           "suite_scale_factor", "Intensity", "record_set_spectra", "suite_warnings", "code_setup", "code_displacements",
            "pair_separation", "code_separations", "simulated_requirement",
            "code_gap_study", "code_gap_table", "code_gap_summary"]
 
@@ -449,11 +449,13 @@ class Intensity:
     pga_target: float | None = None
 
 
-def record_set_spectra(model, records: list[str], periods: Any, *, duration: float | None = None):
+def record_set_spectra(model, records: list[str], periods: Any, *, duration: float | None = None,
+                       read: list | None = None):
     """Each record's 5 % pseudo-spectral acceleration (g) at *periods*, and its PGA (g), as the model reads it.
 
     The record is read and processed as the model's ``ground_motion`` says
-    (units, dt, processing), unscaled, and cut to *duration*.
+    (units, dt, processing), unscaled, and cut to *duration*; each record as read
+    (:class:`~pounding.records.record.Record`, whole) is appended to *read* if given.
     """
     from pounding.records.spectra import response_spectrum
     from pounding.simulation import processed_record_for
@@ -461,6 +463,8 @@ def record_set_spectra(model, records: list[str], periods: Any, *, duration: flo
     psa, pga = [], []
     for spec in records:
         record = processed_record_for(model.with_ground_motion(record=spec, scale=1.0), where="cli")
+        if read is not None:
+            read.append(record)
         acc = np.asarray(record.acceleration)
         if duration is not None:
             acc = acc[:int(round(duration / record.time_step)) + 1]
@@ -468,6 +472,16 @@ def record_set_spectra(model, records: list[str], periods: Any, *, duration: flo
         psa.append(spectrum.psa / STANDARD_GRAVITY)
         pga.append(spectrum.pga / STANDARD_GRAVITY)
     return np.array(psa), np.array(pga)
+
+
+def suite_warnings(model, names: list[str], records: list, factors: list[float]) -> list[str]:
+    """The plausibility warnings of a code check (:mod:`pounding.results.checks`), each kind once: the model's
+    (periods, gaps), and each ground motion's (*names*; *records*: each one's records as read, a pair's two)
+    units and PGA at each intensity's factor (*factors*)."""
+    from pounding.results.checks import ground_motion_warnings, model_warnings, study_warnings
+
+    runs = [ground_motion_warnings(name, group, factor) for factor in factors for name, group in zip(names, records)]
+    return [*model_warnings(model).values(), *study_warnings(runs)]
 
 
 def _design_of(model, code: str, key: str, example: str, designs: list | None = None):
@@ -649,10 +663,12 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
     periods = np.geomspace(0.2 * min(first), 2.0 * max(first), SUITE_PERIODS)
     # the records' spectra over what is simulated: --duration, else the model's ground_motion.duration
     simulated = duration if duration is not None else model.ground_motion.duration
-    psa, pga = record_set_spectra(model, specs, periods, duration=simulated)
-    intensities = []
+    read: list = []
+    psa, pga = record_set_spectra(model, specs, periods, duration=simulated, read=read)
+    intensities, factors = [], []
     for intensity in found["intensities"]:
         factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
+        factors.append(factor)
         ds = gap_study(model_path, specs, scale=factor, duration=duration, **run_options)
         ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
         required = ds.required_gap.values[ok]
@@ -666,6 +682,7 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
                 required[:, c], row["separation"].same_property, use_max)
     return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
             "records": specs, "intensities": intensities, "contacts": rows,
+            "warnings": suite_warnings(model, specs, [[r] for r in read], factors),
             "buildings": {name: {"modes": r.n_modes, "mass_fraction": r.mass_fraction,
                                  "periods": r.periods.tolist(), "spectrum": found["spectra"][name].name,
                                  "elastic_displacement": r.displacement.tolist(),

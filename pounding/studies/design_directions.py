@@ -85,7 +85,7 @@ from pounding.model.outline import place_label
 from pounding.studies.design import (EC8_MEAN_RECORDS, SUITE_PERIODS, ModalResponse, Separation,
                                      code_setup, dof_per_floor, ground_influence, modal_response, modes_for_mass,
                                      pair_separation, response_directions, simulated_requirement,
-                                     suite_scale_factor)
+                                     suite_scale_factor, suite_warnings)
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ACCIDENTAL_ECCENTRICITY", "ORTHOGONAL_FRACTION", "TORSIONAL_IRREGULARITY", "EXTREME_TORSIONAL_IRREGULARITY",
@@ -486,8 +486,9 @@ def _pair_records(model_path: str | os.PathLike, pair: str, duration: float | No
 
 
 def pair_set_spectra(model_path: str | os.PathLike, pairs: list[str], periods: Any, code: str, *,
-                     duration: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """``(psa, pga)`` in g of a set of record pairs as the code judges a three-dimensional suite.
+                     duration: float | None = None, read: list | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``(psa, pga)`` in g of a set of record pairs as the code judges a three-dimensional suite (each pair's two
+    components as read, cut to *duration*, appended to *read* if given).
 
     ASCE 7-22 (§16.2.3): one row per pair, its RotD100 spectrum (:func:`rotd100`) and the
     peak of |(a_a, a_b)|.  Eurocode 8: one row per component (§3.2.3.1.2(4): every
@@ -500,6 +501,8 @@ def pair_set_spectra(model_path: str | os.PathLike, pairs: list[str], periods: A
     psa, pga = [], []
     for pair in pairs:
         a, b = _pair_records(model_path, pair, duration)
+        if read is not None:
+            read.append((a, b))
         if code == "asce7-22":
             if abs(a.time_step - b.time_step) > 1e-12 * a.time_step:
                 raise PoundingError(f"{pair}: its components have different time steps ({a.time_step:g} and "
@@ -603,10 +606,12 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
     principal = [float(b.periods[principal_mode(b, d)]) for b in model.buildings for d in ("x", "y")]
     periods = np.geomspace(0.2 * min(principal), 2.0 * max(principal), SUITE_PERIODS)
     simulated = duration if duration is not None else model.ground_motion.duration
-    psa, pga = pair_set_spectra(model_path, pairs, periods, code, duration=simulated)
-    intensities = []
+    read: list = []
+    psa, pga = pair_set_spectra(model_path, pairs, periods, code, duration=simulated, read=read)
+    intensities, factors = [], []
     for intensity in found["intensities"]:
         factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
+        factors.append(factor)
         ds = gap_study(model_path, pairs, scale=factor, duration=duration, **run_options)
         ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
         use_max = code == "ec8" and int(ok.sum()) < EC8_MEAN_RECORDS
@@ -619,4 +624,5 @@ def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_optio
                             **record_outcomes(ds)})
     return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
             "records": pairs, "intensities": intensities, "contacts": rows, "sides": ("first", "second"),
+            "warnings": suite_warnings(model, pairs, read, factors),
             "buildings": {b.name: _building_summary(b, found, code) for b in model.buildings}}

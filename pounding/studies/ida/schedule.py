@@ -305,6 +305,8 @@ class IdaPlan:
     #: The buildings whose collapse a hunt brackets, in model order (empty: every building); ``pounding p695``
     #: hunts only the building of each IDA.
     hunted: tuple[str, ...] = ()
+    #: The records' plausibility warnings (``units``: their own PGA in their declared units), each kind once.
+    warnings: tuple[str, ...] = ()
     _cache: dict = field(default_factory=dict, repr=False)
 
     def describe_levels(self) -> str:
@@ -517,6 +519,7 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
         Simulated time of every run, s.
     """
     from pounding.model.model import load_model
+    from pounding.results.checks import study_warnings
     from pounding.studies.common import record_sweep
 
     override = collapse_drift
@@ -541,10 +544,10 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
     scenarios = sweep.scenarios()
     if not scenarios:
         raise PoundingError("--records: the record set is empty")
-    labels, documents, components, stored, norm, errors = [], [], [], [], [], []
+    labels, documents, components, stored, norm, errors, checked = [], [], [], [], [], [], []
     for s in scenarios:
         record = str(s.coords["record"])
-        value, nm, error = _record_measure(s, record, base.name, measure, sweep.label)
+        value, nm, error = _record_measure(s, record, base.name, measure, sweep.label, checked)
         for orientation in (ORIENTATIONS if pair else (None,)):
             document = s.data if orientation is None else oriented_document(s.data, record, orientation)
             documents.append(document if override is None else with_collapse_drift(document, float(override)))
@@ -554,10 +557,12 @@ def build_ida_plan(model: str | os.PathLike, records: str | list[str] | None = N
             stored.append(value)
             norm.append(nm)
             errors.append(error)
-    return finish_ida_plan(base, sweep, labels, documents, measure, stored, norm, errors, scaling=scaling,
+    plan = finish_ida_plan(base, sweep, labels, documents, measure, stored, norm, errors, scaling=scaling,
                            without_contacts=without_contacts, limits=drift_limits, collapse_drift=collapse_drift,
                            override=override, levels=levels, hunt=hunt, mce=mce, path=os.path.abspath(os.fspath(model)),
                            pairs=tuple(components))
+    plan.warnings = tuple(study_warnings(checked, "records"))   # the records' units, each kind once (pounding.results.checks)
+    return plan
 
 
 def oriented_document(document: dict, pair: str, orientation: str) -> dict:
@@ -596,10 +601,12 @@ def normalisation_of(records: list) -> float:
 
 
 def _record_measure(scenario, record: str, name: str, measure: IntensityMeasure,
-                    label: str) -> tuple[float, float, str | None]:
-    """``(IM as stored m/s², NM, error)`` of one record (pair) of the IDA's sweep (an error: NaN, NaN, the line)."""
+                    label: str, checked: list) -> tuple[float, float, str | None]:
+    """``(IM as stored m/s², NM, error)`` of one record (pair) of the IDA's sweep (an error: NaN, NaN, the line);
+    its records' ``units`` warning (:func:`pounding.results.checks.ground_motion_warnings`) appended to *checked*."""
     from pounding.model.model import model_from_data, model_from_text
     from pounding.model.document import dump_document
+    from pounding.results.checks import ground_motion_warnings
 
     what = "record pair" if measure.pair else "record"
     try:
@@ -611,6 +618,7 @@ def _record_measure(scenario, record: str, name: str, measure: IntensityMeasure,
         else:
             one = model_from_data(scenario.data, name=name, source=scenario.document, base_dir=scenario.base_dir)
         records = ground_records(one)
+        checked.append(ground_motion_warnings(record, records, ida=True))
         value = measure.of_records(records)
         if not value > 0:
             raise PoundingError(f"{what} {record}: its {measure.describe()} is 0; it cannot be scaled")
