@@ -175,3 +175,22 @@ def test_a_behaviour_factor_below_one_is_refused_in_the_model_and_in_spectrum(tm
     assert main(["spectrum", "ec8", "--ag", "0.3", "--q", "0.5"]) == 2
     err = capsys.readouterr().err
     assert "the behaviour factor q must be >= 1 (got 0.5)" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("plan", [False, True])
+def test_gap_code_where_every_record_fails_says_not_determined(model, tmp_path, capsys, plan):
+    """Scaled past 100 g every run is refused (the record check): the archive of such an intensity has no
+    contacts (they come from a run), and the table says "not determined" on every row instead of a traceback."""
+    if plan:
+        import sys
+
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from test_design_directions import corner_pair_with_design
+
+        model, records = corner_pair_with_design(tmp_path), []
+    else:
+        records = ["--records", RECORDS]
+    assert main(["gap", model, "--code", "asce7-22", "--sds", "30", "--sd1", "20", *records, "--duration", "1",
+                 "--workers", "1", "--no-progress"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("A:")]
+    assert rows and all(line.endswith("not determined at design, MCE_R (no record ran)") for line in rows)

@@ -671,7 +671,8 @@ def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], reco
         factors.append(factor)
         ds = gap_study(model_path, specs, scale=factor, duration=duration, **run_options)
         ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
-        required = ds.required_gap.values[ok]
+        # no record ran: the archive has no contacts (they come from a run); nothing to compare
+        required = ds.required_gap.values[ok] if ok.any() else np.empty((0, len(rows)))
         n_ok = int(ok.sum())
         use_max = code == "ec8" and n_ok < EC8_MEAN_RECORDS
         intensities.append({"name": intensity.name, "why": intensity.why, "target": intensity.spectrum.name,

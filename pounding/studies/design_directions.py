@@ -569,6 +569,11 @@ def _simulated(ds, rows: list[dict[str, Any]], name: str, use_max: bool) -> None
     from pounding.studies.gap import records_ran
 
     ok = records_ran(ds)
+    if not ok.any():   # no record ran: the archive has no points (they come from a run); nothing to compare
+        for row in rows:
+            row.setdefault("simulated", {})[name] = simulated_requirement(np.empty(0), row["separation"].same_property,
+                                                                          use_max)
+        return
     # a contact point of the gap study's archive: its face (YAML order) and place, as the rows name it
     labels = [f"{face}@{place_label((float(x), float(y)))}" for face, x, y in
               zip(ds.point_face.values, ds.point_x.values, ds.point_y.values)]
