@@ -35,6 +35,7 @@ import numpy as np
 
 from pounding.model import floors, outline, schema
 from pounding.model.building import Building, Damping, planar_storeys
+from pounding.model.foundation import Foundation
 from pounding.model.document import dump_document, is_plan_document, parse_document
 from pounding.model.ground import Component, GroundMotionSpec
 from pounding.contact import xi as xi_formulas
@@ -397,12 +398,12 @@ class Model:
     @property
     def dof_offsets(self) -> list[int]:
         """Index of each building's first degree of freedom in the model's vector."""
-        return [int(x) for x in np.cumsum([0] + [b.n_dof for b in self.buildings])[:-1]]
+        return [int(x) for x in np.cumsum([0] + [b.n_model_dof for b in self.buildings])[:-1]]
 
     @property
     def n_dof(self) -> int:
-        """Degrees of freedom of the model."""
-        return sum(b.n_dof for b in self.buildings)
+        """Degrees of freedom of the model (a founded building's base mat's included)."""
+        return sum(b.n_model_dof for b in self.buildings)
 
     def floor_slice(self, building: int, level: int) -> slice:
         """The degrees of freedom of floor *level* (1-based) of *building* in the model's vector."""
@@ -748,6 +749,8 @@ def _building_extras(b: Building, document: dict[str, Any]) -> dict[str, Any]:
         document["design"] = schema.design_document(b.design)
     if b.collapse_drift_ratio is not None:
         document["collapse"] = {"drift_ratio": b.collapse_drift_ratio}
+    if b.foundation is not None:
+        document["foundation"] = b.foundation.to_document()
     return document
 
 
@@ -843,7 +846,15 @@ def _trusted_building(entry: Any, storeys: tuple[floors.Storey, ...], outline: A
     return _trusted(Building, name=entry.name, storeys=storeys, damping=damping, p_delta=entry.p_delta,
                     design=getattr(entry, "design", None),
                     collapse_drift_ratio=None if entry.collapse is None else entry.collapse.drift_ratio,
-                    outline=outline)
+                    outline=outline, foundation=_foundation(getattr(entry, "foundation", None)))
+
+
+def _foundation(entry: Any) -> Foundation | None:
+    """The :class:`Foundation` of a validated ``foundation`` entry (None: a fixed base)."""
+    if entry is None:
+        return None
+    return Foundation(float(entry.mass), float(entry.rotary_inertia), float(entry.sway.stiffness),
+                      float(entry.sway.damping), float(entry.rocking.stiffness), float(entry.rocking.damping))
 
 
 def _build_plan(entry: Any, *, name: str, text: str, path: str | None, base_dir: str | None) -> Model:
