@@ -154,3 +154,78 @@ def test_probability_and_target():
     for bad in ("2%", "200%/50y", "2%/-5y", "x/50y"):
         with pytest.raises(PoundingError, match="--target"):
             parse_target(bad)
+
+
+# --------------------------------------------------------------------------- #
+# The study
+# --------------------------------------------------------------------------- #
+
+@pytest.fixture(scope="module")
+def risk_run(in_process_client, tmp_path_factory):
+    """models/pair.yaml, its own record, 3 stripes of the example curve, 6 s: 6 runs."""
+    from pounding.data import data_path
+    from pounding.studies.risk import build_risk_plan, read_hazard, risk_study
+
+    plan = build_risk_plan(data_path("models", "pair.yaml"), read_hazard("example"), im="sa:1.0", stripes=3,
+                           duration=6.0)
+    out = tmp_path_factory.mktemp("risk") / "risk.nc"
+    return plan, risk_study(plan, out, client=in_process_client, progress=False), out
+
+
+def test_study_separations_are_the_gap_study_of_each_run(risk_run):
+    """Each run without contacts' required separation is what `required_separations` gives for that run's
+    full history, and the separation meeting the target lies where the archived curve crosses it."""
+    from pounding.model.model import load_model
+    from pounding.simulation import simulate
+    from pounding.data import data_path
+    from pounding.studies.gap import required_separations
+
+    plan, ds, _ = risk_run
+    level = float(ds.level.values[1]) / G
+    model = load_model(data_path("models", "pair.yaml")).with_ground_motion(duration=6.0)
+    model = model.with_ground_motion(scale=plan.ida.factor(0, level)).with_contacts_open()
+    expected = required_separations(model, simulate(model))["required"]
+    assert np.allclose(ds.required_separation.values[0, 1], expected, rtol=1e-9, atol=1e-12)
+    # demands grow with intensity (elastic model, one record): each stripe needs more than the one below
+    assert np.all(np.diff(ds.required_separation.values[0], axis=0) > 0)
+    p = ds.attrs["target_probability"]
+    for c in range(ds.contact.size):
+        g = float(ds.target_separation.values[c])
+        assert g in ds.required_separation.values[0, :, c]
+        below = ds.separation.values < g
+        assert np.all(ds.pounding_probability.values[c][below] > p)
+        assert np.all(ds.pounding_probability.values[c][~below] <= p)
+
+
+def test_study_archive_has_units_and_names_and_the_cli_prints_it(risk_run, tmp_path):
+    import xarray as xr
+
+    from pounding.studies.risk import risk_table
+
+    _, ds, out = risk_run
+    with xr.open_dataset(out) as stored:
+        for name, var in stored.data_vars.items():
+            assert "long_name" in var.attrs, name
+        for name in ("pounding_rate", "target_separation", "collapse_rate", "hazard_rate", "required_separation"):
+            assert "units" in stored[name].attrs, name
+        assert stored.attrs["study"] == "risk"
+    text = risk_table(ds)
+    assert "separation for 2 % in 50 years" in text
+    assert all(str(c) in text for c in ds.contact.values)
+    assert all(f"  {b}: " in text for b in ds.building.values)
+
+
+def test_cli_refuses_a_bad_hazard_and_a_bad_im_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    from pounding.data import data_path
+
+    bad = tmp_path / "site.csv"
+    bad.write_text("0.1 0.02\n0.5 0.03\n")
+    for extra in (["--hazard", str(bad)], ["--hazard", "example", "--im", "sa:-1"],
+                  ["--hazard", "example", "--target", "2%"]):
+        done = subprocess.run([sys.executable, "-m", "pounding", "risk", str(data_path("models", "pair.yaml")), *extra],
+                              capture_output=True, text=True)
+        assert done.returncode == 2
+        assert done.stderr.strip().count("\n") == 0 and done.stderr.startswith("pounding: error: ")
