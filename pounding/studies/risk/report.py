@@ -138,7 +138,7 @@ def risk_table(ds) -> str:
     the collapse risk with and without pounding against 1 % in 50 years, one line each."""
     p, years = ds.attrs["target_probability"], ds.attrs["target_years"]
     lines = [f"hazard: {ds.attrs['hazard']}; stripes {', '.join(f'{x:.3g}' for x in ds.level.values / STANDARD_GRAVITY)} g",
-             f"pounding (runs without contacts): separation for {100 * p:g} % in {years:g} years, and the model's gap",
+             f"risk of pounding (runs without contacts): separation for {100 * p:g} % in {years:g} years, and the model's gap",
              f"  {'contact':<20} {'separation':>11} {'model gap':>10} {'P(' + format(years, 'g') + ' y) at gap':>16}"]
     for c, label in enumerate(ds.contact.values):
         share = float(ds.lowest_stripe_pounding.values[c])
