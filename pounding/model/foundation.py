@@ -13,6 +13,9 @@ elevation, m), so that
 * the building's own damping acts on the deformations, ``C = Tᵀ C_fixed T``, and the
   foundation's dashpots on sway and rocking: ``+ diag(0 … 0, c_x, c_θ)``.
 
+The springs and dashpots are given, or computed from the soil and the footing
+(:func:`on_soil`, with :mod:`pounding.model.foundation_impedance`).
+
 SI units: kg, kg·m², N/m, N·s/m, N·m/rad, N·m·s/rad.
 """
 
@@ -24,7 +27,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Foundation", "BASE_DOFS", "BASE_DOF_NAMES", "base_transform", "founded_mass", "founded_matrix",
+from pounding.model.foundation_impedance import Footing, Soil, equivalent_oscillator, flexible_base
+
+__all__ = ["Foundation", "on_soil", "BASE_DOFS", "BASE_DOF_NAMES", "base_transform", "founded_mass", "founded_matrix",
            "founded_weights", "effective_damping", "veletsos_meek_period"]
 
 #: Degrees of freedom a foundation adds to its building: the base mat's sway and rocking.
@@ -47,6 +52,12 @@ class Foundation:
         K_x, N/m, and c_x, N·s/m, on the base mat's sway u_b.
     rocking_stiffness, rocking_damping : float
         K_θ, N·m/rad, and c_θ, N·m·s/rad, on its rocking θ_b.
+    soil, footing : Soil, Footing or None
+        Where the springs and dashpots come from the soil and the footing (:func:`on_soil`); None
+        where they were given.
+    frequency : float or None
+        With *soil*: the circular frequency ω̃ (rad/s) the impedances were evaluated at, the
+        building's flexible-base fundamental frequency (Veletsos & Meek's estimate).
     """
 
     mass: float
@@ -55,12 +66,28 @@ class Foundation:
     sway_damping: float
     rocking_stiffness: float
     rocking_damping: float
+    soil: Soil | None = None
+    footing: Footing | None = None
+    frequency: float | None = None
 
     def to_document(self) -> dict[str, Any]:
-        """The YAML mapping of this foundation."""
-        return {"mass": float(self.mass), "rotary_inertia": float(self.rotary_inertia),
-                "sway": {"stiffness": float(self.sway_stiffness), "damping": float(self.sway_damping)},
+        """The YAML mapping of this foundation: as it was given (springs, or soil and footing)."""
+        base = {"mass": float(self.mass), "rotary_inertia": float(self.rotary_inertia)}
+        if self.soil is not None:
+            return {**base, "soil": {"shear_wave_velocity": float(self.soil.shear_wave_velocity),
+                                     "poisson": float(self.soil.poisson), "density": float(self.soil.density)},
+                    "footing": {"length": float(self.footing.length), "width": float(self.footing.width),
+                                "embedment": float(self.footing.embedment)}}
+        return {**base, "sway": {"stiffness": float(self.sway_stiffness), "damping": float(self.sway_damping)},
                 "rocking": {"stiffness": float(self.rocking_stiffness), "damping": float(self.rocking_damping)}}
+
+    def springs(self) -> dict[str, float]:
+        """The springs and dashpots in use (SI) and, from soil, the frequency ω̃ they were evaluated at (rad/s)."""
+        found = {"sway_stiffness": float(self.sway_stiffness), "sway_damping": float(self.sway_damping),
+                 "rocking_stiffness": float(self.rocking_stiffness), "rocking_damping": float(self.rocking_damping)}
+        if self.frequency is not None:
+            found["frequency"] = float(self.frequency)
+        return found
 
     @property
     def stiffness(self) -> np.ndarray:
@@ -71,6 +98,34 @@ class Foundation:
     def damping(self) -> np.ndarray:
         """(2,) ``(c_x, c_θ)``, N·s/m and N·m·s/rad."""
         return np.array([self.sway_damping, self.rocking_damping], dtype=float)
+
+
+def on_soil(mass: float, rotary_inertia: float, soil: Soil, footing: Footing, floor_mass: np.ndarray,
+            shape: np.ndarray, elevation: np.ndarray, omega: float) -> Foundation:
+    """A building's foundation whose springs and dashpots are the footing's impedances on *soil*.
+
+    The impedances (NIST GCR 12-917-21 §2.2, :func:`~pounding.model.foundation_impedance.impedances`)
+    are evaluated along x (the footing's ``length`` is along the floors' motion) at the
+    flexible-base fundamental frequency ω̃ found by iteration
+    (:func:`~pounding.model.foundation_impedance.flexible_base`) from the building's first
+    fixed-base mode as a single oscillator.
+
+    Parameters
+    ----------
+    mass, rotary_inertia : float
+        The base mat's m_b (kg) and I_b (kg·m²).
+    soil, footing : Soil, Footing
+        The half-space and the rigid footing.
+    floor_mass, shape, elevation : (n,) array_like
+        The floors' masses (kg), the first fixed-base mode shape, the floors' elevations (m).
+    omega : float
+        The first fixed-base circular frequency, rad/s.
+    """
+    oscillator = equivalent_oscillator(floor_mass, shape, elevation, omega)
+    base = flexible_base(soil, footing, oscillator, direction="x")
+    sway, rocking = base.impedances.along("x")
+    return Foundation(float(mass), float(rotary_inertia), sway.stiffness, sway.damping, rocking.stiffness,
+                      rocking.damping, soil, footing, base.impedances.frequency)
 
 
 def base_transform(elevation: np.ndarray) -> np.ndarray:

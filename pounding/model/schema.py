@@ -556,16 +556,73 @@ class FoundationSpringEntry(SchemaEntry):
     damping: NonNegativeNumber = Field(description="dashpot coefficient: sway N s/m, rocking N m s/rad")
 
 
-class FoundationEntry(SchemaEntry):
-    """A planar building's sway–rocking foundation (docs/foundations.md)."""
+#: Poisson's ratio of a soil: 0 to 0.5 (0.5: saturated clay, undrained; NIST GCR 12-917-21 caps ψ there).
+PoissonRatio = Annotated[float, BeforeValidator(located(as_number)),
+                         AfterValidator(located(_bound(lambda v: 0 <= v <= 0.5, "must be in [0, 0.5] (about 0.3 "
+                                                       "for dry soil, up to 0.5 for saturated clay)")))]
 
-    WHAT: ClassVar[str] = "a mapping {mass, rotary_inertia, sway, rocking}"
-    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"sway": FoundationSpringEntry, "rocking": FoundationSpringEntry}
+
+class SoilEntry(SchemaEntry):
+    """The uniform half-space under a footing (docs/foundations-soil.md)."""
+
+    WHAT: ClassVar[str] = "a mapping {shear_wave_velocity, poisson, density}, e.g. {shear_wave_velocity: 150, " \
+                          "poisson: 0.33, density: 1900} (m/s, -, kg/m^3)"
+
+    shear_wave_velocity: PositiveNumber = Field(description="small-strain shear-wave velocity V_s, m/s")
+    poisson: PoissonRatio = Field(description="Poisson's ratio, 0 to 0.5")
+    density: PositiveNumber = Field(description="mass density, kg/m^3")
+
+
+class FootingEntry(SchemaEntry):
+    """A rigid rectangular footing (docs/foundations-soil.md)."""
+
+    WHAT: ClassVar[str] = "a mapping {length, width, embedment}, e.g. {length: 30, width: 20, embedment: 0} (m)"
+
+    length: PositiveNumber = Field(description="plan side along x (the direction the floors move), m")
+    width: PositiveNumber = Field(description="plan side along y, m")
+    embedment: NonNegativeNumber = Field(0.0, description="depth of the footing's base below the ground, m "
+                                                          "(default 0: on the surface)")
+
+
+class FoundationEntry(SchemaEntry):
+    """A planar building's sway–rocking foundation: its springs, or the soil and the footing (docs/foundations.md)."""
+
+    WHAT: ClassVar[str] = "a mapping {mass, rotary_inertia, sway, rocking} or {mass, rotary_inertia, soil, footing}"
+    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"sway": FoundationSpringEntry, "rocking": FoundationSpringEntry,
+                                                      "soil": SoilEntry, "footing": FootingEntry}
+    #: The two ways of giving the springs: the keys of each.
+    WAYS: ClassVar[tuple[tuple[str, str], ...]] = (("sway", "rocking"), ("soil", "footing"))
 
     mass: PositiveNumber = Field(description="base mat mass, kg")
     rotary_inertia: PositiveNumber = Field(description="base mat rotary inertia about its horizontal axis, kg m^2")
-    sway: FoundationSpringEntry = Field(description="{stiffness: N/m, damping: N s/m} on the base mat's sway")
-    rocking: FoundationSpringEntry = Field(description="{stiffness: N m/rad, damping: N m s/rad} on its rocking")
+    sway: FoundationSpringEntry | None = Field(None, description="{stiffness: N/m, damping: N s/m} on the base "
+                                                                 "mat's sway")
+    rocking: FoundationSpringEntry | None = Field(None, description="{stiffness: N m/rad, damping: N m s/rad} on "
+                                                                    "its rocking")
+    soil: SoilEntry | None = Field(None, description="{shear_wave_velocity: m/s, poisson, density: kg/m^3}: the "
+                                                     "springs and dashpots from the soil and the footing")
+    footing: FootingEntry | None = Field(None, description="{length: m (along x), width: m, embedment: m}")
+
+    def given(self) -> tuple[str, ...]:
+        """The keys of :attr:`WAYS` present in the entry."""
+        return tuple(key for way in self.WAYS for key in way if getattr(self, key) is not None)
+
+
+def foundation_problem(foundation: FoundationEntry, building: str) -> PydanticCustomError | None:
+    """The one-line problem of a foundation that gives neither or both of springs and soil, or half of one."""
+    given = foundation.given()
+    fix = ("give either sway: {stiffness, damping} and rocking: {stiffness, damping}, or soil: {shear_wave_velocity, "
+           "poisson, density} and footing: {length, width, embedment}")
+    if set(given) in ({"sway", "rocking"}, {"soil", "footing"}):
+        return None
+    if not given:
+        text = f"of building {building} gives neither springs nor soil; {fix}"
+    elif {"sway", "rocking"} & set(given) and {"soil", "footing"} & set(given):
+        text = f"of building {building} gives springs and soil together ({', '.join(given)}); {fix}, not both"
+    else:
+        missing = next(other for way in foundation.WAYS for key, other in (way, way[::-1]) if key in given)
+        text = f"of building {building} gives {given[0]} without {missing}; {fix}"
+    return problem(text, kind="error", at=("foundation",), line="key", colon=False)
 
 
 class BuildingEntry(SchemaEntry):
@@ -625,6 +682,13 @@ class BuildingEntry(SchemaEntry):
                 hint = "; use damping: {modal: [ratio]} for a one-storey building" if n == 1 else ""
                 raise problem(f"mode {mode} does not exist: building {self.name} has {plural(n, 'storey')}, "
                               f"so {plural(n, 'mode')}{hint}", kind="error", at=("damping", "modes", position))
+        return self
+
+    @model_validator(mode="after")
+    def _foundation_springs(self) -> BuildingEntry:
+        found = None if self.foundation is None else foundation_problem(self.foundation, self.name)
+        if found is not None:
+            raise found
         return self
 
     @model_validator(mode="after")

@@ -786,11 +786,12 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
-    if "foundation" in ds.coords:   # per founded building: fixed- and flexible-base periods, effective damping
+    if "foundation" in ds.coords:   # per founded building: periods, damping, springs (from soil: at which ω)
         ds.attrs["foundations"] = json.dumps({b.name: {
             "fixed_base_periods": [float(x) for x in b.periods], "flexible_base_periods":
             [float(x) for x in b.flexible_periods], "effective_damping": float(b.effective_damping),
-            "fixed_base_damping": float(b.modal_damping_ratios[0])} for _, b, _ in _founded(model)})
+            "fixed_base_damping": float(b.modal_damping_ratios[0]), "springs": b.foundation.springs()}
+            for _, b, _ in _founded(model)})
     if peaks["status_message"]:   # not completed: why (a completed run's archive is as before)
         ds.attrs["status_message"] = peaks["status_message"]
     if model.has_building_records:   # each building's own record: its PGA as recorded and as run, m/s²

@@ -18,6 +18,7 @@ relative size below which a rotation, or a departure from elasticity, is taken f
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import xarray as xr
@@ -227,6 +228,14 @@ def _foundation_lines(ds: xr.Dataset) -> list[str]:
         lines.append(f"  {name}: T {fixed:.3f} / {flexible:.3f} s (x{flexible / fixed:.3f}), "
                      f"{100 * f['fixed_base_damping']:.2f} / {100 * f['effective_damping']:.2f} %; peak base sway "
                      f"{1e3 * sway:.2f} mm, rocking {rocking:.2e} rad")
+        springs = f.get("springs", {})
+        if "frequency" in springs:   # from the soil and the footing: the springs used, and where they were evaluated
+            omega = springs["frequency"]
+            lines.append(f"    springs from the soil and footing at {omega:.4g} rad/s "
+                         f"(T̃ {2 * math.pi / omega:.3f} s, Veletsos & Meek): "
+                         f"K_x {springs['sway_stiffness']:.4g} N/m, c_x {springs['sway_damping']:.4g} N s/m, "
+                         f"K_θ {springs['rocking_stiffness']:.4g} N m/rad, "
+                         f"c_θ {springs['rocking_damping']:.4g} N m s/rad")
     lines.append(f"  foundation dashpots: {100 * share:.1f} % of the damping energy")
     return lines
 
