@@ -190,7 +190,16 @@ def support_motions(model: Model, record: Record | list | tuple | None = None, *
         series, lags = lagged(motion, lag_requested)
         records = [motion] * len(names)
         ends = [(spec.duration or motion.duration + max(lags))] * len(names)
-    return support_motions_from(series, step, records, lag_requested, lags, ends)
+    return _with_zero_row(model, support_motions_from(series, step, records, lag_requested, lags, ends))
+
+
+def _with_zero_row(model: Model, supports: SupportMotions) -> SupportMotions:
+    """*supports* with a row of zeros appended (the ground of a founded building's rocking) when a building has a
+    foundation and there is none yet; else *supports* as they are."""
+    if supports.zero_row >= 0 or all(b.foundation is None for b in model.buildings):
+        return supports
+    rows = np.vstack([supports.rows, np.zeros((1, supports.rows.shape[1]))])
+    return dataclasses.replace(supports, rows=rows, zero_row=rows.shape[0] - 1)
 
 
 def _scaling_period(model: Model, spec: Any) -> float | None:

@@ -23,7 +23,8 @@ from pounding.model.model import is_plan_file, model_from_data
 from pounding.simulation import simulate
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
-PLANAR = sorted(p.stem for p in MODELS.glob("*.yaml") if not is_plan_file(p))
+# A founded building has no plan twin yet (foundations are for planar buildings for now).
+PLANAR = sorted(p.stem for p in MODELS.glob("*.yaml") if not is_plan_file(p) and "foundation:" not in p.read_text())
 #: Simulated time, s: every shipped model's contacts close within it (the moat's and the row's first impacts come at
 #: 8.8 and 9.7 s; checked below), but pair_links', whose links keep the pair apart.
 DURATION = 10.0

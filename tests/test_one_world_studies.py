@@ -33,7 +33,8 @@ from pounding.model.model import is_plan_file, load_model
 from pounding.units import STANDARD_GRAVITY
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
-PLANAR = sorted(p.stem for p in MODELS.glob("*.yaml") if not is_plan_file(p))
+# A founded building has no plan twin yet (foundations are for planar buildings for now).
+PLANAR = sorted(p.stem for p in MODELS.glob("*.yaml") if not is_plan_file(p) and "foundation:" not in p.read_text())
 #: Simulated time of every study's runs, s: every model pounds within it in the compares, the sweep and the IDA
 #: (asserted per study; the moat's and the row's first impacts under their own records come at 8.8 and 9.7 s).
 DURATION = 10.0

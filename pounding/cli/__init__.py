@@ -26,7 +26,8 @@ SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sw
                       "export": "pounding.cli.export", "gap": "pounding.cli.gap", "ida": "pounding.cli.ida",
                       "init": "pounding.cli.init", "spectrum": "pounding.cli.spectrum",
                       "table": "pounding.cli.table", "hysteresis": "pounding.cli.hysteresis",
-                      "pushover": "pounding.cli.pushover", "p695": "pounding.cli.p695"}
+                      "pushover": "pounding.cli.pushover", "p695": "pounding.cli.p695",
+                      "risk": "pounding.cli.risk"}
 
 
 # --------------------------------------------------------------------------- #

@@ -47,6 +47,10 @@ def archive_tables(kind: str, ds) -> dict:
         from pounding.studies.ida.report import ida_tables
 
         return ida_tables(ds)
+    if kind == "risk":
+        from pounding.studies.risk import risk_tables
+
+        return risk_tables(ds)
     if kind == "p695":
         from pounding.studies.p695.report import p695_tables
 

@@ -27,6 +27,8 @@ import numpy as np
 from pounding.errors import ModelError
 from pounding.memory import check_memory
 from pounding.model import floors, schema
+from pounding.model.foundation import BASE_DOFS, Foundation, effective_damping, founded_mass, founded_matrix, \
+    founded_weights
 from pounding.model.floors import PLAN_DOFS, PLANAR_DOFS, Outline, Plane, Storey
 
 __all__ = ["Damping", "Building", "planar_storeys"]
@@ -119,6 +121,11 @@ class Building:
     outline : ((x0, y0), (x1, y1)) or None
         m, in the global plan frame: its floors are rigid diaphragms with u_x, u_y and θ.  None:
         floors with one degree of freedom u_x (a planar shear building).
+    foundation : Foundation or None
+        A planar building's sway–rocking foundation (docs/foundations.md): its DOF are then the
+        floors' displacements relative to the free field, then the base mat's sway and rocking
+        (the ``model_*`` matrices); the fixed-base matrices (``mass_matrix``, ``stiffness_matrix``,
+        ``modes``, ``damping_matrix``) stay those of the building on a fixed base.  None: a fixed base.
 
     Build a planar building with :meth:`shear`.  Equality is identity.
     """
@@ -130,6 +137,7 @@ class Building:
     design: Any = None
     collapse_drift_ratio: float | None = None
     outline: Outline | None = None
+    foundation: Foundation | None = None
 
     @classmethod
     def shear(cls, name: str, mass: Any, stiffness: Any, height: Any, damping: Damping, hysteresis: Any = (),
@@ -175,7 +183,10 @@ class Building:
         shown = " ".join(f"{t:.3f}" for t in periods[:3]) + (" ..." if periods.size > 3 else "")
         return (f"{self.name}: {self.n_floors} storey{'s' if self.n_floors != 1 else ''}, "
                 f"{float(self.height.sum()):.4g} m, periods {shown} s" + (", in plan" if self.in_plan else "")
-                + (", yielding" if self.is_inelastic else "") + (", P-Delta" if self.p_delta else ""))
+                + (", yielding" if self.is_inelastic else "") + (", P-Delta" if self.p_delta else "")
+                + ("" if self.foundation is None else
+                   f", on a foundation: flexible-base period {self.flexible_periods[0]:.3f} s, effective damping "
+                   f"{100 * self.effective_damping:.2f}%"))
 
     def __repr__(self) -> str:
         return f"<Building {self.describe()}>"
@@ -363,6 +374,60 @@ class Building:
         omega, phi = self.modes
         mphi = self.dof_mass[:, None] * phi
         return (mphi * (2.0 * self.damping.ratios(self.n_dof) * omega)) @ mphi.T
+
+    # ----------------------------------------------------------- on a foundation: the model's DOF
+    @property
+    def n_base_dof(self) -> int:
+        """Degrees of freedom of the base mat: 2 (sway, rocking) on a foundation, else 0."""
+        return 0 if self.foundation is None else BASE_DOFS
+
+    @property
+    def n_model_dof(self) -> int:
+        """Degrees of freedom of the building in the model's vector: its floors', then its base mat's."""
+        return self.n_dof + self.n_base_dof
+
+    @cached_property
+    def model_mass(self) -> np.ndarray:
+        """(n_model_dof,) masses of the model's DOF: :attr:`dof_mass`, then m_b (kg) and I_b (kg·m²)."""
+        return self.dof_mass if self.foundation is None else _frozen(founded_mass(self.dof_mass, self.foundation))
+
+    def model_stiffness_matrix(self, *, initial: bool = True) -> np.ndarray:
+        """Stiffness on the model's DOF: ``Tᵀ K T + diag(0 … 0, K_x, K_θ)`` on a foundation (module
+        :mod:`pounding.model.foundation`), else :meth:`stiffness_matrix`; N/m, N, N·m/rad."""
+        k = self.stiffness_matrix(initial=initial)
+        return k if self.foundation is None else founded_matrix(k, self.elevation, self.foundation.stiffness)
+
+    def model_damping_matrix(self) -> np.ndarray:
+        """Damping on the model's DOF: the fixed-base building's C on its deformations, ``Tᵀ C T``, plus the
+        foundation's dashpots on sway and rocking; N·s/m, N·m·s/rad."""
+        c = self.damping_matrix()
+        return c if self.foundation is None else founded_matrix(c, self.elevation, self.foundation.damping)
+
+    def model_plane_weights(self) -> list[tuple[int, int, np.ndarray]]:
+        """``(storey, plane index, a)`` over the model's DOF: each plane's deformation is ``a · q``, m."""
+        found = self.plane_weights()
+        if self.foundation is None:
+            return found
+        return [(i, j, founded_weights(a, self.elevation)) for i, j, a in found]
+
+    @cached_property
+    def flexible_modes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Undamped modes on the model's DOF (on a foundation: the flexible-base building), as :attr:`modes`."""
+        if self.foundation is None:
+            return self.modes
+        self.check_modes_memory()
+        return floors.natural_modes(self.model_stiffness_matrix(), np.diag(self.model_mass), PLANAR_DOFS)
+
+    @property
+    def flexible_periods(self) -> np.ndarray:
+        """Undamped natural periods on the model's DOF, s, longest first (fixed base: :attr:`periods`)."""
+        return 2.0 * math.pi / self.flexible_modes[0]
+
+    @property
+    def effective_damping(self) -> float:
+        """Damping ratio of the fundamental mode of the damped system on the model's DOF (complex modes;
+        on a foundation: the building's damping and the foundation's dashpots together)."""
+        return effective_damping(self.model_mass, self.model_damping_matrix(), self.model_stiffness_matrix())[1]
 
     @property
     def warnings(self) -> tuple[str, ...]:

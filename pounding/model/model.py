@@ -35,6 +35,8 @@ import numpy as np
 
 from pounding.model import floors, outline, schema
 from pounding.model.building import Building, Damping, planar_storeys
+from pounding.model.foundation import Foundation, on_soil
+from pounding.model.foundation_impedance import Footing, Soil
 from pounding.model.document import dump_document, is_plan_document, parse_document
 from pounding.model.ground import Component, GroundMotionSpec
 from pounding.contact import xi as xi_formulas
@@ -397,12 +399,12 @@ class Model:
     @property
     def dof_offsets(self) -> list[int]:
         """Index of each building's first degree of freedom in the model's vector."""
-        return [int(x) for x in np.cumsum([0] + [b.n_dof for b in self.buildings])[:-1]]
+        return [int(x) for x in np.cumsum([0] + [b.n_model_dof for b in self.buildings])[:-1]]
 
     @property
     def n_dof(self) -> int:
-        """Degrees of freedom of the model."""
-        return sum(b.n_dof for b in self.buildings)
+        """Degrees of freedom of the model (a founded building's base mat's included)."""
+        return sum(b.n_model_dof for b in self.buildings)
 
     def floor_slice(self, building: int, level: int) -> slice:
         """The degrees of freedom of floor *level* (1-based) of *building* in the model's vector."""
@@ -748,6 +750,8 @@ def _building_extras(b: Building, document: dict[str, Any]) -> dict[str, Any]:
         document["design"] = schema.design_document(b.design)
     if b.collapse_drift_ratio is not None:
         document["collapse"] = {"drift_ratio": b.collapse_drift_ratio}
+    if b.foundation is not None:
+        document["foundation"] = b.foundation.to_document()
     return document
 
 
@@ -840,10 +844,25 @@ def _trusted_building(entry: Any, storeys: tuple[floors.Storey, ...], outline: A
     damping = (_trusted(Damping, kind="modal", ratio=None, modes=None, modal_ratios=tuple(d.modal))
                if isinstance(d, schema.ModalEntry) else
                _trusted(Damping, kind="rayleigh", ratio=d.ratio, modes=tuple(d.modes), modal_ratios=None))
-    return _trusted(Building, name=entry.name, storeys=storeys, damping=damping, p_delta=entry.p_delta,
-                    design=getattr(entry, "design", None),
-                    collapse_drift_ratio=None if entry.collapse is None else entry.collapse.drift_ratio,
-                    outline=outline)
+    building = _trusted(Building, name=entry.name, storeys=storeys, damping=damping, p_delta=entry.p_delta,
+                        design=getattr(entry, "design", None),
+                        collapse_drift_ratio=None if entry.collapse is None else entry.collapse.drift_ratio,
+                        outline=outline)
+    found = getattr(entry, "foundation", None)
+    return building if found is None else dataclasses.replace(building, foundation=_foundation(found, building))
+
+
+def _foundation(entry: Any, building: Building) -> Foundation:
+    """The :class:`Foundation` of a validated ``foundation`` entry under the fixed-base *building*: its springs
+    as given, or from the soil and the footing at the building's flexible-base frequency."""
+    if entry.soil is None:
+        return Foundation(float(entry.mass), float(entry.rotary_inertia), float(entry.sway.stiffness),
+                          float(entry.sway.damping), float(entry.rocking.stiffness), float(entry.rocking.damping))
+    soil = Soil(entry.soil.shear_wave_velocity, entry.soil.poisson, entry.soil.density)
+    footing = Footing(entry.footing.length, entry.footing.width, entry.footing.embedment)
+    omega, phi = building.modes
+    return on_soil(entry.mass, entry.rotary_inertia, soil, footing, building.dof_mass, phi[:, 0], building.elevation,
+                   float(omega[0]))
 
 
 def _build_plan(entry: Any, *, name: str, text: str, path: str | None, base_dir: str | None) -> Model:

@@ -156,6 +156,16 @@ class PlanBuildingEntry(SchemaEntry):
     collapse: CollapseEntry | None = Field(
         None, description="this building's collapse criterion {drift_ratio}: any of its planes' |drift ratio| "
                           "(default: solver.stop_drift_ratio)")
+    foundation: Any = Field(None, description="not yet in plan: foundations are for planar buildings for now")
+
+    @field_validator("foundation", mode="before")
+    @classmethod
+    def _no_foundation(cls, value: Any) -> Any:
+        if value is not None:
+            raise problem("foundations are for planar buildings for now: remove the foundation, or model the "
+                          "building without plan (storeys with mass, stiffness, height)", kind="error", line="key",
+                          colon=False)
+        return value
 
     @property
     def n_floors(self) -> int:

@@ -546,6 +546,85 @@ class CollapseEntry(SchemaEntry):
                     "ratio| first exceeds this (default: solver.stop_drift_ratio)")
 
 
+class FoundationSpringEntry(SchemaEntry):
+    """A foundation spring and its dashpot: ``stiffness`` and ``damping``."""
+
+    WHAT: ClassVar[str] = ("a mapping {stiffness, damping}, e.g. sway: {stiffness: 3.0e9, damping: 8.0e7} "
+                           "(N/m, N s/m) or rocking: {stiffness: 6.0e11, damping: 5.0e9} (N m/rad, N m s/rad)")
+
+    stiffness: PositiveNumber = Field(description="spring stiffness: sway N/m, rocking N m/rad")
+    damping: NonNegativeNumber = Field(description="dashpot coefficient: sway N s/m, rocking N m s/rad")
+
+
+#: Poisson's ratio of a soil: 0 to 0.5 (0.5: saturated clay, undrained; NIST GCR 12-917-21 caps ψ there).
+PoissonRatio = Annotated[float, BeforeValidator(located(as_number)),
+                         AfterValidator(located(_bound(lambda v: 0 <= v <= 0.5, "must be in [0, 0.5] (about 0.3 "
+                                                       "for dry soil, up to 0.5 for saturated clay)")))]
+
+
+class SoilEntry(SchemaEntry):
+    """The uniform half-space under a footing (docs/foundations-soil.md)."""
+
+    WHAT: ClassVar[str] = "a mapping {shear_wave_velocity, poisson, density}, e.g. {shear_wave_velocity: 150, " \
+                          "poisson: 0.33, density: 1900} (m/s, -, kg/m^3)"
+
+    shear_wave_velocity: PositiveNumber = Field(description="small-strain shear-wave velocity V_s, m/s")
+    poisson: PoissonRatio = Field(description="Poisson's ratio, 0 to 0.5")
+    density: PositiveNumber = Field(description="mass density, kg/m^3")
+
+
+class FootingEntry(SchemaEntry):
+    """A rigid rectangular footing (docs/foundations-soil.md)."""
+
+    WHAT: ClassVar[str] = "a mapping {length, width, embedment}, e.g. {length: 30, width: 20, embedment: 0} (m)"
+
+    length: PositiveNumber = Field(description="plan side along x (the direction the floors move), m")
+    width: PositiveNumber = Field(description="plan side along y, m")
+    embedment: NonNegativeNumber = Field(0.0, description="depth of the footing's base below the ground, m "
+                                                          "(default 0: on the surface)")
+
+
+class FoundationEntry(SchemaEntry):
+    """A planar building's sway–rocking foundation: its springs, or the soil and the footing (docs/foundations.md)."""
+
+    WHAT: ClassVar[str] = "a mapping {mass, rotary_inertia, sway, rocking} or {mass, rotary_inertia, soil, footing}"
+    CHILDREN: ClassVar[dict[str, type[BaseModel]]] = {"sway": FoundationSpringEntry, "rocking": FoundationSpringEntry,
+                                                      "soil": SoilEntry, "footing": FootingEntry}
+    #: The two ways of giving the springs: the keys of each.
+    WAYS: ClassVar[tuple[tuple[str, str], ...]] = (("sway", "rocking"), ("soil", "footing"))
+
+    mass: PositiveNumber = Field(description="base mat mass, kg")
+    rotary_inertia: PositiveNumber = Field(description="base mat rotary inertia about its horizontal axis, kg m^2")
+    sway: FoundationSpringEntry | None = Field(None, description="{stiffness: N/m, damping: N s/m} on the base "
+                                                                 "mat's sway")
+    rocking: FoundationSpringEntry | None = Field(None, description="{stiffness: N m/rad, damping: N m s/rad} on "
+                                                                    "its rocking")
+    soil: SoilEntry | None = Field(None, description="{shear_wave_velocity: m/s, poisson, density: kg/m^3}: the "
+                                                     "springs and dashpots from the soil and the footing")
+    footing: FootingEntry | None = Field(None, description="{length: m (along x), width: m, embedment: m}")
+
+    def given(self) -> tuple[str, ...]:
+        """The keys of :attr:`WAYS` present in the entry."""
+        return tuple(key for way in self.WAYS for key in way if getattr(self, key) is not None)
+
+
+def foundation_problem(foundation: FoundationEntry, building: str) -> PydanticCustomError | None:
+    """The one-line problem of a foundation that gives neither or both of springs and soil, or half of one."""
+    given = foundation.given()
+    fix = ("give either sway: {stiffness, damping} and rocking: {stiffness, damping}, or soil: {shear_wave_velocity, "
+           "poisson, density} and footing: {length, width, embedment}")
+    if set(given) in ({"sway", "rocking"}, {"soil", "footing"}):
+        return None
+    if not given:
+        text = f"of building {building} gives neither springs nor soil; {fix}"
+    elif {"sway", "rocking"} & set(given) and {"soil", "footing"} & set(given):
+        text = f"of building {building} gives springs and soil together ({', '.join(given)}); {fix}, not both"
+    else:
+        missing = next(other for way in foundation.WAYS for key, other in (way, way[::-1]) if key in given)
+        text = f"of building {building} gives {given[0]} without {missing}; {fix}"
+    return problem(text, kind="error", at=("foundation",), line="key", colon=False)
+
+
 class BuildingEntry(SchemaEntry):
     """One building: ``name``, ``storeys``, ``damping``."""
 
@@ -565,6 +644,9 @@ class BuildingEntry(SchemaEntry):
                           "ec8: {q: 3.9}}")
     collapse: CollapseEntry | None = Field(
         None, description="this building's collapse criterion {drift_ratio} (default: solver.stop_drift_ratio)")
+    foundation: FoundationEntry | None = Field(
+        None, description="a sway-rocking foundation {mass, rotary_inertia, sway: {stiffness, damping}, "
+                          "rocking: {stiffness, damping}} (default: a fixed base)")
 
     def column(self, key: str) -> tuple[Any, ...]:
         """Per-floor values of ``mass``, ``stiffness``, ``height`` or ``hysteresis``, from the ground up."""
@@ -603,9 +685,20 @@ class BuildingEntry(SchemaEntry):
         return self
 
     @model_validator(mode="after")
+    def _foundation_springs(self) -> BuildingEntry:
+        found = None if self.foundation is None else foundation_problem(self.foundation, self.name)
+        if found is not None:
+            raise found
+        return self
+
+    @model_validator(mode="after")
     def _statically_stable(self) -> BuildingEntry:
         if not self.p_delta:
             return self
+        if self.foundation is not None:
+            raise problem("is not supported on a building with a foundation yet (the weight's overturning moment "
+                          "on the rocking base is not modelled); set p_delta: false or remove the foundation",
+                          kind="error", at=("p_delta",), line="key", colon=False)
         found = unstable_storey(self.column("mass"), self.column("stiffness"), self.column("height"),
                                 self.column("hysteresis"))
         if found is None:
@@ -1249,7 +1342,8 @@ def _check_period_building(ground_motion: GroundMotionEntry, names: list[str], a
 
 #: The document's top-level keys (kept for the sweep's key lists).
 TopLevel = ModelEntry
-BuildingEntry.CHILDREN = {"storeys": StoreyEntry, "ground_motion": GroundMotionEntry, "design": DesignEntry}
+BuildingEntry.CHILDREN = {"storeys": StoreyEntry, "ground_motion": GroundMotionEntry, "design": DesignEntry,
+                          "collapse": CollapseEntry, "foundation": FoundationEntry}
 GroundMotionEntry.CHILDREN = {"wave_passage": WavePassageEntry}
 BuildingEntry.model_rebuild()
 ModelEntry.model_rebuild()

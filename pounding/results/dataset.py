@@ -52,7 +52,7 @@ from pounding.model.floors import DOF_PER_FLOOR
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.results.corners import CORNERS, corner_displacements, floor_corners, hermite_at
-from pounding.solver.assembly import Assembly
+from pounding.solver.assembly import Assembly, storey_stop_ratios
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver.kinematics import penetration as combined_penetration
 from pounding.solver.storeys import restoring_force
@@ -185,18 +185,30 @@ def _link_results(system: System, raw: RawSolution, ng: int,
     return {"deformation": deformation, "work": work, "stored": stored}
 
 
-def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray) -> dict[str, np.ndarray]:
-    """Per storey: residual drift ratio, yield drift, peak ductility and dissipated energy at the end."""
+def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray,
+                       rows: Assembly | None = None) -> dict[str, np.ndarray]:
+    """Per storey: residual drift ratio, yield drift, peak ductility and dissipated energy at the end.
+
+    *rows*: the assembly of a planar model whose storeys are weighted rows (a building on a foundation);
+    None: a chain, each storey ``u_j − u_below``.
+    """
     n = system.n_floors
     final = raw.final_state
     displacement = final[:n]
-    below = system.below
-    drift = displacement - np.where(below >= 0, displacement[np.maximum(below, 0)], 0.0)
+    if rows is None:
+        below = system.below
+        drift = displacement - np.where(below >= 0, displacement[np.maximum(below, 0)], 0.0)
+        peak, stiffness = raw.peak_drift, system.storey_stiffness
+    else:
+        drift, peak, stiffness = rows.plane_weights @ displacement, raw.peak_plane_drift, rows.plane_stiffness
+    if rows is not None and system.storey_floors is None:   # weighted rows without a yielding one: no storey rows
+        nan = np.full(drift.size, np.nan)
+        return {"residual": drift / heights, "yield_drift": nan, "ductility": nan, "dissipated": np.zeros(drift.size)}
     yielding = system.storey_state >= 0
     yield_drift = np.where(yielding, system.storey_parameters[:, 0], np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
-        ductility = raw.peak_drift / yield_drift
-    dissipated = np.zeros(n)
+        ductility = peak / yield_drift
+    dissipated = np.zeros(drift.size)
     if yielding.any():
         lay = system.layout
         index = system.storey_state[yielding]
@@ -204,7 +216,7 @@ def _inelastic_summary(system: System, raw: RawSolution, heights: np.ndarray) ->
         work = final[lay.storey_work + index]
         table = np.ascontiguousarray(system.storey_parameters, dtype=np.float64)
         recoverable = np.array([_recoverable(int(system.storey_model[j]), table, int(j),
-                                             float(system.storey_stiffness[j]), float(drift[j]), float(r))
+                                             float(stiffness[j]), float(drift[j]), float(r))
                                 for j, r in zip(np.flatnonzero(yielding), state)])
         dissipated[yielding] = work - recoverable
     return {"residual": drift / heights, "yield_drift": yield_drift, "ductility": ductility,
@@ -405,6 +417,81 @@ def run_status(system: System, raw: RawSolution, n_gaps: int, storey: str, build
                                                             cause=collapse_reason(raw, system))
 
 
+def floor_dofs(model: Model) -> np.ndarray:
+    """(floors,) the index of every floor's first degree of freedom in the model's vector (a founded building's
+    base mat DOF, after its floors, are left out)."""
+    return np.concatenate([offset + b.dofs_per_floor * np.arange(b.n_floors)
+                           for b, offset in zip(model.buildings, model.dof_offsets)]).astype(np.int64) \
+        if model.buildings else np.zeros(0, dtype=np.int64)
+
+
+def _founded(model: Model) -> list[tuple[int, Any, int]]:
+    """``(building index, building, index of its base mat's sway)`` of every building on a foundation (its
+    rocking follows the sway)."""
+    return [(i, b, offset + b.n_dof) for i, (b, offset) in enumerate(zip(model.buildings, model.dof_offsets))
+            if b.foundation is not None]
+
+
+def _row_strain(model: Model, assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> np.ndarray:
+    """(nt,) recoverable energy of a planar model with weighted storey rows, J: the storeys' (yielding ones by
+    their hysteresis), the P-Delta potential and the foundations' springs ``½ K_x u_b² + ½ K_θ θ_b²``."""
+    energies = _plane_energies(assembly, raw, drift)
+    return energies["energy_plane_strain"] + energies["energy_p_delta"] + _foundation_energies(model, raw)[0]
+
+
+def _foundation_energies(model: Model, raw: RawSolution) -> tuple[np.ndarray, np.ndarray]:
+    """(nt,) the foundations' spring energy (J) and the energy their dashpots dissipated (J, the trapezoidal
+    rule on the stored samples of ``c_x u̇_b² + c_θ θ̇_b²``: it is part of the damping energy the solver
+    integrates at every step, which the energy audit uses)."""
+    n = raw.peak_displacement.size
+    strain = np.zeros(raw.time.size)
+    power = np.zeros(raw.time.size)
+    for _, b, sway in _founded(model):
+        q = raw.state[:, sway:sway + 2]
+        rate = raw.state[:, n + sway:n + sway + 2]
+        strain += 0.5 * (q * q) @ b.foundation.stiffness
+        power += (rate * rate) @ b.foundation.damping
+    dissipated = np.r_[0.0, np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(raw.time))] if raw.time.size else power
+    return strain, dissipated
+
+
+def foundation_variables(model: Model, raw: RawSolution, floor: np.ndarray) -> dict[str, Any]:
+    """The founded buildings' base mat histories and peaks, their floors' deformation (relative to the base mat),
+    the foundations' energies, and under ``coords`` the ``foundation`` dimension (module docstring)."""
+    n = raw.peak_displacement.size
+    found = _founded(model)
+    sway = np.array([s for *_, s in found], dtype=np.int64)
+    q = raw.state[:, :n]
+    deformation = q[:, floor].copy()
+    for _, b, s in found:   # d_i = x_i − u_b − z_i θ_b (pounding.model.foundation)
+        own = np.flatnonzero(floor == s - b.n_dof) + np.arange(b.n_floors)
+        deformation[:, own] -= q[:, [s]] + q[:, [s + 1]] * b.elevation[None, :]
+    strain, dissipated = _foundation_energies(model, raw)
+    return {
+        "coords": {"foundation": ("foundation", np.array([b.name for _, b, _ in found], dtype=object),
+                                  {"long_name": "building on a foundation"})},
+        "base_sway": _var(("time", "foundation"), q[:, sway], "m", "base mat sway relative to the free field"),
+        "base_rocking": _var(("time", "foundation"), q[:, sway + 1], "rad", "base mat rocking, counter-clockwise"),
+        "base_sway_rate": _var(("time", "foundation"), raw.state[:, n + sway], "m s-1", "base mat sway velocity"),
+        "base_rocking_rate": _var(("time", "foundation"), raw.state[:, n + sway + 1], "rad s-1",
+                                  "base mat rocking rate"),
+        "peak_base_sway": _var(("foundation",), raw.peak_displacement[sway], "m",
+                               "peak |sway| of the base mat (full resolution)"),
+        "peak_base_rocking": _var(("foundation",), raw.peak_displacement[sway + 1], "rad",
+                                  "peak |rocking| of the base mat (full resolution)"),
+        "floor_deformation": _var(("time", "floor"), deformation, "m",
+                                  "floor displacement relative to its base mat (without sway and rocking; a fixed "
+                                  "base: the displacement)"),
+        "peak_floor_deformation": _var(("floor",), np.abs(deformation).max(axis=0, initial=0.0), "m",
+                                       "peak |floor_deformation| (stored samples)"),
+        "energy_foundation_strain": _var(("time",), strain, "J",
+                                         "elastic energy of the foundation springs (part of energy_strain)"),
+        "energy_foundation_damping": _var(("time",), dissipated, "J",
+                                          "energy dissipated by the foundation dashpots (stored samples, trapezoidal "
+                                          "rule; part of energy_damping)"),
+    }
+
+
 def run_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, Any]:
     """The peaks and end-of-run state of one simulation, as plain arrays (what studies keep of a run).
 
@@ -419,9 +506,10 @@ def run_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, A
     ends the run, so at most one building collapses in a run.  They do not depend on the output sampling: the solver tracks peaks at every step.
     Planes in plan: :func:`plane_peaks`.
     """
-    if not assembly.chain:
+    if not assembly.chain and model.in_plan:
         return plane_peaks(model, assembly, raw)
     system = assembly.system
+    rows = None if assembly.chain else assembly   # planar storeys as weighted rows: a building on a foundation
     labels = _labels(model)
     heights = labels["height"]
     ng = len(model.gaps)   # the gap elements; the links follow them in the solver's arrays
@@ -434,8 +522,8 @@ def run_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, A
         "storey": floor_names,
         "storey_building": [str(b) for b in labels["building"]],
         "contact": [g.label(building_names) for g in model.gaps],
-        "peak_drift_ratio": raw.peak_drift / heights,
-        "residual_drift_ratio": _inelastic_summary(system, raw, heights)["residual"],
+        "peak_drift_ratio": (raw.peak_drift if rows is None else raw.peak_plane_drift) / heights,
+        "residual_drift_ratio": _inelastic_summary(system, raw, heights, rows)["residual"],
         "impact_count": (np.bincount(raw.impact_contact, minlength=ng).astype(np.int32) if ng
                          else np.zeros(0, np.int32)),
         "peak_contact_force": raw.peak_contact_force[:ng],
@@ -457,35 +545,37 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
     building stands on *record* (row 0 of the solution's ground).  Planes as weighted rows (floors
     in plan): :func:`plane_dataset`.
     """
-    if not assembly.chain:
+    if not assembly.chain and model.in_plan:
         return plane_dataset(model, record, assembly, raw, end_time=end_time, wall_time=wall_time, supports=supports)
     system = assembly.system
     n = system.n_floors
+    rows = None if assembly.chain else assembly   # planar storeys as weighted rows: a building on a foundation
+    floor = floor_dofs(model)
     labels = _labels(model)
-    u = raw.state[:, :n]
-    v = raw.state[:, n:2 * n]
+    u = raw.state[:, floor]
+    v = raw.state[:, n:2 * n][:, floor]
     lay = system.layout
     work = raw.state[:, lay.work:lay.internal]
     e_input = raw.state[:, lay.input_energy]
     e_damping = raw.state[:, lay.damping_energy]
 
-    drift = _storey_drift(u, system.below)
+    drift = _storey_drift(u, system.below) if rows is None else raw.state[:, :n] @ assembly.plane_weights.T
     heights = labels["height"]
     ground = _grounds(model, record, system, raw, supports)
     # Contacts first, then links (pounding.solver.assembly.assemble puts the links after the gap elements).
     ng = len(model.gaps)
     # Total displacements: the differential ground displacement of each gap element's two sides joins
     # (0 on one common ground, and for a wall, which moves with the ground of the building it faces).
-    penetration = _penetration(u, system, ground["displacement"])[:, :ng]
+    penetration = _penetration(raw.state[:, :n], system, ground["displacement"])[:, :ng]
     links = _link_results(system, raw, ng, ground["displacement"])
 
-    kinetic = 0.5 * np.einsum("ij,ij,j->i", v, v, system.mass)
+    kinetic = 0.5 * np.einsum("ij,ij,j->i", raw.state[:, n:2 * n], raw.state[:, n:2 * n], system.mass)
     # Recoverable storey energy (with the P-Delta potential), summed by the solver at each output time;
     # a yielding storey's dissipated energy is its work ∫F dΔ minus its recoverable part.
-    strain = raw.storey_energy[:, 0]
+    strain = raw.storey_energy[:, 0] if rows is None else _row_strain(model, assembly, raw, drift)
     storey_work = raw.state[:, lay.storey_work:lay.ground_work]
     hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
-    inelastic = _inelastic_summary(system, raw, heights)
+    inelastic = _inelastic_summary(system, raw, heights, rows)
     peaks = run_peaks(model, assembly, raw)
     # Summed over contacts and links by the solver at each output time; the links' share is taken out.
     contact_strain = raw.contact_potential - links["stored"].sum(axis=1)
@@ -525,12 +615,15 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
                      {"long_name": "link element and its parameters"}),
     }
     variables = {
-        "displacement": _var(("time", "floor"), u, "m", "floor displacement relative to the ground"),
+        "displacement": _var(("time", "floor"), u, "m", "floor displacement relative to the ground (on a foundation: "
+                             "to the free field, the base mat's sway and rocking included)"),
         "velocity": _var(("time", "floor"), v, "m s-1", "floor velocity relative to the ground"),
         "absolute_acceleration": _var(("time", "floor"),
-                                      raw.acceleration + np.take(ground["acceleration"], system.floor_ground, axis=1),
+                                      raw.acceleration[:, floor]
+                                      + np.take(ground["acceleration"], system.floor_ground[floor], axis=1),
                                       "m s-2", "absolute floor acceleration (over the building's own ground)"),
-        "storey_drift": _var(("time", "storey"), drift, "m", "storey drift u_i - u_(i-1)"),
+        "storey_drift": _var(("time", "storey"), drift, "m", "storey drift u_i - u_(i-1) (on a foundation: the "
+                             "storey's deformation, without the base mat's rocking)"),
         "drift_ratio": _var(("time", "storey"), drift / heights, "1", "storey drift ratio (drift / height)"),
         "contact_force": _var(("time", "contact"), raw.contact_force[:, :ng], "N", "contact force (>= 0 pushes apart)"),
         "penetration": _var(("time", "contact"), penetration, "m",
@@ -551,11 +644,12 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
                                          "ground velocity under the building (exact integral from rest)"),
         "building_ground_displacement": _var(("time", "ground"), ground["displacement"][:, ground["row"]], "m",
                                              "ground displacement under the building (exact integral from rest)"),
-        "peak_displacement": _var(("floor",), raw.peak_displacement, "m",
+        "peak_displacement": _var(("floor",), raw.peak_displacement[floor], "m",
                                   "peak absolute floor displacement relative to the ground"),
-        "peak_storey_drift": _var(("storey",), raw.peak_drift, "m", "peak absolute storey drift"),
+        "peak_storey_drift": _var(("storey",), raw.peak_drift if rows is None else raw.peak_plane_drift, "m",
+                                  "peak absolute storey drift"),
         "peak_drift_ratio": _var(("storey",), peaks["peak_drift_ratio"], "1", "peak absolute storey drift ratio"),
-        "collapse_drift_ratio": _var(("storey",), np.where(system.storey_stop_ratio > 0, system.storey_stop_ratio,
+        "collapse_drift_ratio": _var(("storey",), np.where(storey_stop_ratios(model) > 0, storey_stop_ratios(model),
                                                            np.nan), "1",
                                      "collapse drift ratio of the storey's building (the run ends when the storey's "
                                      "|drift ratio| first exceeds it; NaN: no drift limit)"),
@@ -608,7 +702,8 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
                                 "peak absolute link force, tracked on every step"),
         "link_dissipated_energy": _var(("link",), links["work"][-1] - links["stored"][-1], "J",
                                        "energy dissipated by the link over the run"),
-        "storey_shear": _var(("time", "storey"), raw.storey_shear, "N",
+        "storey_shear": _var(("time", "storey"), raw.storey_shear if rows is None else
+                             _plane_shear(assembly, raw, drift), "N",
                              "storey restoring (column) shear, without P-Delta and damping"),
         "residual_drift_ratio": _var(("storey",), peaks["residual_drift_ratio"], "1",
                                      "signed storey drift ratio at the end of the run"),
@@ -616,11 +711,16 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
                                "peak absolute storey drift over yield drift (NaN for an elastic storey)"),
         "yield_drift": _var(("storey",), inelastic["yield_drift"], "m",
                             "storey yield drift u_y = F_y / k (NaN for an elastic storey)"),
-        "yield_force": _var(("storey",), inelastic["yield_drift"] * system.storey_stiffness, "N",
+        "yield_force": _var(("storey",), inelastic["yield_drift"] * (system.storey_stiffness if rows is None
+                                                                     else assembly.plane_stiffness), "N",
                             "storey yield force F_y (NaN for an elastic storey)"),
         "storey_hysteretic_energy": _var(("storey",), inelastic["dissipated"], "J",
                                          "energy dissipated by the storey's hysteresis over the run"),
     }
+    if rows is not None and any(b.foundation is not None for b in model.buildings):
+        found = foundation_variables(model, raw, floor)
+        coords.update(found.pop("coords"))
+        variables.update(found)
     if any(g.has_column_point for g in gaps):
         coords.update(_column_point_coords(gaps))
         variables.update(_column_shear_variables(system, raw, gaps))
@@ -686,6 +786,12 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
         "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
+    if "foundation" in ds.coords:   # per founded building: periods, damping, springs (from soil: at which ω)
+        ds.attrs["foundations"] = json.dumps({b.name: {
+            "fixed_base_periods": [float(x) for x in b.periods], "flexible_base_periods":
+            [float(x) for x in b.flexible_periods], "effective_damping": float(b.effective_damping),
+            "fixed_base_damping": float(b.modal_damping_ratios[0]), "springs": b.foundation.springs()}
+            for _, b, _ in _founded(model)})
     if peaks["status_message"]:   # not completed: why (a completed run's archive is as before)
         ds.attrs["status_message"] = peaks["status_message"]
     if model.has_building_records:   # each building's own record: its PGA as recorded and as run, m/s²

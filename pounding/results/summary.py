@@ -18,6 +18,7 @@ relative size below which a rotation, or a departure from elasticity, is taken f
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import xarray as xr
@@ -211,6 +212,34 @@ def _friction_line(ds: xr.Dataset) -> str:
             f"dissipated {float(ds.energy_friction[-1]) / 1e3:.1f} kJ")
 
 
+def _foundation_lines(ds: xr.Dataset) -> list[str]:
+    """Per building on a foundation: fixed- and flexible-base first period, effective damping, the base mat's
+    peak sway and rocking, and the foundation dashpots' share of the damping energy (docs/foundations.md)."""
+    if not ds.attrs.get("foundations"):
+        return []
+    found = json.loads(ds.attrs["foundations"])
+    lines = ["foundations (first period fixed / flexible base, damping ratio fixed / effective):"]
+    damping = float(ds.energy_damping[-1])
+    share = float(ds.energy_foundation_damping[-1]) / damping if damping > 0 else float("nan")
+    for name, f in found.items():
+        fixed, flexible = f["fixed_base_periods"][0], f["flexible_base_periods"][0]
+        sway = float(ds.peak_base_sway.sel(foundation=name))
+        rocking = float(ds.peak_base_rocking.sel(foundation=name))
+        lines.append(f"  {name}: T {fixed:.3f} / {flexible:.3f} s (x{flexible / fixed:.3f}), "
+                     f"{100 * f['fixed_base_damping']:.2f} / {100 * f['effective_damping']:.2f} %; peak base sway "
+                     f"{1e3 * sway:.2f} mm, rocking {rocking:.2e} rad")
+        springs = f.get("springs", {})
+        if "frequency" in springs:   # from the soil and the footing: the springs used, and where they were evaluated
+            omega = springs["frequency"]
+            lines.append(f"    springs from the soil and footing at {omega:.4g} rad/s "
+                         f"(T̃ {2 * math.pi / omega:.3f} s, Veletsos & Meek): "
+                         f"K_x {springs['sway_stiffness']:.4g} N/m, c_x {springs['sway_damping']:.4g} N s/m, "
+                         f"K_θ {springs['rocking_stiffness']:.4g} N m/rad, "
+                         f"c_θ {springs['rocking_damping']:.4g} N m s/rad")
+    lines.append(f"  foundation dashpots: {100 * share:.1f} % of the damping energy")
+    return lines
+
+
 def run_summary(ds: xr.Dataset) -> str:
     """A run archive's summary, a few lines, each part where the archive holds its data (module docstring).
 
@@ -232,6 +261,7 @@ def run_summary(ds: xr.Dataset) -> str:
         sel = ds.peak_drift_ratio.where(ds.storey_building == name, drop=True)
         lines.append(f"  {name}: " + " ".join(f"{100 * v:.3f}" for v in sel.values))
     lines += _yield_lines(ds, periods)
+    lines += _foundation_lines(ds)
     lines += _plan_peak_lines(ds)
     lines += _contact_lines(ds)
     lines.append(f"energy closure error {ds.attrs['energy_closure_error']:.2e}; "

@@ -104,9 +104,10 @@ class Assembly:
 
 
 def is_chain(building: Any) -> bool:
-    """True if *building* is a chain of storey springs: floors of one DOF, one plane along x per storey."""
-    return building.dofs_per_floor == PLANAR_DOFS and all(len(s.planes) == 1 and s.planes[0].direction == "x"
-                                                          for s in building.storeys)
+    """True if *building* is a chain of storey springs: floors of one DOF, one plane along x per storey, a fixed
+    base (a founded building's storey deformations also involve its base mat's rocking: weighted rows)."""
+    return building.dofs_per_floor == PLANAR_DOFS and getattr(building, "foundation", None) is None and \
+        all(len(s.planes) == 1 and s.planes[0].direction == "x" for s in building.storeys)
 
 
 def refusal(model: Model) -> str | None:
@@ -135,15 +136,19 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
 
     A chain building's Rayleigh damping stays per floor (``a0·M + a1·K`` acts storey by storey),
     its modal damping one dense block; any other building has a dense damping block and a
-    dense stiffness block (its planes and P-Delta), banded.
+    dense stiffness block (its planes and P-Delta), banded.  In a model where any building is not
+    a chain, every building is stored the second way (the planes are rows for all of them).  A
+    founded building's block spans its floors and its base mat's sway and rocking
+    (:mod:`pounding.model.foundation`).
     """
+    all_chain = all(is_chain(b) for b in model.buildings)
     masses, stiffness, below, a0, a1 = [], [], [], [], []
     dense_start, dense_size, dense_offset, dense_values, dense_band, dense_stiffness = [], [], [], [], [], []
     offset = used = 0
     for building in model.buildings:
-        n = building.n_dof
-        chain = is_chain(building)
-        masses.append(building.dof_mass)
+        n = building.n_model_dof
+        chain = all_chain
+        masses.append(building.model_mass)
         stiffness.append(building.stiffness if chain else np.zeros(n))
         below.append(np.r_[-1, np.arange(offset, offset + n - 1)] if chain else np.full(n, -1))
         dense_start.append(offset)
@@ -154,11 +159,11 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
         a1.append(c_stiff * _tangent_ratios(building) if rayleigh else np.zeros(n))
         dense_size.append(0 if rayleigh else n)
         if not rayleigh:
-            damping = np.asarray(building.damping_matrix(), dtype=float)
+            damping = np.asarray(building.model_damping_matrix(), dtype=float)
             # The springs act with their elastic stiffness (a yielding plane's row adds F − kΔ); damping is on the
-            # initial tangent (the building's damping matrix).
-            k = (np.zeros((n, n)) if chain else
-                 np.asarray(building.stiffness_matrix(initial=False) + building.geometric_stiffness(), dtype=float))
+            # initial tangent (the building's damping matrix).  P-Delta is refused on a founded building.
+            k = (np.zeros((n, n)) if chain else np.asarray(building.model_stiffness_matrix(initial=False), dtype=float)
+                 + (building.geometric_stiffness() if building.foundation is None else 0.0))
             dense_values.append(damping.ravel())
             dense_stiffness.append(k.ravel())
             dense_band.append(n - 1 if chain else _half_bandwidth(damping, k))
@@ -175,7 +180,7 @@ def building_arrays(model: Model) -> dict[str, np.ndarray]:
         dense_offset=np.asarray(dense_offset, dtype=np.int64),
         dense_values=np.ascontiguousarray(np.concatenate(dense_values) if dense_values else np.zeros(0)),
     )
-    if not all(is_chain(b) for b in model.buildings):
+    if not all_chain:
         # Blocks of every building (a chain's modal block carries a zero stiffness: its springs are per floor).
         arrays["dense_band"] = _bands(dense_size, dense_band)
         arrays["dense_stiffness"] = np.ascontiguousarray(np.concatenate(dense_stiffness) if dense_stiffness
@@ -264,11 +269,13 @@ def _pad(terms: list[tuple[int, float]]) -> list[tuple[int, float]]:
 
 
 def _drift_sides(offset: int, per: int, a: np.ndarray, storey: int) -> tuple[list, list]:
-    """A storey drift ``a · q`` (a over one building's DOF) as two sides: the floor above, the floor below."""
+    """A storey drift ``a · q`` (a over one building's DOF) as two sides: the floor above, and the rest (the floor
+    below; on a foundation, also the base mat's sway and rocking)."""
     top = per * (storey - 1)
     upper = _floor_terms(offset + top, a[top:top + per])
-    lower = _floor_terms(offset + top - per, a[top - per:top]) if storey > 1 else []
-    return _pad(upper), _pad(lower)
+    rest = np.array(a, dtype=float)
+    rest[top:top + per] = 0.0
+    return _pad(upper), _pad(_floor_terms(offset, rest))
 
 
 def _global(offset: int, a: np.ndarray, n: int) -> np.ndarray:
@@ -290,7 +297,7 @@ def plane_rows(model: Model) -> tuple[list, dict[str, np.ndarray]]:
     offsets = model.dof_offsets
     planes = [(float(p.stiffness), a, offset, storey, b.storeys[storey - 1].planes[j], b)
               for b, offset in zip(model.buildings, offsets) for (storey, j, a), (_, _, p)
-              in zip(b.plane_weights(), b.planes())]
+              in zip(b.model_plane_weights(), b.planes())]
     sides = _rows([_drift_sides(offset, b.dofs_per_floor, a, storey) for _, a, offset, storey, _, b in planes])
     fields = {"plane_floors": sides["floors"], "plane_weights": sides["weights"]}
     ratios = dict(zip([b.name for b in model.buildings], model.collapse_drift_ratios()))
@@ -342,7 +349,14 @@ def side_terms(model: Model, building: int, level: int, at: float | None, point:
     # The floor below first (a planar column keeps its place even on the ground: (−1, 0)), then the floor above.
     below = floor(level - 1, n1) or ([(-1, 0.0)] if per == PLANAR_DOFS else [])
     above = floor(level, n2)
-    return _pad(below + above), above[0][0]
+    if b.foundation is None:
+        return _pad(below + above), above[0][0]
+    # On a foundation the column's chord rotates with the base mat: x(ξ) = N1 x_below + N2 x_above + h (ξ − N2) θ_b,
+    # and the floor below storey 1 is the base mat's sway (docs/foundations.md).
+    sway, rocking = offset + b.n_dof, offset + b.n_dof + 1
+    if level == 1:
+        below = [(sway, n1)]
+    return _pad(below + above + [(rocking, b.storeys[level - 1].height * (float(at) - n2))]), above[0][0]
 
 
 def contact_side_terms(model: Model, building: int, level: int, at: float | None) -> list[tuple[int, float]]:
@@ -445,10 +459,15 @@ def friction_arrays(model: Model) -> dict[str, np.ndarray]:
 
 
 def dof_ground(model: Model, ground: GroundRows) -> np.ndarray:
-    """(N,) the ground row of every degree of freedom: its building's along its direction (θ: the zero row)."""
-    return np.concatenate([np.array([ground.of(i, name) for _ in range(b.n_floors) for name in b.dof_names],
-                                    dtype=np.int64) for i, b in enumerate(model.buildings)]) \
-        if model.buildings else np.zeros(0, dtype=np.int64)
+    """(N,) the ground row of every degree of freedom: its building's along its direction (θ: the zero row); a
+    base mat's sway its building's row along x, its rocking the zero row (no ground forcing: the mat's
+    mass centre moves with the free field at rest)."""
+    if any(b.foundation is not None for b in model.buildings) and ground.zero < 0:
+        raise ValueError("a founded building's rocking needs a zero ground row: give GroundRows a zero row")
+    rows = [np.array([ground.of(i, name) for _ in range(b.n_floors) for name in b.dof_names]
+                     + ([ground.of(i, "x"), ground.zero] if b.foundation is not None else []), dtype=np.int64)
+            for i, b in enumerate(model.buildings)]
+    return np.concatenate(rows) if rows else np.zeros(0, dtype=np.int64)
 
 
 def tolerance_factors(model: Model, system: System, peak_ground_acceleration: float, atol: float) -> np.ndarray:
@@ -461,16 +480,19 @@ def tolerance_factors(model: Model, system: System, peak_ground_acceleration: fl
     if all(is_chain(b) for b in model.buildings):
         return floor_tolerance_factors(system.mass, system.storey_stiffness, system.below,
                                        peak_ground_acceleration, atol)
-    mass, stiffness, below, radius = [], [], [], []
+    mass, stiffness, below, radius, rotation = [], [], [], [], []
     for b in model.buildings:
-        per = b.dofs_per_floor
-        mass.append(np.repeat(b.mass, per))
-        stiffness.append(np.repeat(b.stiffness, per))
-        below.append(np.r_[-1, np.zeros(b.n_dof - 1, dtype=np.int64)])
-        radius.append(np.repeat([s.radius_of_gyration if per > PLANAR_DOFS else 1.0 for s in b.storeys], per))
+        per, base = b.dofs_per_floor, b.n_base_dof
+        # A base mat: its sway at the building's static scale, its rocking further over the building's height.
+        mass.append(np.r_[np.repeat(b.mass, per), np.full(base, b.mass.min())])
+        stiffness.append(np.r_[np.repeat(b.stiffness, per), np.full(base, b.stiffness.max())])
+        below.append(np.r_[-1, np.zeros(b.n_model_dof - 1, dtype=np.int64)])
+        radius.append(np.r_[np.repeat([s.radius_of_gyration if per > PLANAR_DOFS else 1.0 for s in b.storeys], per),
+                            np.full(base, float(b.height.sum()))])
+        rotation.append(np.r_[np.tile([name == "rz" for name in b.dof_names], b.n_floors), [False, True][:base]])
     factors = floor_tolerance_factors(np.concatenate(mass), np.concatenate(stiffness), np.concatenate(below),
                                       peak_ground_acceleration, atol)
-    rotation = np.concatenate([np.tile([name == "rz" for name in b.dof_names], b.n_floors) for b in model.buildings])
+    rotation = np.concatenate(rotation).astype(bool)
     factors[rotation] *= np.minimum(1.0, 1.0 / np.concatenate(radius)[rotation])
     return factors
 
@@ -489,7 +511,7 @@ def assemble(model: Model, ground: GroundRows | None = None) -> Assembly:
     else:
         planes, storeys = plane_rows(model)
     p_delta = [(k, _global(offset, a, n)) for b, offset in zip(model.buildings, model.dof_offsets)
-               if b.p_delta and not is_chain(b) for _, k, a in geometric_terms(list(b.storeys), b.dofs_per_floor)]
+               if b.p_delta and not chain for _, k, a in geometric_terms(list(b.storeys), b.dofs_per_floor)]
     system = System(**buildings, **storeys, **element_arrays(model, buildings["mass"], ground),
                     floor_ground=dof_ground(model, ground), **friction_arrays(model))
     return Assembly(system, len(model.gaps), chain,

@@ -15,7 +15,7 @@ from typing import Any
 from pounding.errors import PoundingError
 from pounding.records.catalogue import is_catalogued
 
-__all__ = ["study_parts", "record_list", "record_values", "pair_values", "study_document", "study_sweep",
+__all__ = ["study_parts", "with_base_mats", "record_list", "record_values", "pair_values", "study_document", "study_sweep",
            "check_duration", "finite_or_none", "records_text", "scale_spec_text", "sweep_heading", "record_sweep",
            "floor_states", "dof_peaks", "ground_pga"]
 
@@ -235,17 +235,38 @@ def record_sweep(model: str | os.PathLike, base: Any, prefix: str, settings: dic
 def floor_states(ds) -> tuple[Any, Any]:
     """``(q, q̇)`` (time, DOF) of a run archive in the model's order of degrees of freedom (m, rad; m/s, rad/s).
 
-    Floors of one degree of freedom: ``displacement`` and ``velocity`` (time, floor) as they are; floors in
+    Floors of one degree of freedom: ``displacement`` and ``velocity`` (time, floor) as they are (a founded
+    building's base mat after its floors: :func:`with_base_mats`); floors in
     plan: u_x, u_y (``displacement`` (time, floor, direction)) and θ (``rotation``) of each floor in turn.
     """
     import numpy as np
 
     u, v = ds.displacement.values, ds.velocity.values
     if u.ndim == 2:
+        if "foundation" in ds.dims:   # a founded building's base mat: its sway and rocking after its floors
+            return (with_base_mats(ds, u, ds.base_sway.values, ds.base_rocking.values),
+                    with_base_mats(ds, v, ds.base_sway_rate.values, ds.base_rocking_rate.values))
         return u, v
     q = np.concatenate([u, ds.rotation.values[:, :, None]], axis=2)
     qd = np.concatenate([v, ds.rotation_rate.values[:, :, None]], axis=2)
     return q.reshape(q.shape[0], -1), qd.reshape(qd.shape[0], -1)
+
+
+def with_base_mats(ds, floors: Any, sway: Any, rocking: Any) -> Any:
+    """(time, DOF) in the model's order from (time, floor) *floors* and (time, foundation) *sway* and *rocking*:
+    each building's floors, then its base mat's sway and rocking where it stands on a foundation
+    (:attr:`pounding.model.model.Model.dof_offsets`)."""
+    import numpy as np
+
+    owners = [str(b) for b in ds.building.values]
+    founded = [str(b) for b in ds.foundation.values]
+    columns = []
+    for name in dict.fromkeys(owners):
+        columns.append(floors[:, [i for i, owner in enumerate(owners) if owner == name]])
+        if name in founded:
+            k = founded.index(name)
+            columns.append(np.stack([sway[:, k], rocking[:, k]], axis=1))
+    return np.concatenate(columns, axis=1)
 
 
 def dof_peaks(ds) -> Any:
@@ -255,6 +276,9 @@ def dof_peaks(ds) -> Any:
 
     peak = ds.peak_displacement.values
     if peak.ndim == 1:
+        if "foundation" in ds.dims:
+            return with_base_mats(ds, peak[None, :], ds.peak_base_sway.values[None, :],
+                                  ds.peak_base_rocking.values[None, :])[0]
         return peak
     return np.concatenate([peak, ds.peak_rotation.values[:, None]], axis=1).reshape(-1)
 

@@ -74,7 +74,7 @@ BLOCKS = 16
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 MODELS = ["pair", "pair_inelastic", "pair_collapse", "isolated_moat", "pair_bumper", "pair_column", "pair_links",
-          "pair_wave_passage", "row_of_three", "corner_pair", "isolated_moat_plan"]
+          "pair_wave_passage", "row_of_three", "corner_pair", "isolated_moat_plan", "pair_on_soil"]
 
 #: Small studies: (name, pounding arguments), each writing ``{out}``.
 STUDIES = [
