@@ -22,8 +22,12 @@ without bound (stiff links, hunt settings), allocations beyond memory
 limits, output names that are not UTF-8 and two runs onto one output.  YAML-syntax attacks (NUL bytes, deep nesting,
 aliases) belong to the model-validation tests.
 
-Cost: every case is a fresh interpreter (~1 s to import and load the cached
-compiled solver; all cases share numba's on-disk cache), two cases at a time.
+Cost: a case of a one-run command (``run``, ``rerun``, ``info``, ``plot``,
+``export``) is a child forked from a process that has already imported
+pounding and loaded its compiled solver (:data:`FORK_SERVER`), so it costs
+its own work, not the ~2 s start-up of a fresh interpreter; the studies
+(``sweep``, ``ida``) and the race of two runs are fresh interpreters.  Two
+cases run at a time.
 """
 
 from __future__ import annotations
@@ -220,15 +224,126 @@ def _write_case(folder: Path, model: dict, record: tuple[str, str] = ("quake.txt
     return path
 
 
+#: A process that has imported what a one-run command (``pounding run``, ``info``, ...) imports, set up as
+#: :func:`pounding.cli.console_main` sets up such a process (dask marked absent, OpenBLAS on one thread), and
+#: forks one child per case: the child takes the memory cap, the case's folder and stdout/stderr files, and
+#: runs ``console_main`` as ``python -m pounding`` does, each case in a fresh copy of that process.  The server
+#: has run the valid base model once (its compiled solver and the netCDF library are loaded), so that what a
+#: case costs is its own work, not the ~1.5 s of imports and ~0.5 s of loading that every ``pounding`` process
+#: pays before it reads its input.  Commands that use dask run as real processes.
+FORK_SERVER = r"""
+import json, os, resource, signal, sys, time, traceback
+for name in ("dask", "distributed"):
+    sys.modules.setdefault(name, None)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+cap = int(sys.argv[1])
+import pounding.cli, pounding.cli.run, pounding.simulation, pounding.results.archive, pounding.export.opensees
+protocol = os.fdopen(os.dup(1), "w")
+null = os.open(os.devnull, os.O_WRONLY)
+os.dup2(null, 1)
+assert pounding.cli.main(["run", sys.argv[2], "-o", sys.argv[3]]) == 0   # solver kernels and netCDF loaded
+print("ready", file=protocol, flush=True)
+for line in sys.stdin:
+    case = json.loads(line)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        try:
+            for fd, name in ((1, case["out"]), (2, case["err"])):
+                os.dup2(os.open(name, os.O_WRONLY | os.O_CREAT | os.O_TRUNC), fd)
+            os.chdir(case["cwd"])
+            resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
+            resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+            sys.argv = ["pounding", *case["args"]]
+            status = pounding.cli.console_main()
+        except SystemExit as exc:   # as the interpreter ends on sys.exit()
+            status = exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 1
+            if not isinstance(exc.code, int) and exc.code is not None:
+                print(exc.code, file=sys.stderr)
+        except BaseException:       # as the interpreter prints an uncaught exception
+            traceback.print_exc()
+            status = 1
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(status)
+    deadline, status = time.monotonic() + case["limit"], None
+    while True:
+        done, code = os.waitpid(pid, os.WNOHANG)
+        if done:
+            status = os.waitstatus_to_exitcode(code)
+            break
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            break
+        time.sleep(0.005)
+    print(json.dumps(status), file=protocol, flush=True)
+"""
+
+#: Commands the fork server runs (those :data:`pounding.cli.LEAN_COMMANDS` start without dask).
+FORKED_COMMANDS = {"run", "rerun", "info", "plot", "export"}
+
+
+class ForkServer:
+    """One :data:`FORK_SERVER` process; :meth:`pounding` runs a case as :func:`pounding` does."""
+
+    def __init__(self, folder: Path):
+        environ = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
+        self.folder = folder
+        folder.mkdir()
+        warm_up = _write_case(folder / "warm-up", base_model())
+        self.process = subprocess.Popen([sys.executable, "-c", FORK_SERVER, str(MEMORY_CAP), str(warm_up),
+                                         str(warm_up.parent / "run.nc")], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, text=True, env=environ)
+        assert self.process.stdout.readline().strip() == "ready"
+
+    def pounding(self, args: list[str], cwd: Path, limit: float):
+        """(exit status, stdout, stderr) of ``pounding ARGS`` in a forked child, status None on a timeout."""
+        out, err = self.folder / "stdout", self.folder / "stderr"
+        request = {"args": args, "cwd": str(cwd), "limit": limit, "out": str(out), "err": str(err)}
+        self.process.stdin.write(json.dumps(request) + "\n")
+        self.process.stdin.flush()
+        status = json.loads(self.process.stdout.readline())
+        read = [path.read_text(encoding="utf-8", errors="replace") for path in (out, err)]
+        return status, read[0], read[1]
+
+    def close(self) -> None:
+        self.process.stdin.close()
+        self.process.wait(timeout=60)
+
+
 def _check_all(cases: list[tuple[str, list[str], Path, Path | None, float]]) -> None:
     """Run the cases two at a time; fail listing every case that ended badly."""
+    import queue
+    import tempfile
+
+    servers: queue.Queue = queue.Queue()
+
     def one(case):
         label, args, cwd, archive, limit = case
-        status, out, err = pounding(args, cwd, limit)
+        if args[0] in FORKED_COMMANDS:
+            server = servers.get()
+            try:
+                status, out, err = server.pounding(args, cwd, limit)
+            finally:
+                servers.put(server)
+        else:
+            status, out, err = pounding(args, cwd, limit)
         return label, args, verdict(status, out, err, archive), err
 
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        outcomes = list(pool.map(one, cases))
+    with tempfile.TemporaryDirectory() as scratch, ThreadPoolExecutor(max_workers=2) as pool:
+        started = [ForkServer(Path(scratch) / f"server{k}") for k in range(2)]
+        for server in started:
+            servers.put(server)
+        try:
+            outcomes = list(pool.map(one, cases))
+        finally:
+            for server in started:
+                server.close()
     bad = [f"{label}: {problem}\n    args: {args}\n    stderr: {err[-600:]}" for label, args, problem, err in outcomes
            if problem]
     assert not bad, f"{len(bad)} of {len(cases)} fuzz cases failed (seed {SEED}):\n" + "\n".join(bad)
