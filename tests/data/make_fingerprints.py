@@ -25,7 +25,9 @@ Change the file only in a commit of its own that names the cause and the largest
 from __future__ import annotations
 
 import argparse
+import contextlib
 import hashlib
+import io
 import json
 import os
 import re
@@ -168,8 +170,24 @@ def fingerprint(path: Path, root: Path = ROOT) -> dict:
     return out
 
 
+def _imported_from(root: Path) -> bool:
+    """Whether this process imports (or would import) the package of the tree at *root*."""
+    import importlib.util
+    spec = importlib.util.find_spec("pounding")
+    return spec is not None and spec.origin is not None and Path(spec.origin).resolve().parents[1] == root.resolve()
+
+
 def _pounding(arguments: list[str], root: Path) -> None:
-    """``python -m pounding ARGUMENTS`` with the package of the tree at *root*."""
+    """``pounding ARGUMENTS`` in the tree at *root*: in this process when it imports that tree's package (the
+    archives are bit-identical to a child's, and a run is spared the child's start-up, ~1.5 s of imports and
+    solver loading), else ``python -m pounding`` in a child process with the tree's package."""
+    if _imported_from(root):
+        from pounding.cli import main
+        with contextlib.chdir(root), contextlib.redirect_stdout(io.StringIO()):
+            status = main(arguments)
+        if status != 0:
+            raise subprocess.CalledProcessError(status, ["pounding", *arguments])
+        return
     subprocess.run([sys.executable, "-m", "pounding", *arguments], cwd=root, check=True, stdout=subprocess.DEVNULL,
                    env=dict(os.environ, PYTHONPATH=str(root)))
 
@@ -180,23 +198,49 @@ def model_archive(name: str, folder: Path, root: Path = ROOT) -> Path:
     return out
 
 
-def study_archive(name: str, arguments: list[str], folder: Path, root: Path = ROOT) -> Path:
+def study_archive(name: str, arguments: list[str], folder: Path, root: Path = ROOT,
+                  scheduler: str | None = None) -> Path:
+    """The archive of the study *arguments* (``{out}`` its path); on the Dask cluster at *scheduler* instead of
+    a cluster of its own (``--workers 1``) when given."""
     out = folder / f"{name}.nc"
+    if scheduler is not None:
+        arguments = [*arguments]
+        at = arguments.index("--workers")
+        arguments[at:at + 2] = ["--scheduler", scheduler]
     _pounding([a.replace("{out}", str(out)) for a in arguments], root)
     return out
+
+
+@contextlib.contextmanager
+def _shared_cluster(root: Path):
+    """The address of one single-worker Dask cluster that the studies share, or None (each study starts its own,
+    as ``--workers 1`` says) when the studies run in child processes.  A study's results do not depend on the
+    cluster it runs on (the same worker function, one scenario after another); its cluster's start-up, ~5 s of
+    CPU, would be most of a small study's cost."""
+    if not _imported_from(root):
+        yield None
+        return
+    from pounding.studies.engine.execution import start_client
+    client, cluster = start_client(workers=1)
+    try:
+        yield cluster.scheduler_address
+    finally:
+        client.close()
+        cluster.close()
 
 
 def all_fingerprints(only: list[str] | None = None, root: Path = ROOT) -> dict[str, dict]:
     """The fingerprints of every shipped model's archive and of each small study, run by the tree at *root*."""
     found = {}
+    studies = [(name, arguments) for name, arguments in STUDIES if only is None or name in only]
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         for name in MODELS:
             if only is None or name in only:
                 found[f"model:{name}"] = fingerprint(model_archive(name, folder, root), root)
-        for name, arguments in STUDIES:
-            if only is None or name in only:
-                found[f"study:{name}"] = fingerprint(study_archive(name, arguments, folder, root), root)
+        with _shared_cluster(root) if studies else contextlib.nullcontext() as scheduler:
+            for name, arguments in studies:
+                found[f"study:{name}"] = fingerprint(study_archive(name, arguments, folder, root, scheduler), root)
     return found
 
 
