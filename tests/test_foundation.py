@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 
 import pounding
 from pounding.errors import ModelError
-from pounding.model.foundation import veletsos_meek_period
+from pounding.model.foundation_impedance import veletsos_meek_period
 from pounding.model.model import model_from_text
 from pounding.results.summary import run_summary
 from pounding.simulation import record_for

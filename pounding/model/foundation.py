@@ -30,7 +30,7 @@ import numpy as np
 from pounding.model.foundation_impedance import Footing, Soil, equivalent_oscillator, flexible_base
 
 __all__ = ["Foundation", "on_soil", "BASE_DOFS", "BASE_DOF_NAMES", "base_transform", "founded_mass", "founded_matrix",
-           "founded_weights", "effective_damping", "veletsos_meek_period"]
+           "founded_weights", "effective_damping"]
 
 #: Degrees of freedom a foundation adds to its building: the base mat's sway and rocking.
 BASE_DOFS = 2
@@ -185,12 +185,3 @@ def effective_damping(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarr
     first = oscillating[np.argmin(np.abs(oscillating))]
     return 2.0 * math.pi / float(first.imag), float(-first.real / abs(first))
 
-
-def veletsos_meek_period(period: float, storey_stiffness: float, height: float, sway_stiffness: float,
-                         rocking_stiffness: float) -> float:
-    """Veletsos & Meek (1974)'s flexible-base period of a one-storey building (massless base), s.
-
-    ``T̃ = T √(1 + k/K_x + k h²/K_θ)`` (NIST GCR 12-917-21, 2012, Eq. 2-3a).
-    """
-    return period * math.sqrt(1.0 + storey_stiffness / sway_stiffness
-                              + storey_stiffness * height ** 2 / rocking_stiffness)

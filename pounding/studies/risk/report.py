@@ -11,7 +11,7 @@ import numpy as np
 
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["assemble_risk_dataset", "risk_table", "risk_tables", "plot_risk", "SEPARATION_POINTS"]
+__all__ = ["assemble_risk_dataset", "separation_demands", "COLLAPSE_TARGET", "risk_table", "risk_tables", "plot_risk", "SEPARATION_POINTS"]
 
 #: Separations at which λ(g) is tabulated in the archive (0 to 1.25 x the largest finite demand).
 SEPARATION_POINTS = 121
@@ -98,6 +98,25 @@ def _collapse_vars(plan, ds) -> dict:
 
 #: The collapse target's period, years (ASCE 7-22's 1 % in 50 years).
 COLLAPSE_YEARS = 50.0
+#: ASCE 7-22's collapse risk target: 1 % in 50 years.
+COLLAPSE_TARGET = (0.01, 50.0)
+
+
+def separation_demands(ds, results: dict[str, dict], entries: list, contacts: list[str]) -> np.ndarray:
+    """(record, level, contact): each run without contacts' required separation, m (+inf: a building
+    collapsed; NaN: the run failed)."""
+    levels = [float(x) for x in ds.level.values / STANDARD_GRAVITY]
+    out = np.full((ds.record.size, len(levels), len(contacts)), np.nan)
+    index = {c: k for k, c in enumerate(contacts)}
+    for variant, r, level, key in entries:
+        part = results.get(key) or {}
+        if variant != "without_contacts" or part.get("status") != "ok" or "separation" not in part:
+            continue
+        j = int(np.argmin(np.abs(np.array(levels) - level)))
+        for label, value in zip(part["separation"]["contact"], part["separation"]["required"]):
+            if label in index:
+                out[r, j, index[label]] = math.inf if part.get("unbounded") else value
+    return out
 
 
 def assemble_risk_dataset(plan, results: dict[str, dict[str, Any]], entries: list, *,
@@ -105,7 +124,6 @@ def assemble_risk_dataset(plan, results: dict[str, dict[str, Any]], entries: lis
     """The IDA archive of the stripes (:func:`pounding.studies.ida.assemble_ida_dataset`) with the risk
     variables (module docstring of :mod:`pounding.studies.risk.study`)."""
     from pounding.studies.ida import assemble_ida_dataset
-    from pounding.studies.risk.study import COLLAPSE_TARGET, separation_demands
 
     ds = assemble_ida_dataset(plan.ida, results, entries, elapsed=elapsed, ran=ran)
     contacts = [str(c) for c in ds.contact.values]

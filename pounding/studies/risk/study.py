@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import math
 import os
 from typing import Any
 
@@ -33,7 +32,7 @@ from pounding.studies.risk.hazard import HazardCurve
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["RiskPlan", "build_risk_plan", "default_levels", "run_risk_scenario", "risk_study", "RISK_KEY",
-           "DEFAULT_STRIPES", "COLLAPSE_TARGET", "STRIPE_RATES", "separation_demands"]
+           "DEFAULT_STRIPES", "STRIPE_RATES"]
 
 #: What makes a risk run's part key differ from the same IDA run's (a risk part also holds the separations).
 RISK_KEY = "risk-1"
@@ -41,8 +40,6 @@ RISK_KEY = "risk-1"
 DEFAULT_STRIPES = 8
 #: Annual rates of exceedance of the lowest and highest default stripes, 1/yr.
 STRIPE_RATES = (2e-2, 1e-4)
-#: ASCE 7-22's collapse risk target: 1 % in 50 years.
-COLLAPSE_TARGET = (0.01, 50.0)
 
 
 @dataclasses.dataclass
@@ -145,23 +142,6 @@ def run_risk_scenario(task: dict[str, Any]) -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - a failing run is a result, not a crash
         result.update(status="error", error=f"{task.get('where', 'scenario')}: {one_line(exc)}")
     return result
-
-
-def separation_demands(ds, results: dict[str, dict], entries: list, contacts: list[str]) -> np.ndarray:
-    """(record, level, contact): each run without contacts' required separation, m (+inf: a building
-    collapsed; NaN: the run failed)."""
-    levels = [float(x) for x in ds.level.values / STANDARD_GRAVITY]
-    out = np.full((ds.record.size, len(levels), len(contacts)), np.nan)
-    index = {c: k for k, c in enumerate(contacts)}
-    for variant, r, level, key in entries:
-        part = results.get(key) or {}
-        if variant != "without_contacts" or part.get("status") != "ok" or "separation" not in part:
-            continue
-        j = int(np.argmin(np.abs(np.array(levels) - level)))
-        for label, value in zip(part["separation"]["contact"], part["separation"]["required"]):
-            if label in index:
-                out[r, j, index[label]] = math.inf if part.get("unbounded") else value
-    return out
 
 
 def risk_study(plan: RiskPlan, output: str | os.PathLike | None = None, **run_options):
