@@ -98,10 +98,6 @@ def export_refusal(model) -> str | None:
     (:mod:`pounding.export.opensees_materials`).
     """
     names = [b.name for b in model.buildings]
-    founded = [b.name for b in model.buildings if getattr(b, "foundation", None) is not None]
-    if founded:
-        return (f"building {founded[0]} stands on a foundation: the OpenSees export does not write foundations yet "
-                "(remove foundation: to export the fixed-base model)")
     if len({b.dofs_per_floor for b in model.buildings}) > 1:
         return ("the OpenSees export writes floors with one DOF or floors in plan, not both in one domain (a floor "
                 "with one DOF has no u_y or rotation for a diaphragm's contact to act on)")
