@@ -11,6 +11,12 @@ description (:class:`pounding.model.model.Model`) for every model; what differs 
   on its line's drift with the storey's material (:mod:`pounding.export.opensees_materials`:
   ``Elastic``, ``Steel01``, ``BoucWen``, ``IMKBilin`` / ``IMKPeakOriented`` / ``IMKPinching``);
   P-Delta a leaning column's negative springs at the weight's centroid, undamped;
+* **founded buildings** (:mod:`pounding.export.opensees_elements`, docs/foundations.md): the domain
+  is the plane (x, z) with rotations (``-ndm 2 -ndf 3``); a base mat node on a ``zeroLength`` to
+  its ground node with ``Elastic(K, c)`` sway and rocking, the floors at their elevations turning
+  with it (``equalDOF``), storeys and dashpots as ``twoNodeLink`` shear springs (deformation
+  ``x_j − x_i − (z_j − z_i) θ_b``), Rayleigh's a0·M as dashpots a0·m_i on the floors' deformations:
+  the damping is ``Tᵀ C_fixed T + diag(c_x, c_θ)`` exactly;
 * **contact points and links** (``Model.gaps``, ``Model.links``): a ``zeroLength`` along the
   ``normal`` between the two floors' nodes at the ``point`` (a wall: a fixed node), with
   ``Hertzdamp`` / ``ElasticPPGap`` / ``ImpactMaterial`` for contacts and ``Viscous`` /
@@ -98,10 +104,6 @@ def export_refusal(model) -> str | None:
     (:mod:`pounding.export.opensees_materials`).
     """
     names = [b.name for b in model.buildings]
-    founded = [b.name for b in model.buildings if getattr(b, "foundation", None) is not None]
-    if founded:
-        return (f"building {founded[0]} stands on a foundation: the OpenSees export does not write foundations yet "
-                "(remove foundation: to export the fixed-base model)")
     if len({b.dofs_per_floor for b in model.buildings}) > 1:
         return ("the OpenSees export writes floors with one DOF or floors in plan, not both in one domain (a floor "
                 "with one DOF has no u_y or rotation for a diaphragm's contact to act on)")

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ModalDamping", "rayleigh_row", "writes_damping_matrix", "dashpot_network", "domain_modes",
+__all__ = ["ModalDamping", "rayleigh_row", "mass_proportional_dashpots", "writes_damping_matrix", "dashpot_network", "domain_modes",
            "modal_damping", "repeated_frequency", "REPEATED_FREQUENCY", "EIGEN_TAG_OFFSET"]
 
 #: Two modes whose ω² differ by at most this fraction share a frequency (OpenSees' eigenvectors of it are its own).
@@ -51,10 +51,30 @@ class ModalDamping:
     omega2: list[float] = field(default_factory=list)
 
 
-def rayleigh_row(building, elements: list[int], nodes: list[int]) -> tuple:
-    """``(name, a0 1/s, a1 s, spring elements, nodes carrying the mass)`` of a Rayleigh-damped *building*."""
+def rayleigh_row(building, elements: list[int], nodes: list[int], *, with_mass: bool = True) -> tuple:
+    """``(name, a0 1/s, a1 s, spring elements, nodes carrying the mass)`` of a Rayleigh-damped *building*.
+
+    *with_mass* False: a0 written as 0 (its part is :func:`mass_proportional_dashpots` instead).
+    """
     a0, a1 = building.rayleigh_coefficients
-    return (building.name, float(a0), float(a1), elements, nodes)
+    return (building.name, float(a0) if with_mass else 0.0, float(a1), elements, nodes)
+
+
+def mass_proportional_dashpots(building, nodes, b_index: int, element: int) -> list[tuple]:
+    """``(element, base node, floor node, a0·m_i N s/m)``: the a0·M part of *building*'s Rayleigh damping as dashpots.
+
+    In the plane (x, z) (a domain with a founded building) each is a ``twoNodeLink`` from the building's
+    base (its base mat, or its ground node) to floor i, whose deformation is the floor's deformation
+    ``d_i = x_i − u_b − z_i θ_b``: together they assemble ``a0 Tᵀ M T``, the mass-proportional damping
+    of the fixed-base building acting on its deformations (a Rayleigh region would damp ``x_i``, and
+    the base mat's mass and rotary inertia, instead).  Tags after *element*.
+    """
+    a0, _a1 = building.rayleigh_coefficients
+    rows = []
+    for level, mass in enumerate(building.mass, start=1):
+        element += 1
+        rows.append((element, nodes.floor(b_index, 0), nodes.floor(b_index, level), float(a0 * mass)))
+    return rows
 
 
 def writes_damping_matrix(building) -> bool:

@@ -42,14 +42,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from pounding.export.opensees_damping import (ModalDamping, dashpot_network, modal_damping, rayleigh_row,
-                                              writes_damping_matrix)
+from pounding.export.opensees_damping import (ModalDamping, dashpot_network, mass_proportional_dashpots,
+                                              modal_damping, rayleigh_row, writes_damping_matrix)
 from pounding.export.opensees_materials import contact_material, link_materials, storey_material
 from pounding.model.floors import geometric_terms
 from pounding.model.model import WALL
 
 __all__ = ["AxisNodes", "DiaphragmNodes", "Spring", "PDelta", "Contact", "LinkElement", "Domain", "build_domain",
-           "plane_point", "CORNERS", "DIRECTION_DOF"]
+           "plane_point", "foundation_row", "CORNERS",
+           "DIRECTION_DOF"]
 
 #: The outline's corners, in this order (the archive's ``corner`` coordinate): (name, x index, y index)
 #: into ((x0, y0), (x1, y1)).
@@ -60,30 +61,44 @@ DIRECTION_DOF = {"x": 1, "y": 2, "rz": 6}
 
 
 class AxisNodes:
-    """Nodes of floors with one DOF: per building its fixed ground node, then one node per floor."""
+    """Nodes of floors with one DOF: per building its fixed ground node, (on a foundation) its base mat, its floors.
+
+    With a founded building the domain is the plane (x, z) with rotations (``ndf`` 3,
+    :func:`pounding.export.opensees_text.axis_script`): every node stands at its elevation, a base mat's
+    node sways and rocks on its ground node, and its floors' rotations are its rocking.
+    """
 
     form = "axis"
 
     def __init__(self, model) -> None:
         self.grounds: list[int] = []
         self.floors: list[tuple[int, str, float]] = []          # (node, floor label, mass kg)
+        self.bases: dict[int, int] = {}                          # building -> its base mat's node
+        self.elevation: dict[int, float] = {}                    # node -> z, m
         self._floor: dict[tuple[int, int], int] = {}
         self._building: list[list[int]] = []
+        self.ndf = 3 if any(b.foundation is not None for b in model.buildings) else 1
         node = 0
         for b_index, b in enumerate(model.buildings):
             node += 1
             self.grounds.append(node)
             nodes = [node]
-            for level in range(1, b.n_floors + 1):
+            if b.foundation is not None:
+                node += 1
+                self.bases[b_index] = node
+            for level, z in enumerate(b.elevation, start=1):
                 node += 1
                 self._floor[(b_index, level)] = node
+                self.elevation[node] = float(z)
                 self.floors.append((node, f"{b.name}:{level}", float(b.mass[level - 1])))
                 nodes.append(node)
             self._building.append(nodes)
 
     def floor(self, building: int, level: int, point=None) -> int:
-        """The node of floor *level* (0: the ground) of *building*; every point of a floor is its node."""
-        return self.grounds[building] if level == 0 else self._floor[(building, level)]
+        """The node of floor *level* of *building* (0: the ground, or its base mat on a foundation)."""
+        if level == 0:
+            return self.bases.get(building, self.grounds[building])
+        return self._floor[(building, level)]
 
     def fixed(self, building: int, point=None) -> int:
         """A fixed node beside *building* (a wall): its ground node, which moves with the ground as a wall does."""
@@ -104,6 +119,7 @@ class DiaphragmNodes:
     """
 
     form = "diaphragm"
+    ndf = 6
 
     def __init__(self, model) -> None:
         self.count = 0
@@ -211,6 +227,7 @@ class Domain:
     contacts: list[Contact] = field(default_factory=list)
     links: list[LinkElement] = field(default_factory=list)
     corners: list[tuple] = field(default_factory=list)    # (node, corner label)
+    foundations: list[tuple] = field(default_factory=list)  # foundation_row()
     modal: ModalDamping = field(default_factory=ModalDamping)
     notes: list[str] = field(default_factory=list)
 
@@ -293,6 +310,15 @@ def _corners(domain: Domain, model) -> None:
                 domain.corners.append((domain.nodes.floor(b_index, level, point), f"{b.name}:{level}:{name}"))
 
 
+def foundation_row(nodes: AxisNodes, b_index: int, building) -> tuple:
+    """A founded *building*'s base mat: ``(base node, ground node, building, m_b kg, I_b kg m², K_x N/m,
+    c_x N s/m, K_θ N m/rad, c_θ N m s/rad, floor nodes)``."""
+    f = building.foundation
+    return (nodes.floor(b_index, 0), nodes.grounds[b_index], building.name, float(f.mass), float(f.rotary_inertia),
+            float(f.sway_stiffness), float(f.sway_damping), float(f.rocking_stiffness), float(f.rocking_damping),
+            [nodes.floor(b_index, level) for level in range(1, building.n_floors + 1)])
+
+
 def build_domain(model) -> Domain:
     """Every node and element of *model*'s OpenSees domain (module docstring).
 
@@ -314,13 +340,18 @@ def build_domain(model) -> Domain:
             _p_delta(domain, b_index, b)
         if b.damping.kind == "rayleigh":
             regions.append((b_index, b, elements))
+            if domain.nodes.ndf == 3:
+                domain.dashpots += mass_proportional_dashpots(b, domain.nodes, b_index, domain.elements)
         elif writes_damping_matrix(b):
             domain.dashpots += dashpot_network(b, domain.nodes, b_index, domain.elements)
     _contacts(domain, model)
     _links(domain, model)
     _corners(domain, model)
     domain.nodes.number()
-    domain.rayleigh = [rayleigh_row(b, elements, domain.nodes.building_nodes(b_index))
+    plane = domain.nodes.ndf == 3
+    domain.rayleigh = [rayleigh_row(b, elements, domain.nodes.building_nodes(b_index), with_mass=not plane)
                        for b_index, b, elements in regions]
+    domain.foundations = [foundation_row(domain.nodes, b_index, b) for b_index, b in enumerate(model.buildings)
+                          if plane and b.foundation is not None]
     domain.modal = modal_damping(model)
     return domain

@@ -243,6 +243,19 @@ FLOORS = [
 ]
 # fixed ground node of each building
 GROUNDS = {grounds}
+# 1: every node one DOF along x (model basic -ndm 1 -ndf 1).  3: the plane (x, z) with rotations, since a
+# base mat rocks: every node at its elevation (ELEVATION, m; 0 if absent), vertical DOF fixed; storeys and
+# dashpots are twoNodeLink elements whose shear deformation is x_j - x_i - (z_j - z_i) theta of their end
+# nodes, which rotate with their base mat (equalDOF) or not at all (a fixed base)
+NDF = {ndf}
+ELEVATION = {elevation}
+# base mats on sway and rocking springs and dashpots (Elastic E, eta: linear), a zeroLength to the ground node:
+# (base node, ground node, building, m_b kg, I_b kg m^2, K_x N/m, c_x N s/m, K_theta N m/rad,
+# c_theta N m s/rad, floor nodes that rotate with the base)
+FOUNDATIONS = [
+{foundations}
+]
+FOUNDATION_TAG_OFFSET = 30_000_000  # tags of a base mat's zeroLength and materials
 # (element, node below, node, storey stiffness N/m, storey label, storey height m, material args)
 STOREYS = [
 {storeys}
@@ -255,7 +268,8 @@ P_DELTA = [
 RAYLEIGH = [
 {buildings}
 ]
-# linear dashpots (a modal damping matrix; the Rayleigh part a storey's initial tangent misses):
+# linear dashpots (a modal damping matrix; the Rayleigh part a storey's initial tangent misses; with NDF 3, the
+# a0 M part of Rayleigh damping, from the building's base to each floor: on the deformations only):
 # (element, node i, node j, c N s/m)
 DASHPOTS = [
 {dashpots}
@@ -271,27 +285,56 @@ LINKS = [
 ]
 
 
+def _node(tag, fixed, rocks):
+    """Node *tag* at its elevation: fixed, or free along x (and, if it *rocks*, in rotation)."""
+    if NDF == 1:
+        ops.node(tag, 0.0)
+        if fixed:
+            ops.fix(tag, 1)
+        return
+    ops.node(tag, 0.0, ELEVATION.get(tag, 0.0))
+    ops.fix(tag, int(fixed), 1, int(not rocks))
+
+
+def _storey_element(ele, i, j, damped):
+    """A spring or dashpot on material *ele* between nodes *i* (below) and *j*, Rayleigh-damped if *damped*."""
+    if NDF == 1:
+        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", int(damped))
+    else:  # shear (local y) deformation: -(x_j - x_i - (z_j - z_i) theta), the sign OpenSees' local y gives
+        ops.element("twoNodeLink", ele, i, j, "-mat", ele, "-dir", 2, *(["-doRayleigh"] if damped else []))
+
+
 def build(log_file=None):
     """Create the OpenSees domain (wipes any previous one)."""
     ops.wipe()
     if log_file is not None:
         ops.logFile(log_file, "-noEcho")  # Hertzdamp prints one line per impact
-    ops.model("basic", "-ndm", 1, "-ndf", 1)
+    ops.model("basic", "-ndm", min(NDF, 2), "-ndf", NDF)
+    rocking = {{node for row in FOUNDATIONS for node in [row[0], *row[9]]}}
     for tag in GROUNDS:
-        ops.node(tag, 0.0)
-        ops.fix(tag, 1)
+        _node(tag, True, False)
     for tag, _label, mass in FLOORS:
-        ops.node(tag, 0.0)
-        ops.mass(tag, mass)
+        _node(tag, False, tag in rocking)
+        ops.mass(tag, mass, *[0.0] * (NDF - 1))
+    for base, ground, _name, m_b, i_b, k_x, c_x, k_t, c_t, floors in FOUNDATIONS:
+        _node(base, False, True)
+        ops.mass(base, m_b, 0.0, i_b)
+        tag = FOUNDATION_TAG_OFFSET + 2 * base  # the zeroLength and its sway material; the rocking material tag + 1
+        ops.uniaxialMaterial("Elastic", tag, k_x, c_x)
+        ops.uniaxialMaterial("Elastic", tag + 1, k_t, c_t)
+        ops.element("zeroLength", tag, ground, base, "-mat", tag, tag + 1, "-dir", 1, 3,
+                    "-doRayleigh", 0)
+        for floor in floors:
+            ops.equalDOF(base, floor, 3)
     for ele, i, j, _k, _label, _h, material in STOREYS:
         ops.uniaxialMaterial(material[0], ele, *material[1:])
-        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 1)
+        _storey_element(ele, i, j, True)
     for ele, i, j, k, _label in P_DELTA:
         ops.uniaxialMaterial("Elastic", ele, k)
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
     for ele, i, j, c in DASHPOTS:
         ops.uniaxialMaterial("Elastic", ele, 0.0, c)
-        ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
+        _storey_element(ele, i, j, False)
     for ele, i, j, material, _label in CONTACTS:
         ops.uniaxialMaterial(material[0], ele, *material[1:])
         ops.element("zeroLength", ele, i, j, "-mat", ele, "-dir", 1, "-doRayleigh", 0)
@@ -322,7 +365,11 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
         ops.recorder("EnvelopeElement", "-file", drift, "-precision", 16, "-ele", *storey_elements,
                      "deformation")
 {contact_recorders}
-        ops.constraints("Plain")
+        base_nodes = [row[0] for row in FOUNDATIONS]
+        base = os.path.join(workdir, "base.env")
+        if base_nodes:
+            ops.recorder("EnvelopeNode", "-file", base, "-precision", 16, "-node", *base_nodes, "-dof", 1, 3, "disp")
+        ops.constraints("Plain" if NDF == 1 else "Transformation")  # equalDOF: the floors rotate with their base
         ops.numberer("RCM")
         ops.system("BandGeneral")
 {solution}
@@ -337,6 +384,10 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
         with open(drift) as handle:
             env = [[float(x) for x in line.split()] for line in handle if line.strip()]
         peak_drift = env[2]
+        peak_base = [0.0] * (2 * len(base_nodes))
+        if base_nodes:
+            with open(base) as handle:
+                peak_base = [[float(x) for x in line.split()] for line in handle if line.strip()][2]
 {contact_peaks}
         return {{
             "model": MODEL_NAME,
@@ -347,6 +398,9 @@ def analyse(dt=DT, duration=DURATION, workdir=None):
             "peak_displacement": peak_u,
             "storey": [row[4] for row in STOREYS],
             "peak_drift_ratio": [d / row[5] for d, row in zip(peak_drift, STOREYS)],
+            "foundation": [row[2] for row in FOUNDATIONS],
+            "peak_base_sway": peak_base[0::2],
+            "peak_base_rocking": peak_base[1::2],
 {results_tail}
 
 
@@ -600,7 +654,8 @@ def axis_script(model, domain, ground: ScriptGround, dt: float, notes: list[str]
         storeys=_rows((s.element, s.below, s.node, s.stiffness, s.storey, s.height, s.material)
                       for s in domain.springs),
         p_delta=_rows((p.element, p.below, p.node, p.stiffness[0], p.storey) for p in domain.p_delta),
-        buildings=_rows(domain.rayleigh), dashpots=_rows(domain.dashpots),
+        buildings=_rows(domain.rayleigh), dashpots=_rows(domain.dashpots), ndf=nodes.ndf,
+        elevation=repr(nodes.elevation if nodes.ndf == 3 else {}), foundations=_rows(domain.foundations),
         contacts=_rows(c[:5] for c in domain.contacts), links=_rows(k[:5] for k in domain.links))
 
 
