@@ -47,6 +47,32 @@ def in_process_client():
     cluster.close()
 
 
+@pytest.fixture(scope="module")
+def studies_in_process(in_process_client):
+    """Studies started without a client (the CLI's ``--workers N``, ``workers=``) run on the in-process cluster.
+
+    Starting a LocalCluster of worker processes, and each worker's first run, took 10-40 s per study on a
+    loaded 2-core machine; the tests using this fixture are about a study's results and output, not its worker
+    processes (tests/test_sweep.py keeps real ones: killed workers, a killed sweep).  Each study gets its own
+    client of the cluster and closes it as usual; a ``--scheduler`` address still goes to the real
+    :func:`pounding.studies.engine.execution.start_client`.
+    """
+    from dask.distributed import Client
+
+    from pounding.studies.engine import execution
+
+    real = execution.start_client
+
+    def start_client(*, workers=None, scheduler=None):
+        if scheduler:
+            return real(workers=workers, scheduler=scheduler)
+        return Client(in_process_client.cluster), None
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(execution, "start_client", start_client)
+        yield in_process_client
+
+
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     """Under CI (``CI=true``), a skipped test fails the run: CI installs every peer, so a skip is a missing install."""
     if os.environ.get("CI", "").strip().lower() not in ("1", "true", "yes"):

@@ -27,8 +27,33 @@ from pounding.hysteresis import ImkStorey
 from pounding.studies.imk import ImkMaterial
 
 
+#: Immutable types of an ImkMaterial's state, kept as they are by :func:`_copied`.
+_SCALARS = frozenset({bool, int, float, str, np.float64, np.int64, np.bool_})
+
+
+def _clone(material: ImkMaterial) -> ImkMaterial:
+    """A deep copy of *material*, several times faster than ``copy.deepcopy`` (which took 80 % of a reference
+    run): its numbers and flags are immutable, its dicts (the two Backbone records, the lost flags) are copied
+    with their items; anything else is deep-copied."""
+    return _copied(material)
+
+
+def _copied(value):
+    """*value* itself if immutable, a copy of its __dict__'s items, a dict of copies, else a deepcopy."""
+    kind = type(value)
+    if kind in _SCALARS:
+        return value
+    if kind is dict:
+        return {k: _copied(v) for k, v in value.items()}
+    if hasattr(value, "__dict__") and not hasattr(kind, "__slots__"):
+        new = object.__new__(kind)
+        new.__dict__ = {k: v if type(v) in _SCALARS else _copied(v) for k, v in value.__dict__.items()}
+        return new
+    return copy.deepcopy(value)
+
+
 def _trial(material: ImkMaterial, u: float) -> float:
-    return copy.deepcopy(material).step(u)
+    return _clone(material).step(u)
 
 
 def _kinks(material: ImkMaterial, ahead: bool = True) -> list[float]:
@@ -46,14 +71,14 @@ def _kinks(material: ImkMaterial, ahead: bool = True) -> list[float]:
     if (material.branch > 1 or material.on_backbone) and f != 0.0:
         # Just turned on a loading branch: the unloading stiffness ahead is the one the reversal deteriorates,
         # which the material applies at its next step (a step back toward zero force triggers it).
-        probe = copy.deepcopy(material)
+        probe = _clone(material)
         probe.step(u - 1e-9 * np.sign(f))
         k = probe.k_unload
     if k > 0 and f != 0.0:
         zero = u - f / k
         points.append(zero)
         if ahead:
-            probe = copy.deepcopy(material)
+            probe = _clone(material)
             probe.step(zero + 1e-9 * np.sign(zero - u))
             points += _kinks(probe, ahead=False)
     if material.variant == "bilinear":

