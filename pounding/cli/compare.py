@@ -17,7 +17,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from pounding.studies.engine.store import parts_dir
 
     check_study_options(args)
-    check_outputs(args, [args.model])
+    check_outputs(args)
     scale = None if args.scale is None else parse_scale_option(args.scale)
     try:
         ds = compare(args.model, args.xi, args.records, output=args.output, duration=args.duration,

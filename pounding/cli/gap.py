@@ -74,7 +74,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
 
         if is_plan_file(args.model):
             return _cmd_code_gap(args, plan=True)
-    check_outputs(args, [args.model])
+    check_outputs(args)
     if args.code:
         return _cmd_code_gap(args)
     _refuse_spectrum_without_code(args)

@@ -19,7 +19,7 @@ def _cmd_ida(args: argparse.Namespace) -> int:
     from pounding.results.checks import model_warnings, print_warnings
 
     check_study_options(args)
-    check_outputs(args, [args.model])
+    check_outputs(args)
     hunt = None
     if args.hunt:
         hunt = Hunt(start=args.hunt_start, step=args.hunt_step, increment=args.hunt_increment,

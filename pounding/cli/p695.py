@@ -26,7 +26,7 @@ def _cmd_p695(args: argparse.Namespace) -> int:
                                        parse_quality, parse_systems, plot_p695)
 
     check_study_options(args)
-    check_outputs(args, [args.model])
+    check_outputs(args)
     model = load_model(args.model)
     names = [b.name for b in model.buildings]
     groups = tuple(x.strip() for x in args.group.split(",") if x.strip()) if args.group else ()

@@ -18,7 +18,7 @@ def _cmd_risk(args: argparse.Namespace) -> int:
     from pounding.studies.risk import build_risk_plan, plot_risk, read_hazard, risk_study, risk_table
 
     check_study_options(args)
-    check_outputs(args, [args.model])
+    check_outputs(args)
     curve = read_hazard(args.hazard)
     plan = build_risk_plan(args.model, curve, im=args.im, records=args.records, levels=args.levels,
                            stripes=args.stripes, building=args.building, target=args.target,

@@ -112,7 +112,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
     if args.plot:
         _check_plot_dir(args.plot)
-    check_outputs(args, [args.model])
+    check_outputs(args)
     with output_lock(output):   # a second run onto the same name refuses here, before computing
         return _run_locked(args, output, started)
 

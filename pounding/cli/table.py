@@ -13,7 +13,7 @@ def _cmd_table(args: argparse.Namespace) -> int:
     from pounding.cli.run import open_archive
     from pounding.results.tables import format_tables
 
-    check_outputs(args, [args.archive])
+    check_outputs(args)
     kind, ds = open_archive(args.archive)
     if args.csv:
         write_csv_option(args, kind, ds)
