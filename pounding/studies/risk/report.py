@@ -81,7 +81,7 @@ def _collapse_vars(plan, ds) -> dict:
             if np.any(np.isfinite(hit[i, :, :, b])):
                 empirical[i, b] = exceedance_rates(plan.curve, ds.level.values, hit[i, :, :, b].T,
                                                    np.array([0.5]))[0]
-    years = COLLAPSE_YEARS
+    years = COLLAPSE_TARGET[1]
     return {
         "collapse_rate": _var(("variant", "building"), fitted, "yr-1",
                               "mean annual frequency of collapse, lognormal collapse fragility on the hazard "
@@ -96,9 +96,7 @@ def _collapse_vars(plan, ds) -> dict:
     }
 
 
-#: The collapse target's period, years (ASCE 7-22's 1 % in 50 years).
-COLLAPSE_YEARS = 50.0
-#: ASCE 7-22's collapse risk target: 1 % in 50 years.
+#: ASCE 7-22's collapse risk target: (probability, years), 1 % in 50 years.
 COLLAPSE_TARGET = (0.01, 50.0)
 
 
