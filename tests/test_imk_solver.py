@@ -59,10 +59,11 @@ solver: {{rtol: 1.0e-10, atol: 1.0e-13, atol_velocity: 1.0e-12, output_dt: 0.01}
 
 
 #: Each variant's shortest sine that still takes the first storey through capping into its residual branch
-#: (asserted below): amplitude m/s², duration s, ramp s.  imk-bilinear keeps its 3 s ramp: under a 1.5 s or 2 s
-#: ramp (peak drifts 0.24-0.41 m) the solver's and the reference's peaks were seen to differ by 25-45 %, not
-#: explained yet (at the 3 s ramp they agree to 1e-8).
-MATCH = {"imk-bilinear": (5.0, 4.5, 3.0), "imk-peak-oriented": (4.0, 3.0, 1.5), "imk-pinching": (4.0, 3.0, 1.5)}
+#: (asserted below): amplitude m/s², duration s, ramp s.  imk-bilinear's fast growth (1.5 s) takes the first storey
+#: into its residual branch in both directions, the second time where the post-capping line meets the residual
+#: floor only to round-off (the solver once stayed on the falling line there: peak drift ratio 0.1375 against
+#: the reference's 0.1100).
+MATCH = {"imk-bilinear": (5.0, 3.0, 1.5), "imk-peak-oriented": (4.0, 3.0, 1.5), "imk-pinching": (4.0, 3.0, 1.5)}
 
 
 @pytest.mark.parametrize("name", list(VARIANTS))

@@ -509,8 +509,15 @@ def set_row(st, row, u, at):
             x = sigma * at
             segment = st[o + KP] if x < st[o + UCAP] else st[o + KPC]
             line = st[o + FCAP] + (x - st[o + UCAP]) * segment
-            # At the rise onto the hardening line (line = F_r, rising) the line is ahead: its slope.
-            slope = segment if line > st[o + FRES] or (line == st[o + FRES] and segment > 0.0) else 0.0
+            if segment < 0.0:
+                # Post-capping: the residual floor from its drift u_res on.  *at* is that limit exactly where the
+                # residual is reached, so the drift decides; the line there is F_r only to round-off, and a line a
+                # hair above F_r kept the falling slope past the floor, the shear through zero.
+                on_line = x < st[o + URES]
+            else:
+                # At the rise onto the hardening line (line = F_r, rising) the line is ahead: its slope.
+                on_line = line > st[o + FRES] or (line == st[o + FRES] and segment > 0.0)
+            slope = segment if on_line else 0.0
             st[UREF], st[FREF] = at, sigma * max(line, st[o + FRES])
             force = st[FREF] + slope * (u - at)
         else:
