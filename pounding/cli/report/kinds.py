@@ -125,12 +125,22 @@ def _values(ds, name: str) -> np.ndarray:
     return np.asarray(ds[name].values).ravel()
 
 
+def _labelled(ds, name: str) -> list[tuple[str, object]]:
+    """Each element of variable *name* with its label: its coordinates joined by ``/`` (``with_contacts/A``)."""
+    var = ds[name]
+    labels = [ds[d].values if d in ds.coords else np.arange(ds.sizes[d]) for d in var.dims]
+    return [("/".join(str(labels[k][i]) for k, i in enumerate(index)) or name, var.values[index])
+            for index in np.ndindex(var.shape)]
+
+
 def _study_excitation(ds) -> Rows:
     rows: Rows = []
+    attributes = dict(_STUDY_ATTRIBUTES)
     if "record" in ds.coords:
         records = [str(r) for r in _values(ds, "record")]
         rows.append((f"records ({len(records)})", ", ".join(records)))
-    rows += attribute_rows(ds, _STUDY_ATTRIBUTES)
+        attributes.pop("records_spec")
+    rows += attribute_rows(ds, attributes)
     for name, label in (("scale_factor", "scale factors"), ("intensity", "intensities")):
         if name in ds.variables:
             values = _values(ds, name).astype(float)
@@ -151,15 +161,14 @@ def _study_status(ds) -> Rows:
         rows.append(("runs", ", ".join(f"{n} {s}" for s, n in counts.most_common())))
     if "collapsed" in ds.variables:
         collapsed = _values(ds, "collapsed")
-        rows.append(("collapsed", f"{int(np.sum(collapsed == True))} of {collapsed.size}"))  # noqa: E712
+        rows.append(("collapsed", f"{int(np.sum(collapsed == True))} of {collapsed.size} building-runs"))  # noqa: E712
     if "energy_closure_error" in ds.variables:
         closure = _values(ds, "energy_closure_error").astype(float)
         closure = closure[np.isfinite(closure)]
         if closure.size:
             rows.append(("energy closure error", f"largest {closure.max():.3g} over {closure.size} runs"))
     if "passes" in ds.variables:
-        rows.append(("passes", ", ".join(f"{b}: {'yes' if p else 'no'}" for b, p in
-                                         zip(_values(ds, ds.passes.dims[0]), _values(ds, "passes")))))
+        rows.append(("passes", ", ".join(f"{label}: {'yes' if p else 'no'}" for label, p in _labelled(ds, "passes"))))
     rows += attribute_rows(ds, {"n_run": "runs made by this invocation", "elapsed_time": "elapsed time (s)"})
     return rows
 
@@ -189,7 +198,7 @@ def _hysteresis_excitation(ds) -> Rows:
 
 def _end_status(ds) -> Rows:
     if "end" in ds.variables:
-        return [("end", ", ".join(f"{b}: {e}" for b, e in zip(_values(ds, ds.end.dims[0]), _values(ds, "end"))))]
+        return [("end", ", ".join(f"{label}: {e}" for label, e in _labelled(ds, "end")))]
     return [("steps", str(ds.sizes.get("step", "")))]
 
 
