@@ -161,7 +161,7 @@ def _silence_stdout() -> None:
 
 
 #: Subcommands that never use dask in their own process (everything but sweep/compare).
-LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table"})
+LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table", "report"})
 
 #: Subcommands of one run (or one archive read) whose process is set up for a short life
 #: (:func:`console_main`): no cyclic garbage collector, and OpenBLAS on one thread.
