@@ -27,7 +27,7 @@ SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sw
                       "init": "pounding.cli.init", "spectrum": "pounding.cli.spectrum",
                       "table": "pounding.cli.table", "hysteresis": "pounding.cli.hysteresis",
                       "pushover": "pounding.cli.pushover", "p695": "pounding.cli.p695",
-                      "risk": "pounding.cli.risk"}
+                      "risk": "pounding.cli.risk", "report": "pounding.cli.report"}
 
 
 # --------------------------------------------------------------------------- #
@@ -108,8 +108,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if extra:  # reported with the usage of the subcommand concerned, not the top-level one
         getattr(args, "usage_parser", parser).error(f"unrecognized arguments: {' '.join(extra)}")
     func: Callable[[argparse.Namespace], int] = args.func
+    from pounding.provenance import running
+
     try:
-        status = func(args)
+        with running(argv):   # every archive written meanwhile records this command (`pounding report`)
+            status = func(args)
         if sys.stdout is not None:
             sys.stdout.flush()  # a full or failing stdout shows here, not as a traceback at exit
         return status
@@ -158,7 +161,7 @@ def _silence_stdout() -> None:
 
 
 #: Subcommands that never use dask in their own process (everything but sweep/compare).
-LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table"})
+LEAN_COMMANDS = frozenset({"run", "rerun", "info", "plot", "xi", "verify", "records", "export", "table", "report"})
 
 #: Subcommands of one run (or one archive read) whose process is set up for a short life
 #: (:func:`console_main`): no cyclic garbage collector, and OpenBLAS on one thread.

@@ -10,7 +10,8 @@ from pathlib import Path
 from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 
 __all__ = ["summary", "register_cli", "parse_scale_option", "SCALE_HELP", "open_archive", "add_plot_options", "outcome_status",
-           "UNTRUSTED_RUN_STATUS"]
+           "UNTRUSTED_RUN_STATUS", "archive_summary", "draw_figures", "stored_warnings",
+           "damaged_if_garbled"]
 
 SCALE_HELP = ("factor on the record (0.8), or a target as in the YAML: a PGA (0.4g, 3.9m/s2, 390gal), "
               "sa=0.8g@1.0 (Sa at 1.0 s, 5%% damping), sa=0.8g@A (at building A's first period), "
@@ -81,7 +82,7 @@ def summary(ds) -> str:
 
 
 @contextmanager
-def _damaged_if_garbled(source):
+def damaged_if_garbled(source):
     """Turn a missing or garbled variable met while reading archive *source* into a one-line error."""
     from pounding.errors import ArchiveError
 
@@ -200,7 +201,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
 
 def open_archive(path) -> tuple[str, object]:
     """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run`` (a run of any model), ``sweep``,
-    ``compare``, ``gap``, ``ida``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
+    ``compare``, ``gap``, ``ida``, ``risk``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
     import xarray as xr
 
     from pounding.errors import ArchiveError
@@ -226,11 +227,11 @@ def open_archive(path) -> tuple[str, object]:
                            "verify)")
     with xr.open_dataset(source, engine="netcdf4") as handle:
         ds = load_within_memory(handle, source)
-    if attrs.get("study") in ("gap", "ida") or "sweep_name" in attrs:
+    if attrs.get("study") in ("gap", "ida", "risk") or "sweep_name" in attrs:
         if "status" not in names:   # every study archive has one status per scenario
             raise ArchiveError(f"damaged archive: {source}: variable status missing; run the study again to "
                                "write it again")
-        if attrs.get("study") in ("gap", "ida"):
+        if attrs.get("study") in ("gap", "ida", "risk"):
             return str(attrs["study"]), ds
         return ("compare" if str(attrs.get("sweep_file", "")).startswith("<compare") and names & {"xi", "pounding"}
                 else "sweep"), ds
@@ -254,9 +255,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print(f"{args.run}: {ds.attrs.get('title', kind)} [{kind} archive]")
     print("  " + str(ds.attrs.get("history", "")).replace("\n", "\n  "))
     print("  dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
-    with _damaged_if_garbled(args.run):
+    with damaged_if_garbled(args.run):
         _print_info(kind, ds)
-        for line in _stored_warnings(ds):
+        for line in stored_warnings(ds):
             print(f"  warning: {line}")
     if args.variables:
         for name, var in ds.data_vars.items():
@@ -264,7 +265,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def _stored_warnings(ds) -> list[str]:
+def stored_warnings(ds) -> list[str]:
     """The warnings a study stored when it ran (attribute ``warnings``, a JSON list; issue 28 §4)."""
     import json
 
@@ -273,6 +274,16 @@ def _stored_warnings(ds) -> list[str]:
         return []
     lines = json.loads(text)
     return [str(line) for line in lines] if isinstance(lines, list) else [str(lines)]
+
+
+def archive_summary(kind: str, ds) -> str:
+    """The summary ``pounding info`` prints for an archive of *kind*, as text."""
+    import io
+    from contextlib import redirect_stdout
+
+    with redirect_stdout(io.StringIO()) as text:
+        _print_info(kind, ds)
+    return text.getvalue().rstrip("\n")
 
 
 def _print_info(kind: str, ds) -> None:
@@ -299,6 +310,10 @@ def _print_info(kind: str, ds) -> None:
         from pounding.studies.p695.report import p695_table
 
         print(p695_table(ds))
+    elif kind == "risk":
+        from pounding.studies.risk import risk_table
+
+        print(risk_table(ds))
     elif kind in ("sweep", "compare"):
         from pounding.cli.sweep import summary_lines
 
@@ -318,21 +333,29 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from pounding.errors import PoundingError
 
     kind, ds = open_archive(args.run)
-    with _damaged_if_garbled(args.run):
-        nothing = kind in ("sweep", "compare", "gap", "ida") and \
+    with damaged_if_garbled(args.run):
+        nothing = kind in ("sweep", "compare", "gap", "ida", "risk") and \
             not bool(ds.status.isin(["ok", "completed", "collapsed", "unstable"]).any())
     if nothing:
         raise PoundingError(f"{args.run}: every scenario failed, so there is nothing to plot; "
                             f"`pounding info {args.run}` lists the errors")
     _check_plot_dir(args.output)
     try:
-        with _damaged_if_garbled(args.run):
+        with damaged_if_garbled(args.run):
             written = _draw(kind, ds, Path(args.output), args)
     except OSError as exc:
         raise PoundingError(f"{args.output}: cannot write the plots ({exc.strerror or exc})") from None
     for png in written:
         print(f"wrote {png}")
     return 0
+
+
+def draw_figures(kind: str, ds, out: Path, *, drift_limit: float | None = None, elevation: bool = False) -> list:
+    """The figures of an archive of *kind* written to the folder *out* (``pounding plot``); their paths.
+
+    *drift_limit* (%) and *elevation* as ``--drift-limit`` and ``--elevation``.
+    """
+    return _draw(kind, ds, out, argparse.Namespace(drift_limit=drift_limit, elevation=elevation))
 
 
 def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
@@ -369,6 +392,10 @@ def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
         from pounding.studies.p695.report import plot_p695
 
         return plot_p695(ds, out)
+    if kind == "risk":
+        from pounding.studies.risk import plot_risk
+
+        return plot_risk(ds, out)
     from pounding.studies.verify import plot_verification
 
     out.mkdir(parents=True, exist_ok=True)

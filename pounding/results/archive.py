@@ -509,7 +509,8 @@ def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False
     ds : xarray.Dataset
         From :func:`pounding.simulate`.
     path : path-like
-        Target ``.nc`` file.
+        Target ``.nc`` file.  Written by a command line, the archive also records it (attributes
+        ``command`` and ``command_directory``, :mod:`pounding.provenance`).
     overwrite : bool
         Replace an existing file.  Without it a file that appears under
         *path* while this one is written is not replaced either: the new
@@ -524,7 +525,13 @@ def save_run(ds: xr.Dataset, path: str | os.PathLike, *, overwrite: bool = False
     pathlib.Path
         The written file.
     """
+    from pounding.provenance import command_attributes
+
     target = check_writable(path, overwrite=overwrite or keep_beside)
+    command = command_attributes()
+    if command:   # the command line writing it, for `pounding report` (a rerun records the rerun)
+        ds = ds.copy(deep=False)
+        ds.attrs = {**ds.attrs, **command}
     with atomic_path(target, replace=overwrite) as temporary:
         try:
             with _interrupt_deferred(temporary), _NETCDF_LOCK:
