@@ -100,9 +100,13 @@ def run_examples(text: str, where: str) -> dict[str, bytes]:
                     with contextlib.redirect_stdout(io.StringIO()):
                         exec(compile(body, line, "exec"), namespace)
                     continue
-                for part in (p.strip() for x in re.sub(r"\\\n\s*", " ", body).splitlines() for p in x.split("&&")):
-                    if COMMAND.match(part):
-                        _run_command(part, line)
+                transcript = body.lstrip().startswith("$ ")   # only its `$ ` lines are commands
+                for x in re.sub(r"\\\n\s*", " ", body).splitlines():
+                    if transcript and not x.startswith("$ "):
+                        continue
+                    for part in (p.strip() for p in x.split("&&")):
+                        if COMMAND.match(part):
+                            _run_command(part, line)
             return {p.relative_to(scratch).as_posix(): p.read_bytes()
                     for p in sorted(Path(scratch).rglob("*.png")) if not p.is_symlink()}
         finally:

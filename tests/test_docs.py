@@ -13,6 +13,8 @@ conventions):
   :data:`SHORT_DURATION` s unless it gives ``--duration``;
 * a block whose first line is a comment starting ``# example`` is an example: parsed (commands) but not
   run (full record sets, benchmarks; ``.ci/run`` and the benchmarks run those);
+* in the tutorial and the how-to guides (:data:`WALKTHROUGHS`) transcripts also run in sequence with the
+  other blocks, full length, so that a later block can read what they wrote;
 * an output block that follows ``$ pounding run MODEL`` is the summary of that run, line by line
   (``...`` skips lines; timings and ``wrote`` lines are not compared), and the counts the docs quote
   (records in the catalogue, scenarios of a sweep) are those of the code.
@@ -34,7 +36,10 @@ import pytest
 from pounding.cli import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCS = [ROOT / "README.md", ROOT / "models" / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+DOCS = [ROOT / "README.md", ROOT / "models" / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+#: The tutorial and the how-to guides: their transcripts run in sequence with the other blocks (a later
+#: block reads what they wrote), full length, as the site's build runs them (docs/hooks.py).
+WALKTHROUGHS = re.compile(r"^docs/(tutorial\.md|howto/[\w-]+\.md)$")
 
 #: Simulated time of a ``pounding run`` of the docs that gives no ``--duration``, s.
 SHORT_DURATION = "2"
@@ -266,7 +271,14 @@ def test_the_python_blocks_and_fast_commands_of_a_doc_run(path, tmp_path, monkey
     for i, m in enumerate(matches):
         lang, body = m.group(1), m.group(2)
         where = f"{rel}:{text[:m.start()].count(chr(10)) + 2}"
-        if _is_example(body) or _is_transcript(lang, body):
+        if _is_example(body):
+            continue
+        if _is_transcript(lang, body):
+            if WALKTHROUGHS.match(rel.as_posix()):
+                for segment in re.split(r"^\$ ", body, flags=re.M)[1:]:
+                    command = re.sub(r"^(?:python3? -m )?", "", segment.partition("\n")[0].strip())
+                    status, printed = _run(command, shorten=False)
+                    assert status == 0, f"{where}: `{command}` ended with status {status}:\n{printed}"
             continue
         if lang == "python":
             printed = io.StringIO()
