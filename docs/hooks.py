@@ -31,6 +31,10 @@ ROOT = DOCS.parent
 #: Repository file -> its page in the site, for the Markdown files that live outside docs/.
 OUTSIDE_PAGES = {"README.md": "index.md", "models/README.md": "models/README.md", "CHANGELOG.md": "changelog.md"}
 
+#: Committed figures that a page's run makes again at build time: site path -> (page, figure it writes).
+#: The README's figure (docs/figures/, shown in the repository) is the tutorial's, so the site's is the build's.
+REMADE = {"figures/pair_fifth_floors.png": ("tutorial.md", "tutorial_floor5.png")}
+
 #: Pages whose examples run at build time (and whose figures are the build's).
 RUN_PAGES = re.compile(r"^(tutorial\.md|howto/[\w-]+\.md)$")
 
@@ -61,8 +65,12 @@ def on_files(files, config):
     for repo_path, src_uri in OUTSIDE_PAGES.items():
         _add(files, config, src_uri, (ROOT / repo_path).read_text(encoding="utf-8"))
     for page in [f for f in files.documentation_pages() if RUN_PAGES.match(f.src_uri)]:
-        for rel, data in run_examples(Path(page.abs_src_path).read_text(encoding="utf-8"), page.src_uri).items():
+        made = run_examples(Path(page.abs_src_path).read_text(encoding="utf-8"), page.src_uri)
+        for rel, data in made.items():
             _add(files, config, posixpath.join(posixpath.dirname(page.src_uri), rel), data)
+        for target, (source, figure) in REMADE.items():
+            if source == page.src_uri:
+                _add(files, config, target, made[figure])
     return files
 
 
@@ -97,7 +105,7 @@ def run_examples(text: str, where: str) -> dict[str, bytes]:
                 if EXAMPLE.match(next((x for x in body.splitlines() if x.strip()), "")):
                     continue
                 if lang == "python":
-                    with contextlib.redirect_stdout(io.StringIO()):
+                    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
                         exec(compile(body, line, "exec"), namespace)
                     continue
                 transcript = body.lstrip().startswith("$ ")   # only its `$ ` lines are commands

@@ -1,6 +1,6 @@
 """The documentation cannot lie: its commands parse, its names import, its snippets and fast commands run.
 
-Read from README.md, models/README.md and docs/*.md (docs/testing.md, "Docs that run", states the
+Read from README.md, models/README.md and every docs/**/*.md (docs/testing.md, "Docs that run", states the
 conventions):
 
 * every shell command that starts with ``pounding`` (or ``python3 -m pounding``) in a fenced block,
@@ -362,16 +362,16 @@ def _stripes(levels: str) -> int:
 
 #: Counts the docs quote: (file, pattern whose groups are the numbers, the numbers now).
 COUNTS = [
-    ("README.md", r"the (\d+) far-field records \((\d+) in all\)", lambda: _catalogue_counts()[1::-1]),
-    ("README.md", r"gap_restitution\.nc +# (\d+) scenarios", lambda: (_sweep_size("gap_restitution.yaml"),)),
+    ("docs/tour.md", r"the (\d+) far-field records \((\d+) in all\)", lambda: _catalogue_counts()[1::-1]),
+    ("docs/tour.md", r"gap_restitution\.nc +# (\d+) scenarios", lambda: (_sweep_size("gap_restitution.yaml"),)),
     ("docs/ground_motions.md", r"names (\d+) records with readable keys", lambda: _catalogue_counts()[:1]),
     ("docs/ground_motions.md", r"all (\d+) components of the FEMA P695 far-field", lambda: _catalogue_counts()[1:2]),
     ("docs/ground_motions.md", r"all (\d+) components of the FEMA P695 near-field", lambda: _catalogue_counts()[2:]),
-    ("README.md", r"the same pair pounds (\d+)\s+times", lambda: (_impacts("pair.yaml")["all"],)),
-    ("README.md", r"`pounding run models/pair.yaml`: (\d+) impacts,\s+(\d+) at floor 1",
+    ("docs/tour.md", r"the same pair pounds (\d+)\s+times", lambda: (_impacts("pair.yaml")["all"],)),
+    ("docs/tour.md", r"`pounding run models/pair.yaml`: (\d+) impacts,\s+(\d+) at floor 1",
      lambda: (_impacts("pair.yaml")["all"], _impacts("pair.yaml")["A:1-B:1"])),
-    ("README.md", r"the floor-1 contact pounds (\d+) times", lambda: (_impacts("pair_wave_passage.yaml")["A:1-B:1"],)),
-    ("README.md", r"all (\d+) far-field\s+components at (\d+) stripes of Sa\(T₁ of A\) \((\d+) runs",
+    ("docs/tour.md", r"the floor-1 contact pounds (\d+) times", lambda: (_impacts("pair_wave_passage.yaml")["A:1-B:1"],)),
+    ("docs/tour.md", r"all (\d+) far-field\s+components at (\d+) stripes of Sa\(T₁ of A\) \((\d+) runs",
      lambda: (_catalogue_counts()[1], _stripes("0.1:1.5:0.1"), _catalogue_counts()[1] * _stripes("0.1:1.5:0.1") * 2)),
     ("docs/sweeps.md", r"gap_restitution.yaml: (\d+) gaps x (\d+) restitutions x (\d+) records = (\d+) scenarios",
      lambda: (*(d.size for d in _sweep("gap_restitution.yaml").dimensions), _sweep_size("gap_restitution.yaml"))),
