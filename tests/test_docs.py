@@ -396,3 +396,17 @@ def test_every_far_or_near_field_count_in_the_docs_is_the_catalogue_s():
             if int(m.group(1)) != (components // 2 if m.group(3) else components):  # a pair is two components
                 wrong.append(f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}: {m.group(0)!r}")
     assert not wrong, f"the catalogue has {far} far-field and {near} near-field components: " + "; ".join(wrong)
+
+
+def test_install_md_lists_every_file_pounding_init_copies():
+    """docs/install.md's table of what ``pounding init`` writes names exactly the shipped files of each folder."""
+    from pounding.data import STARTER_FOLDERS, data_path
+
+    text = (ROOT / "docs" / "install.md").read_text(encoding="utf-8")
+    for name in STARTER_FOLDERS:
+        row = re.search(rf"^\| `{name}/` \|(.*)\|$", text, re.M)
+        assert row, f"docs/install.md: no table row for `{name}/`"
+        listed = set(re.findall(r"`([\w-]+\.\w+)`", row.group(1)))
+        shipped = {p.name for p in data_path(name).iterdir() if p.is_file() and not p.name.startswith(("_", "."))}
+        assert listed == shipped, (f"docs/install.md, `{name}/`: not listed {sorted(shipped - listed)}, "
+                                   f"not shipped {sorted(listed - shipped)}")
