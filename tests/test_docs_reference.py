@@ -104,3 +104,25 @@ def test_the_archive_reference_has_every_variable_of_a_run_with_its_units(gen):
         row = re.search(rf"^\| `{re.escape(str(name))}` \| ([^|]*) \| ([^|]*) \|", text, re.M)
         assert row, f"archive variable {name} missing"
         assert row.group(2).strip() == ds[name].attrs.get("units", ""), f"{name}: units"
+
+
+@pytest.mark.parametrize("target, page, expected", [
+    ("docs/gap.md#options", "index.md", "gap.md#options"),             # the README, the site's home page
+    ("../models/README.md#walls", "howto/torsion.md", "../models/README.md#walls"),
+    ("../docs/ida.md", "models/README.md", "../ida.md"),               # models/README.md, a page of the site
+    ("docs/howto/gap.md", "index.md", "howto/gap.md"),
+    ("CHANGELOG.md", "index.md", "changelog.md"),
+    ("development/performance-log.md", "performance.md", "development/performance-log.md"),
+    ("../performance.md#plan-models", "development/performance-log.md", "../performance.md#plan-models"),
+    ("https://example.org/x.md", "index.md", "https://example.org/x.md"),
+    ("#layout", "architecture.md", "#layout"),
+    ("models/pair.yaml", "index.md", None),                            # not a page: shown as its path
+    ("../tests/test_opensees.py", "performance.md", None),
+])
+def test_a_repository_link_becomes_the_site_s(target, page, expected):
+    """docs/hooks.py: links written as they work in the repository point at the same page in the site."""
+    pytest.importorskip("mkdocs", reason="the site's hooks need mkdocs (the docs extra)")
+    spec = importlib.util.spec_from_file_location("hooks", ROOT / "docs" / "hooks.py")
+    hooks = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hooks)
+    assert hooks.site_link(target, page) == expected
