@@ -29,7 +29,7 @@ often preempted (with the load at ~2.4 on 2 cores the median wall time of
 corner_pair came out twice its CPU time, the planar pair's, 8 ms, equal to it).
 Corner peaks of our runs are read at output_dt 1e-3 s (the reference too).
 The figures are written to ``plan_speed.json`` in ``--out DIR``; the table of
-docs/performance.md is written by hand from that output.
+docs/performance.md (current figures) and docs/development/performance-log.md (dated) are written by hand from that output.
 """
 
 from __future__ import annotations

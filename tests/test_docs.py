@@ -1,6 +1,6 @@
 """The documentation cannot lie: its commands parse, its names import, its snippets and fast commands run.
 
-Read from README.md, models/README.md and docs/*.md (docs/testing.md, "Docs that run", states the
+Read from README.md, models/README.md and every docs/**/*.md (docs/testing.md, "Docs that run", states the
 conventions):
 
 * every shell command that starts with ``pounding`` (or ``python3 -m pounding``) in a fenced block,
@@ -13,6 +13,8 @@ conventions):
   :data:`SHORT_DURATION` s unless it gives ``--duration``;
 * a block whose first line is a comment starting ``# example`` is an example: parsed (commands) but not
   run (full record sets, benchmarks; ``.ci/run`` and the benchmarks run those);
+* in the tutorial and the how-to guides (:data:`WALKTHROUGHS`) transcripts also run in sequence with the
+  other blocks, full length, so that a later block can read what they wrote;
 * an output block that follows ``$ pounding run MODEL`` is the summary of that run, line by line
   (``...`` skips lines; timings and ``wrote`` lines are not compared), and the counts the docs quote
   (records in the catalogue, scenarios of a sweep) are those of the code.
@@ -34,7 +36,10 @@ import pytest
 from pounding.cli import build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
-DOCS = [ROOT / "README.md", ROOT / "models" / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+DOCS = [ROOT / "README.md", ROOT / "models" / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+#: The tutorial and the how-to guides: their transcripts run in sequence with the other blocks (a later
+#: block reads what they wrote), full length, as the site's build runs them (docs/hooks.py).
+WALKTHROUGHS = re.compile(r"^docs/(tutorial\.md|howto/[\w-]+\.md)$")
 
 #: Simulated time of a ``pounding run`` of the docs that gives no ``--duration``, s.
 SHORT_DURATION = "2"
@@ -266,7 +271,14 @@ def test_the_python_blocks_and_fast_commands_of_a_doc_run(path, tmp_path, monkey
     for i, m in enumerate(matches):
         lang, body = m.group(1), m.group(2)
         where = f"{rel}:{text[:m.start()].count(chr(10)) + 2}"
-        if _is_example(body) or _is_transcript(lang, body):
+        if _is_example(body):
+            continue
+        if _is_transcript(lang, body):
+            if WALKTHROUGHS.match(rel.as_posix()):
+                for segment in re.split(r"^\$ ", body, flags=re.M)[1:]:
+                    command = re.sub(r"^(?:python3? -m )?", "", segment.partition("\n")[0].strip())
+                    status, printed = _run(command, shorten=False)
+                    assert status == 0, f"{where}: `{command}` ended with status {status}:\n{printed}"
             continue
         if lang == "python":
             printed = io.StringIO()
@@ -350,16 +362,16 @@ def _stripes(levels: str) -> int:
 
 #: Counts the docs quote: (file, pattern whose groups are the numbers, the numbers now).
 COUNTS = [
-    ("README.md", r"the (\d+) far-field records \((\d+) in all\)", lambda: _catalogue_counts()[1::-1]),
-    ("README.md", r"gap_restitution\.nc +# (\d+) scenarios", lambda: (_sweep_size("gap_restitution.yaml"),)),
+    ("docs/tour.md", r"the (\d+) far-field records \((\d+) in all\)", lambda: _catalogue_counts()[1::-1]),
+    ("docs/tour.md", r"gap_restitution\.nc +# (\d+) scenarios", lambda: (_sweep_size("gap_restitution.yaml"),)),
     ("docs/ground_motions.md", r"names (\d+) records with readable keys", lambda: _catalogue_counts()[:1]),
     ("docs/ground_motions.md", r"all (\d+) components of the FEMA P695 far-field", lambda: _catalogue_counts()[1:2]),
     ("docs/ground_motions.md", r"all (\d+) components of the FEMA P695 near-field", lambda: _catalogue_counts()[2:]),
-    ("README.md", r"the same pair pounds (\d+)\s+times", lambda: (_impacts("pair.yaml")["all"],)),
-    ("README.md", r"`pounding run models/pair.yaml`: (\d+) impacts,\s+(\d+) at floor 1",
+    ("docs/tour.md", r"the same pair pounds (\d+)\s+times", lambda: (_impacts("pair.yaml")["all"],)),
+    ("docs/tour.md", r"`pounding run models/pair.yaml`: (\d+) impacts,\s+(\d+) at floor 1",
      lambda: (_impacts("pair.yaml")["all"], _impacts("pair.yaml")["A:1-B:1"])),
-    ("README.md", r"the floor-1 contact pounds (\d+) times", lambda: (_impacts("pair_wave_passage.yaml")["A:1-B:1"],)),
-    ("README.md", r"all (\d+) far-field\s+components at (\d+) stripes of Sa\(T₁ of A\) \((\d+) runs",
+    ("docs/tour.md", r"the floor-1 contact pounds (\d+) times", lambda: (_impacts("pair_wave_passage.yaml")["A:1-B:1"],)),
+    ("docs/tour.md", r"all (\d+) far-field\s+components at (\d+) stripes of Sa\(T₁ of A\) \((\d+) runs",
      lambda: (_catalogue_counts()[1], _stripes("0.1:1.5:0.1"), _catalogue_counts()[1] * _stripes("0.1:1.5:0.1") * 2)),
     ("docs/sweeps.md", r"gap_restitution.yaml: (\d+) gaps x (\d+) restitutions x (\d+) records = (\d+) scenarios",
      lambda: (*(d.size for d in _sweep("gap_restitution.yaml").dimensions), _sweep_size("gap_restitution.yaml"))),
@@ -384,3 +396,17 @@ def test_every_far_or_near_field_count_in_the_docs_is_the_catalogue_s():
             if int(m.group(1)) != (components // 2 if m.group(3) else components):  # a pair is two components
                 wrong.append(f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}: {m.group(0)!r}")
     assert not wrong, f"the catalogue has {far} far-field and {near} near-field components: " + "; ".join(wrong)
+
+
+def test_install_md_lists_every_file_pounding_init_copies():
+    """docs/install.md's table of what ``pounding init`` writes names exactly the shipped files of each folder."""
+    from pounding.data import STARTER_FOLDERS, data_path
+
+    text = (ROOT / "docs" / "install.md").read_text(encoding="utf-8")
+    for name in STARTER_FOLDERS:
+        row = re.search(rf"^\| `{name}/` \|(.*)\|$", text, re.M)
+        assert row, f"docs/install.md: no table row for `{name}/`"
+        listed = set(re.findall(r"`([\w-]+\.\w+)`", row.group(1)))
+        shipped = {p.name for p in data_path(name).iterdir() if p.is_file() and not p.name.startswith(("_", "."))}
+        assert listed == shipped, (f"docs/install.md, `{name}/`: not listed {sorted(shipped - listed)}, "
+                                   f"not shipped {sorted(listed - shipped)}")

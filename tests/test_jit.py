@@ -247,7 +247,7 @@ def test_every_solver_kernel_states_whether_it_is_inlined():
                 elif options["forceinline"]:
                     inlined.append(name)
     assert unset == []
-    # the driver's per-step kernels are the inlined ones (the argument copies they save: docs/performance.md)
+    # the driver's per-step kernels are the inlined ones (the argument copies they save: docs/development/performance-log.md)
     assert {"stages", "error_norm", "locate_contact_events", "record_sample", "rhs"} <= set(inlined)
 
 

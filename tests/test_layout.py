@@ -1,11 +1,11 @@
-"""The package's import graph follows the data flow (README "Layout").
+"""The package's import graph follows the data flow (docs/architecture.md, "Layout").
 
 Every ``import`` in the package — at module level or inside a function, since
 a lazy import is a dependency all the same — is read with :mod:`ast`, and the
 graph is held to three rules:
 
 1. layers: a module imports only from its own subpackage or from a lower
-   layer (the table in README "Layout", from the bottom up);
+   layer (the table in docs/architecture.md "Layout", from the bottom up);
 2. no cycles between modules;
 3. no private name (``_name``) is imported from another module.
 """
@@ -100,7 +100,7 @@ def _graph() -> dict[str, list[tuple[str, str, int]]]:
 
 def test_every_module_has_a_layer():
     unplaced = [m for m in _modules() if _layer(m)[0] < 0]
-    assert not unplaced, f"modules outside every layer of LAYERS (add them to README 'Layout' and here): {unplaced}"
+    assert not unplaced, f"modules outside every layer of LAYERS (add them to docs/architecture.md 'Layout' and here): {unplaced}"
 
 
 def test_imports_point_down_the_data_flow():
