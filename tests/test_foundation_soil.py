@@ -140,3 +140,30 @@ def test_a_bad_soil_or_footing_is_one_located_line(tmp_path, edit, message):
     with pytest.raises(ModelError) as caught:
         pounding.load_model(path)
     assert message in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_the_readme_table_of_what_soil_changes_is_the_two_runs():
+    """README's "What the site changes" table quotes the runs of models/pair.yaml and models/pair_on_soil.yaml
+    under record 1a: each number is the runs', at the digits printed."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    rows = {}
+    for line in (root / "README.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3 and cells[0] in ("first periods A / B", "impacts", "peak contact force (A:5-B:5)",
+                                            "largest peak storey drift ratio A / B"):
+            rows[cells[0]] = [re.findall(r"[\d.]+", c) for c in cells[1:]]
+    assert len(rows) == 4, rows
+    for column, name in enumerate(("pair", "pair_on_soil")):
+        model = pounding.load_model(root / "models" / f"{name}.yaml")
+        ds = pounding.simulate(model)
+        assert int(ds.impact_count.sum()) == int(rows["impacts"][column][0])
+        force = float(ds.peak_contact_force.sel(contact="A:5-B:5")) / 1e6
+        assert f"{force:.1f}" == rows["peak contact force (A:5-B:5)"][column][0]
+        drifts = [f"{100 * float(ds.peak_drift_ratio.where(ds.storey_building == b, drop=True).max()):.3f}"
+                  for b in ("A", "B")]
+        assert drifts == rows["largest peak storey drift ratio A / B"][column]
+        periods = [float((b.flexible_periods if b.foundation is not None else b.periods)[0]) for b in model.buildings]
+        assert [f"{t:.3f}" for t in periods] == rows["first periods A / B"][column]
