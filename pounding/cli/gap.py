@@ -29,12 +29,23 @@ def _code_options(args: argparse.Namespace) -> dict:
     return {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
 
 
+def _rerun_command(args: argparse.Namespace, options: dict) -> str:
+    """The command that reruns this code check (the archive's ``command``): model, code, spectrum, records, time."""
+    import shlex
+
+    words = ["pounding", "gap", args.model, "--code", args.code]
+    for name, value in options.items():
+        words += [f"--{name}", str(value)]
+    for option, value in (("--records", args.records), ("--duration", args.duration)):
+        if value is not None:
+            words += [option, str(value)]
+    return shlex.join(words)
+
+
 def _cmd_code_gap(args: argparse.Namespace) -> int:
     """``pounding gap MODEL --code CODE ...``: the model's gap beside the code's separations and the records' need,
     per contact (a level pair; a contact point of a plan model), with a verdict per level pair
     (:func:`pounding.studies.design_check.code_gap_study`)."""
-    import shlex
-
     from pounding.results.archive import save_run
     from pounding.results.checks import print_warnings
     from pounding.studies.design_check import (code_gap_dataset, code_gap_study, code_gap_summary, code_gap_table,
@@ -51,7 +62,7 @@ def _cmd_code_gap(args: argparse.Namespace) -> int:
     print(json.dumps(code_gap_summary(result), indent=2) if args.json else code_gap_table(result))
     print_warnings(result["warnings"])   # the model's and the scaled records', each kind once
     if args.output or args.csv or args.plot:
-        ds = code_gap_dataset(result, command=shlex.join(["pounding", *sys.argv[1:]]) if sys.argv[1:] else "")
+        ds = code_gap_dataset(result, command=_rerun_command(args, options))
         if args.output:
             print(f"wrote {save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)}", file=out)
         write_csv_option(args, "gap-code", ds, out)

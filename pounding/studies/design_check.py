@@ -282,10 +282,13 @@ def _level_words(pair: dict[str, Any]) -> str:
 
 
 def _mm(value: float) -> str:
-    """Millimetres for the answers: ``57``, the words for +inf, ``-`` for NaN."""
+    """Millimetres for the answers: ``57`` (two significant figures below 10 mm: ``0.1``), the words for +inf,
+    ``-`` for NaN."""
     if value == math.inf:
         return NOT_BOUNDED
-    return "-" if not math.isfinite(value) else f"{1000 * value:.0f}"
+    if not math.isfinite(value):
+        return "-"
+    return f"{1000 * value:.0f}" if abs(value) >= 0.01 or value == 0.0 else f"{1000 * value:.2g}"
 
 
 def _answer(pairs: list[dict[str, Any]], code: str) -> str:
