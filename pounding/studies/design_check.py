@@ -291,6 +291,14 @@ def _mm(value: float) -> str:
     return f"{1000 * value:.0f}" if abs(value) >= 0.01 or value == 0.0 else f"{1000 * value:.2g}"
 
 
+def _listed(places: list[str]) -> str:
+    """``level 2``, ``levels 1, 2 and 4`` (levels by number), or the labels as they are."""
+    if len(places) > 1 and all(p.startswith("level ") and p[6:].isdigit() for p in places):
+        numbers = [p[6:] for p in places]
+        return f"levels {', '.join(numbers[:-1])} and {numbers[-1]}"
+    return ", ".join(places)
+
+
 def _answer(pairs: list[dict[str, Any]], code: str) -> str:
     """The plain-language answer of one pair of buildings from its level pairs (:func:`level_pairs`)."""
     name = CODE_NAMES.get(code, code)
@@ -318,7 +326,7 @@ def _answer(pairs: list[dict[str, Any]], code: str) -> str:
         tail = f"; {found['exceeding']} of {found['records']} records need more than {_mm(top['gap'])} mm"
     others = [_level_words(p) for p in short if p is not top]
     if others:
-        tail += f"; also short at {', '.join(others)}"
+        tail += f"; also short at {_listed(others)}"
     return f"{head} {verdict} at {_level_words(top)}: {asks}{tail}"
 
 
@@ -664,7 +672,7 @@ def code_gap_figure(ds):
         lines = 1000 * ds.pair_code_property_lines.values[sel]
         if np.isfinite(lines).any():
             ax.plot(lines, z, color="C0", lw=1.0, ls=":", marker="s", ms=3, label=f"{CODE_NAMES.get(ds.attrs.get('code'), ds.attrs.get('code'))}, property lines")
-        ax.plot(1000 * ds.pair_gap.values[sel], z, color="C3", lw=2.4, ls="-.", label="the model's gap")
+        ax.plot(1000 * ds.pair_gap.values[sel], z, color="C3", lw=2.4, label="the model's gap")
         short = sel[ds.verdict.values[sel] != VERDICTS[0]]
         if short.size:
             ax.plot(1000 * ds.pair_gap.values[short], ds.pair_elevation.values[short], "x", color="C3", ms=9,
