@@ -277,3 +277,22 @@ def test_the_gap_figures_keep_their_titles_within_the_canvas_and_label_their_axe
     plot_gap(gap_study(model, RECORDS.split(",")[:1], duration=3.0, workers=1, progress=False), tmp_path)
     (figure,) = seen
     _titles_within(figure)
+
+
+def test_where_no_record_ran_the_verdict_says_the_records_are_not_determined():
+    """No run: every record failed, so only the code can be judged (no percentile, no count)."""
+    from pounding.studies.design import Separation, simulated_requirement
+    from pounding.studies.design_check import level_pairs, plain_answers
+
+    found = simulated_requirement(np.zeros(0), 0.04, use_max=False, gap=0.05)
+    assert found["records"] == 0 and math.isnan(found["fraction"]) and found["unconservative"] is None
+    result = {"code": "asce7-22", "records": ["r1", "r2"],
+              "intensities": [{"name": "design", "status": ["error", "error"]}],
+              "contacts": [{"contact": "A:2-B:2", "level_pair": "A:2-B:2", "buildings": ("A", "B"), "levels": (2, 2),
+                            "elevation": 6.4, "gap": 0.05, "separation": Separation(0.04, 0.03, 0.03),
+                            "simulated": {"design": {**found, "needs": [math.nan, math.nan]}}}]}
+    (pair,) = level_pairs(result)
+    assert pair["records_enough"] is None and pair["verdict"] == "enough for the code; the records not determined"
+    result["level_pairs"] = [pair]
+    assert plain_answers(result) == ["A | B: your 50 mm is enough for ASCE 7-22 (the records not determined) at "
+                                     "level 2: ASCE 7-22 asks 40 mm, the records not determined (none ran)"]

@@ -319,8 +319,11 @@ def _answer(pairs: list[dict[str, Any]], code: str) -> str:
     if not short:
         return f"{head} is enough for {name} and the records at every level pair; the most demanding, " \
                f"{_level_words(top)}: {asks}"
-    verdict = {VERDICTS[1]: f"is enough for {name} but not for the records",
-               VERDICTS[2]: f"is enough for the records but not for {name}"}.get(top["verdict"], "is not enough")
+    verdict = {(True, False): f"is enough for {name} but not for the records",
+               (False, True): f"is enough for the records but not for {name}", (False, False): "is not enough",
+               (True, None): f"is enough for {name} (the records not determined)",
+               (False, None): f"is not enough for {name} (the records not determined)"}[
+        (top["code_enough"], top["records_enough"])]
     tail = ""
     if found["records"]:
         tail = f"; {found['exceeding']} of {found['records']} records need more than {_mm(top['gap'])} mm"
