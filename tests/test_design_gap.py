@@ -116,7 +116,8 @@ def test_a_building_without_design_factors_is_refused(tmp_path, capsys):
 def test_a_requirement_no_record_met_is_not_determined_and_small_values_keep_their_digits():
     """At an intensity where every record failed there is nothing to compare: the row says so (not "ok"); a
     code separation of 0.04 mm below a requirement of 0.05 mm is printed with the digits that show it."""
-    from pounding.studies.design import Separation, code_gap_table, simulated_requirement
+    from pounding.studies.design import Separation, simulated_requirement
+    from pounding.studies.design_check import code_gap_table
 
     none = simulated_requirement(np.zeros(0), 0.02, use_max=False)
     assert none["unconservative"] is None and math.isnan(none["used"])
@@ -138,7 +139,8 @@ def test_a_requirement_no_record_met_is_not_determined_and_small_values_keep_the
 def test_a_collapsed_record_makes_the_simulated_requirement_not_bounded_and_every_code_unconservative():
     """A record on which a building collapsed needs +inf (the gap study counts it so): the mean and the max over
     the records are not bounded, any code separation is below them, and the table and JSON say so in words."""
-    from pounding.studies.design import Separation, code_gap_summary, code_gap_table, simulated_requirement
+    from pounding.studies.design import Separation, simulated_requirement
+    from pounding.studies.design_check import code_gap_summary, code_gap_table
 
     found = simulated_requirement(np.array([0.01, math.inf, 0.02]), 0.5, use_max=False)
     assert found["mean"] == found["max"] == found["used"] == math.inf and found["unconservative"] is True

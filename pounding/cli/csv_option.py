@@ -25,7 +25,7 @@ def archive_tables(kind: str, ds) -> dict:
     """The tables (``{name: pandas.DataFrame}``, main table first) of an archive of *kind*.
 
     *kind* is what :func:`pounding.cli.run.open_archive` returns: ``run`` (a run of any model), ``sweep``,
-    ``compare``, ``gap``, ``ida``, ``pushover``, ``hysteresis`` or ``verify``.
+    ``compare``, ``gap``, ``gap-code``, ``ida``, ``pushover``, ``hysteresis`` or ``verify``.
     """
     if kind == "run":
         from pounding.results.tables import run_tables
@@ -43,6 +43,10 @@ def archive_tables(kind: str, ds) -> dict:
         from pounding.studies.gap import gap_tables
 
         return gap_tables(ds)
+    if kind == "gap-code":
+        from pounding.studies.design_check import code_gap_tables
+
+        return code_gap_tables(ds)
     if kind == "ida":
         from pounding.studies.ida.report import ida_tables
 

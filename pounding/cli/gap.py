@@ -15,38 +15,59 @@ from pounding.errors import PoundingError
 __all__ = ["register_cli"]
 
 
-def _cmd_code_gap(args: argparse.Namespace, *, plan: bool = False) -> int:
-    """``pounding gap MODEL --code CODE ...``: the code's separations beside the simulated requirement.
-
-    A plan model (*plan*) is checked at every contact point (:func:`pounding.studies.design_directions.plan_code_gap_study`).
-    """
-    from pounding.results.checks import print_warnings
-    from pounding.studies.design import code_gap_study, code_gap_summary, code_gap_table
-    from pounding.studies.design_directions import plan_code_gap_study
-
-    for given, option in ((args.scale, "--scale"), (args.output, "-o"), (args.plot, "--plot"), (args.csv, "--csv")):
-        if given is not None:
-            why = ("the records are scaled to the code's spectrum" if option == "--scale"
-                   else "not available with --code yet; run without --code for the archive and figure")
-            raise PoundingError(f"--code refuses {option}: {why}")
+def _code_options(args: argparse.Namespace) -> dict:
+    """The design spectrum's options of ``--code``, each missing one refused in one line."""
+    if args.scale is not None:
+        raise PoundingError("--code refuses --scale: the records are scaled to the code's spectrum")
     if args.code == "asce7-22":
         missing = [f"--{name}" for name in ("sds", "sd1") if getattr(args, name) is None]
         if missing:
             raise PoundingError(f"--code asce7-22 needs {' and '.join(missing)} (g)")
-        options = {"sds": args.sds, "sd1": args.sd1, "tl": args.tl}
-    else:
-        if args.ag is None:
-            raise PoundingError("--code ec8 needs --ag (design ground acceleration on ground type A, g)")
-        options = {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
+        return {"sds": args.sds, "sd1": args.sd1, "tl": args.tl}
+    if args.ag is None:
+        raise PoundingError("--code ec8 needs --ag (design ground acceleration on ground type A, g)")
+    return {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
+
+
+def _rerun_command(args: argparse.Namespace, options: dict) -> str:
+    """The command that reruns this code check (the archive's ``command``): model, code, spectrum, records, time."""
+    import shlex
+
+    words = ["pounding", "gap", args.model, "--code", args.code]
+    for name, value in options.items():
+        words += [f"--{name}", str(value)]
+    for option, value in (("--records", args.records), ("--duration", args.duration)):
+        if value is not None:
+            words += [option, str(value)]
+    return shlex.join(words)
+
+
+def _cmd_code_gap(args: argparse.Namespace) -> int:
+    """``pounding gap MODEL --code CODE ...``: the model's gap beside the code's separations and the records' need,
+    per contact (a level pair; a contact point of a plan model), with a verdict per level pair
+    (:func:`pounding.studies.design_check.code_gap_study`)."""
+    from pounding.results.archive import save_run
+    from pounding.results.checks import print_warnings
+    from pounding.studies.design_check import (code_gap_dataset, code_gap_study, code_gap_summary, code_gap_table,
+                                               plot_code_gap)
+
+    options = _code_options(args)
     warn_of_parameters(args, args.code)
-    study = plan_code_gap_study if plan else code_gap_study
-    result = study(args.model, args.code, options, args.records, duration=args.duration,
-                   workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
-    if args.json:
-        print(json.dumps(code_gap_summary(result), indent=2))
-    else:
-        print(code_gap_table(result))
+    try:
+        result = code_gap_study(args.model, args.code, options, args.records, duration=args.duration,
+                                workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
+    except KeyboardInterrupt:
+        return interrupted(None, "records")
+    out = sys.stderr if args.json else sys.stdout
+    print(json.dumps(code_gap_summary(result), indent=2) if args.json else code_gap_table(result))
     print_warnings(result["warnings"])   # the model's and the scaled records', each kind once
+    if args.output or args.csv or args.plot:
+        ds = code_gap_dataset(result, command=_rerun_command(args, options))
+        if args.output:
+            print(f"wrote {save_run(ds, args.output, overwrite=args.overwrite, keep_beside=True)}", file=out)
+        write_csv_option(args, "gap-code", ds, out)
+        for png in plot_code_gap(ds, args.plot) if args.plot else ():
+            print(f"wrote {png}", file=out)
     return 0
 
 
@@ -69,13 +90,8 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     from pounding.studies.gap import gap_study, gap_summary, gap_table, plot_gap, records_ran
 
     check_study_options(args)
-    if args.code:   # the code's separations: design.py for a row, design_directions.py for floors in plan
-        from pounding.model.model import is_plan_file
-
-        if is_plan_file(args.model):
-            return _cmd_code_gap(args, plan=True)
     check_outputs(args)
-    if args.code:
+    if args.code:   # the code's separations beside the records' need and the model's gap: design_check.py
         return _cmd_code_gap(args)
     _refuse_spectrum_without_code(args)
     try:
@@ -135,8 +151,9 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
                         help="report the code's separation per level pair (per contact point of a plan model, "
                              "with accidental torsion and both directions) from design spectra (modal "
                              "response-spectrum analysis of each building with its design: factors in the model) "
-                             "beside the requirement of the records scaled to the code's spectrum (refuses --scale, "
-                             "-o, --plot); docs/design-codes.md")
+                             "beside the model's gap and the need of the records scaled to the code's spectrum, "
+                             "with a verdict per level pair (refuses --scale); -o, --csv, --plot and --json write "
+                             "the same; docs/gap.md, docs/design-codes.md")
     add_spectrum_options(parser, "asce7-22")
     add_spectrum_options(parser, "ec8", q=False)
     add_cluster_options(parser)

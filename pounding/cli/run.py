@@ -201,7 +201,7 @@ def _cmd_rerun(args: argparse.Namespace) -> int:
 
 def open_archive(path) -> tuple[str, object]:
     """Open any pounding archive; returns ``(kind, dataset)`` with kind ``run`` (a run of any model), ``sweep``,
-    ``compare``, ``gap``, ``ida``, ``risk``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
+    ``compare``, ``gap``, ``gap-code`` (``gap --code``), ``ida``, ``risk``, ``verify``, ``hysteresis``, ``pushover`` or ``p695``."""
     import xarray as xr
 
     from pounding.errors import ArchiveError
@@ -237,7 +237,7 @@ def open_archive(path) -> tuple[str, object]:
                 else "sweep"), ds
     if is_verify:
         return "verify", ds
-    if attrs.get("kind") in ("hysteresis", "pushover", "p695"):
+    if attrs.get("kind") in ("hysteresis", "pushover", "p695", "gap-code"):
         return str(attrs["kind"]), ds
     raise ArchiveError(f"{source}: a pounding file of an unknown kind (not from run, rerun, sweep, compare or "
                        "verify); a newer pounding may read it")
@@ -294,6 +294,10 @@ def _print_info(kind: str, ds) -> None:
         from pounding.studies.gap import gap_table
 
         print(gap_table(ds))
+    elif kind == "gap-code":
+        from pounding.studies.design_check import code_gap_info
+
+        print(code_gap_info(ds))
     elif kind == "ida":
         from pounding.studies.ida import ida_table
 
@@ -376,6 +380,10 @@ def _draw(kind: str, ds, out: Path, args: argparse.Namespace) -> list:
         from pounding.studies.gap import plot_gap
 
         return plot_gap(ds, out)
+    if kind == "gap-code":
+        from pounding.studies.design_check import plot_code_gap
+
+        return plot_code_gap(ds, out)
     if kind == "hysteresis":
         from pounding.studies.cyclic import plot_hysteresis
 

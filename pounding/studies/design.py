@@ -40,11 +40,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from pounding.studies.gap import NOT_BOUNDED, bounded_value, cqc_correlation
+from pounding.studies.gap import cqc_correlation, order_statistic
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION", "dof_per_floor", "ground_influence",
@@ -54,8 +54,7 @@ __all__ = ["ModalResponse", "modal_response", "cqc_combine", "MASS_FRACTION", "d
            "nzs1170_5_separation", "NTC_2004_HEIGHT", "NTC_2004_SIMPLIFIED", "NTC_2004_MINIMUM", "ntc2004_setback",
            "ntc2004_separation", "SUITE_FRACTION", "SUITE_PERIODS", "EC8_MEAN_RECORDS", "ASCE_RECORDS",
            "suite_scale_factor", "Intensity", "record_set_spectra", "suite_warnings", "code_setup", "code_displacements",
-           "pair_separation", "code_separations", "simulated_requirement",
-           "code_gap_study", "code_gap_table", "code_gap_summary"]
+           "pair_separation", "code_separations", "simulated_requirement"]
 
 #: Participating mass the modes of a response-spectrum analysis must reach (ASCE 7-22 §12.9.1.1, EC8 §4.3.3.3.1).
 MASS_FRACTION = 0.90
@@ -611,166 +610,33 @@ def code_separations(model, code: str, displacement: dict[str, np.ndarray], *,
         z1, z2 = float(left.elevation[g.level_left - 1]), float(right.elevation[g.level_right - 1])
         same = abs(z1 - z2) <= tolerance + 1e-9
         sep = pair_separation(code, d1, d2, same_levels=same)
-        rows.append({"contact": g.label(names), "left": d1, "right": d2, "elevation": max(z1, z2),
-                     "same_levels": same, "separation": sep})
+        rows.append({"contact": g.label(names), "level_pair": g.label(names), "gap": float(g.gap),
+                     "buildings": (left.name, right.name), "levels": (g.level_left, g.level_right),
+                     "left": d1, "right": d2, "elevation": max(z1, z2), "same_levels": same, "separation": sep})
     return rows
 
 
-def simulated_requirement(required: Any, separation: float, use_max: bool) -> dict[str, Any]:
-    """A contact's simulated requirement over the records that ran (m) beside the code's *separation* (m).
+def simulated_requirement(required: Any, separation: float, use_max: bool, gap: float = math.nan) -> dict[str, Any]:
+    """A contact's simulated requirement over the records that ran (m) beside the code's *separation* and the
+    model's *gap* (m).
 
     ``mean``, ``max``, ``used`` (the max where *use_max*, else the mean) and ``unconservative``: True
     where the code's separation is below the requirement used, None where no record ran (nothing to
-    compare: not "ok").  A record on which a building collapsed needs +inf (the gap study's
-    ``required_gap``): the mean and the max are then +inf, not bounded, and every code separation is
-    below them (unconservative).
+    compare: not "ok").  ``median`` and ``p84`` (:func:`pounding.studies.gap.order_statistic`: +inf where
+    they fall on a collapsed record), ``exceeding`` (how many records need more than *gap*: need > gap)
+    and ``fraction`` (that over the records that ran; NaN where none ran).  A record on which a building
+    collapsed needs +inf (the gap study's ``required_gap``): the mean and the max are then +inf, not
+    bounded, every code separation is below them (unconservative), and it exceeds every gap.
     """
     values = np.asarray(required, dtype=float)
     if values.size == 0:
-        return {"mean": math.nan, "max": math.nan, "used": math.nan, "unconservative": None}
+        return {"mean": math.nan, "max": math.nan, "used": math.nan, "unconservative": None, "median": math.nan,
+                "p84": math.nan, "exceeding": 0, "fraction": math.nan, "records": 0}
     mean, largest = float(np.mean(values)), float(np.max(values))
     used = largest if use_max else mean
-    return {"mean": mean, "max": largest, "used": used, "unconservative": bool(separation < used)}
-
-
-def code_gap_study(model_path, code: str, spectrum_options: dict[str, Any], records: Any = None, *,
-                   duration: float | None = None, **run_options) -> dict[str, Any]:
-    """Each code separation per level pair beside the simulated requirement of records scaled to the code's spectrum.
-
-    The record set is scaled by one factor per intensity
-    (:func:`suite_scale_factor` over 0.2 T_min to 2 T_max of the buildings'
-    first periods) and run with the contacts open (:func:`pounding.studies.gap.gap_study`).
-
-    Returns
-    -------
-    dict
-        ``code``, ``rule``, ``statistic``, ``buildings`` (RSA per building),
-        ``contacts`` (per level pair: the code's separation, and per intensity
-        the simulated mean and max and whether the code is below the one used),
-        ``intensities`` (factor, period range, clause), ``records``.
-    """
-    from pounding.model.model import load_model
-    from pounding.studies.common import record_values
-    from pounding.studies.gap import build_gap_sweep, gap_study, record_outcomes, records_ran
-
-    model = load_model(model_path)
-    model.refuse_building_records("the code check (it runs the model under one record at a time)")
-    build_gap_sweep(model_path, records, duration=duration)   # the gap study's own refusals (walls, no contacts...)
-    found = code_displacements(model, code, spectrum_options)
-    rows = code_separations(model, code, found["displacement"])
-    specs = record_values(records, model)
-    first = [float(b.periods[0]) for b in model.buildings]
-    periods = np.geomspace(0.2 * min(first), 2.0 * max(first), SUITE_PERIODS)
-    # the records' spectra over what is simulated: --duration, else the model's ground_motion.duration
-    simulated = duration if duration is not None else model.ground_motion.duration
-    read: list = []
-    psa, pga = record_set_spectra(model, specs, periods, duration=simulated, read=read)
-    intensities, factors = [], []
-    for intensity in found["intensities"]:
-        factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
-        factors.append(factor)
-        ds = gap_study(model_path, specs, scale=factor, duration=duration, **run_options)
-        ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
-        # no record ran: the archive has no contacts (they come from a run); nothing to compare
-        required = ds.required_gap.values[ok] if ok.any() else np.empty((0, len(rows)))
-        n_ok = int(ok.sum())
-        use_max = code == "ec8" and n_ok < EC8_MEAN_RECORDS
-        intensities.append({"name": intensity.name, "why": intensity.why, "target": intensity.spectrum.name,
-                            "factor": factor, "period_range": (float(periods[0]), float(periods[-1])),
-                            "records_ok": n_ok, "statistic": "max" if use_max else "mean", **record_outcomes(ds)})
-        for c, row in enumerate(rows):
-            row.setdefault("simulated", {})[intensity.name] = simulated_requirement(
-                required[:, c], row["separation"].same_property, use_max)
-    return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
-            "records": specs, "intensities": intensities, "contacts": rows,
-            "warnings": suite_warnings(model, specs, [[r] for r in read], factors),
-            "buildings": {name: {"modes": r.n_modes, "mass_fraction": r.mass_fraction,
-                                 "periods": r.periods.tolist(), "spectrum": found["spectra"][name].name,
-                                 "elastic_displacement": r.displacement.tolist(),
-                                 "design_displacement": np.asarray(found["displacement"][name]).tolist()}
-                          for name, r in found["rsa"].items()}}
-
-
-def code_gap_table(result: dict[str, Any]) -> str:
-    """The code check as a printed table (millimetres): one row per level pair, or per contact point of a plan model.
-
-    A plan model's result (:func:`pounding.studies.design_directions.plan_code_gap_study`) adds the model's
-    gap per point, names the sides ``1`` and ``2`` (the contact's first and second building) and describes
-    each building's analysis in its own ``description``.
-    """
-    def mm(value: float) -> str:
-        # three significant figures below 1 mm: a flag never compares two values printed alike as 0.0
-        if value == math.inf:   # a collapsed record's need (+inf): the mean and the max over records
-            return NOT_BOUNDED
-        if not math.isfinite(value):
-            return "-"
-        return f"{1000 * value:.1f}" if abs(value) >= 1e-3 or value == 0.0 else f"{1000 * value:.3g}"
-
-    first, second = result.get("sides", ("left", "right"))
-    short = {"left": "L", "right": "R", "first": "1", "second": "2"}
-    lines = [f"code {result['code']}: {result['rule']}"]
-    for name, b in result["buildings"].items():
-        lines.append(f"  {name}: " + (b.get("description") or f"RSA with {b['spectrum']}, {b['modes']} mode(s), "
-                                      f"{100 * b['mass_fraction']:.1f} % of the mass, CQC"))
-    for item in result["intensities"]:
-        low, high = item["period_range"]
-        lines.append(f"records at {item['name']} level: x{item['factor']:.3f} on every record (mean "
-                     f"{item.get('spectrum_kind', 'spectrum')} >= 90 % of {item['target']} over {low:.3f}-{high:.3f} "
-                     f"s) - {item['why']}; {item['records_ok']} record(s), {item['statistic']} used")
-        for record, error in item["failed"].items():
-            lines.append(f"  record failed at {item['name']} level: {record}: {error}")
-        for record, why in item.get("collapsed", {}).items():
-            lines.append(f"  record collapsed at {item['name']} level (its need is {NOT_BOUNDED}): {record}: {why}")
-    if result["code"] == "asce7-22" and any(i["records_ok"] < ASCE_RECORDS for i in result["intensities"]):
-        lines.append(f"  (ASCE 7-22 ch. 16 asks for {ASCE_RECORDS} records; fewer were run)")
-    names = [i["name"] for i in result["intensities"]]
-    rows = result["contacts"]
-    width = max([12] + [len(row["contact"]) for row in rows])
-    gap = "gap" in (rows[0] if rows else {})
-    head = (f"{'point' if gap else 'contact':<{width}} " + (f"{'gap':>6} " if gap else "")
-            + f"{'code ' + short[first]:>7} {'code ' + short[second]:>7} {'same prop':>9} {'prop lines':>10}  "
-            + "  ".join(f"{'sim ' + n + ' mean/max':>22}" for n in names) + "  flag")
-    lines.append(f"separations (mm): the code's design displacements of the {first} and {second} "
-                 f"{'sides at the point' if gap else 'floors'}, the code's separation on one property and between "
-                 "property lines, and the simulated requirement")
-    lines.append(head)
-    for row in rows:
-        sep = row["separation"]
-        cells = "  ".join(f"{_mean_max(row['simulated'][n], mm):>22}" for n in names)
-        unsafe = [n for n in names if row["simulated"][n]["unconservative"]]
-        unknown = [n for n in names if row["simulated"][n]["unconservative"] is None]
-        flag = "; ".join(([f"UNCONSERVATIVE at {', '.join(unsafe)}"] if unsafe else [])
-                         + ([f"not determined at {', '.join(unknown)} (no record ran)"] if unknown else [])) or "ok"
-        lines.append(f"{row['contact']:<{width}} " + (f"{mm(row['gap']):>6} " if gap else "")
-                     + f"{mm(row[first]):>7} {mm(row[second]):>7} {mm(sep.same_property):>9} "
-                     f"{mm(sep.property_lines):>10}  {cells}  {flag}")
-    lines.append("flag: the code's same-property separation is below the simulated requirement (the statistic used) "
-                 "at that intensity")
-    return "\n".join(lines)
-
-
-def _mean_max(simulated: dict[str, Any], mm: Callable[[float], str]) -> str:
-    """A simulated requirement's cell: ``mean/max`` in mm, or the words once where the mean is not bounded
-    (a collapsed record: then so is the max)."""
-    if simulated["mean"] == math.inf:
-        return NOT_BOUNDED
-    return f"{mm(simulated['mean'])}/{mm(simulated['max'])}"
-
-
-def code_gap_summary(result: dict[str, Any]) -> dict[str, Any]:
-    """The code check as one JSON-ready document (metres); a simulated requirement that is not bounded (a
-    collapsed record) is the words :data:`pounding.studies.gap.NOT_BOUNDED`."""
-    first, second = result.get("sides", ("left", "right"))
-    out = dict(result)
-
-    def simulated(row: dict[str, Any]) -> dict[str, Any]:
-        return {name: {k: bounded_value(v) if k in ("mean", "max", "used") else v for k, v in entry.items()}
-                for name, entry in row.get("simulated", {}).items()}
-
-    out["contacts"] = [{**{k: v for k, v in row.items() if k not in ("separation", "simulated")},
-                        "simulated": simulated(row),
-                        "same_property": row["separation"].same_property,
-                        f"setback_{first}": row["separation"].setback_left,
-                        f"setback_{second}": row["separation"].setback_right,
-                        "property_lines": row["separation"].property_lines} for row in result["contacts"]]
-    return out
+    exceeding = int(np.count_nonzero(values > gap))
+    return {"mean": mean, "max": largest, "used": used, "unconservative": bool(separation < used),
+            "median": float(order_statistic(values[:, None], 50.0)[0]),
+            "p84": float(order_statistic(values[:, None], 84.0)[0]),
+            "exceeding": exceeding, "fraction": exceeding / values.size if math.isfinite(gap) else math.nan,
+            "records": int(values.size)}

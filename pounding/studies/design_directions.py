@@ -82,10 +82,9 @@ import numpy as np
 
 from pounding.errors import PoundingError
 from pounding.model.outline import place_label
-from pounding.studies.design import (EC8_MEAN_RECORDS, SUITE_PERIODS, ModalResponse, Separation,
+from pounding.studies.design import (ModalResponse, Separation,
                                      code_setup, dof_per_floor, ground_influence, modal_response, modes_for_mass,
-                                     pair_separation, response_directions, simulated_requirement,
-                                     suite_scale_factor, suite_warnings)
+                                     pair_separation, response_directions)
 from pounding.units import STANDARD_GRAVITY
 
 __all__ = ["ACCIDENTAL_ECCENTRICITY", "ORTHOGONAL_FRACTION", "TORSIONAL_IRREGULARITY", "EXTREME_TORSIONAL_IRREGULARITY",
@@ -93,7 +92,8 @@ __all__ = ["ACCIDENTAL_ECCENTRICITY", "ORTHOGONAL_FRACTION", "TORSIONAL_IRREGULA
            "modal_floor_forces", "ec8_floor_forces", "torsion_displacements", "torsion_ratios",
            "torsional_amplification", "asce7_22_design_category", "directional_designs", "combine_directions",
            "floor_weights", "point_design_displacement", "building_designs", "plan_code_displacements",
-           "plan_code_separations", "sdof_foh_displacement", "rotd100", "pair_set_spectra", "plan_code_gap_study"]
+           "plan_code_separations", "sdof_foh_displacement", "rotd100", "pair_set_spectra", "own_pair",
+           "building_summary"]
 
 #: Accidental eccentricity over the plan dimension perpendicular to the motion (ASCE 7-22 §12.8.4.2; EN 1998-1 (4.3)).
 ACCIDENTAL_ECCENTRICITY = 0.05
@@ -414,7 +414,10 @@ def plan_code_separations(model, code: str, found: dict[str, Any], *, tolerance:
             d1, d2 = one["design"], (0.0 if wall else two["design"])
             same = (not wall) and abs(z1 - z2) <= tolerance + 1e-9
             separation = Separation(d1, d1, 0.0) if wall else pair_separation(code, d1, d2, same_levels=same)
-            rows.append({"contact": f"{face}@{place_label((x, y))}", "face": face, "normal": contact.face.normal,
+            rows.append({"contact": f"{face}@{place_label((x, y))}", "face": face, "level_pair": face,
+                         "buildings": (names[contact.first], "wall" if wall else names[contact.second]),
+                         "levels": (contact.level_first, 0 if wall else contact.level_second),
+                         "normal": contact.face.normal,
                          "location": [float(x), float(y)], "gap": float(contact.gap), "first": d1, "second": d2,
                          "first_parts": one, "second_parts": two, "elevation": max(z1, z2), "same_levels": same,
                          "separation": separation})
@@ -520,7 +523,7 @@ def pair_set_spectra(model_path: str | os.PathLike, pairs: list[str], periods: A
     return np.array(psa), np.array(pga)
 
 
-def _own_pair(model_path: str | os.PathLike) -> list[str]:
+def own_pair(model_path: str | os.PathLike) -> list[str]:
     """The model's own record pair (``ground_motion.record``), refused in one line for x/y components."""
     import yaml
 
@@ -533,7 +536,7 @@ def _own_pair(model_path: str | os.PathLike) -> list[str]:
     return [ground["record"]]
 
 
-def _building_summary(building, found: dict[str, Any], code: str) -> dict[str, Any]:
+def building_summary(building, found: dict[str, Any], code: str) -> dict[str, Any]:
     """A building's analysis for the report: modes, mass, torsion, A_x."""
     design = found["designs"][building.name]
     directions = design["directions"]
@@ -561,73 +564,3 @@ def _building_summary(building, found: dict[str, Any], code: str) -> dict[str, A
                                "amplification": item.amplification.tolist(),
                                "displacement_ratio": item.displacement_ratio.tolist(),
                                "drift_ratio": item.drift_ratio.tolist()} for d, item in directions.items()}}
-
-
-def _simulated(ds, rows: list[dict[str, Any]], name: str, use_max: bool) -> None:
-    """Each row's simulated requirement (mean, max over the records that ran, a collapsed one's +inf) at
-    intensity *name*, in place."""
-    from pounding.studies.gap import records_ran
-
-    ok = records_ran(ds)
-    if not ok.any():   # no record ran: the archive has no points (they come from a run); nothing to compare
-        for row in rows:
-            row.setdefault("simulated", {})[name] = simulated_requirement(np.empty(0), row["separation"].same_property,
-                                                                          use_max)
-        return
-    # a contact point of the gap study's archive: its face (YAML order) and place, as the rows name it
-    labels = [f"{face}@{place_label((float(x), float(y)))}" for face, x, y in
-              zip(ds.point_face.values, ds.point_x.values, ds.point_y.values)]
-    for row in rows:
-        row.setdefault("simulated", {})[name] = simulated_requirement(
-            ds.required_gap.values[ok, labels.index(row["contact"])], row["separation"].same_property, use_max)
-
-
-def plan_code_gap_study(model_path: str | os.PathLike, code: str, spectrum_options: dict[str, Any],
-                        records: Any = None, *, duration: float | None = None, **run_options) -> dict[str, Any]:
-    """The code's separation at every contact point of a plan model beside record pairs scaled to the code's spectrum.
-
-    The pairs (default: the model's own) are scaled by one factor per intensity
-    (:func:`pounding.studies.design.suite_scale_factor` on :func:`pair_set_spectra`, periods
-    0.2 T_min to 2 T_max of the buildings' principal periods along x and y) and run with no
-    contacts held open (:func:`pounding.studies.gap.gap_study`).
-
-    Returns
-    -------
-    dict
-        As :func:`pounding.studies.design.code_gap_study`, one ``contacts`` row per contact point
-        (``first``, ``second``: the sides' design displacements; ``gap``: the model's), ``sides``.
-    """
-    from pounding.model.model import load_model
-    from pounding.studies.common import pair_values
-    from pounding.studies.gap import gap_study, record_outcomes, records_ran
-
-    model = load_model(model_path)
-    if not model.faces:
-        raise PoundingError(f"{os.fspath(model_path)}: the model has no contacts; list the faces to check in "
-                            "'contacts' (their gaps come from the outlines)")
-    found = plan_code_displacements(model, code, spectrum_options, building_designs(model, model_path))
-    rows = plan_code_separations(model, code, found)
-    pairs = pair_values(records) if records is not None else _own_pair(model_path)
-    principal = [float(b.periods[principal_mode(b, d)]) for b in model.buildings for d in ("x", "y")]
-    periods = np.geomspace(0.2 * min(principal), 2.0 * max(principal), SUITE_PERIODS)
-    simulated = duration if duration is not None else model.ground_motion.duration
-    read: list = []
-    psa, pga = pair_set_spectra(model_path, pairs, periods, code, duration=simulated, read=read)
-    intensities, factors = [], []
-    for intensity in found["intensities"]:
-        factor = suite_scale_factor(psa, intensity.spectrum.sa(periods), pga=pga, pga_target=intensity.pga_target)
-        factors.append(factor)
-        ds = gap_study(model_path, pairs, scale=factor, duration=duration, **run_options)
-        ok = records_ran(ds)   # completed or collapsed (+inf); a failed record is left out
-        use_max = code == "ec8" and int(ok.sum()) < EC8_MEAN_RECORDS
-        _simulated(ds, rows, intensity.name, use_max)
-        intensities.append({"name": intensity.name, "why": intensity.why, "target": intensity.spectrum.name,
-                            "factor": factor, "period_range": (float(periods[0]), float(periods[-1])),
-                            "spectrum_kind": "RotD100 spectrum of the pairs" if code == "asce7-22"
-                            else "spectrum of the components",
-                            "records_ok": int(ok.sum()), "statistic": "max" if use_max else "mean",
-                            **record_outcomes(ds)})
-    return {"code": code, "model": str(model_path), "rule": found["rule"], "statistic": found["statistic"],
-            "records": pairs, "intensities": intensities, "contacts": rows, "sides": ("first", "second"),
-            "warnings": suite_warnings(model, pairs, read, factors),
-            "buildings": {b.name: _building_summary(b, found, code) for b in model.buildings}}

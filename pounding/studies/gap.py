@@ -67,7 +67,7 @@ from pounding.registry import add_unique
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "order_statistic",
            "records_ran", "record_outcomes", "bounded_value", "NOT_BOUNDED", "COLLAPSE_STATUSES", "gap_attrs",
            "normal_mode", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
-           "gap_summary", "gap_table", "gap_tables", "plot_gap"]
+           "gap_summary", "gap_table", "gap_tables", "not_bounded_words", "plot_gap"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
 GAP_PART = "gap-2"
@@ -836,7 +836,7 @@ def gap_table(ds) -> str:
     return "\n".join(lines)
 
 
-def _not_bounded_words(frame):
+def not_bounded_words(frame):
     """*frame* with every +inf written :data:`NOT_BOUNDED` (its columns then hold text beside numbers)."""
     for column in frame.columns:
         values = frame[column].to_numpy()
@@ -865,7 +865,7 @@ def gap_tables(ds) -> dict:
                               extra=["status", "scale_factor", "intensity", "gap"]),
         "rule_records": long_table(ds, ["rule_gap", "rule_ratio"], extra=["status"]),
     }
-    return {name: _not_bounded_words(frame) for name, frame in tables.items()}
+    return {name: not_bounded_words(frame) for name, frame in tables.items()}
 
 
 def _face_envelope(ds, chosen: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
