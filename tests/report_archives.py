@@ -34,6 +34,8 @@ def commands(folder: Path) -> dict[str, list[str]]:
         "compare": ["compare", PAIR, "--xi", "ye", "--duration", "0.5", *QUIET, "-o", out["compare"]],
         "sweep": ["sweep", str(folder / "tiny.yaml"), *QUIET, "-o", out["sweep"]],
         "gap": ["gap", PAIR, "--duration", "1", *QUIET, "-o", out["gap"]],
+        "gap-code": ["gap", PAIR, "--code", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--records", RECORD,
+                     "--duration", "1", *QUIET, "-o", out["gap-code"]],
         "ida": ["ida", PAIR, "--records", RECORD, "--levels", "0.1:0.3:0.1", "--im", "pga", "--duration", "1",
                 *QUIET, "-o", out["ida"]],
         "risk": ["risk", PAIR, "--hazard", "example", "--records", RECORD, "--stripes", "2", "--duration", "1",
@@ -50,7 +52,8 @@ def commands(folder: Path) -> dict[str, list[str]]:
 
 
 #: Archive name → the kind ``open_archive`` gives it (``plan`` is a run of a model in plan).
-KINDS = {"run": "run", "plan": "run", "compare": "compare", "sweep": "sweep", "gap": "gap", "ida": "ida",
+KINDS = {"run": "run", "plan": "run", "compare": "compare", "sweep": "sweep", "gap": "gap", "gap-code": "gap-code",
+         "ida": "ida",
          "risk": "risk", "p695": "p695", "pushover": "pushover", "hysteresis": "hysteresis", "verify": "verify"}
 
 

@@ -206,7 +206,23 @@ def _verify_excitation(ds) -> Rows:
     return attribute_rows(ds, {"settings": "settings"})
 
 
+def _code_check_excitation(ds) -> Rows:
+    rows = attribute_rows(ds, {"code": "code", "rule": "rule", "statistic": "statistic of the records",
+                               "spectrum_options": "design spectrum", "verdict_intensity": "verdict at"})
+    if "records" in ds.attrs:
+        records = json.loads(ds.attrs["records"])
+        rows.append(("records", f"{len(records)}: {', '.join(map(str, records[:6]))}{' ...' if len(records) > 6 else ''}"))
+    return rows
+
+
+def _code_check_status(ds) -> Rows:
+    """The check's answer per pair of buildings, in its own words."""
+    return [("answer", line) for line in str(ds.attrs.get("answers", "")).splitlines() if line.strip()]
+
+
 register("run", "one run", _run_excitation, _run_status)
+register("gap-code", "a check of the gap against a code and the records", _code_check_excitation,
+         _code_check_status)
 for _name, _what in (("sweep", "a sweep"), ("compare", "a comparison"), ("gap", "a separation study"),
                      ("ida", "an incremental dynamic analysis"), ("risk", "a site risk study"),
                      ("p695", "a FEMA P695 evaluation")):
