@@ -229,3 +229,72 @@ def test_cli_refuses_a_bad_hazard_and_a_bad_im_in_one_line(tmp_path):
                               capture_output=True, text=True)
         assert done.returncode == 2
         assert done.stderr.strip().count("\n") == 0 and done.stderr.startswith("pounding: error: ")
+
+
+# --------------------------------------------------------------------------- #
+# The codes' separations (--code)
+# --------------------------------------------------------------------------- #
+
+ASCE = {"sds": 1.0, "sd1": 0.6, "tl": 8.0}
+EC8 = {"type": 1, "ground": "B", "ag": 0.25, "beta": 0.2}
+
+
+@pytest.fixture(scope="module")
+def code_risk(in_process_client, tmp_path_factory):
+    """models/pair.yaml (it has design: factors), 3 stripes of its own record, 5 s, with both codes."""
+    from pounding.data import data_path
+    from pounding.studies.risk import build_risk_plan, read_hazard, risk_study
+
+    plan = build_risk_plan(data_path("models", "pair.yaml"), read_hazard("example"), im="sa:1.0", stripes=3,
+                           duration=5.0, codes={"asce7-22": ASCE, "ec8": EC8})
+    out = tmp_path_factory.mktemp("code-risk") / "risk.nc"
+    return risk_study(plan, out, client=in_process_client, progress=False), out
+
+
+def test_each_codes_separation_is_the_gap_checks_and_its_risk_is_read_on_the_pounding_curve(code_risk):
+    """The separations are those `pounding gap --code` checks (the same rows: same property, per level pair); the
+    probability at each is the archived λ(g) curve's there: λ is non-increasing in g, so it lies between the
+    curve's values at the grid points either side of the separation."""
+    from pounding.data import data_path
+    from pounding.model.model import load_model
+    from pounding.studies.design_check import code_separation_rows
+
+    ds, _ = code_risk
+    path = data_path("models", "pair.yaml")
+    assert list(ds.code.values) == ["asce7-22", "ec8"]
+    for k, (code, options) in enumerate((("asce7-22", ASCE), ("ec8", EC8))):
+        rows, _ = code_separation_rows(load_model(path), path, code, options)
+        expected = {row["contact"]: row["separation"].same_property for row in rows}
+        for c, label in enumerate(ds.contact.values):
+            g = float(ds.code_separation.values[k, c])
+            assert g == expected[str(label)] and g > 0
+            j = int(np.searchsorted(ds.separation.values, g))
+            lower, upper = ds.pounding_rate.values[c, j], ds.pounding_rate.values[c, j - 1]
+            # (each point's integral is summed on its own: equal values on a flat stretch differ in the last bits)
+            assert lower * (1 - 1e-12) <= float(ds.code_pounding_rate.values[k, c]) <= upper * (1 + 1e-12)
+    # the code's separations grow up the buildings (their design displacements do), and Eurocode 8's 0.7
+    # at matching levels with its smaller spectrum asks less than ASCE 7-22 here
+    assert np.all(np.diff(ds.code_separation.values, axis=1) > 0)
+    assert np.all(ds.code_separation.values[1] < ds.code_separation.values[0])
+    for name in ("code_separation", "code_pounding_rate", "code_pounding_probability"):
+        assert ds[name].attrs["units"] and ds[name].attrs["long_name"]
+
+
+def test_the_cli_prints_the_codes_risk_and_refuses_a_half_given_code(tmp_path, capsys, studies_in_process):
+    from pounding.cli import main
+    from pounding.data import data_path
+
+    model = str(data_path("models", "pair.yaml"))
+    base = ["risk", model, "--hazard", "example", "--im", "sa:1.0", "--stripes", "2", "--duration", "3",
+            "--workers", "1", "--no-progress"]
+    assert main(base + ["--code", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--csv", str(tmp_path / "r.csv"),
+                        "--plot", str(tmp_path)]) == 0
+    printed = capsys.readouterr().out
+    assert "risk of pounding at the codes' separations" in printed and "ASCE 7-22 111 mm" in printed
+    assert (tmp_path / "r.codes.csv").exists() and (tmp_path / "pounding_risk.png").exists()
+    for extra, words in ((["--sds", "1.0"], "--sds sets a design spectrum"),
+                         (["--code", "asce7-22", "--sds", "1.0"], "--code asce7-22 needs --sd1"),
+                         (["--code", "nzs"], "--code: unknown code 'nzs'")):
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and words in err, err

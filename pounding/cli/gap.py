@@ -7,7 +7,7 @@ import json
 import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
-from pounding.cli.spectrum import add_spectrum_options, warn_of_parameters
+from pounding.cli.spectrum import add_spectrum_options, code_options, warn_of_parameters
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted, print_study_warnings
 from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.errors import PoundingError
@@ -19,14 +19,7 @@ def _code_options(args: argparse.Namespace) -> dict:
     """The design spectrum's options of ``--code``, each missing one refused in one line."""
     if args.scale is not None:
         raise PoundingError("--code refuses --scale: the records are scaled to the code's spectrum")
-    if args.code == "asce7-22":
-        missing = [f"--{name}" for name in ("sds", "sd1") if getattr(args, name) is None]
-        if missing:
-            raise PoundingError(f"--code asce7-22 needs {' and '.join(missing)} (g)")
-        return {"sds": args.sds, "sd1": args.sd1, "tl": args.tl}
-    if args.ag is None:
-        raise PoundingError("--code ec8 needs --ag (design ground acceleration on ground type A, g)")
-    return {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
+    return code_options(args, args.code)
 
 
 def _rerun_command(args: argparse.Namespace, options: dict) -> str:

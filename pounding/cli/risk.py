@@ -6,10 +6,29 @@ import argparse
 import sys
 
 from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
+from pounding.cli.spectrum import add_spectrum_options, code_options, warn_of_parameters
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
 from pounding.errors import PoundingError
 
 __all__ = ["register_cli"]
+
+
+def _codes(args: argparse.Namespace) -> dict[str, dict]:
+    """{code: its design spectrum's options} of ``--code`` (empty without it); one line for an unknown code, a
+    missing spectrum option, or a spectrum option without ``--code``."""
+    if not args.code:
+        given = [o for o, v in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag)) if v is not None]
+        if given:
+            raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
+        return {}
+    codes = [c.strip() for c in args.code.split(",") if c.strip()]
+    for code in codes:
+        if code not in ("asce7-22", "ec8"):
+            raise PoundingError(f"--code: unknown code {code!r}; give asce7-22, ec8 or asce7-22,ec8")
+    found = {code: code_options(args, code) for code in codes}
+    for code in codes:
+        warn_of_parameters(args, code)
+    return found
 
 
 def _cmd_risk(args: argparse.Namespace) -> int:
@@ -20,9 +39,10 @@ def _cmd_risk(args: argparse.Namespace) -> int:
     check_study_options(args)
     check_outputs(args)
     curve = read_hazard(args.hazard)
+    codes = _codes(args)
     plan = build_risk_plan(args.model, curve, im=args.im, records=args.records, levels=args.levels,
                            stripes=args.stripes, building=args.building, target=args.target,
-                           duration=args.duration, collapse_drift=args.collapse_drift)
+                           duration=args.duration, collapse_drift=args.collapse_drift, codes=codes)
     ida = plan.ida
     print(f"risk of '{ida.model_name}': {len(ida.records)} records x {len(ida.levels)} stripes x 2 variants = "
           f"{ida.planned_runs()} runs; IM {ida.im.describe()}; {curve.describe()}", file=sys.stderr)
@@ -83,6 +103,12 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("-o", "--output", metavar="RISK.nc", help="also write the results (NetCDF); resumable")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--plot", metavar="DIR", help="write pounding_risk.png to DIR")
+    parser.add_argument("--code", metavar="CODE[,CODE]",
+                        help="also the risk of pounding at each code's separation: asce7-22, ec8 or both "
+                             "(comma-separated), from each building's design: factors and the code's design "
+                             "spectrum (--sds/--sd1, --ag... as pounding gap --code); docs/risk.md")
+    add_spectrum_options(parser, "asce7-22")
+    add_spectrum_options(parser, "ec8", q=False)
     add_csv_option(parser)
     add_cluster_options(parser)
     parser.set_defaults(func=_cmd_risk)

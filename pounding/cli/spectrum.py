@@ -47,6 +47,19 @@ def warn_of_parameters(args: argparse.Namespace, code: str) -> None:
     print_warnings(spectrum_warnings({name: getattr(args, key, None) for name, key in given.items()}).values())
 
 
+def code_options(args: argparse.Namespace, code: str, option: str = "--code") -> dict:
+    """The design spectrum's options of *code* (``asce7-22``: sds, sd1, tl; ``ec8``: type, ground, ag, beta) from
+    the parsed *args*, each missing one refused in one line naming *option*."""
+    if code == "asce7-22":
+        missing = [f"--{name}" for name in ("sds", "sd1") if getattr(args, name) is None]
+        if missing:
+            raise PoundingError(f"{option} asce7-22 needs {' and '.join(missing)} (g)")
+        return {"sds": args.sds, "sd1": args.sd1, "tl": args.tl}
+    if args.ag is None:
+        raise PoundingError(f"{option} ec8 needs --ag (design ground acceleration on ground type A, g)")
+    return {"type": args.type, "ground": args.ground, "ag": args.ag, "beta": args.beta}
+
+
 def add_spectrum_options(parser: argparse.ArgumentParser, code: str, *, q: bool = True) -> None:
     """The options of one code's spectrum (shared by ``pounding spectrum`` and ``pounding gap --code``).
 

@@ -49,7 +49,7 @@ from pounding.studies.design_directions import (building_designs, building_summa
                                                 plan_code_displacements, plan_code_separations, principal_mode)
 from pounding.studies.gap import NOT_BOUNDED, bounded_value, order_statistic
 
-__all__ = ["CODE_NAMES", "PERCENTILE", "VERDICTS", "code_check_source", "record_needs", "code_gap_study",
+__all__ = ["code_separation_rows", "CODE_NAMES", "PERCENTILE", "VERDICTS", "code_check_source", "record_needs", "code_gap_study",
            "level_pairs", "verdict_words", "plain_answers", "code_gap_table", "code_gap_summary", "code_gap_dataset",
            "code_gap_tables", "code_gap_figure", "plot_code_gap", "code_gap_info", "CODE_GAP_KIND"]
 
@@ -69,6 +69,18 @@ CODE_GAP_KIND = "gap-code"
 # --------------------------------------------------------------------------- #
 
 
+def code_separation_rows(model, model_path, code: str, options: dict[str, Any]) -> tuple[list[dict[str, Any]], dict]:
+    """The code's separation at each contact of *model* from each building's ``design:`` factors and the code's
+    design spectrum (*options*: ``--sds``... as :func:`pounding.studies.design.code_setup`), no record read:
+    ``(rows, found)``, each row with ``contact`` (its label: a level pair, or face@point in plan) and
+    ``separation`` (:class:`pounding.studies.design.Separation`, m); *found*: the buildings' analyses."""
+    if any(dof_per_floor(b) > 1 for b in model.buildings):
+        found = plan_code_displacements(model, code, options, building_designs(model, model_path))
+        return plan_code_separations(model, code, found), found
+    found = code_displacements(model, code, options)
+    return code_separations(model, code, found["displacement"]), found
+
+
 def _planar_source(model, model_path, code: str, options: dict[str, Any], records: Any,
                    duration: float | None) -> dict[str, Any]:
     """Rows, records and the records' spectra of a row of planar buildings (one direction, single records)."""
@@ -77,7 +89,7 @@ def _planar_source(model, model_path, code: str, options: dict[str, Any], record
 
     model.refuse_building_records("the code check (it runs the model under one record at a time)")
     build_gap_sweep(model_path, records, duration=duration)   # the gap study's own refusals (walls, no contacts...)
-    found = code_displacements(model, code, options)
+    rows, found = code_separation_rows(model, model_path, code, options)
     specs = record_values(records, model)
     first = [float(b.periods[0]) for b in model.buildings]
     periods = np.geomspace(0.2 * min(first), 2.0 * max(first), SUITE_PERIODS)
@@ -87,7 +99,7 @@ def _planar_source(model, model_path, code: str, options: dict[str, Any], record
                         "spectrum": found["spectra"][name].name, "elastic_displacement": r.displacement.tolist(),
                         "design_displacement": np.asarray(found["displacement"][name]).tolist()}
                  for name, r in found["rsa"].items()}
-    return {"found": found, "rows": code_separations(model, code, found["displacement"]), "records": specs,
+    return {"found": found, "rows": rows, "records": specs,
             "periods": periods, "psa": psa, "pga": pga, "read": [[r] for r in read], "sides": ("left", "right"),
             "spectrum_kind": "spectrum", "buildings": buildings}
 
@@ -100,14 +112,14 @@ def _plan_source(model, model_path, code: str, options: dict[str, Any], records:
     if not model.faces:
         raise PoundingError(f"{os.fspath(model_path)}: the model has no contacts; list the faces to check in "
                             "'contacts' (their gaps come from the outlines)")
-    found = plan_code_displacements(model, code, options, building_designs(model, model_path))
+    rows, found = code_separation_rows(model, model_path, code, options)
     pairs = pair_values(records) if records is not None else own_pair(model_path)
     principal = [float(b.periods[principal_mode(b, d)]) for b in model.buildings for d in ("x", "y")]
     periods = np.geomspace(0.2 * min(principal), 2.0 * max(principal), SUITE_PERIODS)
     read: list = []
     psa, pga = pair_set_spectra(model_path, pairs, periods, code, duration=_simulated_time(model, duration),
                                 read=read)
-    return {"found": found, "rows": plan_code_separations(model, code, found), "records": pairs,
+    return {"found": found, "rows": rows, "records": pairs,
             "periods": periods, "psa": psa, "pga": pga, "read": read, "sides": ("first", "second"),
             "spectrum_kind": "RotD100 spectrum of the pairs" if code == "asce7-22" else "spectrum of the components",
             "buildings": {b.name: building_summary(b, found, code) for b in model.buildings}}

@@ -64,6 +64,29 @@ def _pounding_vars(plan, stripes: np.ndarray, demands: np.ndarray) -> tuple[dict
     }, grid
 
 
+def _code_vars(plan, stripes: np.ndarray, demands: np.ndarray, contacts: list[str]) -> dict:
+    """Per code and contact: the code's separation and the annual frequency and probability of pounding at it."""
+    from pounding.studies.risk.integrals import exceedance_rates, probability_in
+
+    years = plan.target[1]
+    separation = np.array([[plan.codes[code].get(label, np.nan) for label in contacts] for code in plan.codes])
+    rates = np.full(separation.shape, np.nan)
+    for c in range(len(contacts)):
+        d = demands[:, :, c].T   # (stripe, record)
+        given = np.isfinite(separation[:, c])
+        if np.any(~np.isnan(d)) and given.any():
+            rates[given, c] = exceedance_rates(plan.curve, stripes, d, separation[given, c])
+    return {
+        "code_separation": _var(("code", "contact"), separation, "m",
+                                "the code's separation of the level pair (same property; NaN: not a contact of "
+                                "the code's rows)"),
+        "code_pounding_rate": _var(("code", "contact"), rates, "yr-1",
+                                   "mean annual frequency of pounding at the code's separation"),
+        "code_pounding_probability": _var(("code", "contact"), probability_in(rates, years), "1",
+                                          f"probability of pounding in {years:g} years at the code's separation"),
+    }
+
+
 def _collapse_vars(plan, ds) -> dict:
     """Per variant and building: collapse rate from the lognormal fit and from the stripes' fractions."""
     from pounding.studies.ida import exceeds
@@ -127,11 +150,14 @@ def assemble_risk_dataset(plan, results: dict[str, dict[str, Any]], entries: lis
     contacts = [str(c) for c in ds.contact.values]
     demands = separation_demands(ds, results, entries, contacts)
     gaps = plan.gaps if plan.gaps.size == len(contacts) else np.full(len(contacts), np.nan)
-    plan = type(plan)(plan.ida, plan.curve, plan.target, gaps)
+    plan = type(plan)(plan.ida, plan.curve, plan.target, gaps, plan.codes)
     variables, grid = _pounding_vars(plan, ds.level.values, demands)
     ds = ds.assign_coords(separation=("separation", grid, {"units": "m", "long_name": "separation g"}),
                           hazard_point=("hazard_point", np.arange(plan.curve.intensity.size),
                                         {"units": "1", "long_name": "row of the hazard curve"}))
+    if plan.codes:
+        ds = ds.assign_coords(code=("code", list(plan.codes), {"long_name": "design code of the separation"}))
+        variables.update(_code_vars(plan, ds.level.values, demands, contacts))
     for name, value in {**variables, **_collapse_vars(plan, ds)}.items():
         ds[name] = value
     ds["hazard_intensity"] = _var(("hazard_point",), plan.curve.intensity, "m s-2",
@@ -162,6 +188,7 @@ def risk_table(ds) -> str:
         lines.append(f"  {str(label):<20} {_mm(float(ds.target_separation.values[c])):>11} "
                      f"{_mm(float(ds.model_gap.values[c])):>10} {100 * float(ds.gap_pounding_probability.values[c]):>15.2f} %"
                      + note)
+    lines += _code_lines(ds)
     target = 100 * ds.attrs["collapse_target_probability"]
     lines.append(f"collapse in {ds.attrs['collapse_target_years']:g} years (lognormal fragility; stripe fractions) "
                  f"against {target:g} %:")
@@ -178,6 +205,22 @@ def risk_table(ds) -> str:
         verdict = _verdict(over.get("with_contacts", False), over.get("without_contacts", False))
         lines.append(f"  {building}: {'; '.join(parts)}: {verdict}")
     return "\n".join(lines)
+
+
+def _code_lines(ds) -> list[str]:
+    """Per contact, each code's separation and the probability of pounding at it (none without ``--code``)."""
+    from pounding.studies.design_check import CODE_NAMES
+
+    if "code" not in ds.dims:
+        return []
+    years = ds.attrs["target_years"]
+    lines = [f"risk of pounding at the codes' separations (same property), in {years:g} years:"]
+    for c, label in enumerate(ds.contact.values):
+        parts = [f"{CODE_NAMES.get(str(code), str(code))} {_mm(float(ds.code_separation.values[k, c]))}: "
+                 f"{100 * float(ds.code_pounding_probability.values[k, c]):.2f} %"
+                 for k, code in enumerate(ds.code.values) if math.isfinite(float(ds.code_separation.values[k, c]))]
+        lines.append(f"  {str(label):<20} {'; '.join(parts) if parts else 'no code separation'}")
+    return lines
 
 
 def _verdict(with_contacts: bool, without_contacts: bool) -> str:
@@ -199,13 +242,21 @@ def risk_tables(ds) -> dict:
             "collapse": long_table(ds, ["collapse_rate", "collapse_probability", "collapse_rate_empirical",
                                         "collapse_probability_empirical"]),
             "curve": long_table(ds, ["pounding_rate", "pounding_probability"]),
+            **({"codes": long_table(ds, ["code_separation", "code_pounding_rate", "code_pounding_probability"])}
+               if "code" in ds.dims else {}),
             **ida_tables(ds)}
+
+
+#: Markers of the codes' separations on the risk figure, in the order of the archive's ``code``.
+CODE_MARKERS = ("s", "^")
 
 
 def plot_risk(ds, directory: str | os.PathLike) -> list[Path]:
     """``pounding_risk.png``: per contact, the probability of pounding in the target's years against the
-    separation (log scale), the target and each contact's separation meeting it and own gap marked."""
+    separation (log scale), the target and each contact's separation meeting it, own gap and (``--code``) the
+    codes' separations marked."""
     from pounding.results.plots import plot_directory, pyplot, save_figure
+    from pounding.studies.design_check import CODE_NAMES
 
     plt = pyplot()
     out = plot_directory(directory)
@@ -219,6 +270,11 @@ def plot_risk(ds, directory: str | os.PathLike) -> list[Path]:
         gap = float(ds.model_gap.values[c])
         if math.isfinite(gap) and gap <= ds.separation.values[-1]:
             ax.axvline(1000 * gap, color=line.get_color(), ls=":", lw=1)
+        for k, marker in zip(range(ds.sizes.get("code", 0)), CODE_MARKERS):
+            ax.plot([1000 * float(ds.code_separation.values[k, c])], [float(ds.code_pounding_probability.values[k, c])],
+                    marker, color=line.get_color(), mfc="none", ms=7)
+    for k, marker in zip(range(ds.sizes.get("code", 0)), CODE_MARKERS):   # one legend entry per code
+        ax.plot([], [], marker, color="k", mfc="none", label=f"{CODE_NAMES.get(str(ds.code.values[k]), '')} separation")
     ax.axhline(p, color="k", ls="--", lw=1, label=f"target {100 * p:g} % in {years:g} years")
     ax.set_yscale("log")
     ax.set_xlabel("separation g (mm); dotted: the model's gap")

@@ -31,7 +31,7 @@ from pounding.errors import PoundingError
 from pounding.studies.risk.hazard import HazardCurve
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["RiskPlan", "build_risk_plan", "default_levels", "run_risk_scenario", "risk_study", "RISK_KEY",
+__all__ = ["RiskPlan", "build_risk_plan", "code_separations", "default_levels", "run_risk_scenario", "risk_study", "RISK_KEY",
            "DEFAULT_STRIPES", "STRIPE_RATES"]
 
 #: What makes a risk run's part key differ from the same IDA run's (a risk part also holds the separations).
@@ -56,12 +56,16 @@ class RiskPlan:
         (probability, years) of pounding to meet.
     gaps : ndarray
         The model's own gap of each contact, m.
+    codes : dict
+        Per design code (``asce7-22``, ``ec8``) its separation of each contact, {contact label: m}
+        (:func:`pounding.studies.design_check.code_separation_rows`, same property); empty without ``--code``.
     """
 
     ida: Any
     curve: HazardCurve
     target: tuple[float, float]
     gaps: np.ndarray
+    codes: dict = dataclasses.field(default_factory=dict)
 
 
 def default_levels(curve: HazardCurve, count: int = DEFAULT_STRIPES) -> np.ndarray:
@@ -76,7 +80,7 @@ def default_levels(curve: HazardCurve, count: int = DEFAULT_STRIPES) -> np.ndarr
 def build_risk_plan(model: str | os.PathLike, hazard: HazardCurve, *, im: str | None = None,
                     records: Any = None, levels: Any = None, stripes: int = DEFAULT_STRIPES,
                     building: str | None = None, target: str = "2%/50y", duration: float | None = None,
-                    collapse_drift: float | None = None) -> RiskPlan:
+                    collapse_drift: float | None = None, codes: dict[str, dict] | None = None) -> RiskPlan:
     """Check the inputs of a risk study and plan its stripes (before any run).
 
     Parameters
@@ -93,6 +97,9 @@ def build_risk_plan(model: str | os.PathLike, hazard: HazardCurve, *, im: str | 
         Stripes in g (``--levels``); default :func:`default_levels` with *stripes* stripes.
     target : str
         ``--target``, the probability of pounding to meet (``2%/50y``).
+    codes : dict, optional
+        {code: its design spectrum's options} (``--code``, as ``pounding gap --code``): the risk that each code's
+        separation implies is reported beside the target's (each building needs its ``design:`` factors).
     """
     from pounding.model.model import load_model
     from pounding.studies.ida import build_ida_plan
@@ -107,8 +114,21 @@ def build_risk_plan(model: str | os.PathLike, hazard: HazardCurve, *, im: str | 
                           levels=levels, without_contacts=True, collapse_drift=collapse_drift, duration=duration)
     if periods:
         plan = with_measure(plan, name, periods)
-    gaps = np.array([float(g.gap) for g in load_model(model).gaps])
-    return RiskPlan(plan, hazard, goal, gaps)
+    loaded = load_model(model)
+    gaps = np.array([float(g.gap) for g in loaded.gaps])
+    return RiskPlan(plan, hazard, goal, gaps, code_separations(loaded, model, codes or {}))
+
+
+def code_separations(model, path, codes: dict[str, dict]) -> dict[str, dict[str, float]]:
+    """{code: {contact label: the code's separation (same property), m}} for each code of *codes* ({code: its
+    spectrum options}), from the buildings' ``design:`` factors (no record read)."""
+    from pounding.studies.design_check import code_separation_rows
+
+    found = {}
+    for code, options in codes.items():
+        rows, _ = code_separation_rows(model, path, code, options)
+        found[code] = {str(row["contact"]): float(row["separation"].same_property) for row in rows}
+    return found
 
 
 def _risk_key(key: str) -> str:
