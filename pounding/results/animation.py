@@ -202,7 +202,8 @@ class RunAnimation:
         count = self.forces.shape[1]
         self.norm = Normalize(0.0, float(self.forces.max(initial=0.0)) or 1.0)
         self.flash = self.ax.scatter(np.zeros(count), np.zeros(count), s=np.zeros(count), c=np.zeros(count),
-                                     cmap="autumn_r", norm=self.norm, edgecolors="k", linewidths=0.6, zorder=6)
+                                     cmap="autumn_r", norm=self.norm, edgecolors="k", linewidths=0.6, zorder=6,
+                                     gid="impacts")
         proxy = plt.Line2D([], [], ls="none", marker="o", ms=8, mfc="orange", mec="k", mew=0.6,
                            label="impact (size and colour: force)")
         self.ax.legend(handles=self.ax.get_legend_handles_labels()[0] + ([proxy] if count else []), fontsize=7,
@@ -300,11 +301,11 @@ class _ElevationScene:
         self.factor = float(exaggerate) if exaggerate else magnification(peak, 0.25 * self.width)
         self.x0 = self._positions(order)
         self.sides = self._contact_sides()
-        self.lines = {b: ax.plot([], [], lw=1.4, color=f"C{k}", label=f"building {b}")[0]
+        self.lines = {b: ax.plot([], [], lw=1.4, color=f"C{k}", label=f"building {b}", gid=f"building {b}")[0]
                       for k, b in enumerate(order)}
         self.walls = [(ax.plot([], [], color="0.5", lw=4, solid_capstyle="butt",
                                label="wall" if k == 0 else None)[0], *wall) for k, wall in enumerate(self._walls())]
-        self.rest = ax.plot([], [], "o", ms=3, color="0.4", label="contact", zorder=5)[0]
+        self.rest = ax.plot([], [], "o", ms=3, color="0.4", label="contact", zorder=5, gid="contacts")[0]
         self._frame_axes(order)
 
     def _positions(self, order: list[str]) -> dict[str, float]:
@@ -422,12 +423,13 @@ class _PlanScene:
             for f in np.flatnonzero(ds.building.values == b):
                 solid = f == roof
                 line = ax.plot([], [], lw=1.6 if solid else 0.6, alpha=1.0 if solid else 0.45, color=f"C{k}",
-                               label=f"building {b}" if solid else None)[0]
+                               label=f"building {b}" if solid else None, gid=f"floor {ds.floor.values[f]}")[0]
                 self.outlines.append((int(f), line))
         self.roofs = list(roofs.values())
         self.corners = ax.plot([], [], "s", ms=3.5, color="k", label="roof corners", zorder=5)[0]
         self.points = self._points(shift)
-        self.point_marks = ax.plot([], [], "o", ms=3, color="0.4", label="contact points", zorder=5)[0]
+        self.point_marks = ax.plot([], [], "o", ms=3, color="0.4", label="contact points", zorder=5,
+                                   gid="contacts")[0]
         self._walls(shift)
         self._frame_axes()
 
