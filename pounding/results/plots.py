@@ -583,6 +583,7 @@ def _draw_forces(ax, ds: xr.Dataset, extent: float) -> str:
         key = (float(ds.point_x.values[p]), float(ds.point_y.values[p]), str(ds.point_normal.values[p]))
         if key not in locations or peaks[p] > peaks[locations[key]]:
             locations[key] = int(p)
+    ax.plot([], [], color="C3", lw=1.4, label="peak normal force (arrow pair)")   # the arrows' legend entry
     for (x, y, normal), p in locations.items():
         length = 0.1 * extent * float(peaks[p]) / top
         along = (length, 0.0) if normal == "x" else (0.0, length)
@@ -590,6 +591,8 @@ def _draw_forces(ax, ds: xr.Dataset, extent: float) -> str:
         ax.annotate(force_text(float(peaks[p])), (x + along[0], y + along[1]), textcoords="offset points",
                     xytext=(3, 0) if normal == "x" else (0, 3), ha="left" if normal == "x" else "center",
                     va="center" if normal == "x" else "bottom", fontsize=7, color="C3")
+    if friction:
+        ax.plot([], [], color="C2", lw=1.4, label="peak friction force (arrow pair)")
     for x, y, tangent, force in friction:
         length = 0.1 * extent * force / top
         shift = 0.01 * extent
@@ -651,7 +654,7 @@ def _plan_view(plt, ds: xr.Dataset, path: Path) -> float:
             best = ((f, c, moved[c]), float(magnitude[c]))
     if best[0] is not None and best[1] > 0.0:
         f, c, at = best[0]
-        ax.plot(*at, marker="*", ms=14, color="k", zorder=5)
+        ax.plot(*at, marker="*", ms=14, color="k", zorder=5, ls="none", label="most displaced corner")
         ax.annotate(f"{ds.floor.values[f]} {ds.corner.values[c]}: {1e3 * best[1]:.1f} mm", at,
                     textcoords="offset points", xytext=(8, 8), fontsize=8)
     if ds.sizes.get("contact", 0):

@@ -174,7 +174,7 @@ def plot_p695(ds, directory: str | os.PathLike) -> list[Path]:
                           f"({VERDICT_WORDS[int(b.passes.sel(variant=variant))]})")
         ax.axvline(float(b.s_mt) / g, color="k", lw=0.8, ls=":", label=f"S_MT {float(b.s_mt) / g:.2f} g")
         ax.axhline(0.5, color="0.6", lw=0.6)
-        ax.set_xlabel(f"median Sa(T = {float(b.period):.2f} s) of the normalised set, g")
+        ax.set_xlabel(f"median Sa(T = {float(b.period):.2f} s) of the normalised set (g)")
         ax.set_ylabel("fraction of records collapsed")
         ax.set_title(f"building {name}")
         ax.set_ylim(0, 1.02)
