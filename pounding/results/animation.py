@@ -298,7 +298,7 @@ class _ElevationScene:
         self.ground = _ground_offsets(ds, order)
         peak = max(float(np.abs(ds.displacement.values[:, f] + self.ground[b][:, None]).max(initial=0.0))
                    for b, f in self.floors.items())
-        self.factor = float(exaggerate) if exaggerate else magnification(peak, 0.25 * self.width)
+        self.factor = float(exaggerate) if exaggerate else _default_factor(ds, peak, 0.25 * self.width, self.width)
         self.x0 = self._positions(order)
         self.sides = self._contact_sides()
         self.lines = {b: ax.plot([], [], lw=1.4, color=f"C{k}", label=f"building {b}", gid=f"building {b}")[0]
@@ -306,7 +306,7 @@ class _ElevationScene:
         self.walls = [(ax.plot([], [], color="0.5", lw=4, solid_capstyle="butt",
                                label="wall" if k == 0 else None)[0], *wall) for k, wall in enumerate(self._walls())]
         self.rest = ax.plot([], [], "o", ms=3, color="0.4", label="contact", zorder=5, gid="contacts")[0]
-        self._frame_axes(order)
+        self._frame_axes()
 
     def _positions(self, order: list[str]) -> dict[str, float]:
         """Each building's left face at rest, m: the next one the exaggerated smallest gap between them
@@ -363,7 +363,7 @@ class _ElevationScene:
                     walls.append((building, float(at), float(self.sides[2][i]) + 1.0))
         return walls
 
-    def _frame_axes(self, order: list[str]) -> None:
+    def _frame_axes(self) -> None:
         ax = self.ax
         reach = self.factor * max(float(np.abs(self.ds.displacement.values).max(initial=0.0)), 1e-9) + \
             self.factor * max((float(np.abs(g).max(initial=0.0)) for g in self.ground.values()), default=0.0)
@@ -412,7 +412,8 @@ class _PlanScene:
         rest = np.stack([ds.corner_x.values, ds.corner_y.values], axis=-1)          # (floor, corner, 2)
         self.extent = float(max(np.ptp(rest[..., 0]), np.ptp(rest[..., 1]), 1.0))
         peak = float(ds.peak_corner_displacement_magnitude.max()) if ds.sizes.get("floor", 0) else 0.0
-        self.factor = float(exaggerate) if exaggerate else magnification(peak, 0.1 * self.extent)
+        self.factor = float(exaggerate) if exaggerate else _default_factor(ds, peak, 0.1 * self.extent,
+                                                                            0.2 * self.extent)
         shift = self._shifts()
         names = [str(b) for b in ds.building.values]
         self.rest = rest + np.array([shift[b] for b in names])[:, None, :]
@@ -510,6 +511,15 @@ class _PlanScene:
         at = self.points["place"] + factor * motion
         self.point_marks.set_data(at[:, 0], at[:, 1])
         return at
+
+
+def _default_factor(ds: xr.Dataset, peak: float, drawn: float, room: float) -> float:
+    """The default exaggeration: the largest displacement *peak* (m) drawn as about *drawn* (m), yet no gap
+    drawn wider than *room* (m; a run that hardly moves would push its buildings apart); a gap wider than
+    *room* at true scale (a wall held open) does not count."""
+    factor = magnification(peak, drawn)
+    gaps = [float(g) for g in (ds.gap.values if ds.sizes.get("contact", 0) else ()) if 0.0 < g < room]
+    return min(factor, magnification(max(gaps), room)) if gaps else factor
 
 
 def _fit_aspect(ax) -> None:
