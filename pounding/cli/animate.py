@@ -13,19 +13,11 @@ def _cmd_animate(args: argparse.Namespace) -> int:
     from pounding.cli.csv_option import check_outputs
     from pounding.cli.run import open_archive
     from pounding.errors import PoundingError
-    from pounding.results.animation import SUFFIXES, RunAnimation, parse_window
+    from pounding.results.animation import RunAnimation, film_format, parse_window
     from pounding.results.archive import check_writable
 
     out = Path(args.output)
-    if out.suffix.lower() not in SUFFIXES:
-        raise PoundingError(f"-o {out}: unknown suffix {out.suffix or '(none)'}; write "
-                            + " or ".join(f"{s} ({what})" for s, what in SUFFIXES.items()))
-    if out.suffix.lower() == ".mp4":
-        from matplotlib.animation import FFMpegWriter
-
-        if not FFMpegWriter.isAvailable():
-            raise PoundingError(f"-o {out}: writing an .mp4 needs ffmpeg, which is not installed (Debian: "
-                                "apt-get install ffmpeg); or write a .gif instead")
+    suffix = film_format(out)
     window = parse_window(args.window)
     check_writable(out, overwrite=args.overwrite, inputs=[args.run])
     check_outputs(args)
@@ -34,7 +26,7 @@ def _cmd_animate(args: argparse.Namespace) -> int:
         raise PoundingError(f"{args.run}: a {kind} archive; pounding animate draws the archive of one run "
                             "(pounding run MODEL -o RUN.nc)")
     film = RunAnimation(ds, exaggerate=args.exaggerate, speed=args.speed, window=window,
-                        dpi=100.0 if out.suffix.lower() == ".mp4" else 80.0)
+                        dpi=100.0 if suffix == ".mp4" else 80.0)
     film.save(out)
     print(f"wrote {out}: {film.n_frames} frames at {film.fps:.3g} frames/s ({film.times[0]:g} to "
           f"{film.times[-1]:g} s at {args.speed:g} simulated s per s), displacements and gaps x{film.exaggerate:g}")

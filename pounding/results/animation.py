@@ -34,8 +34,8 @@ from pounding.results.plots import lay_out, magnification, pyplot, side_displace
 from pounding.results.summary import force_text
 from pounding.units import STANDARD_GRAVITY
 
-__all__ = ["RunAnimation", "frame_indices", "frame_forces", "building_order", "FRAME_RATE", "SUFFIXES",
-           "parse_window"]
+__all__ = ["RunAnimation", "frame_indices", "frame_forces", "building_order", "film_format", "parse_window",
+           "FRAME_RATE", "SUFFIXES", "FIGURE_SIZE"]
 
 #: Frames per real second aimed at (a film's 24-25; the rate is lower in slow motion, where every stored
 #: sample is a frame).
@@ -264,7 +264,7 @@ class RunAnimation:
         from pounding.results.archive import atomic_path
 
         target = Path(path)
-        writer = _writer(target.suffix.lower(), self.fps)
+        writer = _writer(target, self.fps)
         try:
             with atomic_path(target) as temporary, writer.saving(self.fig, temporary, self.fig.dpi):
                 for k in range(self.n_frames):
@@ -548,18 +548,25 @@ def _ground_offsets(ds: xr.Dataset, order: list[str]) -> dict[str, np.ndarray]:
 
 
 
-def _writer(suffix: str, fps: float):
-    """The matplotlib movie writer of *suffix*: ffmpeg for ``.mp4``, Pillow for ``.gif``."""
-    if suffix == ".mp4":
-        if not FFMpegWriter.isAvailable():
-            raise PoundingError("writing an .mp4 needs ffmpeg, which is not installed (Debian: apt-get install "
-                                "ffmpeg); or write a .gif instead")
-        # the temporary file has no .mp4 suffix: the container is named (-f)
+def film_format(path: str | os.PathLike) -> str:
+    """The suffix of the film *path* (``.mp4`` or ``.gif``), refused in one line if unknown, or if it is an
+    MP4 and ffmpeg is not installed (checked before any work)."""
+    target = Path(path)
+    suffix = target.suffix.lower()
+    if suffix not in SUFFIXES:
+        raise PoundingError(f"-o {target}: unknown suffix {target.suffix or '(none)'}; write "
+                            + " or ".join(f"{s} ({what})" for s, what in SUFFIXES.items()))
+    if suffix == ".mp4" and not FFMpegWriter.isAvailable():
+        raise PoundingError(f"-o {target}: writing an .mp4 needs ffmpeg, which is not installed (Debian: apt-get "
+                            "install ffmpeg); or write a .gif instead")
+    return suffix
+
+
+def _writer(path: Path, fps: float):
+    """The matplotlib movie writer of *path*: ffmpeg for ``.mp4``, Pillow for ``.gif``."""
+    if film_format(path) == ".mp4":   # the temporary file has no .mp4 suffix: the container is named (-f)
         return FFMpegWriter(fps=fps, codec="h264", extra_args=["-pix_fmt", "yuv420p", "-f", "mp4"])
-    if suffix == ".gif":
-        return _GifWriter(fps=fps)
-    raise PoundingError(f"unknown animation suffix {suffix or '(none)'}: write "
-                        + " or ".join(f"{s} ({what})" for s, what in SUFFIXES.items()))
+    return _GifWriter(fps=fps)
 
 
 class _GifWriter(PillowWriter):
