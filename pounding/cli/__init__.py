@@ -27,7 +27,7 @@ SUBCOMMAND_MODULES = {"verify": "pounding.cli.verify", "sweep": "pounding.cli.sw
                       "init": "pounding.cli.init", "spectrum": "pounding.cli.spectrum",
                       "table": "pounding.cli.table", "hysteresis": "pounding.cli.hysteresis",
                       "pushover": "pounding.cli.pushover", "p695": "pounding.cli.p695",
-                      "risk": "pounding.cli.risk", "report": "pounding.cli.report"}
+                      "risk": "pounding.cli.risk", "report": "pounding.cli.report", "animate": "pounding.cli.animate"}
 
 
 # --------------------------------------------------------------------------- #

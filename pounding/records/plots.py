@@ -54,6 +54,7 @@ def plot_record(record, path: str | os.PathLike, damping: float = 0.05) -> Path:
         ax.set_ylabel(label)
         ax.axhline(0.0, color="0.6", lw=0.5)
         ax.grid(alpha=0.3)
+        ax.tick_params(labelbottom=row == len(series) - 1)   # the time axis is the bottom panel's
     ax.set_xlabel("time (s)")
     ax_s = fig.add_subplot(grid[3])
     ax_s.semilogx(spectrum.periods, spectrum.psa / STANDARD_GRAVITY, color="C1")

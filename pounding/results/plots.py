@@ -42,7 +42,8 @@ from pounding.results.summary import force_text, rotating_buildings, yielding_pl
 
 __all__ = ["plot_run", "plot_sweep", "plot_directory", "save_figure", "lay_out", "fit_titles", "pyplot", "suptitle",
            "storey_spans", "draw_drift_profile", "finish_drift_axes", "finish_profile_panel", "hysteresis_storeys",
-           "hysteresis_left_out", "LOOPS_SHOWN", "sweep_axis_is_numeric", "plan_view_instant", "shown_floors"]
+           "hysteresis_left_out", "LOOPS_SHOWN", "sweep_axis_is_numeric", "plan_view_instant", "shown_floors",
+           "side_displacement", "magnification"]
 
 def pyplot():
     """``matplotlib.pyplot`` on the non-interactive Agg backend (imported on first use: it is slow)."""
@@ -154,7 +155,7 @@ def _point_motion(ds: xr.Dataset, i: int, floor: int) -> np.ndarray:
     return ds.displacement.values[:, floor, 1] + theta * (float(ds.point_x[i]) - float(ds.floor_centre_x[floor]))
 
 
-def _side_displacement(ds: xr.Dataset, i: int, side: str) -> tuple[str, np.ndarray]:
+def side_displacement(ds: xr.Dataset, i: int, side: str) -> tuple[str, np.ndarray]:
     """Label and displacement history (m) of one side of contact *i*: a floor, a wall (0) or a column point.
 
     A floor in plan moves at the contact point along the face's normal.  A column point at fraction ξ of
@@ -183,8 +184,8 @@ def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
     fig, axes = _grid(plt, n)
     t = ds.time.values
     for i, ax in enumerate(axes[:n]):
-        left_name, left = _side_displacement(ds, i, "left")
-        right_name, right = _side_displacement(ds, i, "right")
+        left_name, left = side_displacement(ds, i, "left")
+        right_name, right = side_displacement(ds, i, "right")
         gap = float(ds.gap.values[i])
         ax.plot(t, 1e3 * left, lw=0.8, label=f"{left_name} (left)")
         ax.plot(t, 1e3 * (right + gap), lw=0.8, label=f"{right_name} (right) + gap")
@@ -524,15 +525,21 @@ def _corners_at(ds: xr.Dataset, at: float) -> np.ndarray:
     return np.einsum("fk,fcdk->fcd", floors, corner_weights(centres, corners))
 
 
-def _magnification(ds: xr.Dataset, extent: float) -> float:
-    """Displacements drawn ×this: the largest corner displacement of the run as about 10 % of the plan's extent
-    (1, 2 or 5 times a power of ten, at least 1)."""
-    peak = float(ds.peak_corner_displacement_magnitude.max()) if ds.sizes.get("floor", 0) else 0.0
-    if peak <= 0.0 or 0.1 * extent / peak <= 1.0:
+def magnification(peak: float, drawn: float) -> float:
+    """Displacements drawn ×this: a displacement of *peak* (m) drawn as about *drawn* (m), the factor rounded
+    down to 1, 2 or 5 times a power of ten, at least 1."""
+    if peak <= 0.0 or drawn / peak <= 1.0:
         return 1.0
-    factor = 0.1 * extent / peak
+    factor = drawn / peak
     decade = 10.0 ** np.floor(np.log10(factor))
     return float(max(m for m in (1.0, 2.0, 5.0) if m * decade <= factor) * decade)
+
+
+def _magnification(ds: xr.Dataset, extent: float) -> float:
+    """Displacements drawn ×this: the largest corner displacement of the run as about 10 % of the plan's extent
+    (:func:`magnification`)."""
+    peak = float(ds.peak_corner_displacement_magnitude.max()) if ds.sizes.get("floor", 0) else 0.0
+    return magnification(peak, 0.1 * extent)
 
 
 def _peak_friction(ds: xr.Dataset) -> list[tuple[float, float, str, float]]:
@@ -576,6 +583,7 @@ def _draw_forces(ax, ds: xr.Dataset, extent: float) -> str:
         key = (float(ds.point_x.values[p]), float(ds.point_y.values[p]), str(ds.point_normal.values[p]))
         if key not in locations or peaks[p] > peaks[locations[key]]:
             locations[key] = int(p)
+    ax.plot([], [], color="C3", lw=1.4, label="peak normal force (arrow pair)")   # the arrows' legend entry
     for (x, y, normal), p in locations.items():
         length = 0.1 * extent * float(peaks[p]) / top
         along = (length, 0.0) if normal == "x" else (0.0, length)
@@ -583,6 +591,8 @@ def _draw_forces(ax, ds: xr.Dataset, extent: float) -> str:
         ax.annotate(force_text(float(peaks[p])), (x + along[0], y + along[1]), textcoords="offset points",
                     xytext=(3, 0) if normal == "x" else (0, 3), ha="left" if normal == "x" else "center",
                     va="center" if normal == "x" else "bottom", fontsize=7, color="C3")
+    if friction:
+        ax.plot([], [], color="C2", lw=1.4, label="peak friction force (arrow pair)")
     for x, y, tangent, force in friction:
         length = 0.1 * extent * force / top
         shift = 0.01 * extent
@@ -644,7 +654,7 @@ def _plan_view(plt, ds: xr.Dataset, path: Path) -> float:
             best = ((f, c, moved[c]), float(magnitude[c]))
     if best[0] is not None and best[1] > 0.0:
         f, c, at = best[0]
-        ax.plot(*at, marker="*", ms=14, color="k", zorder=5)
+        ax.plot(*at, marker="*", ms=14, color="k", zorder=5, ls="none", label="most displaced corner")
         ax.annotate(f"{ds.floor.values[f]} {ds.corner.values[c]}: {1e3 * best[1]:.1f} mm", at,
                     textcoords="offset points", xytext=(8, 8), fontsize=8)
     if ds.sizes.get("contact", 0):

@@ -31,6 +31,7 @@ displacements and the roof's peak rotation (:func:`building_rows`), read from th
 from __future__ import annotations
 
 import os
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -169,7 +170,16 @@ def compare(model: str | os.PathLike, formulas: str | list[str] | None = None,
     run_options.setdefault("plan", plan_line(sweep, "compare"))
     if contacts is not None:
         return run_sweep(sweep, output, assemble=_with_pounding_change, **run_options)
-    ds = run_sweep(sweep, output, **run_options)
+    return run_sweep(sweep, output, assemble=partial(_with_formula_title, reference=reference), **run_options)
+
+
+def _with_formula_title(sweep, results, *, reference: str, **kwargs):
+    """The sweep layout of a ξ-formula compare, titled as a compare (its figures carry the title) and with its
+    reference formula, both archived."""
+    from pounding.studies.sweep.dataset import build_dataset
+
+    ds = build_dataset(sweep, results, **kwargs)
+    ds.attrs["title"] = _compare_title(sweep, "storey drifts per xi formula")
     ds.attrs["reference_xi"] = reference
     return ds
 
@@ -186,11 +196,16 @@ def _with_pounding_change(sweep, results, **kwargs):
                   "the drift without pounding is at most roundoff_scale (see pounding_drift_difference)")
     ds["pounding_drift_difference"] = pounding_difference(ds).assign_attrs(
         units="1", long_name="change of the peak storey drift ratio due to pounding: with - without")
+    ds.attrs["title"] = _compare_title(sweep, "storey drifts with and without pounding")
+    return ds
+
+
+def _compare_title(sweep, what: str) -> str:
+    """A compare archive's title (its figures carry it): ``pounding compare 'NAME': WHAT (N scenarios) of`` the
+    model, records and intensity."""
     from pounding.studies.common import sweep_heading
 
-    ds.attrs["title"] = f"pounding compare '{sweep.name}': storey drifts with and without pounding " \
-                        f"({sweep.size} scenarios) of {sweep_heading(sweep)}"
-    return ds
+    return f"pounding compare '{sweep.name}': {what} ({sweep.size} scenarios) of {sweep_heading(sweep)}"
 
 
 def pounding_change(ds, variable: str = "peak_drift_ratio"):
@@ -462,6 +477,7 @@ def _plot_pounding(ds, directory: str | os.PathLike, *, drift_limit: float | Non
         right.set_yticks(ax.get_yticks())
         right.set_yticklabels([t.get_text() for t in ax.get_yticklabels()])
         right.set_xlabel("change due to pounding (%)")
+        right.set_ylabel("storey")
         right.set_title(f"building {building}: (with - without) / without", fontsize=9)
         right.grid(alpha=0.3)
     what = (f"mean over {n_records} records; bars: mean change, lines: its span over the records" if n_records > 1

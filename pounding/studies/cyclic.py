@@ -300,8 +300,8 @@ def plot_hysteresis(ds: xr.Dataset, folder: str | Path) -> list[Path]:
     ax.plot(100.0 * ds.storey_drift.values / ds.attrs["height"], ds.storey_shear.values / 1e3, lw=0.9)
     ax.axhline(0.0, color="0.7", lw=0.5)
     ax.axvline(0.0, color="0.7", lw=0.5)
-    ax.set_xlabel(f"storey drift ratio of {ds.attrs['storey']}, %")
-    ax.set_ylabel("storey shear, kN")
+    ax.set_xlabel(f"storey drift ratio of {ds.attrs['storey']} (%)")
+    ax.set_ylabel("storey shear (kN)")
     ax.set_title(f"{ds.attrs['hysteresis'][:70]}\nprotocol {Path(ds.attrs['protocol']).name}", fontsize=8)
     fig.tight_layout()
     out = folder / "hysteresis.png"

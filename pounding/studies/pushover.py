@@ -294,8 +294,8 @@ def plot_pushover(ds: xr.Dataset, folder: str | Path) -> list[Path]:
         for value, style in ((row.effective_yield_roof_displacement, ":"), (row.ultimate_roof_displacement, "--")):
             if np.isfinite(float(value)):
                 ax.axvline(100 * float(value) / height, color=line.get_color(), ls=style, lw=0.8)
-    ax.set_xlabel("roof drift ratio, %")
-    ax.set_ylabel("base shear, kN")
+    ax.set_xlabel("roof drift ratio (%)")
+    ax.set_ylabel("base shear (kN)")
     ax.set_title(f"pushover ({ds.attrs['pattern']}); dotted δ_y,eff, dashed δ_u", fontsize=9)
     ax.legend()
     fig.tight_layout()

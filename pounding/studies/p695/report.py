@@ -174,10 +174,20 @@ def plot_p695(ds, directory: str | os.PathLike) -> list[Path]:
                           f"({VERDICT_WORDS[int(b.passes.sel(variant=variant))]})")
         ax.axvline(float(b.s_mt) / g, color="k", lw=0.8, ls=":", label=f"S_MT {float(b.s_mt) / g:.2f} g")
         ax.axhline(0.5, color="0.6", lw=0.6)
-        ax.set_xlabel(f"median Sa(T = {float(b.period):.2f} s) of the normalised set, g")
+        ax.set_xlabel(f"median Sa(T = {float(b.period):.2f} s) of the normalised set (g)")
         ax.set_ylabel("fraction of records collapsed")
         ax.set_title(f"building {name}")
         ax.set_ylim(0, 1.02)
         ax.legend(fontsize=7, loc="lower right")
-    suptitle(fig, ds.attrs.get("title", "FEMA P695"))
+    suptitle(fig, f"{ds.attrs.get('title', 'FEMA P695')}\n{_p695_intensity(ds)}")
     return [save_figure(fig, out / "p695.png")]
+
+
+def _p695_intensity(ds) -> str:
+    """The records and intensities of a P695 archive in words, for its figure's title."""
+    from pounding.studies.common import records_text
+
+    g = STANDARD_GRAVITY
+    return (f"{records_text(list(ds.record.values))}, normalised (FEMA P695 Appendix A) and scaled by the collapse "
+            f"hunt; SDC {ds.attrs.get('sdc', '')}: S_MS {float(ds.attrs.get('s_ms', 'nan')) / g:.3g} g, "
+            f"S_M1 {float(ds.attrs.get('s_m1', 'nan')) / g:.3g} g")

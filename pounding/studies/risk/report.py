@@ -255,7 +255,7 @@ def plot_risk(ds, directory: str | os.PathLike) -> list[Path]:
     """``pounding_risk.png``: per contact, the probability of pounding in the target's years against the
     separation (log scale), the target and each contact's separation meeting it, own gap and (``--code``) the
     codes' separations marked."""
-    from pounding.results.plots import plot_directory, pyplot, save_figure
+    from pounding.results.plots import plot_directory, pyplot, save_figure, suptitle
     from pounding.studies.design_check import CODE_NAMES
 
     plt = pyplot()
@@ -279,7 +279,8 @@ def plot_risk(ds, directory: str | os.PathLike) -> list[Path]:
     ax.set_yscale("log")
     ax.set_xlabel("separation g (mm); dotted: the model's gap")
     ax.set_ylabel(f"probability of pounding in {years:g} years")
-    ax.set_title(f"Pounding risk of {ds.attrs.get('model_name', '')} ({ds.attrs['hazard']})", fontsize=9)
+    suptitle(fig, f"pounding risk over the hazard curve {Path(ds.attrs['hazard']).name}\n{ds.attrs.get('title', '')}",
+             8)
     ax.legend(fontsize=8)
     path = out / "pounding_risk.png"
     save_figure(fig, path)
