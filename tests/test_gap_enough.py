@@ -133,8 +133,10 @@ def test_text_json_csv_and_archive_agree(asce_check, tmp_path, capsys):
     for name, var in ds.data_vars.items():
         assert var.attrs.get("long_name"), name
         assert var.dtype.kind in "OUS" or "units" in var.attrs, name   # text (status, verdict) has no units
-    assert ds.attrs["command"] == (f"pounding gap {model} --code asce7-22 --sds 1.0 --sd1 0.6 --tl 8.0 --records "
-                                   f"{RECORDS} --duration 3.0")
+    # the check alone, without its outputs (``command``: the command line as typed, -o and all)
+    assert ds.attrs["rerun_command"] == (f"pounding gap {model} --code asce7-22 --sds 1.0 --sd1 0.6 --tl 8.0 "
+                                         f"--records {RECORDS} --duration 3.0")
+    assert ds.attrs["command"].startswith(f"pounding gap {model} --code asce7-22") and " -o " in ds.attrs["command"]
     assert json.loads(ds.attrs["spectrum_options"]) == {"sds": 1.0, "sd1": 0.6, "tl": 8.0}
     pairs = {p["level_pair"]: p for p in doc["level_pairs"]}
     with open(out / "check.level_pairs.csv", newline="", encoding="utf-8") as handle:

@@ -240,9 +240,16 @@ def test_a_design_spectrum_above_3g_is_warned_of(capsys, argv, warned):
     assert _warnings(capsys.readouterr().err) == ([f"pounding: warning: {warned}"] if warned else [])
 
 
+def _pair_without_design() -> str:
+    """models/pair.yaml without its buildings' ``design:`` factors."""
+    return "".join(line for line in PAIR.read_text().splitlines(keepends=True) if not line.strip().startswith("design:"))
+
+
 def test_gap_code_and_p695_warn_of_their_spectrum_before_they_run(tmp_path, capsys):
     # the warning comes first: a refusal of the study itself (no design factors, a near-field record) follows it
-    assert main(["gap", str(PAIR), "--code", "ec8", "--ag", "4.9", "--duration", "1", "--no-progress"]) == 2
+    bare = tmp_path / "pair_no_design.yaml"
+    bare.write_text(_pair_without_design())
+    assert main(["gap", str(bare), "--code", "ec8", "--ag", "4.9", "--duration", "1", "--no-progress"]) == 2
     err = capsys.readouterr().err.splitlines()
     assert err[0] == "pounding: warning: a_g = 4.9 g is more than 3 g: is it given in m/s2 or in % of g?"
     assert "has no design.ec8" in err[1]
@@ -257,7 +264,7 @@ def test_gap_code_warns_of_records_scaled_past_3g(tmp_path, capsys):
     from pounding.records.load import load_record
 
     model = tmp_path / "pair_design.yaml"
-    model.write_text(PAIR.read_text().replace("    damping: {ratio: 0.05, modes: [1, 3]}\n",
+    model.write_text(_pair_without_design().replace("    damping: {ratio: 0.05, modes: [1, 3]}\n",
                                               "    damping: {ratio: 0.05, modes: [1, 3]}\n"
                                               "    design: {asce7_22: {R: 8, Cd: 5.5}}\n"))
     assert main(["gap", str(model), "--code", "asce7-22", "--sds", "1.5", "--sd1", "1.0", "--records", ",".join(PEER),

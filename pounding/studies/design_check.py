@@ -514,7 +514,7 @@ def _archive_attrs(result: dict[str, Any], command: str) -> dict[str, Any]:
             "sides": ",".join(result["sides"]), "verdict_intensity": (result["level_pairs"] or [{}])[0].get(
                 "verdict_intensity", ""), "percentile": PERCENTILE,
             "buildings": json.dumps(result["buildings"]), "answers": "\n".join(result.get("answers", [])),
-            "warnings": json.dumps(result.get("warnings", [])), "command": command, "history": command,
+            "warnings": json.dumps(result.get("warnings", [])), "rerun_command": command, "history": command,
             "Conventions": "CF-1.8"}
 
 

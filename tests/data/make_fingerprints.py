@@ -44,7 +44,8 @@ TARGET = Path(__file__).with_name("fingerprints.json")
 #: Attributes that legitimately differ between two runs of the same thing.
 VOLATILE_ATTRIBUTES = {"history", "wall_time", "model_path", "run_spec", "elapsed", "elapsed_s",
                        "created", "date", "workers", "scheduler", "output", "sweep_path", "model_file",
-                       "sweep_yaml", "base_dir", "parts", "wall_time_s", "elapsed_time"}
+                       "sweep_yaml", "base_dir", "parts", "wall_time_s", "elapsed_time", "command",
+                       "command_directory"}
 
 #: Variables that time the run rather than compute it, and ``scenario_id``: the head of a part key,
 #: which hashes the package's source files so that a changed code never resumes old parts.
