@@ -6,7 +6,3 @@
 ``tables``   report tables of a run or sweep archive, and CSV writing (units in the headers)
 ``lazy_dask`` xarray without importing dask.array where no dask array is made
 """
-
-from pounding.results.lazy_dask import defer_dask_import
-
-defer_dask_import()   # xarray's datasets without importing dask.array (0.3-1.2 s a process): lazy_dask

@@ -52,6 +52,7 @@ from pounding.model.floors import DOF_PER_FLOOR
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.results.corners import CORNERS, corner_displacements, floor_corners, hermite_at
+from pounding.results.lazy_dask import defer_dask_import
 from pounding.solver.assembly import Assembly, storey_stop_ratios
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver.kinematics import penetration as combined_penetration
@@ -60,6 +61,8 @@ from pounding.solver.status import STATUS_ENERGY_INCONSISTENT, STATUS_MESSAGES, 
 from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
 from pounding.units import STANDARD_GRAVITY
+
+defer_dask_import()   # xarray's variables without importing dask.array (lazy_dask)
 
 __all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
            "RAGGED_DIMS", "loaded_record_pga"]

@@ -2,13 +2,17 @@
 
 xarray asks, for every variable it builds from a NumPy array, whether the data is a dask array,
 and to know what a dask array is it imports ``dask.array`` the first time (when dask is
-installed, as it is for the studies): 0.3-1.2 s of every ``pounding run`` and of the end of every
-study (the study's dataset), spent in a process that holds no dask array.  :func:`defer_dask_import`
-gives xarray the same answer without the import: nothing is a dask array while ``dask.array`` has
-not been imported (no such object can exist), and once it has been imported (a user's own dask
-work in the same process) xarray sees its real ``Array`` type, as before.
+installed, as it is for the studies): 0.5-1.2 s at the end of every study (its dataset, built in
+the process that ran the study) and in each sweep worker, spent in processes that hold no dask
+array (``pounding run`` and the other one-run commands keep dask out altogether:
+``pounding.cli.LEAN_COMMANDS``).  :func:`defer_dask_import` gives xarray the same answer without
+the import: nothing is a dask array while ``dask.array`` has not been imported (no such object
+can exist), and once it has been imported (a user's own dask work in the same process) xarray
+sees its real ``Array`` type, as before.
 
-Only xarray's cache of that answer is filled in advance (``xarray.namedarray.pycompat``); if a
+``pounding.results.dataset`` and ``pounding.results.archive`` call it when they are imported (every
+path that builds or writes a dataset goes through one of them).  Only xarray's cache of that answer is
+filled in advance (``xarray.namedarray.pycompat``); if a
 later xarray lays it out differently, nothing is changed and xarray imports dask as it always did.
 """
 
