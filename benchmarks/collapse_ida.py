@@ -45,7 +45,7 @@ def warm_up(client, plan, level: float = 0.1) -> None:
     """On every worker: one run per record at *level* g (kernels compiled or loaded, records read and cached)."""
     tasks = [plan.scenario(plan.variants[0], r, level).task(sweep_label="warm-up", name="ida")
              for r in range(len(plan.records))]
-    for worker in client.scheduler_info()["workers"]:
+    for worker in client.nthreads():
         client.gather([client.submit(run_ida_scenario, t, workers=[worker], pure=False) for t in tasks])
 
 

@@ -55,7 +55,7 @@ def warm_up(client, plan) -> None:
     """On every worker: one run per record at the lowest stripe (kernels loaded, records read and cached)."""
     tasks = [plan.scenario(plan.variants[0], r, float(plan.levels[0])).task(sweep_label="warm-up", name="ida")
              for r in range(len(plan.records))]
-    for worker in client.scheduler_info()["workers"]:
+    for worker in client.nthreads():
         futures = [client.submit(run_ida_scenario, t, workers=[worker], pure=False) for t in tasks]
         client.gather(futures)
 
@@ -80,7 +80,7 @@ def parallel_capacity(client, plan, repeats: int = 30) -> tuple[float, float]:
     """
     task = plan.scenario(plan.variants[0], 0, float(plan.levels[len(plan.levels) // 2])).task(
         sweep_label="probe", name="ida")
-    workers = list(client.scheduler_info()["workers"])
+    workers = list(client.nthreads())
     alone = min(client.submit(repeat_run, task, repeats, workers=[workers[0]], pure=False).result()
                 for _ in range(2))
     if len(workers) == 1:

@@ -58,7 +58,7 @@ def warm_up(client, sweep: sw.Sweep) -> None:
     for s in sweep.scenarios():
         seen.setdefault(s.coords["record"], s)
     tasks = [s.task(sweep_label="warm-up", name="pair") for s in seen.values()]
-    for worker in client.scheduler_info()["workers"]:
+    for worker in client.nthreads():
         futures = [client.submit(sw.run_scenario, t, workers=[worker], pure=False) for t in tasks]
         client.gather(futures)
 

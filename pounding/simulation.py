@@ -16,6 +16,8 @@ import math
 import os
 import time as _time
 import dataclasses
+import threading
+import weakref
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -483,7 +485,7 @@ def _checked_end_time(model: Model, supports: SupportMotions) -> float:
     return end_time
 
 
-def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]:
+def simulate_peaks(model: Model, record: Record | None = None, *, reuse: bool = False) -> dict[str, Any]:
     """Run *model* under its own ground motion (or *record*, loaded and scaled) and keep only its peaks.
 
     What an IDA or a sweep of many runs keeps of each: the values
@@ -496,26 +498,28 @@ def simulate_peaks(model: Model, record: Record | None = None) -> dict[str, Any]
     per-sample work and the dataset.  Errors as :func:`simulate`; a wave
     passage is applied as there.  *record* (optional) is used as
     :func:`support_motions` uses it: instead of loading the model's.  No
-    histories and no dataset are made.
+    histories and no dataset are made.  With *reuse* the model's assembly (its
+    solver arrays) and its work check are kept with it (:func:`reused_assembly`):
+    for a model object a study runs many times and never changes.
     """
     _check_modes_memory(model)
     supports = support_motions(model, record, where="yaml")
     motion = supports.records[0]
     end_time = _positive_end_time(supports)
-    assembly, raw, wall, _ = _solve(model, supports, end_time, end_time)
+    assembly, raw, wall, _ = _solve(model, supports, end_time, end_time, reuse=reuse)
     peaks = run_peaks(model, assembly, raw)
     peaks.update(record_scale=float(motion.scale), wall_time=wall)
     return peaks
 
 
-def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: float):
+def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: float, *, reuse: bool = False):
     """Integrate *model* on its *supports* up to *end_time*: ``(assembly, raw solution, wall time in s,
-    the ground rows as given to the solver (G, ns))``."""
+    the ground rows as given to the solver (G, ns))``; *reuse*: :func:`reused_assembly`."""
     settings = model.solver
-    why = refusal(model)
-    if why is not None:
-        raise PoundingError(f"{_where(model)}{why}")
-    check_work(model, end_time, where=_where(model))   # a stiff element would take hours, silently
+    if reuse:
+        assembly = reused_assembly(model, ground_rows(supports), end_time)
+    else:
+        assembly = _checked_assembly(model, ground_rows(supports), end_time)
     step = supports.time_step
     samples_needed = int(np.ceil(end_time / step - 1e-9)) + 1
     ground = np.zeros((supports.rows.shape[0], max(samples_needed, supports.rows.shape[1])))
@@ -524,7 +528,6 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
     if ground.shape[0] == 1:
         ground = ground[0]
 
-    assembly = assemble(model, ground_rows(supports))
     system = assembly.system
     scaling = settings.tolerance_scaling
     factors = tolerance_factors(model, system, float(np.max(np.abs(rows))) if rows.size and scaling else 0.0,
@@ -538,6 +541,42 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
         raise PoundingError(f"{_where(model)}" + STATUS_MESSAGES[raw.status].format(t=raw.final_time))
     return assembly, raw, wall, rows
+
+
+def _checked_assembly(model: Model, ground: GroundRows, end_time: float):
+    """*model* assembled on *ground* (:func:`~pounding.solver.assembly.assemble`), once the solver accepts it
+    and a run of *end_time* s is not too much work (one line naming the model file if not)."""
+    why = refusal(model)
+    if why is not None:
+        raise PoundingError(f"{_where(model)}{why}")
+    check_work(model, end_time, where=_where(model))   # a stiff element would take hours, silently
+    return assemble(model, ground)
+
+
+#: Per model object (weakly held: gone with the model), its checked assemblies by ground rows and duration.
+_ASSEMBLIES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_ASSEMBLIES_LOCK = threading.Lock()
+
+
+def reused_assembly(model: Model, ground: GroundRows, end_time: float):
+    """:func:`_checked_assembly` of *model*, made once per model object, ground rows and duration.
+
+    What a study's worker runs many times: an IDA runs each model object (a variant and a record) at
+    every stripe, and assembling it took ~1 ms of each ~12 ms run.  The cache is keyed by the
+    object itself (a :class:`Model` compares by identity), held weakly, so a different model, even
+    one equal to it, never shares an assembly and a model that is gone takes its entries along.  The
+    solver only reads the assembly's arrays, so a run on a reused assembly is the same run, bit for
+    bit.  A model changed in place after its first run would keep its first assembly: only for
+    model objects that are not changed (studies build each from its document and keep it as is).
+    """
+    key = (ground, float(end_time))
+    with _ASSEMBLIES_LOCK:
+        found = _ASSEMBLIES.get(model, {}).get(key)
+    if found is None:
+        found = _checked_assembly(model, ground, end_time)
+        with _ASSEMBLIES_LOCK:
+            _ASSEMBLIES.setdefault(model, {})[key] = found
+    return found
 
 
 def refuse_failed_run(status: str, message: str) -> None:

@@ -4,4 +4,5 @@
 ``archive``  atomic NetCDF writing, reopening
 ``plots``    PNG figures of a run
 ``tables``   report tables of a run or sweep archive, and CSV writing (units in the headers)
+``lazy_dask`` xarray without importing dask.array where no dask array is made
 """

@@ -30,6 +30,9 @@ import numpy as np
 import xarray as xr
 
 from pounding.errors import ArchiveError
+from pounding.results.lazy_dask import defer_dask_import
+
+defer_dask_import()   # xarray's variables without importing dask.array (lazy_dask)
 
 __all__ = ["save_run", "open_run", "load_within_memory", "check_writable", "make_folder", "nearest_existing",
            "check_output_place", "atomic_path", "write_error", "write_reason", "check_not_input", "check_regular_file",

@@ -52,6 +52,7 @@ from pounding.model.floors import DOF_PER_FLOOR
 from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.results.corners import CORNERS, corner_displacements, floor_corners, hermite_at
+from pounding.results.lazy_dask import defer_dask_import
 from pounding.solver.assembly import Assembly, storey_stop_ratios
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver.kinematics import penetration as combined_penetration
@@ -60,6 +61,8 @@ from pounding.solver.status import STATUS_ENERGY_INCONSISTENT, STATUS_MESSAGES, 
 from pounding.solver import kinematics
 from pounding.solver.storeys import recoverable_energy
 from pounding.units import STANDARD_GRAVITY
+
+defer_dask_import()   # xarray's variables without importing dask.array (lazy_dask)
 
 __all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
            "RAGGED_DIMS", "loaded_record_pga"]
@@ -333,20 +336,29 @@ def energy_closure(ds: xr.Dataset) -> float:
 
     ``W_g`` (``energy_ground_work``) is the work of the contact forces on the
     differential ground motion, an input when buildings stand on different
-    grounds (0 otherwise).
+    grounds (0 otherwise).  Summed on the plain arrays, in the order written
+    (xarray's arithmetic on the same time axis gives the same numbers, at ten
+    times the cost of a run's whole energy audit).
     """
-    inputs = ds.energy_input + ds.energy_ground_work if "energy_ground_work" in ds else ds.energy_input
-    parts = (ds.energy_kinetic + ds.energy_strain + ds.energy_damping
-             + ds.energy_contact_dissipated + ds.energy_contact_strain)
-    for name in ("energy_link_dissipated", "energy_link_strain"):
+    energy = _energies(ds)
+    inputs = energy("energy_input") + energy("energy_ground_work") if "energy_ground_work" in ds \
+        else energy("energy_input")
+    parts = (energy("energy_kinetic") + energy("energy_strain") + energy("energy_damping")
+             + energy("energy_contact_dissipated") + energy("energy_contact_strain"))
+    for name in ("energy_link_dissipated", "energy_link_strain", "energy_hysteretic"):
         if name in ds:
-            parts = parts + ds[name]
-    if "energy_hysteretic" in ds:
-        parts = parts + ds.energy_hysteretic
+            parts = parts + energy(name)
     scale = float(np.abs(inputs).max())
     if scale == 0.0:
         return 0.0
     return float(np.abs(inputs - parts).max()) / scale
+
+
+def _energies(ds: xr.Dataset):
+    """``energy(name, default)``: the history *name* of *ds* as a plain array (J), *default* if absent."""
+    def energy(name: str, default: float | None = None):
+        return ds[name].values if default is None or name in ds else default
+    return energy
 
 
 #: Energy closure error above which a run is flagged (attribute ``energy_status``, summary
@@ -534,6 +546,24 @@ def run_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str, A
         "collapse_building": building,
         "collapse_cause": raw.collapse_cause if collapsed else "",
     }
+
+
+def _ragged_coords(variables: dict[str, Any], coords: dict[str, Any], raw: RawSolution, what: str) -> dict:
+    """*coords* with the ragged dimensions' times and contact labels, taken out of *variables* (both changed).
+
+    ``impact_time``, ``trace_time`` and each impact's and trace sample's contact label (*what*: the kind of
+    contact) are coordinates, so that ``ds.trace_force.plot(x="trace_time")`` and
+    ``groupby("trace_contact_label")`` work; given to the dataset's constructor (not set afterwards: each
+    change of a dataset copies it, ~8 ms of every run).
+    """
+    labels = np.asarray(coords["contact"][1], dtype=object)
+    for name in ("impact_time", "trace_time"):
+        coords[name] = variables.pop(name)
+    coords["impact_contact_label"] = ("impact", labels[raw.impact_contact] if labels.size else np.zeros(0, object),
+                                      {"long_name": f"{what} of the impact (label of impact_contact)"})
+    coords["trace_contact_label"] = ("trace", labels[raw.trace_contact] if labels.size else np.zeros(0, object),
+                                     {"long_name": f"{what} of the sample (label of trace_contact)"})
+    return coords
 
 
 def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *,
@@ -731,15 +761,7 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         for name in ("energy_link_dissipated", "energy_link_strain", "link_force", "link_deformation",
                      "peak_link_force", "link_dissipated_energy"):
             del variables[name]
-    ds = xr.Dataset(variables, coords=coords)
-    # The ragged dims get their times and contact labels as coordinates, so that
-    # ds.trace_force.plot(x="trace_time") and groupby("trace_contact_label") work.
-    labels = np.asarray(ds.contact.values, dtype=object)
-    ds = ds.set_coords(["impact_time", "trace_time"]).assign_coords(
-        impact_contact_label=("impact", labels[raw.impact_contact] if ng else np.zeros(0, dtype=object),
-                              {"long_name": "gap element of the impact (label of impact_contact)"}),
-        trace_contact_label=("trace", labels[raw.trace_contact] if ng else np.zeros(0, dtype=object),
-                             {"long_name": "gap element of the sample (label of trace_contact)"}))
+    ds = xr.Dataset(variables, coords=_ragged_coords(variables, coords, raw, "gap element"))
     closure = energy_closure(ds)
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     ds.attrs = {
@@ -1010,11 +1032,13 @@ def _plane_shear(assembly: Assembly, raw: RawSolution, drift: np.ndarray) -> np.
 
 def plane_energy_closure(ds: xr.Dataset) -> float:
     """``max |E_0 + E_in − Σ parts| / max (E_0 + |E_in|)`` of an archive with plane rows (dimensionless)."""
-    parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta + ds.energy_contact
-             + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0)
-             + ds.get("energy_link_dissipated", 0.0) + ds.get("energy_link_strain", 0.0))
+    energy = _energies(ds)   # plain arrays, summed in the order written (see energy_closure)
+    parts = (energy("energy_kinetic") + energy("energy_damping") + energy("energy_plane_strain")
+             + energy("energy_p_delta") + energy("energy_contact") + energy("energy_hysteretic", 0.0)
+             + energy("energy_friction", 0.0) + energy("energy_link_dissipated", 0.0)
+             + energy("energy_link_strain", 0.0))
     initial = float(parts[0])
-    supplied = initial + ds.energy_input + ds.get("energy_ground_work", 0.0)
+    supplied = initial + energy("energy_input") + energy("energy_ground_work", 0.0)
     scale = float(np.abs(supplied).max())
     return 0.0 if scale == 0.0 else float(np.abs(supplied - parts).max()) / scale
 
@@ -1293,14 +1317,9 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
               **_floor_coords(model), **_plan_floor_labels(model), **_plane_labels(model), **_plane_coords(model),
               **contact_coords(model), **_point_labels(model), **_face_labels(model, assembly), **_link_coords(model)}
     status = plane_status(model, assembly, raw)
-    ds = xr.Dataset(data, coords=coords, attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time,
-                                                               wall_time=wall_time, status=status))
-    labels = np.asarray(ds.contact.values, dtype=object)
-    ds = ds.set_coords(["impact_time", "trace_time"]).assign_coords(
-        impact_contact_label=("impact", labels[raw.impact_contact] if labels.size else np.zeros(0, dtype=object),
-                              {"long_name": "contact point of the impact (label of impact_contact)"}),
-        trace_contact_label=("trace", labels[raw.trace_contact] if labels.size else np.zeros(0, dtype=object),
-                             {"long_name": "contact point of the sample (label of trace_contact)"}))
+    ds = xr.Dataset(data, coords=_ragged_coords(data, coords, raw, "contact point"),
+                    attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time, wall_time=wall_time,
+                                          status=status))
     ds.attrs["energy_closure"] = plane_energy_closure(ds)
     ds.attrs["energy_closure_error"] = ds.attrs["energy_closure"]
     ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"

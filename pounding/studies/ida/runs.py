@@ -105,7 +105,8 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     try:
         model, record, alone = _model_and_record(task)
         if alone is None:
-            peaks = simulate_peaks(model, record)   # the peaks of simulate(model), without histories or dataset
+            # the peaks of simulate(model), without histories or dataset; the model's assembly kept with it
+            peaks = simulate_peaks(model, record, reuse=True)
             refuse_failed_run(peaks["status"], peaks["status_message"])   # energy_inconsistent: failed
         else:   # buildings that cannot act on each other: each its own run, so no collapse ends another's
             peaks = separate_peaks(alone, record)
@@ -171,7 +172,7 @@ def separate_peaks(models: list, record) -> dict[str, Any]:
 
     runs = []
     for model in models:
-        peaks = simulate_peaks(model, record)
+        peaks = simulate_peaks(model, record, reuse=True)
         refuse_failed_run(peaks["status"], peaks["status_message"])
         runs.append(peaks)
     fallen = [p for p in runs if p["collapse_building"]]

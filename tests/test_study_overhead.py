@@ -1,0 +1,129 @@
+"""What a study's worker keeps between runs, and the shortcuts around the solver, give the runs' own results.
+
+A worker that runs one model many times (an IDA: every stripe of a variant and a record) keeps the
+model's assembly (:func:`pounding.simulation.reused_assembly`); a cache keyed wrong would hand one
+model another's stiffnesses.  The energy audit is summed on plain arrays; xarray is kept from
+importing ``dask.array`` where nothing is a dask array (:mod:`pounding.results.lazy_dask`).
+"""
+
+from __future__ import annotations
+
+import gc
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from pounding.model.model import model_from_data
+from pounding.simulation import ground_rows, reused_assembly, simulate, simulate_peaks, support_motions
+
+ROOT = Path(__file__).resolve().parents[1]
+PAIR = ROOT / "models" / "pair.yaml"
+
+#: Every peak of simulate_peaks that a study keeps.
+PEAKS = ("peak_drift_ratio", "residual_drift_ratio", "impact_count", "peak_contact_force")
+
+
+def pair(duration: float = 4.0, **storey_a) -> object:
+    """models/pair.yaml on its record's first *duration* s, building A's storeys changed by *storey_a*."""
+    data = yaml.safe_load(PAIR.read_text())
+    data["ground_motion"]["duration"] = duration
+    data["buildings"][0]["storeys"].update(storey_a)
+    return model_from_data(data, name="pair", source=PAIR.read_text(), base_dir=str(PAIR.parent))
+
+
+def assert_same_peaks(a: dict, b: dict) -> None:
+    for key in PEAKS:
+        np.testing.assert_array_equal(a[key], b[key], err_msg=key)   # bit for bit: the same run
+    assert a["status"] == b["status"]
+
+
+def test_each_model_object_has_its_own_assembly_and_keeps_it():
+    """Two models, even built from one document, never share an assembly; a model that is gone takes
+    its entry along; the same model on the same ground and duration gets the same assembly."""
+    first, twin, stiffer = pair(), pair(), pair(stiffness=7.0e8)
+    ground = ground_rows(support_motions(first, where="yaml"))
+    a = reused_assembly(first, ground, 4.0)
+    assert reused_assembly(first, ground, 4.0) is a
+    assert reused_assembly(twin, ground, 4.0) is not a
+    assert reused_assembly(first, ground, 5.0) is not a   # another duration: checked and assembled again
+    # building A's 8 storeys come first in the solver's storey arrays: 3.5e8 N/m each, doubled in *stiffer*
+    np.testing.assert_array_equal(a.system.storey_stiffness[:8], 3.5e8)
+    np.testing.assert_array_equal(reused_assembly(stiffer, ground, 4.0).system.storey_stiffness[:8], 7.0e8)
+    from pounding import simulation
+
+    held = len(simulation._ASSEMBLIES)
+    del stiffer
+    gc.collect()
+    assert len(simulation._ASSEMBLIES) == held - 1
+
+
+def test_models_run_in_turn_with_reuse_give_their_fresh_runs_peaks():
+    """Two different models run alternately with their assemblies kept give, each time, exactly the
+    peaks of a fresh run (the solver never writes into an assembly), and not each other's."""
+    soft, stiff = pair(), pair(stiffness=7.0e8)
+    fresh = {"soft": simulate_peaks(pair()), "stiff": simulate_peaks(pair(stiffness=7.0e8))}
+    assert not np.array_equal(fresh["soft"]["peak_drift_ratio"], fresh["stiff"]["peak_drift_ratio"])
+    for name, model in (("soft", soft), ("stiff", stiff), ("soft", soft), ("stiff", stiff)):
+        assert_same_peaks(simulate_peaks(model, reuse=True), fresh[name])
+
+
+def test_a_scaled_record_on_a_kept_assembly_gives_the_fresh_run():
+    """An IDA's runs of one model differ only in the record's factor: the kept assembly (built at the
+    first factor) with another factor is the fresh run at that factor."""
+    from pounding.records.processing import scale_record
+    from pounding.simulation import processed_record_for
+
+    model = pair()
+    record = processed_record_for(model, where="yaml")
+    for factor in (0.5, 2.0, 0.5):
+        kept = simulate_peaks(model, scale_record(record, factor), reuse=True)
+        assert_same_peaks(kept, simulate_peaks(pair(), scale_record(record, factor)))
+        assert kept["record_scale"] == pytest.approx(factor * record.scale, rel=0, abs=0)
+
+
+@pytest.mark.parametrize("path", ["models/pair_inelastic.yaml", "models/corner_pair.yaml"])
+def test_energy_closure_is_the_documented_sum_of_the_archive(path):
+    """The closure error equals the formula of its docstring evaluated with xarray's arithmetic on the
+    archive's own energy histories, bit for bit (the sum on plain arrays is the same sum)."""
+    from pounding.model.model import load_model
+
+    ds = simulate(load_model(ROOT / path))
+    if "plane" in ds.dims:   # floors in plan: max |E_0 + E_in − Σ parts| / max |E_0 + E_in|
+        parts = (ds.energy_kinetic + ds.energy_damping + ds.energy_plane_strain + ds.energy_p_delta
+                 + ds.energy_contact + ds.get("energy_hysteretic", 0.0) + ds.get("energy_friction", 0.0)
+                 + ds.get("energy_link_dissipated", 0.0) + ds.get("energy_link_strain", 0.0))
+        supplied = float(parts[0]) + ds.energy_input + ds.get("energy_ground_work", 0.0)
+    else:                    # max |E_in − Σ parts| / max |E_in|
+        parts = (ds.energy_kinetic + ds.energy_strain + ds.energy_damping + ds.energy_contact_dissipated
+                 + ds.energy_contact_strain + ds.energy_hysteretic)
+        supplied = ds.energy_input
+    expected = float(np.abs(supplied - parts).max()) / float(np.abs(supplied).max())
+    assert ds.attrs["energy_closure_error"] == expected
+    assert 0.0 < expected < 1e-3   # a converged run closes; a zero would mean nothing was summed
+
+
+def test_datasets_are_built_without_importing_dask_array_and_dask_arrays_still_work():
+    """A process that builds and writes a run's dataset does not import dask.array (0.3-1.2 s); once
+    the process imports it, xarray keeps a dask array lazy, as it always did."""
+    pytest.importorskip("dask.array")
+    script = (
+        "import sys, numpy as np, xarray as xr\n"
+        "import pounding.results.dataset\n"
+        "ds = xr.Dataset({'a': ('t', np.arange(4.0))}, coords={'t': np.arange(4)})\n"
+        "assert float(ds.a.sum()) == 6.0\n"
+        "print('dask.array' in sys.modules)\n"
+        "import dask.array as da\n"
+        "v = xr.DataArray(da.ones(6, chunks=3), dims='t')\n"
+        "print(v.chunks, type(v.data).__module__.split('.')[0], float(v.sum()))\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, cwd=ROOT,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    imported, chunks = out.stdout.splitlines()
+    assert imported == "False"
+    assert chunks == "((3, 3),) dask 6.0"
