@@ -34,8 +34,10 @@ def commands(folder: Path) -> dict[str, list[str]]:
         "compare": ["compare", PAIR, "--xi", "ye", "--duration", "0.5", *QUIET, "-o", out["compare"]],
         "sweep": ["sweep", str(folder / "tiny.yaml"), *QUIET, "-o", out["sweep"]],
         "gap": ["gap", PAIR, "--duration", "1", *QUIET, "-o", out["gap"]],
+        # 8 s: the record's strong motion has begun (over its first second the code's scaling asks x1437 and
+        # the run is refused as beyond 100 g: a report of "records not determined" only)
         "gap-code": ["gap", PAIR, "--code", "asce7-22", "--sds", "1.0", "--sd1", "0.6", "--records", RECORD,
-                     "--duration", "1", *QUIET, "-o", out["gap-code"]],
+                     "--duration", "8", *QUIET, "-o", out["gap-code"]],
         "ida": ["ida", PAIR, "--records", RECORD, "--levels", "0.1:0.3:0.1", "--im", "pga", "--duration", "1",
                 *QUIET, "-o", out["ida"]],
         "risk": ["risk", PAIR, "--hazard", "example", "--records", RECORD, "--stripes", "2", "--duration", "1",
