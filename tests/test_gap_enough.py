@@ -60,6 +60,14 @@ def expected_verdict(gap: float, code: float, needs: np.ndarray) -> str:
             (False, True): "enough for the records, not the code", (False, False): "not enough"}[(for_code, for_records)]
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _in_process(studies_in_process):
+    """Every check here runs its records on the in-process cluster (tests/conftest.py): a cluster of worker
+    processes started per check cost 10-40 s each on the 2-core machine, and these tests are about the check's
+    numbers and outputs, not its workers."""
+    yield
+
+
 def test_a_huge_gap_is_enough_a_tiny_one_is_not_and_the_fraction_counts_the_records_over_the_gap(tmp_path, capsys):
     # 1. a gap of 0.1 mm: every record needs more (the floors move centimetres under these records)
     tiny = run_json(capsys, ["gap", model_with_gap(tmp_path, 1e-4)] + EC8 + FAST + ["-o", str(tmp_path / "t.nc")])
