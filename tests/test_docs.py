@@ -259,7 +259,7 @@ def _runnable_docs() -> list[Path]:
 
 
 @pytest.mark.parametrize("path", _runnable_docs(), ids=lambda p: str(p.relative_to(ROOT)))
-def test_the_python_blocks_and_fast_commands_of_a_doc_run(path, tmp_path, monkeypatch):
+def test_the_python_blocks_and_fast_commands_of_a_doc_run(path, tmp_path, monkeypatch, studies_in_process):
     """In reading order, in a scratch folder: python blocks share one namespace; a python block directly
     followed by an unlabelled block prints that block; commands run (``run`` shortened); transcripts are
     :func:`test_every_transcript_is_what_the_command_prints`'s."""
@@ -317,7 +317,8 @@ def _transcripts() -> list[tuple[str, str, str]]:
 
 
 @pytest.mark.parametrize("where, command, expected", _transcripts(), ids=[t[0] for t in _transcripts()])
-def test_every_transcript_is_what_the_command_prints(where, command, expected, tmp_path, monkeypatch):
+def test_every_transcript_is_what_the_command_prints(where, command, expected, tmp_path, monkeypatch,
+                                                    studies_in_process):
     """A ``$ pounding ...`` line and the lines below it are the command's output, in full (not shortened)."""
     monkeypatch.chdir(_scratch(tmp_path))
     status, printed = _run(command, shorten=False)
