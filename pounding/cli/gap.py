@@ -7,7 +7,8 @@ import json
 import sys
 
 from pounding.cli.run import SCALE_HELP, parse_scale_option
-from pounding.cli.spectrum import add_spectrum_options, code_options, warn_of_parameters
+from pounding.cli.spectrum import (add_spectrum_options, code_options, refuse_spectrum_without_code,
+                                    warn_of_parameters)
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted, print_study_warnings
 from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
 from pounding.errors import PoundingError
@@ -64,14 +65,6 @@ def _cmd_code_gap(args: argparse.Namespace) -> int:
     return 0
 
 
-def _refuse_spectrum_without_code(args: argparse.Namespace) -> None:
-    """A design spectrum's option (--sds, --sd1, --ag) without --code is refused in one line."""
-    given = [option for option, value in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag))
-             if value is not None]
-    if given:
-        raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
-
-
 def _study_options(args: argparse.Namespace) -> dict:
     """The keyword arguments of the gap study from the command's options."""
     return {"scale": None if args.scale is None else parse_scale_option(args.scale), "duration": args.duration,
@@ -86,7 +79,7 @@ def _cmd_gap(args: argparse.Namespace) -> int:
     check_outputs(args)
     if args.code:   # the code's separations beside the records' need and the model's gap: design_check.py
         return _cmd_code_gap(args)
-    _refuse_spectrum_without_code(args)
+    refuse_spectrum_without_code(args)
     try:
         ds = gap_study(args.model, args.records, **_study_options(args))
     except KeyboardInterrupt:

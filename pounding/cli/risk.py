@@ -6,7 +6,8 @@ import argparse
 import sys
 
 from pounding.cli.csv_option import add_csv_option, check_outputs, write_csv_option
-from pounding.cli.spectrum import add_spectrum_options, code_options, warn_of_parameters
+from pounding.cli.spectrum import (add_spectrum_options, code_options, refuse_spectrum_without_code,
+                                    warn_of_parameters)
 from pounding.cli.sweep import add_cluster_options, check_study_options, interrupted
 from pounding.errors import PoundingError
 
@@ -17,9 +18,7 @@ def _codes(args: argparse.Namespace) -> dict[str, dict]:
     """{code: its design spectrum's options} of ``--code`` (empty without it); one line for an unknown code, a
     missing spectrum option, or a spectrum option without ``--code``."""
     if not args.code:
-        given = [o for o, v in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag)) if v is not None]
-        if given:
-            raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
+        refuse_spectrum_without_code(args)
         return {}
     codes = [c.strip() for c in args.code.split(",") if c.strip()]
     for code in codes:

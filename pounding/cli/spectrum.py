@@ -47,6 +47,14 @@ def warn_of_parameters(args: argparse.Namespace, code: str) -> None:
     print_warnings(spectrum_warnings({name: getattr(args, key, None) for name, key in given.items()}).values())
 
 
+def refuse_spectrum_without_code(args: argparse.Namespace) -> None:
+    """A design spectrum's option (--sds, --sd1, --ag) given without --code is refused in one line."""
+    given = [option for option, value in (("--sds", args.sds), ("--sd1", args.sd1), ("--ag", args.ag))
+             if value is not None]
+    if given:
+        raise PoundingError(f"{given[0]} sets a design spectrum: give --code asce7-22 or --code ec8 with it")
+
+
 def code_options(args: argparse.Namespace, code: str, option: str = "--code") -> dict:
     """The design spectrum's options of *code* (``asce7-22``: sds, sd1, tl; ``ec8``: type, ground, ag, beta) from
     the parsed *args*, each missing one refused in one line naming *option*."""
