@@ -535,7 +535,7 @@ def _solve(model: Model, supports: SupportMotions, end_time: float, output_dt: f
     started = _time.perf_counter()
     raw = integrate(system, ground, step, end_time, rtol=settings.rtol,
                     atol=settings.atol, atol_velocity=settings.atol_velocity,
-                    output_dt=output_dt, floor_factors=factors)
+                    output_dt=output_dt, floor_factors=factors, linear_phases=settings.linear_phases)
     wall = _time.perf_counter() - started
     if raw.status not in (STATUS_OK, STATUS_COLLAPSED, STATUS_UNSTABLE):
         # STATUS_STEP_TOO_SMALL, STATUS_EVENT_LIMIT, STATUS_TABLE_LIMIT: one line each (pounding.solver).
@@ -706,14 +706,18 @@ def _rerun_two_components(model: Model, spec: dict, name: str) -> xr.Dataset:
 
 
 def _archived_tolerances(model: Model, spec: dict) -> Model:
-    """*model* as an archive written before tolerances followed the model's scales (issue 25) ran it:
-    ``solver.tolerance_scaling`` off where its effective model does not name it."""
+    """*model* as an archive written before a solver setting existed ran it: ``solver.tolerance_scaling``
+    off (before tolerances followed the model's scales) and ``solver.linear_phases: runge-kutta`` (before
+    linear phases ran in closed form) where its effective model does not name them."""
     import yaml
 
     document = spec.get("model")
     solver = (yaml.safe_load(document) or {}).get("solver") if isinstance(document, str) else None
-    if isinstance(solver, dict) and "tolerance_scaling" not in solver:
-        return model.with_solver(tolerance_scaling=False)
+    if isinstance(solver, dict):
+        if "tolerance_scaling" not in solver:
+            model = model.with_solver(tolerance_scaling=False)
+        if "linear_phases" not in solver:
+            model = model.with_solver(linear_phases="runge-kutta")
     return model
 
 

@@ -308,6 +308,10 @@ class SolverSettings:
         Tighten ``atol`` and ``atol_velocity`` for a building far stiffer than
         the row moves (its static drift scale below 100·atol;
         :mod:`pounding.solver.tolerances`).  False: the given values for every floor.
+    linear_phases : str
+        ``exact``: phases with every contact open and every storey on its elastic branch are advanced
+        by their exact state transition where that is cheaper than Runge–Kutta steps
+        (:mod:`pounding.solver.closed_form`); ``runge-kutta``: Runge–Kutta steps throughout.
     """
 
     rtol: float = 1e-6
@@ -316,6 +320,7 @@ class SolverSettings:
     output_dt: float = 0.01
     stop_drift_ratio: float | None = None
     tolerance_scaling: bool = True
+    linear_phases: str = "exact"
 
     def __post_init__(self) -> None:
         entry = schema.checked(schema.SolverEntry, dataclasses.asdict(self), ("solver",))
@@ -635,7 +640,7 @@ class Model:
                                              for b in self.buildings))
 
     def with_solver(self, **changes: Any) -> Model:
-        """The same model with solver settings changed (rtol, atol, atol_velocity, output_dt)."""
+        """The same model with solver settings changed (rtol, atol, atol_velocity, output_dt, …)."""
         _check_keys("solver", changes, SolverSettings)
         return self._derived(solver=dataclasses.replace(self.solver, **changes))
 

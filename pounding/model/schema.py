@@ -301,6 +301,21 @@ OptionalBehaviourFactor = Annotated[
 Rtol = Annotated[float, BeforeValidator(located(as_number)),
                  AfterValidator(located(_bound(lambda v: v >= MIN_RTOL, f"must be >= {MIN_RTOL:g}")))]
 
+#: ``solver.linear_phases``: linear phases advanced in closed form (where it pays), or Runge–Kutta steps throughout.
+LINEAR_PHASES = ("exact", "runge-kutta")
+
+
+def linear_phases_name(value: Any) -> str:
+    """``solver.linear_phases``, one of :data:`LINEAR_PHASES` (case and surrounding blanks ignored)."""
+    name = value.strip().lower() if isinstance(value, str) else value
+    if name not in LINEAR_PHASES:
+        hint = did_you_mean(str(name), list(LINEAR_PHASES)).strip() if isinstance(value, str) else ""
+        raise Problem(f"must be one of {', '.join(LINEAR_PHASES)}", hint)
+    return name
+
+
+LinearPhases = Annotated[str, BeforeValidator(located(linear_phases_name))]
+
 
 def registry_union(registry: dict[str, type[BaseModel]], key: str, kind: str) -> Any:
     """A discriminated union of the classes of a registry, chosen by the value of *key*.
@@ -1180,6 +1195,9 @@ class SolverEntry(SchemaEntry):
         None, description="end the run (status collapsed) when a storey's |drift ratio| exceeds this")
     tolerance_scaling: bool = Field(
         True, description="tighten atol per building to its own static drift scale (docs/numerics.md)")
+    linear_phases: LinearPhases = Field(
+        "exact", description="advance the phases with every contact open and every storey elastic in closed form "
+                             "where that is cheaper (exact), or by Runge-Kutta steps throughout (runge-kutta)")
 
 
 def list_shape(must: str, empty: str) -> Callable[[Any], Any]:

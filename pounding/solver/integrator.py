@@ -92,6 +92,8 @@ from numba import njit
 from pounding import hysteresis
 from pounding.solver import imk, jit
 from pounding.solver import kernels
+from pounding.solver.closed_form import (GRAZE_SPLIT, closed_form_step, count_linear_step, exact_motion_at, graze_fraction,
+                                         linear_phase, record_exact_peaks, run_closed_form, start_phase, wants_exact)
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
 from pounding.solver.dense import interpolate
@@ -130,6 +132,9 @@ jit.load_registries_without_scipy()
 EVENT_END_TOLERANCE = 1e-9
 #: Retakes of one step to bring a located event to its end before it is accepted as is.
 MAX_RETAKES = 8
+#: Halvings of an exact step whose interpolant might miss a grazing closure (each divides the cubic's
+#: error bound by 16; pounding.solver.closed_form.graze_fraction), on top of the retakes.
+MAX_GRAZE_SPLITS = 12
 
 
 @dataclass(frozen=True)
@@ -330,6 +335,7 @@ class RawSolution:
     collapse_cause: str = ""         # status.COLLAPSE_CAUSES: why collapse_storey collapsed ("" if none)
     friction_history: np.ndarray | None = None  # (nt, 3·nf): each face's N (N), λ (N), mode code (None: no friction)
     peak_plane_drift: np.ndarray | None = None  # (R,) m, |drift| of a plan model's planes (System.plane_floors)
+    exact_steps: int = 0             # steps of linear phases taken in closed form (of n_steps)
 
 
 
@@ -486,6 +492,27 @@ def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_f
     return s_first, collapse_s, collapse_floor, stop_status
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _exact_start(cf, linear, t, seg, forcing, ground, work) -> bool:
+    """Whether the step from *t* runs in closed form (:mod:`pounding.solver.closed_form`): a *linear* phase
+    in an exact window; starts the phase's modal state from ``work.y`` and its rate ``work.K[0]`` when
+    it is new (else marks it to be started)."""
+    if not linear or not wants_exact(cf):
+        cf.valid[0] = 0
+        return False
+    if cf.valid[0] == 0:
+        start_phase(cf, work.y, work.K[0], t, seg, forcing, ground)
+    return True
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _keep_modal(cf) -> None:
+    """An accepted exact step's end becomes the modal state."""
+    z, z_end = cf.z, cf.z_end
+    for i in range(z.size):
+        z[i] = z_end[i]
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _accept(work) -> None:
     """Accept the trial step: its end state and rate become the next step's start (first same as last)."""
@@ -553,9 +580,10 @@ def _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey
 
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED)
-def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial):
+def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial, cf):
     """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile
-    time."""
+    time; *cf* (:class:`~pounding.solver.closed_form.ClosedForm`, None: Runge–Kutta steps throughout) advances
+    the linear phases in closed form."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
     dt_rec, t_end, output_dt = forcing.record_step, settings.end_time, settings.output_step
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
@@ -585,6 +613,12 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
     window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
     stop_status = zero + STATUS_COLLAPSED  # which stop collapse_s / collapse_pending is: collapsed or unstable
+    # The closed form's flags, taken out of *cf* once (a record member read in the loop counts a reference);
+    # whether the phase is linear changes only at events, so it is decided after each (linear_known).
+    exact, linear, linear_known = False, False, False
+    valid, policy, threshold = np.zeros(1, dtype=np.int64), np.zeros(4, dtype=np.int64), np.zeros(1)
+    if cf is not None:
+        valid, policy, threshold = cf.valid, cf.policy, cf.threshold
     while t < t_end - tiny and i_out <= n_out:
         while (seg + 1) * dt_rec <= t + 1e-9 * dt_rec:
             seg += 1
@@ -593,15 +627,32 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         h_try = h
         if h_try >= room or t + 1.01 * h_try >= seg_end:
             h_try = room
+        if cf is not None:
+            if not linear_known:
+                linear, linear_known = linear_phase(cstate, structure, storey, friction), True
+            exact = linear and policy[0] == 1
+            if exact and valid[0] == 0:
+                start_phase(cf, y, k1, t, seg, forcing, ground)
+            elif not exact:
+                valid[0] = 0
+            if exact:
+                h_try = room
         h_before_events = h_try  # the error-controlled size a located event shortens
-        rejected, n_retake, collapse_pending = False, zero, False
+        rejected, n_retake, collapse_pending, n_graze = False, zero, False, zero
         _set_pending(events, -1.0, friction)
         while True:  # attempt -> locate -> retake, or apply events at the step's start and attempt again
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
-            stages(work, h_try, t, seg, forcing, lay, structure, contacts, cstate, storey, ground, friction)
-            err, finite = error_norm(work, h_try, tol, normed, rtol)
+            stepped = False
+            if cf is not None:
+                if exact:
+                    closed_form_step(cf, work, h_try, t, seg, forcing, structure, contacts, cstate, storey, ground,
+                                     friction)
+                    err, finite, stepped = 0.0, True, True
+            if not stepped:
+                stages(work, h_try, t, seg, forcing, lay, structure, contacts, cstate, storey, ground, friction)
+                err, finite = error_norm(work, h_try, tol, normed, rtol)
             if not finite or err > 1.0:
                 n_rej += 1
                 rejected = True
@@ -621,6 +672,15 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             if storey is not None:
                 s_first, collapse_s, collapse_floor, stop_status = _locate_storeys(
                     work, h_try, lay, structure, storey, events, s_first, collapse_floor, stop_status)
+            if cf is not None:
+                if exact and s_first > GRAZE_SPLIT and n_graze < MAX_GRAZE_SPLITS:
+                    # The exact δ might touch 0 before the first located event unseen by the cubic: halve.
+                    if graze_fraction(cf, work, h_try, lay, contacts, cstate, ground) < 1.0:
+                        n_graze += 1
+                        h_try *= GRAZE_SPLIT
+                        h_before_events = h_try
+                        _set_pending(events, -1.0, friction)
+                        continue
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 _keep_events_within(events, h_try, tiny, friction)
@@ -635,6 +695,10 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 if status != 0:
                     break
                 _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
+                if cf is not None:  # the events may end the linear phase, or change its constant load
+                    valid[0] = 0
+                    linear = linear_phase(cstate, structure, storey, friction)
+                    exact = _exact_start(cf, linear, t, seg, forcing, ground, work)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -653,9 +717,15 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             break
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
-        record_floor_peaks(work, h_used, n, below, peaks)
-        record_plane_peaks(work, h_used, n, structure.plane_floors, structure.plane_weights, structure.plane_width,
-                           peaks)
+        peaked = False
+        if cf is not None:
+            if exact:
+                record_exact_peaks(cf, work, h_used, n, structure, peaks)
+                peaked = True
+        if not peaked:
+            record_floor_peaks(work, h_used, n, below, peaks)
+            record_plane_peaks(work, h_used, n, structure.plane_floors, structure.plane_weights,
+                               structure.plane_width, peaks)
         rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
         if rows > trace.shape[0]:
             trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
@@ -667,14 +737,27 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             t_o = min(i_out * output_dt, t_new)
             s = (t_o - t) / h_used
             interpolate(work, h_used, s, ystage)
+            if cf is not None:
+                if exact and s < 1.0:
+                    exact_motion_at(cf, h_used, s, ystage)
             ag_o = _rates_at(t_o, seg, ystage, k2, forcing, structure, contacts, cstate, work, storey, ground, friction)
             record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, forces, storey, ground, out)
             record_friction(i_out, friction)
             i_out += 1
         t = t_new  # accept
         _accept(work)
+        if cf is not None:
+            if exact:
+                _keep_modal(cf)
+            else:
+                valid[0] = 0
+            if linear:
+                count_linear_step(policy, threshold, exact, t_new == seg_end)
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
+        if cf is not None:
+            if exact:  # only those found at the exact end: one the cubic placed early is found in the next step
+                _set_pending(events, -1.0, friction)
         any_events = _with_pending(events, friction)
         if storey is not None:  # located: this step ends where the drift limit is first exceeded (or stability lost)
             status = stop_status if collapse_s >= 0.0 or collapse_pending else status
@@ -685,6 +768,9 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, structure, contacts, cstate, work, events,
                                                           ImpactTable(impacts, n_imp), storey, ground, friction)
         if any_events and n_applied > 0:
+            if cf is not None:
+                valid[0] = 0
+                linear_known = False
             window_start, window_events, status = _count_events(t, n_applied, window_start, window_events, dt_rec,
                                                                 event_cap, status)
             _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
@@ -746,7 +832,8 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
               *, rtol: float, atol: float, atol_velocity: float, output_dt: float,
               scale_tolerances: bool = True, initial_displacement: np.ndarray | None = None,
               initial_velocity: np.ndarray | None = None,
-              floor_factors: np.ndarray | None = None) -> RawSolution:
+              floor_factors: np.ndarray | None = None, linear_phases: str = "exact",
+              closed_form_threshold: float | None = None) -> RawSolution:
     """Integrate the row of buildings under a piecewise-linear ground motion.
 
     Parameters
@@ -774,6 +861,14 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
     floor_factors : (N,) ndarray, optional
         Factors (0, 1] on atol and atol_velocity per floor, given by the caller (a plan model's
         rotations, :mod:`pounding.solver.plan_assembly`); replaces *scale_tolerances*.
+    linear_phases : {"exact", "runge-kutta"}
+        How the linear phases (every contact open, every storey elastic) are advanced: in closed form
+        (:mod:`pounding.solver.closed_form`; a model it refuses takes Runge–Kutta steps) or by the
+        Runge–Kutta steps of every other phase.
+    closed_form_threshold : float, optional
+        Runge–Kutta steps per record sample of a linear phase above which the closed form runs (default:
+        :func:`pounding.solver.closed_form.pays_threshold`, where it is cheaper); negative: every linear
+        phase in closed form (the tests' and benchmarks' setting).
     """
     # A fresh writable copy: a read-only array would compile a second specialisation.  One ground:
     # a 1-D array (ground None: the single-record solver); several: one row each (row 0 also as *ag*).
@@ -806,8 +901,11 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                         float(output_dt), float(first_step), factors)
     storey = _storey_arguments(system, float(atol))
     friction = _friction_argument(system, float(duration), float(output_dt))
+    cf = None
+    if linear_phases == "exact":
+        cf = run_closed_form(system, float(time_step), rows.shape[0], closed_form_threshold)
     raw = _integrate(system.layout, structure, contacts, storey, ground, friction, Forcing(ag, float(time_step)),
-                     settings, y_initial)
+                     settings, y_initial, cf)
     out, impacts, trace = raw.outputs, raw.impacts, raw.trace
     return RawSolution(out.time, out.state, out.acceleration, out.force, out.ground, out.potential,
                        raw.peaks.displacement, raw.peaks.drift, raw.peaks.force,
@@ -820,7 +918,7 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        None if ground is None else out.support,
                        _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)),
                        friction_history=None if friction is None else friction.history[:out.time.size].copy(),
-                       peak_plane_drift=raw.peaks.plane)
+                       peak_plane_drift=raw.peaks.plane, exact_steps=0 if cf is None else int(cf.policy[3]))
 
 
 def _friction_argument(system: System, duration: float, output_dt: float) -> Friction | None:
