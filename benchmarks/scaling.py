@@ -245,13 +245,13 @@ def by_storeys(sides: list[Side], storeys: list[int], repeat: int) -> list[dict]
     return rows
 
 
-def by_duration(sides: list[Side], repeat: int, n: int = 20) -> list[dict]:
-    """Cost against the record's length: the 2 × *n* pair under record 1a repeated, 10 … 120 s."""
+def by_duration(sides: list[Side], durations: list[float], repeat: int, n: int = 20) -> list[dict]:
+    """Cost against the record's length: the 2 × *n* pair under record 1a repeated, for *durations* (s)."""
     print(f"\n== cost against duration: 2 x {n} pair, {RECORD} repeated back to back, median of {repeat} ==")
     header("duration s", 10, None)
     rows: list[dict] = []
-    for duration in DURATIONS:
-        row = {"duration": duration, **measure(sides, repeat, n, duration, repeated=max(DURATIONS))}
+    for duration in durations:
+        row = {"duration": duration, **measure(sides, repeat, n, duration, repeated=max(durations))}
         print_point(f"{duration:.0f}", row, 10)
         rows.append(row)
     for name in rows[0]["sides"]:
@@ -322,7 +322,7 @@ def plot(result: dict, path: str) -> None:
                        xytext=(0, -13), ha="center", fontsize=7)
     a.set_ylim(min(every) / 2, max(every) * 2)
     for axis in (a.xaxis, a.yaxis):
-        axis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+        axis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
         axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     a.set_xticks(floors)
     a.set_yticks([t for t in (0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
@@ -347,6 +347,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=5, help="runs per point and side (median)")
     parser.add_argument("--storeys", type=int, nargs="+", default=STOREYS, metavar="N",
                         help=f"storeys per building of the 2 x N pairs (default: {' '.join(map(str, STOREYS))})")
+    parser.add_argument("--durations", type=float, nargs="+", default=DURATIONS, metavar="T",
+                        help=f"simulated seconds of the 2 x 20 pair (default: {' '.join(f'{d:g}' for d in DURATIONS)})")
     parser.add_argument("--before", metavar="REF", help="measure this commit (or checkout folder) as well, "
                         "alternating with this tree")
     parser.add_argument("--before-settings", type=setting, action="append", metavar="KEY=VALUE",
@@ -360,15 +362,16 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.update_docs and args.no_plot:
         parser.error("--update-docs rewrites docs/scaling.png: leave out --no-plot")
-    if args.repeat < 1 or min(args.storeys) < 1:
-        parser.error("--repeat and --storeys take whole numbers >= 1")
+    if args.repeat < 1 or min(args.storeys) < 3 or min(args.durations) <= 0:
+        parser.error("--repeat takes a whole number >= 1, --storeys >= 3 (damped at modes 1 and 3), "
+                     "--durations seconds > 0")
     out = out_dir(args, "scaling")
     started = time.perf_counter()
     sides = start_sides(args, out)
     try:
         result = {"sides": {side.name: side.label for side in sides},
                   "storeys": by_storeys(sides, sorted(set(args.storeys)), args.repeat),
-                  "durations": by_duration(sides, args.repeat)}
+                  "durations": by_duration(sides, sorted(set(args.durations)), args.repeat)}
     finally:
         for side in sides:
             side.close()
