@@ -12,7 +12,10 @@ stdout (anything the library prints goes to stderr):
   "repeated": total or null}``: simulate the 2 × n pair under record 1a (or
   1a repeated back to back to *total* seconds), for *T* seconds (null: the
   record's length); ``{"wall_time": s, "duration": s, "steps", "impacts",
-  "contacts"}``.
+  "contacts"}``.  ``wall_time`` is the solver's own wall time (the archive's
+  attribute), or with the argument ``cpu`` its thread's CPU time over the same
+  call (``pounding.simulation.integrate`` timed by ``time.thread_time``; on a
+  machine shared with other jobs the wall time also counts waiting for a core).
 
 Settings are ``KEY=VALUE`` strings written into the model's ``solver:``
 mapping as ``KEY: VALUE`` lines, so a value is read by the model's own YAML
@@ -26,6 +29,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from typing import Any, TextIO
 
 import numpy as np
@@ -71,11 +75,35 @@ def repeated_record(total: float):
 
 
 class Runs:
-    """The models and records of one process, built once each; answers the requests."""
+    """The models and records of one process, built once each; answers the requests.
 
-    def __init__(self) -> None:
+    *clock*: ``wall`` (the solver's wall time) or ``cpu`` (its thread's CPU time).
+    """
+
+    def __init__(self, clock: str = "wall") -> None:
         self.models: dict[tuple[int, tuple[str, ...]], Any] = {}
         self.records: dict[float | None, Any] = {}
+        self.cpu: list[float] | None = None
+        if clock == "cpu":
+            self.cpu = []
+            self.time_the_solver_s_thread()
+
+    def time_the_solver_s_thread(self) -> None:
+        """Wrap ``pounding.simulation.integrate`` to note its thread's CPU time in ``self.cpu``."""
+        import pounding.simulation as simulation
+
+        solve = getattr(simulation, "integrate", None)
+        if solve is None:
+            return  # each run then answers an error
+
+        def timed(*args, **kwargs):
+            started = time.thread_time()
+            try:
+                return solve(*args, **kwargs)
+            finally:
+                self.cpu.append(time.thread_time() - started)
+
+        simulation.integrate = timed
 
     def model(self, n: int, settings: list[str]):
         from pounding.model.model import model_from_text
@@ -103,14 +131,20 @@ class Runs:
             return {"version": pounding.__version__}
         kw = {} if request["duration"] is None else {"duration": request["duration"]}
         ds = pounding.simulate(model, self.record(request["repeated"]), **kw)
-        return {"wall_time": float(ds.attrs["wall_time"]), "duration": float(ds.attrs["duration"]),
+        spent = float(ds.attrs["wall_time"])
+        if self.cpu is not None:
+            if len(self.cpu) != 1:
+                return {"error": "--clock cpu: this tree's simulate() does not call pounding.simulation.integrate "
+                                 "once per run; measure with --clock wall"}
+            spent = self.cpu.pop()
+        return {"wall_time": spent, "duration": float(ds.attrs["duration"]),
                 "steps": int(ds.attrs["solver_steps"]), "impacts": int(ds.impact_count.sum()),
                 "contacts": int(ds.sizes["contact"])}
 
 
-def serve(requests: TextIO, answers: TextIO) -> None:
+def serve(requests: TextIO, answers: TextIO, clock: str) -> None:
     """Answer each request line of *requests* with one line on *answers*, until end of input."""
-    runs = Runs()
+    runs = Runs(clock)
     for line in requests:
         answers.write(json.dumps(runs.answer(json.loads(line))) + "\n")
         answers.flush()
@@ -118,4 +152,4 @@ def serve(requests: TextIO, answers: TextIO) -> None:
 
 if __name__ == "__main__":
     replies, sys.stdout = sys.stdout, sys.stderr  # the library's prints must not mix with the answers
-    serve(sys.stdin, replies)
+    serve(sys.stdin, replies, sys.argv[1] if len(sys.argv) > 1 else "wall")

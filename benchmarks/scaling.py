@@ -48,12 +48,12 @@ both alike; printed per point: each side's time and the ratio after / before.
   ``output_dt`` 0.005 and 0.05 s to show that decimating the output never
   changes the peaks or the impacts (they are tracked at full solver resolution).
 
-Time on the development machine (2 shared cores, Runge-Kutta for every
-phase): one side at the default ``--repeat 5`` ~1.5 min plus ~10 s of memory
-run; the 2 × 500 point is most of it (~3 s a run: 2.2 s solving, the rest
-building the 1000-floor dataset).  Two sides take twice the measuring time,
-~3.5 min; a first ``--before`` of a commit adds its extraction and numba
-compilation.
+Time on the development machine (2 cores shared with other jobs, load 4 – 6,
+Runge-Kutta for every phase): the default run with ``--before`` (two sides,
+``--repeat 5``, memory run included) took 143 s, of which the 2 × 500 point
+54 s (~3 s a run: its solver, then the 1000-floor dataset) and the memory run
+29 s; one side takes about half the measuring, ~1.5 min in all.  A first
+``--before`` of a commit adds its extraction and numba compilation (~50 s).
 """
 
 from __future__ import annotations
@@ -88,11 +88,11 @@ DURATIONS = [10.0, 20.0, 30.0, 60.0, 90.0, 120.0]
 class Side:
     """One side of the comparison: a tree and the ``solver:`` settings of its models, in its own process."""
 
-    def __init__(self, name: str, tree_label: str, tree: Path, settings: list[str]) -> None:
+    def __init__(self, name: str, tree_label: str, tree: Path, settings: list[str], clock: str) -> None:
         self.name, self.tree, self.settings = name, tree, settings
         self.tree_label, self.label = tree_label, tree_label + (f" [{', '.join(settings)}]" if settings else "")
         env = dict(os.environ, PYTHONPATH=str(tree))
-        self.process = subprocess.Popen([sys.executable, str(WORKER)], cwd=tree, env=env, text=True,
+        self.process = subprocess.Popen([sys.executable, str(WORKER), clock], cwd=tree, env=env, text=True,
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE)
 
     def ask(self, **request) -> dict:
@@ -164,10 +164,11 @@ def start_sides(args: argparse.Namespace, out: Path) -> list[Side]:
     """The measured sides, each checked (its models built with its settings) before any timing."""
     after = this_tree_label()
     if args.before is None and args.before_settings is None:
-        sides = [Side("this", after, ROOT, args.settings)]
+        sides = [Side("this", after, ROOT, args.settings, args.clock)]
     else:
         tree, label = tree_of(args.before, out) if args.before else (ROOT, after)
-        sides = [Side("before", label, tree, args.before_settings or []), Side("after", after, ROOT, args.settings)]
+        sides = [Side("before", label, tree, args.before_settings or [], args.clock),
+                 Side("after", after, ROOT, args.settings, args.clock)]
     try:
         for side in sides:
             started = time.perf_counter()
@@ -356,6 +357,8 @@ def main(argv: list[str] | None = None) -> int:
                         "settings of this tree")
     parser.add_argument("--settings", type=setting, action="append", default=[], metavar="KEY=VALUE",
                         help="solver: setting of this tree's models (repeatable), e.g. linear_phases=runge-kutta")
+    parser.add_argument("--clock", choices=("wall", "cpu"), default="wall",
+                        help="the solver's wall time (default) or its thread's CPU time")
     parser.add_argument("--no-plot", action="store_true", help="draw no figure")
     parser.add_argument("--no-memory", action="store_true", help="skip the /usr/bin/time memory run")
     add_output_arguments(parser, "scaling", owns=("docs/scaling.png",))
