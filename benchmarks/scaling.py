@@ -329,12 +329,12 @@ def plot(result: dict, path: str) -> None:
     a.set_yticks([t for t in (0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
                   if min(every) / 2 <= t <= max(every) * 2])
     a.set_xlabel("floors (2 x n)" + (";  figures: after / before" if "after" in result["sides"] else ""))
-    a.set_ylabel("solver time per simulated second (ms)")
+    a.set_ylabel(f"solver {'CPU ' if result['clock'] == 'cpu' else ''}time per simulated second (ms)")
     a.set_title(f"cost against storeys ({RECORD}, 30 s)")
     a.legend(fontsize=7)
     b.set_ylim(bottom=0)
     b.set_xlabel("simulated duration (s)")
-    b.set_ylabel("solver time per simulated second (ms)")
+    b.set_ylabel(f"solver {'CPU ' if result['clock'] == 'cpu' else ''}time per simulated second (ms)")
     b.set_title("cost against duration (2 x 20, record repeated)")
     b.legend(fontsize=7)
     fig.tight_layout()
@@ -372,7 +372,7 @@ def main(argv: list[str] | None = None) -> int:
     started = time.perf_counter()
     sides = start_sides(args, out)
     try:
-        result = {"sides": {side.name: side.label for side in sides},
+        result = {"sides": {side.name: side.label for side in sides}, "clock": args.clock,
                   "storeys": by_storeys(sides, sorted(set(args.storeys)), args.repeat),
                   "durations": by_duration(sides, sorted(set(args.durations)), args.repeat)}
     finally:
