@@ -53,3 +53,41 @@ def test_help_offers_out_and_update_docs_only_where_docs_are_owned(script):
     assert ("--update-docs" in done.stdout) == bool(owns)
     for path in owns:
         assert path in done.stdout
+
+
+def _scaling(tmp_path: Path, *options: str) -> subprocess.CompletedProcess:
+    """``benchmarks/scaling.py`` in its smallest form: 2 x 3 storeys, 1 s, one run, no figure, no memory run."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    command = [sys.executable, str(BENCHMARKS / "scaling.py"), "--storeys", "3", "--durations", "1", "--repeat", "1",
+               "--no-plot", "--no-memory", "--out", str(tmp_path), *options]
+    return subprocess.run(command, capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
+
+
+def test_scaling_before_and_after_with_the_same_solver_take_the_same_steps(tmp_path):
+    """Two sides that differ only in a setting that does not change the step (a coarser output_dt):
+    the same steps and impacts on both, and a ratio after / before of the solver's CPU times at every point."""
+    import json
+
+    done = _scaling(tmp_path, "--before-settings", "output_dt=0.01", "--settings", "output_dt=0.02", "--clock", "cpu")
+    assert done.returncode == 0, done.stderr
+    found = json.loads((tmp_path / "scaling.json").read_text())
+    assert set(found["sides"]) == {"before", "after"}
+    assert "output_dt=0.02" in found["sides"]["after"]
+    for point in found["storeys"] + found["durations"]:
+        before, after = point["sides"]["before"], point["sides"]["after"]
+        assert (before["steps"], before["impacts"]) == (after["steps"], after["impacts"])
+        assert min(before["times"] + after["times"]) > 0 and point["after_over_before"] > 0
+
+
+@pytest.mark.parametrize("options, says", [
+    (["--settings", "no_such_setting=1"], "--settings no_such_setting=1: 2 x 5 pair:"),
+    (["--before-settings", "rtol=abc"], "--before-settings rtol=abc: 2 x 5 pair:"),
+    (["--settings", "rtol"], "expected KEY=VALUE"),
+    (["--storeys", "2"], "--storeys >= 3"),
+    (["--before", "no-such-commit"], "--before no-such-commit: neither a commit"),
+])
+def test_scaling_refuses_a_bad_side_in_one_line(tmp_path, options, says):
+    done = _scaling(tmp_path, *options)
+    assert done.returncode != 0
+    assert says in done.stderr and "Traceback" not in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 or "usage:" in done.stderr
