@@ -1,9 +1,12 @@
 """Whole-process time of the first and of a warm ``pounding run models/pair.yaml -o pair.nc``,
 this checkout against a baseline checkout, measured alternately in the same run (issue 24 §4).
 
-``python benchmarks/startup.py --baseline DIR [--cold 3] [--warm 5] [--no-prebuilt] [--out DIR]``
+``python benchmarks/startup.py --baseline DIR|REF [--cold 3] [--warm 7] [--no-prebuilt] [--out DIR]``
 
-*DIR* is another checkout of pounding (e.g. ``git worktree add --detach /tmp/base <commit>``).
+``--baseline`` is another checkout of pounding, or a git ref of this one (a commit, ``HEAD``,
+a branch): that tree is then checked out for the measurement in a temporary worktree
+(``git worktree add --detach``), removed afterwards, with this checkout's kernels compiled ahead of
+time copied into it (used only if the solver's sources are the same: their stamp is checked).
 Each tree runs as ``python -m pounding`` with ``PYTHONPATH`` set to it, from the tree's root.
 
 * **first run**: an empty numba cache (a fresh ``NUMBA_CACHE_DIR``) and an empty FEMA P695
@@ -34,12 +37,15 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -103,6 +109,29 @@ def measure(trees: dict[str, Path], cold: int, warm: int) -> dict[str, dict[str,
     return found
 
 
+@contextmanager
+def baseline_tree(given: str) -> Iterator[Path]:
+    """The checkout *given* names: a folder as it is, else a git ref checked out in a temporary worktree."""
+    folder = Path(given).expanduser()
+    if folder.is_dir():
+        yield folder.resolve()
+        return
+    with tempfile.TemporaryDirectory(prefix="pounding-baseline-") as tmp:
+        tree = Path(tmp) / "tree"
+        added = subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), given],
+                               capture_output=True, text=True)
+        if added.returncode != 0:
+            raise SystemExit(f"--baseline {given}: neither a folder nor a git ref of {ROOT} "
+                             f"({added.stderr.strip().splitlines()[-1] if added.stderr.strip() else 'git failed'})")
+        kernels = ROOT / "pounding" / "solver" / "prebuilt"
+        if kernels.is_dir():   # kernels built for other solver sources are ignored (their stamp): spares a compile
+            shutil.copytree(kernels, tree / "pounding" / "solver" / "prebuilt")
+        try:
+            yield tree
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
+
+
 def report(found: dict[str, dict[str, list[float]]]) -> dict[str, dict[str, float]]:
     medians = {name: {figure: statistics.median(values) for figure, values in figures.items() if values}
                for name, figures in found.items()}
@@ -118,23 +147,24 @@ def report(found: dict[str, dict[str, list[float]]]) -> dict[str, dict[str, floa
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--baseline", type=Path, required=True, help="another checkout of pounding")
+    parser.add_argument("--baseline", required=True,
+                        help="another checkout of pounding, or a git ref of this one (e.g. HEAD, main, a commit)")
     parser.add_argument("--cold", type=int, default=3, help="first runs of each tree (median; 0: none)")
-    parser.add_argument("--warm", type=int, default=5, help="warm runs of each tree (median)")
+    parser.add_argument("--warm", type=int, default=7, help="warm runs of each tree (median)")
     parser.add_argument("--no-prebuilt", action="store_true",
                         help="POUNDING_PREBUILT=0: kernels compiled ahead of time are not used (first runs compile)")
     add_output_arguments(parser, "startup")
     args = parser.parse_args(argv)
     if args.no_prebuilt:
         os.environ["POUNDING_PREBUILT"] = "0"
-    baseline = args.baseline.expanduser().resolve()
-    if not (baseline / "pounding" / "__init__.py").is_file():
-        parser.error(f"--baseline {baseline}: not a pounding checkout (no pounding/__init__.py)")
-    trees = {"baseline": baseline, "this": ROOT}
-    for name, tree in trees.items():
-        compile_bytecode(tree)
-        print(f"{name} ({tree}): {prebuilt_status(tree)}")
-    found = measure(trees, args.cold, args.warm)
+    with baseline_tree(args.baseline) as baseline:
+        if not (baseline / "pounding" / "__init__.py").is_file():
+            parser.error(f"--baseline {baseline}: not a pounding checkout (no pounding/__init__.py)")
+        trees = {"baseline": baseline, "this": ROOT}
+        for name, tree in trees.items():
+            compile_bytecode(tree)
+            print(f"{name} ({tree}): {prebuilt_status(tree)}")
+        found = measure(trees, args.cold, args.warm)
     medians = report(found)
     path = out_dir(args, "startup") / "startup.json"
     path.write_text(json.dumps({"runs": found, "medians": medians, "no_prebuilt": args.no_prebuilt}, indent=1))

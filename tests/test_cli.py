@@ -91,16 +91,18 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
     # process never makes any, so the console entry point marks dask absent
     # (≈0.5 s of start-up), and the other subcommands' modules are not
     # imported (≈0.05 s); the cyclic garbage collector is off and everything is
-    # frozen at the end (≈0.2 s); OpenBLAS starts no threads (≈0.05 s).  The
+    # frozen at the end (≈0.2 s); OpenBLAS starts no threads (≈0.05 s); pydantic
+    # does not read every installed distribution's entry points for plugins.  The
     # run must still write a complete archive.
     out = tmp_path / "run.nc"
     code = ("import os, sys; from pounding.cli import console_main; "
-            "os.environ.pop('OPENBLAS_NUM_THREADS', None); "
+            "os.environ.pop('OPENBLAS_NUM_THREADS', None); os.environ.pop('PYDANTIC_DISABLE_PLUGINS', None); "
             f"sys.argv = ['pounding', 'run', {PAIR!r}, '--duration', '3', '-o', {str(out)!r}]; "
             "status = console_main(exit_when_done=False); "
             "assert sys.modules.get('dask', 'absent') is None, 'dask was imported'; "
             "import gc, os; assert not gc.isenabled() and gc.get_freeze_count() > 0, 'the run was collected'; "
             "assert os.environ['OPENBLAS_NUM_THREADS'] == '1'; "
+            "assert os.environ['PYDANTIC_DISABLE_PLUGINS'] == '__all__', 'pydantic looked for plugins'; "
             "assert not [m for m, v in sys.modules.items() if v is not None and m.split('.')[0] in "
             "            ('matplotlib', 'distributed', 'tqdm')], 'matplotlib, distributed or tqdm imported'; "
             "other = [m for m in ('studies.sweep', 'studies.compare', 'studies.verify', 'studies.engine', "
@@ -111,6 +113,20 @@ def test_console_entry_point_keeps_dask_out_of_a_single_run(tmp_path):
             "sys.exit(status)")
     _python_succeeds(code)
     assert open_run(out).sizes["time"] == 301
+
+
+def test_a_run_reads_and_validates_its_model_once(tmp_path, monkeypatch):
+    # The model serves both the check that no output is one of the run's inputs (its record files)
+    # and the run itself: read once, the archive is the same.
+    import pounding.model.model as model_module
+
+    loads = []
+    load_model = model_module.load_model
+    monkeypatch.setattr(model_module, "load_model", lambda path: loads.append(path) or load_model(path))
+    out = tmp_path / "run.nc"
+    assert main(["run", PAIR, "--duration", "1", "-o", str(out)]) == 0
+    assert loads == [PAIR]
+    assert open_run(out).sizes["time"] == 101
 
 
 def test_a_single_run_exits_at_once_yet_runs_exit_handlers_and_flushes_its_output(tmp_path):

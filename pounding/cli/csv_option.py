@@ -77,12 +77,13 @@ def add_csv_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--csv", metavar="FILE", help=CSV_HELP)
 
 
-def check_outputs(args: argparse.Namespace, inputs: list | tuple = ()) -> None:
+def check_outputs(args: argparse.Namespace, inputs: list | tuple = (), *, model=None) -> None:
     """Before anything runs: no file the command writes is one of the files it reads.
 
     The outputs are ``-o``, ``--csv`` and the tables written beside it (``STEM.NAME.csv``); the inputs
     are :func:`command_inputs` and *inputs*, compared after resolving links and ``..``.  ``--csv`` is
-    also checked for its place (not a folder, not under a file, its folder writable).
+    also checked for its place (not a folder, not under a file, its folder writable).  *model*, the
+    command's ``MODEL`` already loaded, spares reading it again (:func:`command_inputs`).
 
     Raises
     ------
@@ -91,7 +92,7 @@ def check_outputs(args: argparse.Namespace, inputs: list | tuple = ()) -> None:
     """
     from pounding.results.archive import check_not_input, check_output_place
 
-    read = [*command_inputs(args), *inputs]
+    read = [*command_inputs(args, model=model), *inputs]
     output = getattr(args, "output", None)
     if output:
         check_not_input(output, read, "-o")
@@ -104,14 +105,15 @@ def check_outputs(args: argparse.Namespace, inputs: list | tuple = ()) -> None:
             check_not_input(beside, [*read, output], f"--csv {csv} writes tables beside it, and")
 
 
-def command_inputs(args: argparse.Namespace) -> list[str]:
+def command_inputs(args: argparse.Namespace, *, model=None) -> list[str]:
     """Every file the command of *args* reads that its outputs could land on.
 
     The model (``MODEL``) with its record files (:func:`pounding.simulation.model_inputs`: the model's
     record, each building's, the components of a pair), ``--record``, files among ``--records``, a sweep
     file with its base model and records, an archive (``table``, ``rerun``: the records a rerun reads
     again), a user spectrum and a cyclic protocol file.  A model or archive that cannot be read adds only
-    its own name: the command refuses it in its own words.
+    its own name: the command refuses it in its own words.  *model* is ``MODEL`` if the command has
+    loaded it already (:class:`pounding.model.model.Model`); else it is loaded here.
     """
     found: list[str] = []
     for name in ("model", "sweep", "archive", "run", "spectrum_file", "protocol", "record"):
@@ -126,7 +128,7 @@ def command_inputs(args: argparse.Namespace) -> list[str]:
             from pounding.model.model import load_model
             from pounding.simulation import model_inputs
 
-            found += model_inputs(load_model(args.model))
+            found += model_inputs(load_model(args.model) if model is None else model)
         if isinstance(getattr(args, "sweep", None), str):
             from pounding.studies.sweep import load_sweep
             from pounding.studies.sweep.execution import sweep_inputs

@@ -113,13 +113,25 @@ def _cmd_run(args: argparse.Namespace) -> int:
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
     if args.plot:
         _check_plot_dir(args.plot)
-    check_outputs(args)
+    model = _model_or_none(args.model)   # read once: for the inputs checked here and for the run
+    check_outputs(args, model=model)
     with output_lock(output):   # a second run onto the same name refuses here, before computing
-        return _run_locked(args, output, started)
+        return _run_locked(args, output, started, model)
 
 
-def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
-    """``pounding run`` once *output* is claimed."""
+def _model_or_none(path: str):
+    """The model of *path*, or None if it cannot be read (then :func:`_run_locked` reports why)."""
+    from pounding.errors import PoundingError
+    from pounding.model.model import load_model
+
+    try:
+        return load_model(path)
+    except (PoundingError, OSError):
+        return None
+
+
+def _run_locked(args: argparse.Namespace, output: Path, started: float, model=None) -> int:
+    """``pounding run`` once *output* is claimed; *model* is ``MODEL`` if already loaded."""
     from pounding.errors import PoundingError
     from pounding.results.archive import check_writable, save_run
     from pounding.results.checks import print_warnings, run_warnings
@@ -127,7 +139,8 @@ def _run_locked(args: argparse.Namespace, output: Path, started: float) -> int:
     from pounding.simulation import model_inputs, simulate
 
     check_writable(output, overwrite=args.overwrite, inputs=[args.model])   # finished by another meanwhile?
-    model = load_model(args.model)
+    if model is None:
+        model = load_model(args.model)   # raises the model's own one-line error
     scale = None if args.scale is None else parse_scale_option(args.scale, [b.name for b in model.buildings])
     refused = [flag for flag, given in (("--units", args.units), ("--dt", args.dt)) if given is not None]
     if refused and model.ground_motion.two_components:
