@@ -37,11 +37,12 @@ from pounding.model.scales import check_work
 from pounding.model.ground import ground_components
 from pounding.records.supports import SupportMotions, common_step, lagged, on_step, support_motions_from
 from pounding.results.archive import check_archive, open_run
-from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, run_peaks, to_dataset
+from pounding.results.dataset import ENERGY_CLOSURE_LIMIT, run_arrays, run_peaks, to_dataset
+from pounding.results.run_arrays import RunArrays
 from pounding.solver.assembly import GroundRows, assemble, contact_side_terms, refusal, tolerance_factors
 from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS_OK, STATUS_UNSTABLE, integrate
 
-__all__ = ["assemble", "contact_side_terms", "simulate", "with_overrides", "simulate_peaks", "record_for",
+__all__ = ["assemble", "contact_side_terms", "simulate", "simulate_arrays", "with_overrides", "simulate_peaks", "record_for",
            "processed_record_for", "component_records", "ground_on_grid", "support_motions", "SupportMotions", "rerun", "record_path",
            "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION", "estimate_memory", "available_memory", "check_memory",
            "model_inputs", "FAILED_STATUSES", "refuse_failed_run", "ground_rows"]
@@ -385,6 +386,25 @@ def simulate(model: Model, record: Record | str | None = None, xi: str | None = 
     return ds
 
 
+def simulate_arrays(model: Model) -> RunArrays:
+    """Run *model* under its own ground motion as :func:`simulate` does, its results left as plain arrays.
+
+    What a study's worker reads a run's values from when the run's own archive is not written (a sweep's
+    peaks, a gap study's separations): the same variables, coordinates and attributes as
+    ``simulate(model)``'s dataset, value for value, less ``run_spec``
+    (:func:`pounding.results.dataset.run_arrays`), without making the ``xarray.Dataset`` (~25 ms a run).
+    Errors as :func:`simulate`.
+    """
+    _check_modes_memory(model)
+    supports = support_motions(model, where="yaml")
+    end_time = _checked_end_time(model, supports)
+    assembly, raw, wall, rows = _solve(model, supports, end_time, model.solver.output_dt)
+    run = run_arrays(model, supports.records[0], assembly, raw, end_time=end_time, wall_time=wall,
+                     supports=dataclasses.replace(supports, rows=rows), archive=False)
+    mark_energy_status(run)
+    return run
+
+
 def with_overrides(model: Model, record: Record | str | list | None = None, *, xi: str | None = None,
                    scale: Any = None, duration: float | None = None, rtol: float | None = None,
                    atol: float | None = None, atol_velocity: float | None = None, output_dt: float | None = None,
@@ -588,7 +608,7 @@ def refuse_failed_run(status: str, message: str) -> None:
         raise PoundingError(message)
 
 
-def mark_energy_status(ds: xr.Dataset) -> str:
+def mark_energy_status(ds: xr.Dataset | RunArrays) -> str:
     """Set the archive attribute ``energy_status``: ``ok``, or a warning when energy does not close.
 
     A closure error above :data:`ENERGY_CLOSURE_LIMIT` (or not finite) means

@@ -3,7 +3,9 @@
 A worker that runs one model many times (an IDA: every stripe of a variant and a record) keeps the
 model's assembly (:func:`pounding.simulation.reused_assembly`); a cache keyed wrong would hand one
 model another's stiffnesses.  The energy audit is summed on plain arrays; xarray is kept from
-importing ``dask.array`` where nothing is a dask array (:mod:`pounding.results.lazy_dask`).
+importing ``dask.array`` where nothing is a dask array (:mod:`pounding.results.lazy_dask`).  A sweep's,
+compare's or gap study's worker reads each run's values from its plain arrays
+(:func:`pounding.simulation.simulate_arrays`), which must hold the archive's values.
 """
 
 from __future__ import annotations
@@ -127,3 +129,43 @@ def test_datasets_are_built_without_importing_dask_array_and_dask_arrays_still_w
     imported, chunks = out.stdout.splitlines()
     assert imported == "False"
     assert chunks == "((3, 3),) dask 6.0"
+
+
+@pytest.mark.parametrize("path", ["models/pair_links.yaml", "models/pair_on_soil.yaml", "models/corner_pair.yaml"])
+def test_a_run_left_as_arrays_holds_its_archive_values(path):
+    """What a sweep's or gap study's worker reads instead of the dataset (simulate_arrays) holds every
+    variable, coordinate and attribute of simulate()'s archive, bit for bit, less run_spec (what a rerun
+    needs; the worker never writes the run's archive).  Models of one chain of storeys, of weighted rows
+    (a foundation) and in plan."""
+    from pounding.model.model import load_model
+    from pounding.simulation import simulate_arrays
+
+    model = load_model(ROOT / path).with_ground_motion(duration=3.0)
+    ds, run = simulate(model), simulate_arrays(model)
+    assert set(ds.variables) == set(run.variables)
+    assert set(ds.coords) == set(run.coords)
+    assert dict(ds.sizes) == run.dims
+    for name, variable in ds.variables.items():
+        assert variable.dims == run[name].dims, name
+        np.testing.assert_array_equal(variable.values, run[name].values, err_msg=name)   # bit for bit
+    moving = {"history", "created", "wall_time", "run_spec"}   # the clock, and the archive's own
+    assert {k: repr(v) for k, v in ds.attrs.items() if k not in moving} == \
+        {k: repr(v) for k, v in run.attrs.items() if k not in moving}   # repr: a NaN equals a NaN
+    assert "run_spec" in ds.attrs and "run_spec" not in run.attrs
+
+
+def test_a_sweep_scenario_keeps_the_same_values_whether_its_archive_is_written_or_not():
+    """A scenario run with --keep-histories (its dataset built and returned) and without (plain arrays)
+    gives the same part: peaks, energy closure error, warnings, intensity."""
+    from pounding.studies.sweep.scenario import run_scenario
+    from pounding.studies.sweep.spec import load_sweep
+
+    sweep = load_sweep(ROOT / "tests" / "data" / "fingerprint_sweep.yaml")
+    task = next(iter(sweep.scenarios())).task(sweep_label=sweep.label, name=sweep.model_name)
+    kept, light = run_scenario({**task, "keep_history": True}), run_scenario(task)
+    assert kept["status"] == light["status"] == "ok", (kept["error"], light["error"])
+    assert "dataset" in kept and "dataset" not in light
+    for part in (kept, light):
+        for name in ("dataset", "wall_time", "solver_wall_time"):   # the clock; the archive kept
+            part.pop(name, None)
+    assert kept == light

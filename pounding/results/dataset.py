@@ -53,6 +53,7 @@ from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.results.corners import CORNERS, corner_displacements, floor_corners, hermite_at
 from pounding.results.lazy_dask import defer_dask_import
+from pounding.results.run_arrays import RunArrays
 from pounding.solver.assembly import Assembly, storey_stop_ratios
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver.kinematics import penetration as combined_penetration
@@ -64,7 +65,7 @@ from pounding.units import STANDARD_GRAVITY
 
 defer_dask_import()   # xarray's variables without importing dask.array (lazy_dask)
 
-__all__ = ["to_dataset", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
+__all__ = ["to_dataset", "run_arrays", "plane_arrays", "run_peaks", "energy_closure", "drop_ragged", "record_pga", "PGA_LONG_NAME", "REFERENCES",
            "RAGGED_DIMS", "loaded_record_pga"]
 
 #: Dimensions whose length depends on the run (impacts, full-resolution contact samples).
@@ -568,15 +569,28 @@ def _ragged_coords(variables: dict[str, Any], coords: dict[str, Any], raw: RawSo
 
 def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *,
                end_time: float, wall_time: float, supports=None) -> xr.Dataset:
-    """Build the results dataset of one simulation.
+    """Build the results dataset of one simulation (:func:`run_arrays`, made an ``xarray.Dataset``).
 
     *supports* (:class:`pounding.records.supports.SupportMotions`, rows as given to
     the solver) describes the ground under each building; without it every
     building stands on *record* (row 0 of the solution's ground).  Planes as weighted rows (floors
     in plan): :func:`plane_dataset`.
     """
+    return run_arrays(model, record, assembly, raw, end_time=end_time, wall_time=wall_time,
+                      supports=supports).to_dataset()
+
+
+def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *, end_time: float,
+               wall_time: float, supports=None, archive: bool = True) -> RunArrays:
+    """The variables, coordinates and attributes of one simulation's results dataset, as plain arrays
+    (:class:`~pounding.results.run_arrays.RunArrays`; arguments as :func:`to_dataset`).
+
+    *archive*: also the attribute ``run_spec`` (what a rerun needs: the effective model as YAML, ~7 ms a
+    run); a study's worker that keeps only the run's peaks leaves it out.
+    """
     if not assembly.chain and model.in_plan:
-        return plane_dataset(model, record, assembly, raw, end_time=end_time, wall_time=wall_time, supports=supports)
+        return plane_arrays(model, record, assembly, raw, end_time=end_time, wall_time=wall_time,
+                            supports=supports, archive=archive)
     system = assembly.system
     n = system.n_floors
     rows = None if assembly.chain else assembly   # planar storeys as weighted rows: a building on a foundation
@@ -761,7 +775,7 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         for name in ("energy_link_dissipated", "energy_link_strain", "link_force", "link_deformation",
                      "peak_link_force", "link_dissipated_energy"):
             del variables[name]
-    ds = xr.Dataset(variables, coords=_ragged_coords(variables, coords, raw, "gap element"))
+    ds = RunArrays(variables, _ragged_coords(variables, coords, raw, "gap element"))
     closure = energy_closure(ds)
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     ds.attrs = {
@@ -773,7 +787,7 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "model_name": model.name,
         "model_path": str(model.path or ""),
         "model_yaml": model.source,
-        "run_spec": json.dumps(run_spec(model, record, end_time, ground)),
+        "run_spec": json.dumps(run_spec(model, record, end_time, ground)) if archive else "",
         "multi_support": ("per-building records" if model.has_building_records else
                           "wave passage" if model.ground_motion.wave_passage is not None else ""),
         "record_name": record.name,
@@ -826,6 +840,8 @@ def to_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         ds.attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
                                 "(the run without pounding)")
     ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"
+    if not archive:
+        del ds.attrs["run_spec"]
     return ds
 
 
@@ -1169,14 +1185,15 @@ def _floor_coords(model: Model) -> dict[str, tuple]:
 
 
 def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *, end_time: float,
-                    wall_time: float, status: dict[str, Any]) -> dict[str, Any]:
-    """A run's attributes with floors in plan: the model, the record pair and its factor, the solver, the status."""
+                    wall_time: float, status: dict[str, Any], archive: bool = True) -> dict[str, Any]:
+    """A run's attributes with floors in plan: the model, the record pair and its factor, the solver, the status
+    (*archive*: with ``run_spec``, :func:`run_arrays`)."""
     from pounding import __version__
 
     now = datetime.now(timezone.utc)
     components = [] if supports is None else [r for pair in zip(supports.records, supports.records_y) for r in pair]
     meta = record.metadata
-    spec = {"model": model.to_document(), "base_dir": model.ground_motion.base_dir,
+    spec = {"model": model.to_document() if archive else "", "base_dir": model.ground_motion.base_dir,
             "record": str(model.ground_motion.record or record.source), "scale": float(meta.get(
         "scale_factor", record.scale)), "duration": float(end_time),
             "component_sha256": [None if r is None else str(r.metadata.get("sha256", "")) for r in components[:2]]}
@@ -1206,6 +1223,8 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
                              "(the run without pounding)")
     attrs["multi_support"] = ("per-building records" if model.has_building_records else
                               "wave passage" if model.ground_motion.wave_passage is not None else "")
+    if not archive:
+        del attrs["run_spec"]
     return attrs
 
 
@@ -1248,7 +1267,15 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
                   wall_time: float, supports=None) -> xr.Dataset:
     """The archive of a run with plane rows (floors in plan): floors per direction with their rotation and
     corners, planes (drift, drift ratio, shear), each storey's largest plane drift ratio, contact points,
-    friction faces, impacts and the energy audit."""
+    friction faces, impacts and the energy audit (:func:`plane_arrays`, made an ``xarray.Dataset``)."""
+    return plane_arrays(model, record, assembly, raw, end_time=end_time, wall_time=wall_time,
+                        supports=supports).to_dataset()
+
+
+def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *, end_time: float,
+                 wall_time: float, supports=None, archive: bool = True) -> RunArrays:
+    """:func:`plane_dataset`'s variables, coordinates and attributes as plain arrays; *archive* as in
+    :func:`run_arrays`."""
     system = assembly.system
     n = system.n_floors
     nf = n // DOF_PER_FLOOR
@@ -1320,9 +1347,9 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
               **_floor_coords(model), **_plan_floor_labels(model), **_plane_labels(model), **_plane_coords(model),
               **contact_coords(model), **_point_labels(model), **_face_labels(model, assembly), **_link_coords(model)}
     status = plane_status(model, assembly, raw)
-    ds = xr.Dataset(data, coords=_ragged_coords(data, coords, raw, "contact point"),
-                    attrs=_plan_run_attrs(model, record, raw, supports, end_time=end_time, wall_time=wall_time,
-                                          status=status))
+    ds = RunArrays(data, _ragged_coords(data, coords, raw, "contact point"),
+                   _plan_run_attrs(model, record, raw, supports, end_time=end_time, wall_time=wall_time,
+                                   status=status, archive=archive))
     ds.attrs["energy_closure"] = plane_energy_closure(ds)
     ds.attrs["energy_closure_error"] = ds.attrs["energy_closure"]
     ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"

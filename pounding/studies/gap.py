@@ -277,8 +277,9 @@ def required_separations(model, ds) -> dict[str, np.ndarray]:
     ----------
     model : pounding.model.model.Model
         The model (its contact points, their sides and the buildings' modes).
-    ds : xarray.Dataset
-        Results of :func:`pounding.simulation.simulate` on *model* with its contacts held open
+    ds : xarray.Dataset or pounding.results.run_arrays.RunArrays
+        Results of :func:`pounding.simulation.simulate` (or :func:`~pounding.simulation.simulate_arrays`) on
+        *model* with its contacts held open
         (:meth:`pounding.model.model.Model.with_contacts_open`).
 
     Returns
@@ -357,20 +358,20 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
     Never raises for a problem of the scenario: the result then has
     ``status = "error"`` and the message.
     """
-    from pounding.model.model import model_from_text
     from pounding.results.checks import run_warnings
     from pounding.results.dataset import record_pga
-    from pounding.simulation import component_records, refuse_failed_run, simulate
+    from pounding.simulation import component_records, refuse_failed_run, simulate_arrays
     from pounding.studies.common import ground_pga
     from pounding.studies.engine.keys import PARTS_FORMAT
     from pounding.studies.engine.tasks import one_line
+    from pounding.studies.sweep.scenario import scenario_model
 
     started = time.perf_counter()
     result: dict[str, Any] = {"key": task["key"], "status": "error", "error": "", "study": GAP_PART,
                               "format": PARTS_FORMAT}
     try:
-        model = model_from_text(task["document"], name=task.get("name", "model"), base_dir=task.get("base_dir"))
-        ds = simulate(model.with_contacts_open())
+        model = scenario_model(task)
+        ds = simulate_arrays(model.with_contacts_open())   # its archive is never written: no dataset
         status = ds.attrs.get("status", "completed")
         message = str(ds.attrs.get("status_message", status))
         refuse_failed_run(status, message)   # energy_inconsistent: no answer, an error
