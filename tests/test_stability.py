@@ -14,6 +14,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import re
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -382,7 +384,11 @@ def test_contacts_that_dissipate_more_than_the_run_received_are_not_a_completed_
     assert ds.attrs["status"] == "energy_inconsistent"
     message = ds.attrs["status_message"]
     assert "\n" not in message and "tighten solver.atol" in message
-    assert message.startswith("energy_inconsistent: the contacts dissipated 7.")
+    # the amount is the unresolved run's (7.9e5 J with Runge-Kutta steps throughout, 1.05e5 J with its
+    # linear phases exact): any amount above what the run received is the inconsistency
+    dissipated, received = re.match(r"energy_inconsistent: the contacts dissipated ([0-9.e+]+) J, more than the "
+                                    r"([0-9.e+]+) J the run received", message).groups()
+    assert float(dissipated) > 1.5 * float(received)
     # run writes it (nothing computed is lost) and exits 1: a script must not take it as completed.
     assert main(["run", str(path), "-o", str(tmp_path / "z.nc")]) == 1
     assert "ENERGY INCONSISTENT: the contacts dissipated" in capsys.readouterr().out

@@ -31,7 +31,7 @@ the Runge–Kutta stages while :func:`linear_phase` holds, and keeps locating ev
 peaks and output samples on the step's cubic Hermite interpolant of exact end states
 and rates; :func:`graze_fraction` shortens a step whose interpolant might miss a
 grazing closure, :func:`refine_peaks` moves each peak found on the interpolant onto the
-exact solution, and :func:`exact_motion_at` gives the output samples inside a step.
+exact solution, and :func:`exact_state_at` gives the output samples inside a step.
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ from pounding.solver.kinematics import (combo, contact_sums, drift, fill_grounds
 from pounding.solver.rhs import rhs_called
 
 __all__ = ["ClosedForm", "closed_form", "closed_form_refusal", "linear_phase", "closed_form_step", "start_phase",
-           "graze_fraction", "record_exact_peaks", "exact_motion_at", "run_closed_form", "wants_exact",
+           "graze_fraction", "record_exact_peaks", "exact_state_at", "run_closed_form", "wants_exact",
            "count_linear_step", "pays_threshold", "GRAZE_SPLIT", "LINEAR_PHASES", "CONDITION_LIMIT",
            "QUADRATURE_ERROR"]
 
@@ -120,6 +120,7 @@ class ClosedForm(NamedTuple):
     load: np.ndarray          #: (3, m) complex: constant load f, β₀, β₁ of the trial step
     scratch: np.ndarray       #: (4, m) complex: step factors of a step other than the record step
     valid: np.ndarray         #: (1,) int, 1 while *z* and the constant load hold the current state
+    z_at: np.ndarray          #: (m,) complex scratch: the modal state at an output sample inside a step
     node_state: np.ndarray    #: (m,) complex scratch: the modal state at a quadrature node
     bound: np.ndarray         #: (m,) scratch: each mode's bound on |d⁴(w z)/dτ⁴| over the trial step
     policy: np.ndarray        #: (4,) int: window kind (0 probing, 1 exact), its linear samples, its Runge–Kutta
@@ -382,7 +383,8 @@ def _built(mass, damping, stiffness, system, record_step: float, n_grounds: int)
                     np.zeros((3, nodes.size, m), dtype=np.complex128), np.zeros(m, dtype=np.complex128),
                     np.zeros(m, dtype=np.complex128), np.zeros((3, m), dtype=np.complex128),
                     np.zeros((4, m), dtype=np.complex128), np.zeros(1, dtype=np.int64),
-                    np.zeros(m, dtype=np.complex128), np.zeros(m), np.zeros(4, dtype=np.int64),
+                    np.zeros(m, dtype=np.complex128), np.zeros(m, dtype=np.complex128), np.zeros(m),
+                    np.zeros(4, dtype=np.int64),
                     np.array([pays_threshold(row_start, mode_start)]))
     _fill_factors(cf, float(record_step))
     return cf
@@ -533,12 +535,12 @@ def start_phase(cf, y, rate, t, seg, forcing, ground) -> None:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
-def _modal_end(cf, h, t, seg, forcing, ground):
-    """The trial step's loads ``β₀, β₁`` (into ``cf.load[1:]``) and its end ``z(h)`` (``cf.z_end``);
-    returns whether its factors are the cached ones (:func:`_step_factors`)."""
+def _modal_end(cf, h, t, seg, forcing, ground, z_end):
+    """The trial step's loads ``β₀, β₁`` (into ``cf.load[1:]``; the same for any *h* inside the record step)
+    and ``z(h)`` into *z_end*; returns whether its factors are the cached ones (:func:`_step_factors`)."""
     cached = _step_factors(cf, h)
     fac = cf.factors if cached else cf.scratch
-    lam, gl, z, load, z_end = cf.eigenvalue, cf.ground_load, cf.z, cf.load, cf.z_end
+    lam, gl, z, load = cf.eigenvalue, cf.ground_load, cf.z, cf.load
     for i in range(lam.size):
         b0 = load[0, i]
         b1 = 0j
@@ -646,26 +648,40 @@ def _storey_work(y, ynew, lay, structure, storey) -> None:
     _ = n
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def _exact_state(cf, y, h, t, seg, forcing, structure, storey, ground, lay, out, z_out) -> None:
+    """The exact state *h* s after *t* (from *y* at *t*) into *out*, its modal state into *z_out*: the motion,
+    the energy audit and the yielding storeys' states; the contacts' states (all open) unchanged."""
+    n = lay.n_floors
+    cached = _modal_end(cf, h, t, seg, forcing, ground, z_out)
+    for i in range(2 * n, y.size):
+        out[i] = y[i]
+    _motion(cf, z_out, out)
+    out[lay.input_energy] = y[lay.input_energy] + _input_energy(cf, y, out, h, t, seg, forcing, ground, cached,
+                                                                structure.mass)
+    out[lay.damping_energy] = y[lay.damping_energy] + _damped_energy(cf, h)
+    if storey is not None:
+        _storey_work(y, out, lay, structure, storey)
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def closed_form_step(cf, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground, friction) -> None:
+def exact_state_at(cf, work, h, s, t, seg, forcing, structure, storey, ground, out) -> None:
+    """The exact state at fraction *s* of the accepted step of *h* s from *t* into *out* (an output sample
+    inside an exact step: its motion and its energy audit, not the cubic's)."""
+    _exact_state(cf, work.y, s * h, t, seg, forcing, structure, storey, ground, work.layout, out, cf.z_at)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def closed_form_step(cf, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground) -> None:
     """The exact trial step of *h* s from *t* (in record step *seg*) of a linear phase: its end state into
     ``work.ynew`` and its rate into ``work.K[6]`` (the interpolant's data, as a Runge–Kutta step's)."""
-    y, ynew, lay = work.y, work.ynew, work.layout
-    n = lay.n_floors
-    cached = _modal_end(cf, h, t, seg, forcing, ground)
-    for i in range(2 * n, y.size):
-        ynew[i] = y[i]
-    _motion(cf, cf.z_end, ynew)
-    ynew[lay.input_energy] = y[lay.input_energy] + _input_energy(cf, y, ynew, h, t, seg, forcing, ground, cached,
-                                                                 structure.mass)
-    ynew[lay.damping_energy] = y[lay.damping_energy] + _damped_energy(cf, h)
-    if storey is not None:
-        _storey_work(y, ynew, lay, structure, storey)
+    ynew, lay = work.ynew, work.layout
+    _exact_state(cf, work.y, h, t, seg, forcing, structure, storey, ground, lay, ynew, cf.z_end)
     t_end = t + h
     if ground is not None:
         fill_grounds(ground, forcing.record_step, seg, t_end, ground.now)
     rhs_called(ynew, ground_at(forcing.acceleration, forcing.record_step, seg, t_end), lay, structure, contacts,
-               cstate, work.K[6], work.fbuf, work.forces, storey, ground, friction)
+               cstate, work.K[6], work.fbuf, work.forces, storey, ground, None)  # a linear phase has no friction
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -845,25 +861,6 @@ def record_exact_peaks(cf, work, h, n, structure, peaks) -> None:
                                    combo(ynew, n, floors, weights, width, p), h, peaks.plane[p])
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def exact_motion_at(cf, h, s, out) -> None:
-    """Floor displacements and velocities at fraction *s* of the trial step on the exact solution into
-    *out* (its other states are left as they are: the interpolant's)."""
-    lam, z, load, zq = cf.eigenvalue, cf.z, cf.load, cf.node_state
-    tau = s * h
-    for i in range(lam.size):
-        x = lam[i] * tau
-        e = cmath.exp(x)
-        if abs(x) >= 1e-3:
-            p1 = (e - 1.0) / x
-            p2 = (p1 - 1.0) / x
-        else:
-            p1 = 1.0 + x / 2.0 + x * x / 6.0 + x * x * x / 24.0
-            p2 = 0.5 + x / 6.0 + x * x / 24.0 + x * x * x / 120.0
-        zq[i] = e * z[i] + tau * p1 * load[1, i] + tau * tau * p2 * load[2, i]
-    _motion(cf, zq, out)
-
-
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def wants_exact(cf) -> bool:
     """True in an exact window of the run (:func:`count_linear_step`)."""
@@ -921,7 +918,8 @@ def run_closed_form(system, record_step: float, n_grounds: int, threshold: float
     m = cf.eigenvalue.size
     cf = cf._replace(z=np.zeros(m, dtype=np.complex128), z_end=np.zeros(m, dtype=np.complex128),
                        load=np.zeros((3, m), dtype=np.complex128), scratch=np.zeros((4, m), dtype=np.complex128),
-                       valid=np.zeros(1, dtype=np.int64), node_state=np.zeros(m, dtype=np.complex128),
+                       valid=np.zeros(1, dtype=np.int64), z_at=np.zeros(m, dtype=np.complex128),
+                       node_state=np.zeros(m, dtype=np.complex128),
                        bound=np.zeros(m), policy=np.array([0, 0, 0, 0], dtype=np.int64),
                        threshold=cf.threshold.copy() if threshold is None else np.array([float(threshold)]))
     if cf.threshold[0] < 0.0:

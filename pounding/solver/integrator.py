@@ -92,7 +92,7 @@ from numba import njit
 from pounding import hysteresis
 from pounding.solver import imk, jit
 from pounding.solver import kernels
-from pounding.solver.closed_form import (GRAZE_SPLIT, closed_form_step, count_linear_step, exact_motion_at, graze_fraction,
+from pounding.solver.closed_form import (GRAZE_SPLIT, closed_form_step, count_linear_step, exact_state_at, graze_fraction,
                                          linear_phase, record_exact_peaks, run_closed_form, start_phase, wants_exact)
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
@@ -505,12 +505,121 @@ def _exact_start(cf, linear, t, seg, forcing, ground, work) -> bool:
     return True
 
 
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def _locate_contacts(work, h, t, seg, forcing, structure, contacts, cstate, events, storey, ground, friction):
+    """The contacts' events in a trial step of *h* s, their friction faces' and their stuck contacts'
+    releases: the first one's fraction of the step (2.0: none)."""
+    lay = work.layout
+    s_first, n_release = locate_contact_events(work, h, t, seg, forcing, lay, contacts, cstate, events, ground)
+    if friction is not None:  # before locate_releases: friction.force still holds the step's end
+        s_first = min(s_first, locate_friction_events(work, h, t, seg, forcing, lay, structure, contacts, cstate,
+                                                      storey, ground, friction))
+    if n_release > 0:
+        s_first = min(s_first, locate_releases(work, h, t, seg, forcing, structure, contacts, cstate, events,
+                                               storey, ground, friction))
+    return s_first
+
+
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _keep_modal(cf) -> None:
-    """An accepted exact step's end becomes the modal state."""
-    z, z_end = cf.z, cf.z_end
-    for i in range(z.size):
-        z[i] = z_end[i]
+def _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction, work):
+    """After events at *t*: ``(linear, exact)`` of the step from there (the events may end the linear phase or
+    change its constant load: a new modal state)."""
+    cf.valid[0] = 0
+    linear = linear_phase(cstate, structure, storey, friction)
+    return linear, _exact_start(cf, linear, t, seg, forcing, ground, work)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED)
+def _record_closed(work, h, t, contacts, cstate, ground, peaks, impacts, trace, n_trace):
+    """The closed contacts over an accepted step (:func:`.recorder.record_contacts`), the trace grown to
+    hold their samples: ``(trace, rows in use, status)``."""
+    zero = n_trace - n_trace
+    rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
+    if rows > trace.shape[0]:
+        trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
+    n_trace, status = record_contacts(work, h, t, work.layout, contacts, cstate, ground, peaks, impacts, trace,
+                                      n_trace)
+    return trace, n_trace, status
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, storey, ground, friction, work):
+    """``(linear, linear_known, exact)`` of the step from *t*: whether the phase is linear is decided again
+    only after events (*linear_known* False), and a linear phase's step is exact in an exact window."""
+    if cf is None:
+        return False, True, False
+    if not linear_known:
+        linear, linear_known = linear_phase(cstate, structure, storey, friction), True
+    return linear, linear_known, _exact_start(cf, linear, t, seg, forcing, ground, work)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _phase_ended(cf) -> bool:
+    """Events were applied: the linear phase (if any) must be decided again; returns False (not known)."""
+    if cf is not None:
+        cf.valid[0] = 0
+    return False
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _exact_accepted(cf, exact, linear, at_sample) -> None:
+    """After an accepted step: an exact step's end becomes the modal state (a Runge–Kutta step ends the
+    phase's modal state), and a linear phase's step is counted (:func:`.closed_form.count_linear_step`)."""
+    if cf is None:
+        return
+    if exact:
+        z, z_end = cf.z, cf.z_end
+        for i in range(z.size):
+            z[i] = z_end[i]
+    else:
+        cf.valid[0] = 0
+    if linear:
+        count_linear_step(cf.policy, cf.threshold, exact, at_sample)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _exact_step(cf, exact, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground) -> bool:
+    """Take the trial step in closed form if it is an exact one (:func:`.closed_form.closed_form_step`)."""
+    if cf is None or not exact:
+        return False
+    closed_form_step(cf, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground)
+    return True
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _grazes(cf, exact, s_first, n_graze, work, h, lay, contacts, cstate, ground) -> bool:
+    """An exact trial step to halve: no event before GRAZE_SPLIT, halvings left, and an open contact's exact
+    δ might touch 0 unseen by the cubic (:func:`.closed_form.graze_fraction`)."""
+    if cf is None or not exact or s_first <= GRAZE_SPLIT or n_graze >= MAX_GRAZE_SPLITS:
+        return False
+    return graze_fraction(cf, work, h, lay, contacts, cstate, ground) < 1.0
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def _record_peaks(cf, exact, work, h, n, structure, peaks) -> None:
+    """The peaks over an accepted step: on the cubic of a Runge–Kutta step, on the exact solution of an
+    exact one (:func:`.closed_form.record_exact_peaks`)."""
+    if cf is not None:
+        if exact:
+            record_exact_peaks(cf, work, h, n, structure, peaks)
+            return
+    record_floor_peaks(work, h, n, structure.below, peaks)
+    record_plane_peaks(work, h, n, structure.plane_floors, structure.plane_weights, structure.plane_width, peaks)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _exact_output(cf, exact, work, h, s, t, seg, forcing, structure, storey, ground, out) -> None:
+    """An output sample inside an exact step: the exact state (:func:`.closed_form.exact_state_at`)."""
+    if cf is not None and exact and s < 1.0:
+        exact_state_at(cf, work, h, s, t, seg, forcing, structure, storey, ground, out)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _exact_end_events(cf, exact, events, friction) -> None:
+    """At an exact step's end only the events found there are applied (the pending ones are dropped): one
+    the long step's cubic placed a little early is found at the start of the next step."""
+    if cf is not None and exact:
+        _set_pending(events, -1.0, friction)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -581,21 +690,17 @@ def _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial, cf):
-    """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile
-    time; *cf* (:class:`~pounding.solver.closed_form.ClosedForm`, None: Runge–Kutta steps throughout) advances
-    the linear phases in closed form."""
+    """The run (module docstring); *storey*, *ground*, *friction*, *cf* (the linear phases' closed form,
+    :mod:`.closed_form`) None: their blocks are pruned at compile time."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
     dt_rec, t_end, output_dt = forcing.record_step, settings.end_time, settings.output_step
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
-    # Sizes and counters non-literal (``zero``): a literal reaching np.empty or a callee compiles a throw-away one.
-    zero = nc - nc
+    zero = nc - nc  # sizes and counters non-literal: a literal reaching np.empty or a callee compiles a throw-away one
     work = Work(np.zeros(S), np.zeros(S), np.zeros(S), np.zeros((zero + 7, S)), np.zeros(n), np.zeros(nc), np.zeros(nc),
                 lay)
     y, ystage, k1, k2 = work.y, work.ystage, work.K[0], work.K[1]
-    # Arrays are taken out of the records once, here: each ``record.member`` in the loop counts a reference.
-    below, forces, rtol = structure.below, work.forces, settings.rtol
-    for i in range(2 * n):
-        y[i] = y_initial[i]
+    forces, rtol = work.forces, settings.rtol  # taken out once: each ``record.member`` in the loop counts a reference
+    y[:2 * n] = y_initial[:2 * n]
     tol = np.empty(S)  # each state's absolute tolerance in the error norm
     fill_tolerances(tol, lay, contacts, settings.atol, settings.atol_velocity, settings.floor_factor, storey)
     cstate, events = _new_contact_state(contacts), _new_events(contacts, nh, tol)
@@ -606,19 +711,13 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     trace, n_trace = np.empty((zero + 1024, zero + 4)), zero  # full-resolution samples of closed contacts
     t, seg = 0.0, zero
     ag_t = _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
-    # No contact force in the first sample (work.forces_end is still all 0; a link's first force is not kept).
-    record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces_end, storey, ground, out)
+    record_sample(zero, t, y, k1, ag_t, lay, structure, contacts, work.forces_end, storey, ground, out)  # no force yet
     record_friction(zero, friction)
     h, n_steps, n_rej, status, collapse_floor, i_out = settings.first_step, zero, zero, zero, zero - 1, zero + 1
     tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
     window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
     stop_status = zero + STATUS_COLLAPSED  # which stop collapse_s / collapse_pending is: collapsed or unstable
-    # The closed form's flags, taken out of *cf* once (a record member read in the loop counts a reference);
-    # whether the phase is linear changes only at events, so it is decided after each (linear_known).
-    exact, linear, linear_known = False, False, False
-    valid, policy, threshold = np.zeros(1, dtype=np.int64), np.zeros(4, dtype=np.int64), np.zeros(1)
-    if cf is not None:
-        valid, policy, threshold = cf.valid, cf.policy, cf.threshold
+    exact, linear, linear_known = False, False, False  # linear changes only at events: decided after each
     while t < t_end - tiny and i_out <= n_out:
         while (seg + 1) * dt_rec <= t + 1e-9 * dt_rec:
             seg += 1
@@ -627,16 +726,10 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         h_try = h
         if h_try >= room or t + 1.01 * h_try >= seg_end:
             h_try = room
-        if cf is not None:
-            if not linear_known:
-                linear, linear_known = linear_phase(cstate, structure, storey, friction), True
-            exact = linear and policy[0] == 1
-            if exact and valid[0] == 0:
-                start_phase(cf, y, k1, t, seg, forcing, ground)
-            elif not exact:
-                valid[0] = 0
-            if exact:
-                h_try = room
+        linear, linear_known, exact = _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, storey,
+                                                 ground, friction, work)
+        if exact:
+            h_try = room
         h_before_events = h_try  # the error-controlled size a located event shortens
         rejected, n_retake, collapse_pending, n_graze = False, zero, False, zero
         _set_pending(events, -1.0, friction)
@@ -644,43 +737,26 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
-            stepped = False
-            if cf is not None:
-                if exact:
-                    closed_form_step(cf, work, h_try, t, seg, forcing, structure, contacts, cstate, storey, ground,
-                                     friction)
-                    err, finite, stepped = 0.0, True, True
-            if not stepped:
+            if _exact_step(cf, exact, work, h_try, t, seg, forcing, structure, contacts, cstate, storey, ground):
+                err, finite = 0.0, True
+            else:
                 stages(work, h_try, t, seg, forcing, lay, structure, contacts, cstate, storey, ground, friction)
                 err, finite = error_norm(work, h_try, tol, normed, rtol)
             if not finite or err > 1.0:
-                n_rej += 1
-                rejected = True
+                n_rej, rejected = n_rej + 1, True
                 h_try *= step_factor(err, finite, False)
                 h_before_events, n_retake, collapse_pending = h_try, zero, False
                 _set_pending(events, -1.0, friction)
                 continue
-            s_first, n_release = locate_contact_events(work, h_try, t, seg, forcing, lay, contacts, cstate, events,
-                                                       ground)
-            if friction is not None:  # before locate_releases: friction.force still holds the step's end
-                s_first = min(s_first, locate_friction_events(work, h_try, t, seg, forcing, lay, structure, contacts,
-                                                              cstate, storey, ground, friction))
-            if n_release > 0:
-                s_first = min(s_first, locate_releases(work, h_try, t, seg, forcing, structure, contacts, cstate,
-                                                       events, storey, ground, friction))
-            collapse_s = -1.0
+            s_first, collapse_s = _locate_contacts(work, h_try, t, seg, forcing, structure, contacts, cstate, events,
+                                                   storey, ground, friction), -1.0
             if storey is not None:
                 s_first, collapse_s, collapse_floor, stop_status = _locate_storeys(
                     work, h_try, lay, structure, storey, events, s_first, collapse_floor, stop_status)
-            if cf is not None:
-                if exact and s_first > GRAZE_SPLIT and n_graze < MAX_GRAZE_SPLITS:
-                    # The exact δ might touch 0 before the first located event unseen by the cubic: halve.
-                    if graze_fraction(cf, work, h_try, lay, contacts, cstate, ground) < 1.0:
-                        n_graze += 1
-                        h_try *= GRAZE_SPLIT
-                        h_before_events = h_try
-                        _set_pending(events, -1.0, friction)
-                        continue
+            if _grazes(cf, exact, s_first, n_graze, work, h_try, lay, contacts, cstate, ground):
+                n_graze, h_try, h_before_events = n_graze + 1, h_try * GRAZE_SPLIT, h_try * GRAZE_SPLIT  # halve
+                _set_pending(events, -1.0, friction)
+                continue
             if s_first <= 1.0 and s_first * h_try <= tiny:
                 # Events at the very start of the step: apply them at t and redo the step.
                 _keep_events_within(events, h_try, tiny, friction)
@@ -696,9 +772,8 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                     break
                 _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
                 if cf is not None:  # the events may end the linear phase, or change its constant load
-                    valid[0] = 0
-                    linear = linear_phase(cstate, structure, storey, friction)
-                    exact = _exact_start(cf, linear, t, seg, forcing, ground, work)
+                    linear, exact = _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction,
+                                                        work)
                 if cap < h_try:
                     h_try = cap
                     h_before_events = cap
@@ -717,47 +792,25 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             break
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
-        peaked = False
-        if cf is not None:
-            if exact:
-                record_exact_peaks(cf, work, h_used, n, structure, peaks)
-                peaked = True
-        if not peaked:
-            record_floor_peaks(work, h_used, n, below, peaks)
-            record_plane_peaks(work, h_used, n, structure.plane_floors, structure.plane_weights,
-                               structure.plane_width, peaks)
-        rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
-        if rows > trace.shape[0]:
-            trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
-        n_trace, status = record_contacts(work, h_used, t, lay, contacts, cstate, ground, peaks, impacts, trace,
-                                          n_trace)
+        _record_peaks(cf, exact, work, h_used, n, structure, peaks)
+        trace, n_trace, status = _record_closed(work, h_used, t, contacts, cstate, ground, peaks, impacts, trace, n_trace)
         if status != 0:
             break
         while i_out < n_out and i_out * output_dt <= t_new + 1e-9 * output_dt:  # output samples in (t, t_new]
             t_o = min(i_out * output_dt, t_new)
             s = (t_o - t) / h_used
             interpolate(work, h_used, s, ystage)
-            if cf is not None:
-                if exact and s < 1.0:
-                    exact_motion_at(cf, h_used, s, ystage)
+            _exact_output(cf, exact, work, h_used, s, t, seg, forcing, structure, storey, ground, ystage)
             ag_o = _rates_at(t_o, seg, ystage, k2, forcing, structure, contacts, cstate, work, storey, ground, friction)
             record_sample(i_out, t_o, ystage, k2, ag_o, lay, structure, contacts, forces, storey, ground, out)
             record_friction(i_out, friction)
             i_out += 1
         t = t_new  # accept
         _accept(work)
-        if cf is not None:
-            if exact:
-                _keep_modal(cf)
-            else:
-                valid[0] = 0
-            if linear:
-                count_linear_step(policy, threshold, exact, t_new == seg_end)
+        _exact_accepted(cf, exact, linear, t_new == seg_end)
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
-        if cf is not None:
-            if exact:  # only those found at the exact end: one the cubic placed early is found in the next step
-                _set_pending(events, -1.0, friction)
+        _exact_end_events(cf, exact, events, friction)
         any_events = _with_pending(events, friction)
         if storey is not None:  # located: this step ends where the drift limit is first exceeded (or stability lost)
             status = stop_status if collapse_s >= 0.0 or collapse_pending else status
@@ -768,14 +821,11 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             n_imp, n_applied, cap, status = _apply_events(t, seg, forcing, structure, contacts, cstate, work, events,
                                                           ImpactTable(impacts, n_imp), storey, ground, friction)
         if any_events and n_applied > 0:
-            if cf is not None:
-                valid[0] = 0
-                linear_known = False
+            linear_known = _phase_ended(cf)
             window_start, window_events, status = _count_events(t, n_applied, window_start, window_events, dt_rec,
                                                                 event_cap, status)
             _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
-            # The step the controller accepted before the event cut it short; a newly closed
-            # compliant contact starts at a fraction of its duration estimate instead.
+            # the step accepted before the event cut it short (a newly closed contact: its cap)
             h = min(h_before_events, cap)
             if status != 0:
                 break
@@ -784,8 +834,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     close_open_impacts(y, lay, cstate, impacts)
     if status == 0:  # t_end reached within round-off before the last output sample: fill it
         i_out = _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey, ground, friction, out)
-    if status != STATUS_COLLAPSED and status != STATUS_UNSTABLE:
-        collapse_floor = zero - 1
+    collapse_floor = collapse_floor if status == STATUS_COLLAPSED or status == STATUS_UNSTABLE else zero - 1
     return Integration(trimmed_outputs(out, i_out), peaks, impacts[:n_imp], trace[:n_trace], y,
                        collapse_floor, n_steps, n_rej, status, t)
 
