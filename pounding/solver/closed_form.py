@@ -69,8 +69,9 @@ QUADRATURE_ERROR = 1e-10
 #: A step whose interpolant might miss a grazing closure is retaken at this fraction of its length.
 GRAZE_SPLIT = 0.5
 #: Cost of an exact step in Runge–Kutta steps of a small model, and the rows × modes products that cost
-#: one more (:func:`pays_threshold`; measured on models/pair.yaml: an exact step 2.5–3 Runge–Kutta steps).
-BASE_RATIO = 2.0
+#: one more (:func:`pays_threshold`; measured: an exact step costs 2.5–3 Runge–Kutta steps of models/pair.yaml,
+#: and a 2 × 5 pair switched at 2.7 ran 1.18× slower: 3.5 keeps runs where the gain is not sure on Runge–Kutta).
+BASE_RATIO = 3.5
 WORK_PER_STEP = 150.0
 #: Linear-phase samples of a probing window (Runge–Kutta steps, counted) and of an exact window.
 PROBE_SAMPLES = 32
