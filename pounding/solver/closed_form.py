@@ -73,6 +73,10 @@ GRAZE_SPLIT = 0.5
 #: and a 2 × 5 pair switched at 2.7 ran 1.18× slower: 3.5 keeps runs where the gain is not sure on Runge–Kutta).
 BASE_RATIO = 3.5
 WORK_PER_STEP = 150.0
+#: Floors above which no closed form is built (the threshold of a single building of 60 floors is already
+#: 51 Runge–Kutta steps per sample), and the threshold above which none is (:func:`closed_form`).
+MAX_FLOORS = 400
+MAX_THRESHOLD = 50.0
 #: Linear-phase samples of a probing window (Runge–Kutta steps, counted) and of an exact window.
 PROBE_SAMPLES = 32
 EXACT_SAMPLES = 512
@@ -204,6 +208,8 @@ def closed_form_refusal(system) -> str | None:
         return "a link keeps the buildings coupled through its own law"
     if system.n_faces > 0:
         return "friction faces"
+    if system.n_floors > MAX_FLOORS:
+        return f"more than {MAX_FLOORS} floors: the closed form would cost more than Runge-Kutta steps"
     return None
 
 
@@ -296,6 +302,10 @@ def closed_form(system, record_step: float, n_grounds: int) -> ClosedForm | None
     if closed_form_refusal(system) is not None:
         return None
     mass, damping, stiffness = linear_matrices(system)
+    groups = coupled_groups(stiffness, damping)
+    if pays_threshold(np.cumsum([0] + [2 * g.size for g in groups]), np.cumsum([0] + [g.size for g in groups])) \
+            > MAX_THRESHOLD:
+        return None  # no run takes that many Runge-Kutta steps per sample: the modes are not worth computing
     key = _content_key(system, mass, damping, stiffness, float(record_step), int(n_grounds))
     if key not in _BY_CONTENT:
         if len(_BY_CONTENT) >= CONTENT_CACHE_SIZE:
@@ -578,21 +588,20 @@ def _input_energy(cf, y, ynew, h, t, seg, forcing, ground, cached, mass) -> floa
     ``U = Σ m_j u_j``, with ``∫U`` from the exact ``∫z``."""
     lam, ml, z, load, weight = cf.eigenvalue, cf.mass_load, cf.z, cf.load, cf.weight
     fac = cf.factors if cached else cf.scratch
+    # Floor by floor and mode by mode, each term with its own ground's values: the same sums, in the same
+    # order, whether the floors stand on one ground or on several identical ones.
     total = 0.0
-    for g in range(ml.shape[1]):
-        u0 = 0.0
-        u1 = 0.0
-        for j in range(mass.size):
-            if (0 if ground is None else ground.floor_row[j]) == g:
-                u0 += mass[j] * y[j]
-                u1 += mass[j] * ynew[j]
-        integral = 0.0
-        for i in range(lam.size):
-            zint = fac[1, i] * z[i] + fac[2, i] * load[1, i] + fac[3, i] * load[2, i]
-            integral += weight[i] * (ml[i, g] * zint).real
+    for j in range(mass.size):
+        g = 0 if ground is None else ground.floor_row[j]
         a0 = _ground_values(forcing, ground, seg, t, g)
         a1 = _ground_values(forcing, ground, seg, t + h, g)
-        total += -(a1 * u1 - a0 * u0) + (a1 - a0) / h * integral
+        total -= mass[j] * (a1 * ynew[j] - a0 * y[j])
+    for i in range(lam.size):
+        zint = fac[1, i] * z[i] + fac[2, i] * load[1, i] + fac[3, i] * load[2, i]
+        for g in range(ml.shape[1]):
+            if ml[i, g] != 0j:
+                slope = (_ground_values(forcing, ground, seg, t + h, g) - _ground_values(forcing, ground, seg, t, g)) / h
+                total += slope * (weight[i] * (ml[i, g] * zint).real)
     return total
 
 
