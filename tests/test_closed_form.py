@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from decimal import Decimal, getcontext
 
+import numba
 import numpy as np
 import pytest
 import scipy.linalg
@@ -21,7 +22,8 @@ from pounding.contact.laws import N_PARAMETERS
 from pounding.errors import PoundingError
 from pounding.model.model import model_from_text
 from pounding.solver.assembly import assemble
-from pounding.solver.closed_form import closed_form, closed_form_refusal, linear_matrices, phis
+from pounding.solver.closed_form import (closed_form, closed_form_refusal, linear_matrices, no_closed_form, phis,
+                                         run_closed_form)
 from pounding.solver.integrator import System, integrate
 
 RNG = np.random.default_rng(20261128)
@@ -259,6 +261,23 @@ def test_models_without_a_linear_phase_are_refused():
         system = assemble(pounding.load_model(f"models/{name}.yaml")).system
         assert why in closed_form_refusal(system)
         assert closed_form(system, 0.01, 1) is None
+
+
+def test_runs_without_modes_share_the_compiled_solver_of_runs_with_them():
+    """A ``runge-kutta`` run of a model with a closed form gets :func:`no_closed_form`, of the numba type
+    of a built closed form (one compiled solver serves both settings: a type that differed in one
+    array's dimension or dtype would compile a second one), and takes no exact step; a refused model
+    gets none (its solver is compiled without the closed form's code)."""
+    system = assemble(pounding.load_model("models/pair.yaml")).system
+    built = run_closed_form(system, 0.01, 1)
+    assert built.eigenvalue.size > 0
+    assert numba.typeof(no_closed_form()) == numba.typeof(built)
+    assert run_closed_form(system, 0.01, 1, linear_phases="runge-kutta").eigenvalue.size == 0
+    refused = assemble(pounding.load_model("models/pair_links.yaml")).system
+    assert run_closed_form(refused, 0.01, 1) is None
+    record = RNG.standard_normal(301)
+    raw = run(one_building([2e5] * 3, [3e8] * 3, rayleigh=(0.3, 0.002)), record, 0.01, exact=False)
+    assert raw.exact_steps == 0 and raw.n_steps > 0
 
 
 def test_setting_is_validated_in_one_line(tmp_path):

@@ -8,6 +8,7 @@ import pytest
 from pounding.contact import laws as contact
 from pounding.solver import kernels
 from pounding.solver.integrator import System, integrate
+from pounding.solver.recorder import FORCE_SAMPLES
 
 
 def free_pair(m1: float, m2: float, law: contact.ContactLaw, gap: float = 0.01) -> System:
@@ -285,3 +286,21 @@ def test_every_event_kind_codes_none_as_the_shared_bookkeeping_does():
     from pounding.solver.storey_events import STOREY_NONE
 
     assert EVENT_NONE == STOREY_NONE == FRICTION_EVENT_NONE == NO_EVENT
+
+
+def test_the_run_counts_its_trial_steps_and_its_steps_in_contact():
+    """``trial_steps`` counts every attempt (accepted, rejected, retaken to end at an event) and
+    ``contact_steps`` the accepted steps with an impact under way: checked against what the run
+    records independently (its impact table and its full-resolution trace of closed contacts)."""
+    law = contact.HertzDamp(kh=1e10, restitution=0.65, xi="ye")
+    raw = collide(law, rtol=1e-6, atol=1e-8, atol_velocity=1e-7)
+    assert raw.impact_time.size == 1
+    # each located event (closure, separation) retakes its step at least once
+    assert raw.trial_steps >= raw.n_steps + raw.n_rejected + 2
+    # the impact lasts a few ms: several steps, each adding FORCE_SAMPLES samples of the one contact to the
+    # trace (FORCE_SAMPLES + 1 where a step starts a closed stretch, its start sample)
+    assert raw.contact_steps > 3
+    assert FORCE_SAMPLES * raw.contact_steps <= raw.trace_time.size <= (FORCE_SAMPLES + 1) * raw.contact_steps
+    apart = integrate(free_pair(2e5, 3e5, law), np.zeros(51), 0.01, 0.5, rtol=1e-6, atol=1e-8, atol_velocity=1e-7,
+                      output_dt=0.01, initial_velocity=np.array([-0.5, 0.2]))  # moving apart: no event
+    assert apart.contact_steps == 0 and apart.trial_steps == apart.n_steps + apart.n_rejected

@@ -30,7 +30,7 @@ the driver (:mod:`pounding.solver.integrator`) calls :func:`closed_form_step` in
 the Runge–Kutta stages while :func:`linear_phase` holds, and keeps locating events,
 peaks and output samples on the step's cubic Hermite interpolant of exact end states
 and rates; :func:`graze_fraction` shortens a step whose interpolant might miss a
-grazing closure, :func:`refine_peaks` moves each peak found on the interpolant onto the
+grazing closure, :func:`record_exact_peaks` moves each peak found on the interpolant onto the
 exact solution, and :func:`exact_state_at` gives the output samples inside a step.
 """
 
@@ -40,7 +40,6 @@ import cmath
 import functools
 import hashlib
 import math
-import weakref
 from typing import NamedTuple
 
 import numpy as np
@@ -49,18 +48,17 @@ from numba import njit
 from pounding import hysteresis
 from pounding.solver import imk, jit, storeys
 from pounding.solver.kernels import FIRST_LINK_ID
-from pounding.solver.dense import extremum_in_step, hermite
+from pounding.solver.dense import cubic_max, extremum_in_step, rate_root
 from pounding.solver.kinematics import (combo, contact_sums, drift, fill_grounds, ground_at, ground_offset,
                                         storey_drift, storey_stiffness)
 from pounding.solver.rhs import rhs_called
 
 __all__ = ["ClosedForm", "closed_form", "closed_form_refusal", "linear_phase", "closed_form_step", "start_phase",
-           "graze_fraction", "record_exact_peaks", "exact_state_at", "run_closed_form", "wants_exact",
-           "count_linear_step", "pays_threshold", "GRAZE_SPLIT", "LINEAR_PHASES", "CONDITION_LIMIT",
+           "graze_fraction", "record_exact_peaks", "exact_state_at", "run_closed_form", "no_closed_form", "has_modes",
+           "wants_exact",
+           "count_linear_step", "pays_threshold", "phis", "GRAZE_SPLIT", "CONDITION_LIMIT",
            "QUADRATURE_ERROR"]
 
-#: The solver setting's values: closed form in linear phases (default), or Runge–Kutta steps throughout.
-LINEAR_PHASES = ("exact", "runge-kutta")
 #: Eigenvector matrices worse conditioned than this (a nearly defective system: a critically damped
 #: mode) are not used: the model runs on Runge–Kutta steps throughout.
 CONDITION_LIMIT = 1e8
@@ -243,24 +241,13 @@ def _kept(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def phis(x: np.ndarray) -> np.ndarray:
-    """``φ₀(x) … φ₃(x)`` elementwise, ``φ_k(x) = Σ_j x^j/(j + k)!`` (φ₀ = eˣ, φ₁ = (eˣ − 1)/x, …):
-    by the recurrence ``φ_k = (φ_{k−1} − 1/(k − 1)!)/x`` from |x| = 1 up, by their series below."""
+    """``φ₀(x) … φ₃(x)`` elementwise, ``φ_k(x) = Σ_j x^j/(j + k)!`` (φ₀ = eˣ, φ₁ = (eˣ − 1)/x, …), shape
+    ``(4,) + x.shape``: the compiled :func:`phi_values` the steps use."""
     x = np.asarray(x, dtype=complex)
-    small = np.abs(x) < 1.0
-    safe = np.where(small, 1.0, x)
-    out = np.empty((4,) + x.shape, dtype=complex)
-    out[0] = np.exp(x)
-    for k in range(1, 4):
-        out[k] = (out[k - 1] - 1.0 / math.factorial(k - 1)) / safe
-    if np.any(small):
-        xs = x[small]
-        for k in range(1, 4):
-            series, term = np.zeros_like(xs), np.full_like(xs, 1.0 / math.factorial(k))
-            for j in range(SERIES_TERMS):
-                series += term
-                term = term * xs / (j + k + 1)
-            out[k][small] = series
-    return out
+    flat = np.ascontiguousarray(x.ravel())
+    out = np.empty((4, flat.size), dtype=complex)
+    _phi_table(flat, out)
+    return out.reshape((4,) + x.shape)
 
 
 def gauss_nodes(fastest: float, step: float) -> tuple[np.ndarray, np.ndarray]:
@@ -302,10 +289,6 @@ def closed_form(system, record_step: float, n_grounds: int) -> ClosedForm | None
     if closed_form_refusal(system) is not None:
         return None
     mass, damping, stiffness = linear_matrices(system)
-    groups = coupled_groups(stiffness, damping)
-    if pays_threshold(np.cumsum([0] + [2 * g.size for g in groups]), np.cumsum([0] + [g.size for g in groups])) \
-            > MAX_THRESHOLD:
-        return None  # no run takes that many Runge-Kutta steps per sample: the modes are not worth computing
     key = _content_key(system, mass, damping, stiffness, float(record_step), int(n_grounds))
     if key not in _BY_CONTENT:
         if len(_BY_CONTENT) >= CONTENT_CACHE_SIZE:
@@ -327,20 +310,24 @@ def _content_key(system, mass, damping, stiffness, record_step: float, n_grounds
                   system.plane_weights, system.contact_floors, system.contact_weights,
                   np.array([record_step, n_grounds], dtype=float)):
         item = np.ascontiguousarray(array)
-        digest.update(str(item.shape).encode() + str(item.dtype).encode())
-        digest.update(item.tobytes())
+        digest.update(repr(item.shape).encode() + item.dtype.str.encode())
+        digest.update(item.data)
     return digest.digest()
 
 
 def _built(mass, damping, stiffness, system, record_step: float, n_grounds: int) -> ClosedForm | None:
     """:func:`closed_form` from the linear phase's matrices."""
+    groups = coupled_groups(stiffness, damping)
+    sizes = np.array([g.size for g in groups], dtype=np.int64)
+    if pays_threshold(np.cumsum(np.r_[0, 2 * sizes]), np.cumsum(np.r_[0, sizes])) > MAX_THRESHOLD:
+        return None  # no run takes that many Runge-Kutta steps per sample: the modes are not worth computing
     n = system.n_floors
     masses = np.diag(mass)
     ground_of = np.asarray(system.floor_ground, dtype=np.int64)
     rows, row_start, mode_start, vector_start = [], [0], [0], [0]
     values_all, weights_all, vectors_flat, inverse_flat = [], [], [], []
     full_vectors = []  # (2N, m_g) columns of each group in the whole state's rows
-    for floors in coupled_groups(stiffness, damping):
+    for floors in groups:
         values, vectors = _group_modes(mass, damping, stiffness, floors)
         if _mode_refusal(values, vectors) is not None:
             return None
@@ -443,26 +430,42 @@ def _fill_factors(cf: ClosedForm, step: float) -> None:
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _phis(x, out, i) -> None:
-    """``e^x, φ₁(x), φ₂(x), φ₃(x)`` into ``out[0..3, i]`` (series below |x| = 1)."""
+def phi_values(x):
+    """``(e^x, φ₁(x), φ₂(x), φ₃(x))``: their Taylor series below |x| = 1 (SERIES_TERMS terms), the
+    recurrence ``φ_k = (φ_{k−1} − 1/(k − 1)!)/x`` above (its cancellation is below a few ulps there)."""
     e = cmath.exp(x)
-    out[0, i] = e
-    if abs(x) < 1.0:
-        for k in range(1, 4):
-            total = 0j
-            term = 1.0 + 0j
-            for f in range(2, k + 1):
-                term /= f
-            for j in range(SERIES_TERMS):
-                total += term
-                term *= x / (j + k + 1)
-            out[k, i] = total
-        return
-    p1 = (e - 1.0) / x
-    p2 = (p1 - 1.0) / x
-    out[1, i] = p1
-    out[2, i] = p2
-    out[3, i] = (p2 - 0.5) / x
+    if abs(x) >= 1.0:
+        p1 = (e - 1.0) / x
+        p2 = (p1 - 1.0) / x
+        return e, p1, p2, (p2 - 0.5) / x
+    p1, p2, p3 = 0j, 0j, 0j
+    t1, t2, t3 = 1.0 + 0j, 0.5 + 0j, 0.5 / 3.0 + 0j
+    for j in range(SERIES_TERMS):
+        p1 += t1
+        p2 += t2
+        p3 += t3
+        t1 *= x / (j + 2)
+        t2 *= x / (j + 3)
+        t3 *= x / (j + 4)
+    return e, p1, p2, p3
+
+
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # with a Python wrapper: :func:`phis`
+def _phi_table(x, out) -> None:
+    """:func:`phi_values` of each entry of *x* into ``out[0..3, i]``."""
+    for i in range(x.size):
+        e, p1, p2, p3 = phi_values(x[i])
+        out[0, i] = e
+        out[1, i] = p1
+        out[2, i] = p2
+        out[3, i] = p3
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def _modal_at(cf, i, tau):
+    """Mode *i*'s state ``z(τ) = e^{λτ}z₀ + τφ₁β₀ + τ²φ₂β₁`` at *tau* s into the trial step."""
+    e, p1, p2, _ = phi_values(cf.eigenvalue[i] * tau)
+    return e * cf.z[i] + tau * p1 * cf.load[1, i] + tau * tau * p2 * cf.load[2, i]
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -474,10 +477,11 @@ def _step_factors(cf, h) -> bool:
         return True
     out = cf.scratch
     for i in range(cf.eigenvalue.size):
-        _phis(cf.eigenvalue[i] * h, out, i)
-        out[1, i] *= h
-        out[2, i] *= h * h
-        out[3, i] *= h * h * h
+        e, p1, p2, p3 = phi_values(cf.eigenvalue[i] * h)
+        out[0, i] = e
+        out[1, i] = p1 * h
+        out[2, i] = p2 * (h * h)
+        out[3, i] = p3 * (h * h * h)
     return False
 
 
@@ -621,11 +625,7 @@ def _damped_energy(cf, h) -> float:
             if cached:
                 zq[i] = nf[0, q, i] * z[i] + nf[1, q, i] * load[1, i] + nf[2, q, i] * load[2, i]
             else:
-                x = lam[i] * tau
-                e = cmath.exp(x)
-                p1 = (e - 1.0) / x if abs(x) >= 1e-3 else 1.0 + x / 2.0 + x * x / 6.0 + x * x * x / 24.0
-                p2 = (p1 - 1.0) / x if abs(x) >= 1e-3 else 0.5 + x / 6.0 + x * x / 24.0 + x * x * x / 120.0
-                zq[i] = e * z[i] + tau * p1 * load[1, i] + tau * tau * p2 * load[2, i]
+                zq[i] = _modal_at(cf, i, tau)
         power = 0.0
         for k in range(value.size):
             a, b = index[k, 0], index[k, 1]
@@ -720,28 +720,6 @@ def _row_bound(cf, size, r, h) -> float:
     return h * h * h * h / 384.0 * total
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
-def _cubic_max(y0, r0, y1, r1, h) -> float:
-    """Largest value of the Hermite cubic over the step (ends and interior stationary points)."""
-    best = max(y0, y1)
-    qa = 6.0 * y0 + 3.0 * h * r0 - 6.0 * y1 + 3.0 * h * r1
-    qb = -6.0 * y0 - 4.0 * h * r0 + 6.0 * y1 - 2.0 * h * r1
-    qc = h * r0
-    for k in range(2):
-        s = -1.0
-        if abs(qa) < 1e-300:
-            if k == 0 and abs(qb) > 1e-300:
-                s = -qc / qb
-        else:
-            disc = qb * qb - 4.0 * qa * qc
-            if disc >= 0.0:
-                sq = math.sqrt(disc)
-                s = (-qb + (sq if k == 0 else -sq)) / (2.0 * qa)
-        if 0.0 < s < 1.0:
-            best = max(best, hermite(y0, r0, y1, r1, h, s))
-    return best
-
-
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def graze_fraction(cf, work, h, lay, contacts, cstate, ground) -> float:
     """Fraction of the trial step to retake it at (GRAZE_SPLIT), or 2.0: an open contact's δ stays
@@ -768,7 +746,7 @@ def graze_fraction(cf, work, h, lay, contacts, cstate, ground) -> float:
         bound = _row_bound(cf, cf.contact_size, c, h)
         if reach + bound < 0.0:
             continue
-        top = _cubic_max(d0, r0, d1, r1, h)
+        top = cubic_max(d0, r0, d1, r1, h)
         if top < 0.0 and top + bound >= 0.0:
             return GRAZE_SPLIT
     return 2.0
@@ -777,7 +755,7 @@ def graze_fraction(cf, work, h, lay, contacts, cstate, ground) -> float:
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _exact_at(cf, modes, r, tau):
     """``(value, rate, rate of rate)`` of the combination ``modes[r]`` at *tau* s into the trial step."""
-    lam, z, load, weight = cf.eigenvalue, cf.z, cf.load, cf.weight
+    lam, load, weight = cf.eigenvalue, cf.load, cf.weight
     value = 0.0
     rate = 0.0
     accel = 0.0
@@ -785,15 +763,7 @@ def _exact_at(cf, modes, r, tau):
         row = modes[r, i]
         if row == 0j:
             continue
-        x = lam[i] * tau
-        e = cmath.exp(x)
-        if abs(x) >= 1e-3:
-            p1 = (e - 1.0) / x
-            p2 = (p1 - 1.0) / x
-        else:
-            p1 = 1.0 + x / 2.0 + x * x / 6.0 + x * x * x / 24.0
-            p2 = 0.5 + x / 6.0 + x * x / 24.0 + x * x * x / 120.0
-        zi = e * z[i] + tau * p1 * load[1, i] + tau * tau * p2 * load[2, i]
+        zi = _modal_at(cf, i, tau)
         zd = lam[i] * zi + load[1, i] + load[2, i] * tau
         zdd = lam[i] * zd + load[2, i]
         value += weight[i] * (row * zi).real
@@ -818,7 +788,7 @@ def _row_peak(cf, modes, size, r, y0, r0, y1, r1, h, peak) -> float:
         return peak
     if extremum_in_step(y0, r0, y1, r1, h) + _row_bound(cf, size, r, h) <= peak:
         return peak
-    s = _stationary(y0, r0, y1, r1, h)
+    s = rate_root(y0, r0, y1, r1, h)
     tau = s * h
     for _ in range(NEWTON_STEPS):
         _, rate, accel = _exact_at(cf, modes, r, tau)
@@ -827,30 +797,6 @@ def _row_peak(cf, modes, size, r, y0, r0, y1, r1, h, peak) -> float:
         tau = min(h, max(0.0, tau - rate / accel))
     value, _, _ = _exact_at(cf, modes, r, tau)
     return max(peak, abs(value))
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _stationary(y0, r0, y1, r1, h) -> float:
-    """Fraction of the step where the Hermite cubic's rate changes sign (r0·r1 < 0: exactly one root)."""
-    lo, hi = 0.0, 1.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        rate = hermite_rate(y0, r0, y1, r1, h, mid)
-        if (rate > 0.0) == (r0 > 0.0):
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo < 1e-12:
-            break
-    return 0.5 * (lo + hi)
-
-
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
-def hermite_rate(y0, r0, y1, r1, h, s) -> float:
-    """Rate of the Hermite cubic at fraction *s* of the step, per second."""
-    s2 = s * s
-    return ((6.0 * s2 - 6.0 * s) * y0 / h + (3.0 * s2 - 4.0 * s + 1.0) * r0
-            + (-6.0 * s2 + 6.0 * s) * y1 / h + (3.0 * s2 - 2.0 * s) * r1)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
@@ -869,6 +815,12 @@ def record_exact_peaks(cf, work, h, n, structure, peaks) -> None:
         peaks.plane[p] = _row_peak(cf, cf.plane_modes, cf.plane_size, p, combo(y, 0, floors, weights, width, p),
                                    combo(y, n, floors, weights, width, p), combo(ynew, 0, floors, weights, width, p),
                                    combo(ynew, n, floors, weights, width, p), h, peaks.plane[p])
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def has_modes(cf) -> bool:
+    """False for :func:`no_closed_form` (Runge–Kutta steps throughout)."""
+    return cf.eigenvalue.size > 0
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -905,26 +857,33 @@ def count_linear_step(policy, threshold, exact, at_sample) -> None:
 jit.stamp_solver_kernels(globals())
 
 
-#: Per system (by id, dropped with the system), its closed forms by record step and ground count (None: refused).
-_BUILT: dict[int, dict] = {}
+def no_closed_form() -> ClosedForm:
+    """A :class:`ClosedForm` without modes: a run on Runge–Kutta steps throughout.  Its arrays have the
+    types of a built one, so the solver is compiled once for both (:func:`has_modes` is False)."""
+    c1, c2, c3 = (np.zeros((0,) * k, dtype=np.complex128) for k in (1, 2, 3))
+    f1, f2 = np.zeros(0), np.zeros((0, 0))
+    i1, i2 = np.zeros(0, dtype=np.int64), np.zeros((0, 0), dtype=np.int64)
+    return ClosedForm(i1, np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64),
+                      c1, f1, c1, c1, c2, c2, c2, c2, c2, c2, f2, f2, f2, f2, i2, f1, f1, f1, np.zeros(1), c2, c3,
+                      c1, c1, c2, c2, np.zeros(1, dtype=np.int64), c1, c1, f1, np.zeros(4, dtype=np.int64),
+                      np.array([np.inf]))
 
 
-def run_closed_form(system, record_step: float, n_grounds: int, threshold: float | None = None) -> ClosedForm | None:
-    """The :class:`ClosedForm` of *system* for one run: built once per system, record step and ground
-    count (:func:`closed_form`), with fresh scratch arrays each call (two runs never share one).
+def run_closed_form(system, record_step: float, n_grounds: int, threshold: float | None = None,
+                    linear_phases: str = "exact") -> ClosedForm | None:
+    """The :class:`ClosedForm` of *system* for one run: built once per structure, record step and ground
+    count (:func:`closed_form`'s cache), with fresh scratch arrays each call (two runs never share one).
 
     *threshold*: Runge–Kutta steps per linear sample above which the run switches to closed form
-    (default :func:`pays_threshold`); negative: every linear phase in closed form from the start."""
-    key = (float(record_step), int(n_grounds))
-    if id(system) not in _BUILT:
-        _BUILT[id(system)] = {}
-        weakref.finalize(system, _BUILT.pop, id(system), None)
-    built = _BUILT[id(system)]
-    if key not in built:
-        built[key] = closed_form(system, record_step, n_grounds)
-    cf = built[key]
+    (default :func:`pays_threshold`); negative: every linear phase in closed form from the start.
+    None for a model :func:`closed_form` refuses (the solver is compiled without the closed form's code);
+    :func:`no_closed_form` for *linear_phases* ``"runge-kutta"`` on a model it does not (the solver
+    compiled for the model's default serves the run)."""
+    cf = closed_form(system, record_step, n_grounds)
     if cf is None:
         return None
+    if linear_phases != "exact":
+        return no_closed_form()
     m = cf.eigenvalue.size
     cf = cf._replace(z=np.zeros(m, dtype=np.complex128), z_end=np.zeros(m, dtype=np.complex128),
                        load=np.zeros((3, m), dtype=np.complex128), scratch=np.zeros((4, m), dtype=np.complex128),

@@ -15,7 +15,8 @@ from numba import njit
 
 from pounding.solver import jit
 
-__all__ = ["DELTA_ROUNDOFF", "hermite", "interpolate", "extremum_in_step", "first_crossing"]
+__all__ = ["DELTA_ROUNDOFF", "hermite", "hermite_rate", "stationary_points", "interpolate", "extremum_in_step",
+           "cubic_max", "rate_root", "first_crossing"]
 
 #: Grazing floor: an overlap smaller than this multiple of the round-off of
 #: δ = u_L − u_R − gap (``eps·(|u_L| + |u_R| + gap)``) is indistinguishable from zero and is
@@ -32,32 +33,78 @@ def hermite(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> f
             + (-2.0 * s3 + 3.0 * s2) * y1 + (s3 - s2) * h * r1)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
-    """Largest |y| of the Hermite cubic at its interior stationary points (0 if none)."""
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def hermite_rate(y0: float, r0: float, y1: float, r1: float, h: float, s: float) -> float:
+    """Rate of the Hermite cubic at fraction *s* of a step of length *h*, per second."""
+    s2 = s * s
+    return ((6.0 * s2 - 6.0 * s) * y0 / h + (3.0 * s2 - 4.0 * s + 1.0) * r0
+            + (-6.0 * s2 + 6.0 * s) * y1 / h + (3.0 * s2 - 2.0 * s) * r1)
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def stationary_points(y0: float, r0: float, y1: float, r1: float, h: float) -> tuple[float, float]:
+    """Fractions of the step where the Hermite cubic's rate vanishes, ascending; 2.0 for a root that
+    does not exist (the rate is a quadratic in s, its roots taken in the numerically stable form)."""
     qa = 6.0 * y0 + 3.0 * h * r0 - 6.0 * y1 + 3.0 * h * r1
     qb = -6.0 * y0 - 4.0 * h * r0 + 6.0 * y1 - 2.0 * h * r1
     qc = h * r0
-    best = 0.0
+    s_a = 2.0
+    s_b = 2.0
     if abs(qa) < 1e-300:
         if abs(qb) > 1e-300:
-            s = -qc / qb
-            if 0.0 < s < 1.0:
-                best = abs(hermite(y0, r0, y1, r1, h, s))
-        return best
-    disc = qb * qb - 4.0 * qa * qc
-    if disc < 0.0:
-        return best
-    sq = math.sqrt(disc)
-    # Numerically stable quadratic roots.
-    q = -0.5 * (qb + math.copysign(sq, qb))
-    roots = (q / qa, qc / q if q != 0.0 else -1.0)
-    for s in roots:
-        if 0.0 < s < 1.0:
-            val = abs(hermite(y0, r0, y1, r1, h, s))
-            if val > best:
-                best = val
+            s_a = -qc / qb
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
+            s_a = q / qa
+            s_b = qc / q if q != 0.0 else 2.0
+    if s_a > s_b:
+        s_a, s_b = s_b, s_a
+    return s_a, s_b
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def extremum_in_step(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
+    """Largest |y| of the Hermite cubic at its interior stationary points (0 if none)."""
+    s_a, s_b = stationary_points(y0, r0, y1, r1, h)
+    best = 0.0
+    if 0.0 < s_a < 1.0:
+        best = abs(hermite(y0, r0, y1, r1, h, s_a))
+    if 0.0 < s_b < 1.0:
+        val = abs(hermite(y0, r0, y1, r1, h, s_b))
+        if val > best:
+            best = val
     return best
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def cubic_max(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
+    """Largest value (signed) of the Hermite cubic over the step: its ends and interior stationary points."""
+    s_a, s_b = stationary_points(y0, r0, y1, r1, h)
+    best = max(y0, y1)
+    if 0.0 < s_a < 1.0:
+        best = max(best, hermite(y0, r0, y1, r1, h, s_a))
+    if 0.0 < s_b < 1.0:
+        best = max(best, hermite(y0, r0, y1, r1, h, s_b))
+    return best
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def rate_root(y0: float, r0: float, y1: float, r1: float, h: float) -> float:
+    """Fraction of the step where the Hermite cubic's rate changes sign, for ``r0·r1 < 0`` (exactly one
+    root inside): bisected to 1e-12 of the step."""
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        rate = hermite_rate(y0, r0, y1, r1, h, mid)
+        if (rate > 0.0) == (r0 > 0.0):
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo < 1e-12:
+            break
+    return 0.5 * (lo + hi)
 
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # with a Python wrapper: tested directly
@@ -88,23 +135,7 @@ def first_crossing(d0: float, r0: float, d1: float, r1: float, h: float, upward:
     # functions' bounds): a step that cannot reach the far side needs no search (most steps).
     if max(sign * d0, sign * d1) + 0.25 * h * (abs(r0) + abs(r1)) <= threshold:
         return -1.0
-    # Stationary points of the cubic (roots of its derivative, a quadratic in s).
-    qa = 6.0 * d0 + 3.0 * h * r0 - 6.0 * d1 + 3.0 * h * r1
-    qb = -6.0 * d0 - 4.0 * h * r0 + 6.0 * d1 - 2.0 * h * r1
-    qc = h * r0
-    s_a = 2.0
-    s_b = 2.0
-    if abs(qa) < 1e-300:
-        if abs(qb) > 1e-300:
-            s_a = -qc / qb
-    else:
-        disc = qb * qb - 4.0 * qa * qc
-        if disc >= 0.0:
-            q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
-            s_a = q / qa
-            s_b = qc / q if q != 0.0 else 2.0
-    if s_a > s_b:
-        s_a, s_b = s_b, s_a
+    s_a, s_b = stationary_points(d0, r0, d1, r1, h)
     near = f0 <= 0.0
     lo = 0.0
     for piece in range(3):

@@ -93,7 +93,8 @@ from pounding import hysteresis
 from pounding.solver import imk, jit
 from pounding.solver import kernels
 from pounding.solver.closed_form import (GRAZE_SPLIT, closed_form_step, count_linear_step, exact_state_at, graze_fraction,
-                                         linear_phase, record_exact_peaks, run_closed_form, start_phase, wants_exact)
+                                         has_modes, linear_phase, record_exact_peaks, run_closed_form, start_phase,
+                                         wants_exact)
 from pounding.solver.contact_events import (EVENT_NONE, EVENTS_PER_WINDOW_BASE, EVENTS_PER_WINDOW_PER_CONTACT,
                                             apply_contact_events, locate_contact_events, locate_releases)
 from pounding.solver.dense import interpolate
@@ -336,6 +337,8 @@ class RawSolution:
     friction_history: np.ndarray | None = None  # (nt, 3·nf): each face's N (N), λ (N), mode code (None: no friction)
     peak_plane_drift: np.ndarray | None = None  # (R,) m, |drift| of a plan model's planes (System.plane_floors)
     exact_steps: int = 0             # steps of linear phases taken in closed form (of n_steps)
+    trial_steps: int = 0             # every trial step: accepted, rejected, retaken to end at an event, halved
+    contact_steps: int = 0           # accepted steps with an impact under way (of n_steps)
 
 
 
@@ -364,6 +367,9 @@ class Integration(NamedTuple):
     n_rejected: int
     status: int
     final_time: float
+    n_trials: int          #: every trial step: accepted, rejected by the error control, retaken to end at an
+                           #: event or redone after events at its start, halved by the graze guard
+    n_contact: int         #: accepted steps with an impact under way (a contact closed, neither a link nor stuck)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -524,6 +530,8 @@ def _locate_contacts(work, h, t, seg, forcing, structure, contacts, cstate, even
 def _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction, work):
     """After events at *t*: ``(linear, exact)`` of the step from there (the events may end the linear phase or
     change its constant load: a new modal state)."""
+    if cf is None or not has_modes(cf):
+        return False, False
     cf.valid[0] = 0
     linear = linear_phase(cstate, structure, storey, friction)
     return linear, _exact_start(cf, linear, t, seg, forcing, ground, work)
@@ -532,28 +540,36 @@ def _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED)
 def _record_closed(work, h, t, contacts, cstate, ground, peaks, impacts, trace, n_trace):
     """The closed contacts over an accepted step (:func:`.recorder.record_contacts`), the trace grown to
-    hold their samples: ``(trace, rows in use, status)``."""
+    hold their samples: ``(trace, rows in use, status, 1 if an impact is under way else 0)``."""
     zero = n_trace - n_trace
-    rows = min(n_trace + trace_rows(contacts, cstate), zero + TRACE_ROW_LIMIT)
+    added = trace_rows(contacts, cstate)
+    rows = min(n_trace + added, zero + TRACE_ROW_LIMIT)
     if rows > trace.shape[0]:
         trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
     n_trace, status = record_contacts(work, h, t, work.layout, contacts, cstate, ground, peaks, impacts, trace,
                                       n_trace)
-    return trace, n_trace, status
+    return trace, n_trace, status, zero + (1 if added > 0 else 0)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+# The closed form's calls in the driver's loop are inlined: a run that takes no exact step (most runs at
+# default tolerances; every run of :func:`.closed_form.no_closed_form`) pays a few tests a step for them,
+# not a call that passes the whole ClosedForm record.  Without a closed form (cf None: a model it refuses)
+# they are pruned at compile time.
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, storey, ground, friction, work):
     """``(linear, linear_known, exact)`` of the step from *t*: whether the phase is linear is decided again
     only after events (*linear_known* False), and a linear phase's step is exact in an exact window."""
     if cf is None:
         return False, True, False
     if not linear_known:
-        linear, linear_known = linear_phase(cstate, structure, storey, friction), True
+        linear = has_modes(cf) and linear_phase(cstate, structure, storey, friction)
+        linear_known = True
+    if not linear or not wants_exact(cf):  # (a probing window's steps: _exact_accepted ends the modal state)
+        return linear, linear_known, False
     return linear, linear_known, _exact_start(cf, linear, t, seg, forcing, ground, work)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _phase_ended(cf) -> bool:
     """Events were applied: the linear phase (if any) must be decided again; returns False (not known)."""
     if cf is not None:
@@ -561,11 +577,11 @@ def _phase_ended(cf) -> bool:
     return False
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _exact_accepted(cf, exact, linear, at_sample) -> None:
     """After an accepted step: an exact step's end becomes the modal state (a Runge–Kutta step ends the
     phase's modal state), and a linear phase's step is counted (:func:`.closed_form.count_linear_step`)."""
-    if cf is None:
+    if cf is None or not linear:
         return
     if exact:
         z, z_end = cf.z, cf.z_end
@@ -573,11 +589,10 @@ def _exact_accepted(cf, exact, linear, at_sample) -> None:
             z[i] = z_end[i]
     else:
         cf.valid[0] = 0
-    if linear:
-        count_linear_step(cf.policy, cf.threshold, exact, at_sample)
+    count_linear_step(cf.policy, cf.threshold, exact, at_sample)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _exact_step(cf, exact, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground) -> bool:
     """Take the trial step in closed form if it is an exact one (:func:`.closed_form.closed_form_step`)."""
     if cf is None or not exact:
@@ -586,7 +601,7 @@ def _exact_step(cf, exact, work, h, t, seg, forcing, structure, contacts, cstate
     return True
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _grazes(cf, exact, s_first, n_graze, work, h, lay, contacts, cstate, ground) -> bool:
     """An exact trial step to halve: no event before GRAZE_SPLIT, halvings left, and an open contact's exact
     δ might touch 0 unseen by the cubic (:func:`.closed_form.graze_fraction`)."""
@@ -599,26 +614,25 @@ def _grazes(cf, exact, s_first, n_graze, work, h, lay, contacts, cstate, ground)
 def _record_peaks(cf, exact, work, h, n, structure, peaks) -> None:
     """The peaks over an accepted step: on the cubic of a Runge–Kutta step, on the exact solution of an
     exact one (:func:`.closed_form.record_exact_peaks`)."""
-    if cf is not None:
-        if exact:
-            record_exact_peaks(cf, work, h, n, structure, peaks)
-            return
+    if cf is not None and exact:
+        record_exact_peaks(cf, work, h, n, structure, peaks)
+        return
     record_floor_peaks(work, h, n, structure.below, peaks)
     record_plane_peaks(work, h, n, structure.plane_floors, structure.plane_weights, structure.plane_width, peaks)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _exact_output(cf, exact, work, h, s, t, seg, forcing, structure, storey, ground, out) -> None:
     """An output sample inside an exact step: the exact state (:func:`.closed_form.exact_state_at`)."""
     if cf is not None and exact and s < 1.0:
         exact_state_at(cf, work, h, s, t, seg, forcing, structure, storey, ground, out)
 
 
-@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _exact_end_events(cf, exact, events, friction) -> None:
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
+def _exact_end_events(exact, events, friction) -> None:
     """At an exact step's end only the events found there are applied (the pending ones are dropped): one
     the long step's cubic placed a little early is found at the start of the next step."""
-    if cf is not None and exact:
+    if exact:
         _set_pending(events, -1.0, friction)
 
 
@@ -717,7 +731,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
     tiny, event_cap = 1e-12 * max(dt_rec, 1.0), EVENTS_PER_WINDOW_BASE + EVENTS_PER_WINDOW_PER_CONTACT * nc
     window_start, window_events, err, collapse_s, n_applied, cap = 0.0, zero, 0.0, -1.0, zero, np.inf
     stop_status = zero + STATUS_COLLAPSED  # which stop collapse_s / collapse_pending is: collapsed or unstable
-    exact, linear, linear_known = False, False, False  # linear changes only at events: decided after each
+    exact, linear, linear_known, n_trials, n_contact = False, False, False, zero, zero  # linear: decided after events
     while t < t_end - tiny and i_out <= n_out:
         while (seg + 1) * dt_rec <= t + 1e-9 * dt_rec:
             seg += 1
@@ -737,6 +751,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             if h_try < 1e-14 * max(1.0, t):
                 status = STATUS_STEP_TOO_SMALL
                 break
+            n_trials += 1
             if _exact_step(cf, exact, work, h_try, t, seg, forcing, structure, contacts, cstate, storey, ground):
                 err, finite = 0.0, True
             else:
@@ -771,12 +786,11 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 if status != 0:
                     break
                 _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
-                if cf is not None:  # the events may end the linear phase, or change its constant load
-                    linear, exact = _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction,
-                                                        work)
+                # the events may end the linear phase, or change its constant load
+                linear, exact = _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction,
+                                                    work)
                 if cap < h_try:
-                    h_try = cap
-                    h_before_events = cap
+                    h_try, h_before_events = cap, cap
                 n_retake, collapse_pending = zero, False
                 _set_pending(events, -1.0, friction)
                 continue
@@ -793,7 +807,9 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
         _record_peaks(cf, exact, work, h_used, n, structure, peaks)
-        trace, n_trace, status = _record_closed(work, h_used, t, contacts, cstate, ground, peaks, impacts, trace, n_trace)
+        trace, n_trace, status, in_contact = _record_closed(work, h_used, t, contacts, cstate, ground, peaks, impacts,
+                                                            trace, n_trace)
+        n_contact += in_contact
         if status != 0:
             break
         while i_out < n_out and i_out * output_dt <= t_new + 1e-9 * output_dt:  # output samples in (t, t_new]
@@ -810,7 +826,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         _exact_accepted(cf, exact, linear, t_new == seg_end)
         n_steps += 1
         # Events at the step's end: those the retaken step was shortened to, and any other found there.
-        _exact_end_events(cf, exact, events, friction)
+        _exact_end_events(exact, events, friction)
         any_events = _with_pending(events, friction)
         if storey is not None:  # located: this step ends where the drift limit is first exceeded (or stability lost)
             status = stop_status if collapse_s >= 0.0 or collapse_pending else status
@@ -836,7 +852,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         i_out = _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey, ground, friction, out)
     collapse_floor = collapse_floor if status == STATUS_COLLAPSED or status == STATUS_UNSTABLE else zero - 1
     return Integration(trimmed_outputs(out, i_out), peaks, impacts[:n_imp], trace[:n_trace], y,
-                       collapse_floor, n_steps, n_rej, status, t)
+                       collapse_floor, n_steps, n_rej, status, t, n_trials, n_contact)
 
 
 jit.stamp_solver_kernels(globals())
@@ -950,9 +966,7 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                         float(output_dt), float(first_step), factors)
     storey = _storey_arguments(system, float(atol))
     friction = _friction_argument(system, float(duration), float(output_dt))
-    cf = None
-    if linear_phases == "exact":
-        cf = run_closed_form(system, float(time_step), rows.shape[0], closed_form_threshold)
+    cf = run_closed_form(system, float(time_step), rows.shape[0], closed_form_threshold, linear_phases)
     raw = _integrate(system.layout, structure, contacts, storey, ground, friction, Forcing(ag, float(time_step)),
                      settings, y_initial, cf)
     out, impacts, trace = raw.outputs, raw.impacts, raw.trace
@@ -967,7 +981,8 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        None if ground is None else out.support,
                        _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)),
                        friction_history=None if friction is None else friction.history[:out.time.size].copy(),
-                       peak_plane_drift=raw.peaks.plane, exact_steps=0 if cf is None else int(cf.policy[3]))
+                       peak_plane_drift=raw.peaks.plane, exact_steps=0 if cf is None else int(cf.policy[3]),
+                       trial_steps=int(raw.n_trials), contact_steps=int(raw.n_contact))
 
 
 def _friction_argument(system: System, duration: float, output_dt: float) -> Friction | None:
