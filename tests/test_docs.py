@@ -221,6 +221,32 @@ def _is_transcript(lang: str, body: str) -> bool:
     return lang == "" and body.lstrip().startswith("$ ")
 
 
+@pytest.fixture(scope="module", autouse=True)
+def one_ball_drop_per_setting():
+    """The ball drop of ``pounding verify`` computed once per setting for the module's doc runs.
+
+    The docs run ``pounding verify`` with its default settings six times (plain, ``--json``, ``--plot``, ``-o``,
+    in docs/verification.md, docs/tour.md and their transcripts), ~5.5 s each: the same deterministic
+    computation (:func:`pounding.studies.verify.run_verification`, tested by tests/test_verify.py) of the same
+    arguments.  Each command still runs through the CLI, prints, writes and plots what it documents from a
+    deep copy of the dataset its arguments give; another setting (``--gravity 0``, ``--models``) is computed.
+    """
+    from pounding.studies import verify
+
+    real, computed = verify.run_verification, {}
+
+    def run_verification(e_pre=verify.DEFAULT_E_PRE, models=None, **settings):
+        key = (tuple(float(e) for e in e_pre), None if models is None else tuple(models),
+               tuple(sorted(settings.items())))
+        if key not in computed:
+            computed[key] = real(e_pre, models, **settings)
+        return computed[key].copy(deep=True)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(verify, "run_verification", run_verification)
+        yield
+
+
 def _scratch(folder: Path) -> Path:
     """A folder holding links to the shipped models, records, sweeps and examples (as the checkout does)."""
     for name in ("models", "ground_motions", "sweeps", "examples"):
