@@ -58,7 +58,7 @@ def _reference_row(masses, stiffness, contact_force, t_end, times):
             f[i] -= force
             if i + 1 < n:
                 f[i + 1] += force
-        return np.r_[v, f / m]
+        return np.concatenate((v, f / m))   # the same vector as np.r_, without its parsing (a third of the time)
 
     # max_step: the contact stiffness' period over 50 (tolerance: the comparison's 1e-6 below)
     solution = solve_ivp(rates, (0.0, t_end), np.zeros(2 * n), method="DOP853", rtol=1e-12, atol=1e-15,

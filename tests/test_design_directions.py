@@ -25,6 +25,10 @@ from pounding.studies.design_directions import (asce7_22_design_category, combin
                                           plan_code_separations, point_design_displacement, rotd100)
 from pounding.units import STANDARD_GRAVITY
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 ROOT = Path(__file__).resolve().parents[1]
 ASCE = {"sds": 1.0, "sd1": 0.6, "tl": 8.0}
 EC8 = {"type": 1, "ground": "B", "ag": 0.3, "beta": 0.2}

@@ -12,6 +12,10 @@ import pytest
 from pounding.cli import main
 from pounding.studies.design import suite_scale_factor
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 ROOT = Path(__file__).resolve().parents[1]
 RECORDS = f"{ROOT / 'ground_motions' / 'peer' / 'NIS090.AT2'},{ROOT / 'ground_motions' / 'peer' / 'ARL360.at2'}"
 MODEL = """

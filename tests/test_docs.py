@@ -13,8 +13,9 @@ conventions):
   :data:`SHORT_DURATION` s unless it gives ``--duration``;
 * a block whose first line is a comment starting ``# example`` is an example: parsed (commands) but not
   run (full record sets, benchmarks; ``.ci/run`` and the benchmarks run those);
-* in the tutorial and the how-to guides (:data:`WALKTHROUGHS`) transcripts also run in sequence with the
-  other blocks, full length, so that a later block can read what they wrote;
+* in the tutorial and the how-to guides (:data:`WALKTHROUGHS`) transcripts run in sequence with the
+  other blocks, full length, so that a later block can read what they wrote, and their output is compared
+  there (the other pages' transcripts each run and are compared on their own);
 * an output block that follows ``$ pounding run MODEL`` is the summary of that run, line by line
   (``...`` skips lines; timings and ``wrote`` lines are not compared), and the counts the docs quote
   (records in the catalogue, scenarios of a sweep) are those of the code.
@@ -221,6 +222,32 @@ def _is_transcript(lang: str, body: str) -> bool:
     return lang == "" and body.lstrip().startswith("$ ")
 
 
+@pytest.fixture(scope="module", autouse=True)
+def one_ball_drop_per_setting():
+    """The ball drop of ``pounding verify`` computed once per setting for the module's doc runs.
+
+    The docs run ``pounding verify`` with its default settings six times (plain, ``--json``, ``--plot``, ``-o``,
+    in docs/verification.md, docs/tour.md and their transcripts), ~5.5 s each: the same deterministic
+    computation (:func:`pounding.studies.verify.run_verification`, tested by tests/test_verify.py) of the same
+    arguments.  Each command still runs through the CLI, prints, writes and plots what it documents from a
+    deep copy of the dataset its arguments give; another setting (``--gravity 0``, ``--models``) is computed.
+    """
+    from pounding.studies import verify
+
+    real, computed = verify.run_verification, {}
+
+    def run_verification(e_pre=verify.DEFAULT_E_PRE, models=None, **settings):
+        key = (tuple(float(e) for e in e_pre), None if models is None else tuple(models),
+               tuple(sorted(settings.items())))
+        if key not in computed:
+            computed[key] = real(e_pre, models, **settings)
+        return computed[key].copy(deep=True)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(verify, "run_verification", run_verification)
+        yield
+
+
 def _scratch(folder: Path) -> Path:
     """A folder holding links to the shipped models, records, sweeps and examples (as the checkout does)."""
     for name in ("models", "ground_motions", "sweeps", "examples"):
@@ -275,10 +302,15 @@ def test_the_python_blocks_and_fast_commands_of_a_doc_run(path, tmp_path, monkey
             continue
         if _is_transcript(lang, body):
             if WALKTHROUGHS.match(rel.as_posix()):
-                for segment in re.split(r"^\$ ", body, flags=re.M)[1:]:
-                    command = re.sub(r"^(?:python3? -m )?", "", segment.partition("\n")[0].strip())
+                # Run here, in sequence, and compared here (not again in the transcript test): what it prints
+                # is the lines below it, as test_every_transcript_is_what_the_command_prints compares elsewhere.
+                for k, segment in enumerate(re.split(r"^\$ ", body, flags=re.M)[1:]):
+                    line, _, expected = segment.partition("\n")
+                    command = re.sub(r"^(?:python3? -m )?", "", line.strip())
                     status, printed = _run(command, shorten=False)
                     assert status == 0, f"{where}: `{command}` ended with status {status}:\n{printed}"
+                    if expected.strip():
+                        _compare_output(f"{where} ${k + 1}", expected, printed)
             continue
         if lang == "python":
             printed = io.StringIO()
@@ -303,9 +335,12 @@ def test_the_python_blocks_and_fast_commands_of_a_doc_run(path, tmp_path, monkey
 
 
 def _transcripts() -> list[tuple[str, str, str]]:
-    """(where, command, expected output) of every ``$ pounding ...`` line of an unlabelled block."""
+    """(where, command, expected output) of every ``$ pounding ...`` line of an unlabelled block, but those of
+    the walkthroughs (:data:`WALKTHROUGHS`), which their doc run runs in sequence and compares."""
     found = []
     for path in DOCS:
+        if WALKTHROUGHS.match(path.relative_to(ROOT).as_posix()):
+            continue
         for lang, body, line in _blocks(path):
             if not _is_transcript(lang, body) or _is_example(body):
                 continue

@@ -1,7 +1,8 @@
 """Regression tests of issue 25 §2–§4 (third adversarial audit): one test per item, each failing before its fix.
 
 Cases that would take hours or allocate hundreds of GiB are run in a
-subprocess under ``RLIMIT_AS`` and a time limit (:func:`tests.test_fuzz.pounding`)
+subprocess under ``RLIMIT_AS`` and a time limit (:func:`tests.test_fuzz.pounding`;
+one-run commands in a child forked from a warmed process, :func:`one_run`)
 and must be refused before any run starts.
 """
 
@@ -19,8 +20,19 @@ import xarray as xr
 from pounding.cli import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_fuzz import _write_case, base_model, pounding, verdict  # noqa: E402
+from test_fuzz import ForkServer, _write_case, base_model, pounding, verdict  # noqa: E402
 from test_hostile import _error  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def one_run(tmp_path_factory):
+    """``pounding ARGS`` of a one-run command (run, rerun, info) as tests/test_fuzz.py runs its cases: a child
+    forked from a process that has imported pounding and loaded its solver, under the same memory cap
+    (3 GB) and time limit as a fresh ``python -m pounding``; (exit status, stdout, stderr).  What a refusal
+    before allocating costs is then its own work, not the ~2 s start-up of an interpreter per case."""
+    server = ForkServer(tmp_path_factory.mktemp("one-run") / "server")
+    yield server.pounding
+    server.close()
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -183,11 +195,11 @@ def _linked(folder: Path, law: str, **parameters) -> Path:
                                                       "the shortest period"),
     ("viscous", {"damping": 1.0e15}, "relaxes the floors' relative motion in m/c = 1e-10 s"),
 ])
-def test_a_stiff_link_is_refused_before_running(tmp_path, law, parameters, expected):
+def test_a_stiff_link_is_refused_before_running(tmp_path, one_run, law, parameters, expected):
     # Before: hours of solver steps for 8 s of record, silently (2.4e9 and 2.4e10 steps).
     path = _linked(tmp_path, law, **parameters)
     started = time.perf_counter()
-    status, out, err = pounding(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    status, out, err = one_run(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, 60)
     assert status == 2 and verdict(status, out, err, None) is None, err
     assert expected in err and "the solver would take about" in err and "steps for 8 s" in err
     assert time.perf_counter() - started < 60 and not (tmp_path / "out.nc").exists()
@@ -237,10 +249,14 @@ def test_a_hunt_never_repeats_a_level_and_stays_within_its_estimate():
             continue
         hunt.check()
         done: list[tuple[float, bool]] = []
+        # The levels run so far, kept as they are appended (a set rebuilt from *done* at every level was
+        # two thirds of this test's time: up to 5,000 levels a hunt); the estimate is the hunt's, fixed.
+        levels, estimate = set(), hunt.max_runs()
         while (level := next_hunt_level(hunt, done)) is not None:
-            assert level not in {s for s, _ in done}
+            assert level not in levels
             done.append((level, collapse is not None and level >= collapse))
-            assert len(done) <= hunt.max_runs(), hunt
+            levels.add(level)
+            assert len(done) <= estimate, hunt
 
 
 def test_an_ida_prints_its_number_of_runs_before_it_starts(case, tmp_path):
@@ -282,22 +298,22 @@ def _wave_model(folder: Path, position: float, velocity: float, west: float = 0.
     (1e308, 1e-300, 0.0, "the lag of building B is inf s (position difference 1e+308 m / apparent velocity"),
     (1.7e308, 500.0, -1.7e308, "the lag of building B is inf s (position difference inf m"),
 ])
-def test_wave_passage_lags_are_checked_before_allocating(tmp_path, position, velocity, west, expected):
+def test_wave_passage_lags_are_checked_before_allocating(tmp_path, one_run, position, velocity, west, expected):
     # Before: MemoryError / ValueError (negative dimensions) / OverflowError tracebacks from the lag arrays.
     path = _wave_model(tmp_path, position, velocity, west)
-    status, out, err = pounding(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    status, out, err = one_run(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, 60)
     assert status == 2 and verdict(status, out, err, None) is None, err
     assert f"{path.name}: ground_motion.wave_passage: " in err and expected in err
 
 
 @pytest.mark.parametrize("damping", [{"modal": [0.05]}, {"ratio": 0.05, "modes": [1, 2]}])
-def test_ten_thousand_storeys_are_checked_before_the_eigensolver(tmp_path, damping):
+def test_ten_thousand_storeys_are_checked_before_the_eigensolver(tmp_path, one_run, damping):
     # Before: MemoryError from numpy's eigh (dense 10,000 x 10,000 matrices under a 3 GB cap).
     model = base_model()
     model["buildings"][0]["storeys"]["count"] = 10_000
     model["buildings"][0]["damping"] = damping
     path = _write_case(tmp_path, model)
-    status, out, err = pounding(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, limit=60)
+    status, out, err = one_run(["run", str(path), "-o", str(tmp_path / "out.nc")], tmp_path, 60)
     assert status == 2 and verdict(status, out, err, None) is None, err
     assert "building A: the modes of its 10000 storeys (dense 10000 x 10000 matrices) would need about" in err
     assert "lump several storeys into one" in err
@@ -319,14 +335,14 @@ def _huge_netcdf(path: Path, **attributes) -> None:
     ("run", "info", "reading its 1 variables (2.4 GB)"),
     ("sweep", "info", "reading its 1 variables (2.4 GB)"),
 ])
-def test_a_huge_netcdf_is_not_loaded_whole(tmp_path, kind, command, expected):
+def test_a_huge_netcdf_is_not_loaded_whole(tmp_path, one_run, kind, command, expected):
     # Before: the 2.4 GB variable was loaded (MemoryError under the cap) before anything was checked.
     attributes = {"foreign": {}, "run": {"source": "pounding 1", "run_spec": "{}"},
                   "sweep": {"source": "pounding 1", "sweep_name": "s"}}[kind]
     archive = tmp_path / "big.nc"
     _huge_netcdf(archive, **attributes)
     args = ["rerun", str(archive), "-o", str(tmp_path / "again.nc")] if command == "rerun" else ["info", str(archive)]
-    status, out, err = pounding(args, tmp_path, limit=60)
+    status, out, err = one_run(args, tmp_path, 60)
     assert status == 2 and verdict(status, out, err, None) is None, err
     assert expected in err
 

@@ -27,17 +27,20 @@ Cost: a case of a one-run command (``run``, ``rerun``, ``info``, ``plot``,
 pounding and loaded its compiled solver (:data:`FORK_SERVER`), so it costs
 its own work, not the ~2 s start-up of a fresh interpreter; the studies
 (``sweep``, ``ida``) and the race of two runs are fresh interpreters.  Two
-cases run at a time.
+cases run at a time, on two fork servers that the module's tests share
+(started once, when a case first needs one).
 """
 
 from __future__ import annotations
 
 import json
 import os
+import queue
 import random
 import resource
 import subprocess
 import sys
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -316,12 +319,51 @@ class ForkServer:
         self.process.wait(timeout=60)
 
 
+class ForkServers:
+    """The module's two :class:`ForkServer` processes, started when a case first needs one and shared by every
+    test of the module (:func:`fork_servers`).  A server's state never changes after its warm-up run: each case
+    runs in a forked copy of it, so a case sees the same process whichever test ran before.  Starting two
+    servers costs ~6 s of CPU (imports, the warm-up run); started once, not once per test."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.started: list[ForkServer] = []
+        self.idle: queue.Queue = queue.Queue()
+        self.lock = threading.Lock()
+
+    def get(self) -> ForkServer:
+        """An idle server; the first two calls start one each."""
+        with self.lock:
+            if len(self.started) < 2 and self.idle.empty():
+                server = ForkServer(self.folder / f"server{len(self.started)}")
+                self.started.append(server)
+                return server
+        return self.idle.get()
+
+    def put(self, server: ForkServer) -> None:
+        self.idle.put(server)
+
+    def close(self) -> None:
+        for server in self.started:
+            server.close()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def fork_servers(tmp_path_factory):
+    """The module's :class:`ForkServers`, closed after its last test."""
+    global SERVERS
+    SERVERS = ForkServers(tmp_path_factory.mktemp("fork-servers"))
+    yield SERVERS
+    SERVERS.close()
+    SERVERS = None
+
+
+SERVERS: ForkServers | None = None
+
+
 def _check_all(cases: list[tuple[str, list[str], Path, Path | None, float]]) -> None:
     """Run the cases two at a time; fail listing every case that ended badly."""
-    import queue
-    import tempfile
-
-    servers: queue.Queue = queue.Queue()
+    servers = SERVERS
 
     def one(case):
         label, args, cwd, archive, limit = case
@@ -335,15 +377,8 @@ def _check_all(cases: list[tuple[str, list[str], Path, Path | None, float]]) -> 
             status, out, err = pounding(args, cwd, limit)
         return label, args, verdict(status, out, err, archive), err
 
-    with tempfile.TemporaryDirectory() as scratch, ThreadPoolExecutor(max_workers=2) as pool:
-        started = [ForkServer(Path(scratch) / f"server{k}") for k in range(2)]
-        for server in started:
-            servers.put(server)
-        try:
-            outcomes = list(pool.map(one, cases))
-        finally:
-            for server in started:
-                server.close()
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        outcomes = list(pool.map(one, cases))
     bad = [f"{label}: {problem}\n    args: {args}\n    stderr: {err[-600:]}" for label, args, problem, err in outcomes
            if problem]
     assert not bad, f"{len(bad)} of {len(cases)} fuzz cases failed (seed {SEED}):\n" + "\n".join(bad)

@@ -94,6 +94,14 @@ def test_reaching_the_ultimate_drift_collapses_the_building_there(tmp_path, name
     ds = pounding.simulate(model)
     record = record_for(model)
     ref = imk_reference_run(model, record.acceleration, record.time_step, 4.0)
+    assert ds.attrs["status"] == "collapsed" and ds.attrs["collapse_storey"] == "A:1"
+    assert ref["collapse"] is not None and ref["collapse"][0] == 0
+    # Located: the run ends where the first storey's drift reaches θ_u·h, at the reference's instant.
+    assert float(ds.attrs["collapse_time"]) == pytest.approx(ref["collapse"][1], rel=1e-6)
+    assert float(ds.peak_storey_drift[0]) == pytest.approx(ultimate * 3.0, rel=1e-9)
+    np.testing.assert_allclose(ds.peak_storey_drift.values, ref["peak_drift"], rtol=1e-6)
+
+
 @pytest.mark.parametrize("name", list(VARIANTS))
 def test_opensees_export_of_imk_storeys_agrees_on_peaks(tmp_path, name):
     # The exported script (IMKBilin / IMKPeakOriented / IMKPinching, Newmark at a fixed step) over a 4 s window

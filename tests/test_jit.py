@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -55,8 +56,16 @@ def _last_json_line(command: list[str], **kwargs) -> dict:
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 
+@functools.lru_cache(maxsize=None)
+def _probe_once(mode: str) -> str:
+    return json.dumps(_last_json_line([sys.executable, "-c", STARTUP_PROBE, str(ROOT / "models" / "pair.yaml"), mode]))
+
+
 def _probe(mode: str) -> dict:
-    return _last_json_line([sys.executable, "-c", STARTUP_PROBE, str(ROOT / "models" / "pair.yaml"), mode])
+    """The probe's results in *mode*, run once per mode for the module: the shortcut tests and the prebuilt
+    test compare the same fresh processes (the "fast" and "numba" runs of the shipped pair, ~3 s each), which
+    are deterministic; each caller gets its own copy."""
+    return json.loads(_probe_once(mode))
 
 
 def test_start_up_shortcuts_change_nothing_but_time():

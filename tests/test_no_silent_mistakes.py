@@ -14,6 +14,10 @@ from pounding.cli import main
 from pounding.results import checks
 from pounding.units import STANDARD_GRAVITY
 
+#: Studies run on the in-process cluster (tests/conftest.py: no worker processes to start; their results and
+#: output are what is tested here).
+pytestmark = pytest.mark.usefixtures("studies_in_process")
+
 ROOT = Path(__file__).resolve().parents[1]
 PAIR = ROOT / "models" / "pair.yaml"
 G = STANDARD_GRAVITY

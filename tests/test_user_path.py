@@ -252,7 +252,10 @@ def test_every_subcommand_and_argument_has_help():
 # ---------------------------------------------------------------- failure reports
 
 
-def test_compare_failures_are_reported_once_each_and_all_failing_stops(client, tmp_path, capsys):
+def test_compare_failures_are_reported_once_each_and_all_failing_stops(in_process_client, tmp_path, capsys):
+    # The in-process cluster (tests/conftest.py): each scenario's error is caught in its task and kept in the
+    # results, which is what is reported; no worker processes to start (two, ~4 s of CPU).
+    client = in_process_client
     from pounding.cli.sweep import raise_if_all_failed
     from pounding.studies.compare import compare, comparison_table
     from pounding.studies.sweep.execution import failure_report, failures
