@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import subprocess
 import sys
@@ -192,3 +193,22 @@ def test_output_into_a_closed_pipe_ends_quietly():
         os.close(write_end)
     assert writer.returncode == 141
     assert writer.stderr == ""
+
+
+def test_no_help_text_shows_a_doubled_percent_sign():
+    """argparse %-formats help strings but not descriptions: a ``%%`` written in a description is printed
+    as it is (``ACMR20%%``).  Every command's whole help, as printed, has single percent signs."""
+    from pounding.cli import build_parser
+
+    parser = build_parser()
+    leaves = [parser]
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            leaves += list(action.choices.values())
+    for leaf in list(leaves):
+        for action in leaf._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                leaves += list(action.choices.values())
+    assert len(leaves) > 15  # every subcommand and its subcommands were registered
+    for leaf in leaves:
+        assert "%%" not in leaf.format_help(), leaf.prog

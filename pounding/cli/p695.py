@@ -65,7 +65,7 @@ def register_cli(subparsers) -> argparse.ArgumentParser:
         description="FEMA P695 (2009) for every building of MODEL: T = C_u T_a from its height and --system, "
                     "mu_T from a pushover, a hunt-and-fill collapse IDA of the normalised far-field set (with "
                     "and without contacts), S_CT, CMR = S_CT/S_MT, SSF, ACMR, beta_TOT from --quality and the "
-                    "verdict (ACMR >= ACMR20%%; a --group on its mean ACMR against ACMR10%%). See docs/p695.md.")
+                    "verdict (ACMR >= ACMR20%; a --group on its mean ACMR against ACMR10%). See docs/p695.md.")
     parser.add_argument("model", help="YAML model, e.g. models/pair_inelastic.yaml")
     parser.add_argument("--system", metavar="SYSTEM|B=SYSTEM,...",
                         help=f"structural system for T_a (ASCE 7 Table 12.8-2): {', '.join(SYSTEMS)}; one for "
