@@ -530,7 +530,7 @@ def _locate_contacts(work, h, t, seg, forcing, structure, contacts, cstate, even
 def _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction, work):
     """After events at *t*: ``(linear, exact)`` of the step from there (the events may end the linear phase or
     change its constant load: a new modal state)."""
-    if cf is None or not has_modes(cf):
+    if not has_modes(cf):
         return False, False
     cf.valid[0] = 0
     linear = linear_phase(cstate, structure, storey, friction)
@@ -553,14 +553,11 @@ def _record_closed(work, h, t, contacts, cstate, ground, peaks, impacts, trace, 
 
 # The closed form's calls in the driver's loop are inlined: a run that takes no exact step (most runs at
 # default tolerances; every run of :func:`.closed_form.no_closed_form`) pays a few tests a step for them,
-# not a call that passes the whole ClosedForm record.  Without a closed form (cf None: a model it refuses)
-# they are pruned at compile time.
+# not a call that passes the whole ClosedForm record.
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, storey, ground, friction, work):
     """``(linear, linear_known, exact)`` of the step from *t*: whether the phase is linear is decided again
     only after events (*linear_known* False), and a linear phase's step is exact in an exact window."""
-    if cf is None:
-        return False, True, False
     if not linear_known:
         linear = has_modes(cf) and linear_phase(cstate, structure, storey, friction)
         linear_known = True
@@ -572,8 +569,7 @@ def _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, sto
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _phase_ended(cf) -> bool:
     """Events were applied: the linear phase (if any) must be decided again; returns False (not known)."""
-    if cf is not None:
-        cf.valid[0] = 0
+    cf.valid[0] = 0
     return False
 
 
@@ -581,7 +577,7 @@ def _phase_ended(cf) -> bool:
 def _exact_accepted(cf, exact, linear, at_sample) -> None:
     """After an accepted step: an exact step's end becomes the modal state (a Runge–Kutta step ends the
     phase's modal state), and a linear phase's step is counted (:func:`.closed_form.count_linear_step`)."""
-    if cf is None or not linear:
+    if not linear:
         return
     if exact:
         z, z_end = cf.z, cf.z_end
@@ -595,7 +591,7 @@ def _exact_accepted(cf, exact, linear, at_sample) -> None:
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _exact_step(cf, exact, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground) -> bool:
     """Take the trial step in closed form if it is an exact one (:func:`.closed_form.closed_form_step`)."""
-    if cf is None or not exact:
+    if not exact:
         return False
     closed_form_step(cf, work, h, t, seg, forcing, structure, contacts, cstate, storey, ground)
     return True
@@ -605,7 +601,7 @@ def _exact_step(cf, exact, work, h, t, seg, forcing, structure, contacts, cstate
 def _grazes(cf, exact, s_first, n_graze, work, h, lay, contacts, cstate, ground) -> bool:
     """An exact trial step to halve: no event before GRAZE_SPLIT, halvings left, and an open contact's exact
     δ might touch 0 unseen by the cubic (:func:`.closed_form.graze_fraction`)."""
-    if cf is None or not exact or s_first <= GRAZE_SPLIT or n_graze >= MAX_GRAZE_SPLITS:
+    if not exact or s_first <= GRAZE_SPLIT or n_graze >= MAX_GRAZE_SPLITS:
         return False
     return graze_fraction(cf, work, h, lay, contacts, cstate, ground) < 1.0
 
@@ -614,7 +610,7 @@ def _grazes(cf, exact, s_first, n_graze, work, h, lay, contacts, cstate, ground)
 def _record_peaks(cf, exact, work, h, n, structure, peaks) -> None:
     """The peaks over an accepted step: on the cubic of a Runge–Kutta step, on the exact solution of an
     exact one (:func:`.closed_form.record_exact_peaks`)."""
-    if cf is not None and exact:
+    if exact:
         record_exact_peaks(cf, work, h, n, structure, peaks)
         return
     record_floor_peaks(work, h, n, structure.below, peaks)
@@ -624,7 +620,7 @@ def _record_peaks(cf, exact, work, h, n, structure, peaks) -> None:
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
 def _exact_output(cf, exact, work, h, s, t, seg, forcing, structure, storey, ground, out) -> None:
     """An output sample inside an exact step: the exact state (:func:`.closed_form.exact_state_at`)."""
-    if cf is not None and exact and s < 1.0:
+    if exact and s < 1.0:
         exact_state_at(cf, work, h, s, t, seg, forcing, structure, storey, ground, out)
 
 
@@ -704,8 +700,8 @@ def _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial, cf):
-    """The run (module docstring); *storey*, *ground*, *friction*, *cf* (the linear phases' closed form,
-    :mod:`.closed_form`) None: their blocks are pruned at compile time."""
+    """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile time;
+    *cf* the linear phases' closed form (:mod:`.closed_form`; :func:`~.closed_form.no_closed_form`: none)."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
     dt_rec, t_end, output_dt = forcing.record_step, settings.end_time, settings.output_step
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
@@ -981,7 +977,7 @@ def integrate(system: System, ground_acceleration: np.ndarray, time_step: float,
                        None if ground is None else out.support,
                        _collapse_cause(storey, int(raw.status), int(raw.collapse_floor)),
                        friction_history=None if friction is None else friction.history[:out.time.size].copy(),
-                       peak_plane_drift=raw.peaks.plane, exact_steps=0 if cf is None else int(cf.policy[3]),
+                       peak_plane_drift=raw.peaks.plane, exact_steps=int(cf.policy[3]),
                        trial_steps=int(raw.n_trials), contact_steps=int(raw.n_contact))
 
 
