@@ -880,8 +880,8 @@ def run_closed_form(system, record_step: float, n_grounds: int, threshold: float
     ``"runge-kutta"``: every run passes a closed form of one type, so the solver is compiled once for
     models with and without one (a pruned variant without it was 1 % faster on ``pair_inelastic``,
     within the noise, and cost a compilation of its own, ~50 s, for every combination of features)."""
-    cf = closed_form(system, record_step, n_grounds)
-    if cf is None or linear_phases != "exact":
+    cf = closed_form(system, record_step, n_grounds) if linear_phases == "exact" else None
+    if cf is None:
         return no_closed_form()
     m = cf.eigenvalue.size
     cf = cf._replace(z=np.zeros(m, dtype=np.complex128), z_end=np.zeros(m, dtype=np.complex128),

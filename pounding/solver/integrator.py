@@ -499,13 +499,10 @@ def _locate_storeys(work, h, lay, structure, storey, events, s_first, collapse_f
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
-def _exact_start(cf, linear, t, seg, forcing, ground, work) -> bool:
-    """Whether the step from *t* runs in closed form (:mod:`pounding.solver.closed_form`): a *linear* phase
-    in an exact window; starts the phase's modal state from ``work.y`` and its rate ``work.K[0]`` when
-    it is new (else marks it to be started)."""
-    if not linear or not wants_exact(cf):
-        cf.valid[0] = 0
-        return False
+def _exact_start(cf, t, seg, forcing, ground, work) -> bool:
+    """The step from *t* of a linear phase in an exact window runs in closed form
+    (:mod:`pounding.solver.closed_form`): the phase's modal state is started from ``work.y`` and its rate
+    ``work.K[0]`` when it is new.  Returns True."""
     if cf.valid[0] == 0:
         start_phase(cf, work.y, work.K[0], t, seg, forcing, ground)
     return True
@@ -530,11 +527,9 @@ def _locate_contacts(work, h, t, seg, forcing, structure, contacts, cstate, even
 def _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction, work):
     """After events at *t*: ``(linear, exact)`` of the step from there (the events may end the linear phase or
     change its constant load: a new modal state)."""
-    if not has_modes(cf):
-        return False, False
     cf.valid[0] = 0
-    linear = linear_phase(cstate, structure, storey, friction)
-    return linear, _exact_start(cf, linear, t, seg, forcing, ground, work)
+    linear, _, exact = _phase_now(cf, False, False, t, seg, forcing, cstate, structure, storey, ground, friction, work)
+    return linear, exact
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED)
@@ -563,7 +558,7 @@ def _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, sto
         linear_known = True
     if not linear or not wants_exact(cf):  # (a probing window's steps: _exact_accepted ends the modal state)
         return linear, linear_known, False
-    return linear, linear_known, _exact_start(cf, linear, t, seg, forcing, ground, work)
+    return linear, linear_known, _exact_start(cf, t, seg, forcing, ground, work)
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
