@@ -116,51 +116,56 @@ def measured(clocks: Clocks, model, repeat: int) -> dict:
             "counts": runs[-1]["counts"]}
 
 
+def trial_costs(result: dict, bare: dict) -> tuple[float, float]:
+    """The time of the steps without an impact under way (s, at *bare*'s time per trial step) and the
+    time per other trial step (s): the rest of the compiled solver's time over their count."""
+    c, kernel = result["counts"], result["seconds"]["kernel"]
+    open_cost = bare["seconds"]["kernel"] / max(bare["counts"]["trial_steps"], 1)
+    open_rk = min(kernel, (c["accepted"] - c["contact"] - c["exact"]) * open_cost)
+    others = c["trial_steps"] - c["accepted"] + c["contact"] + c["exact"]
+    return open_rk, (kernel - open_rk) / max(others, 1)
+
+
 def split(result: dict, bare: dict) -> dict:
     """The run's time split (s) from its clocks and counts (module docstring): the steps without an impact
     under way at the time per trial step of the same buildings without contacts (*bare*), the rest of the
     compiled solver's time shared by the steps with an impact under way and the trial steps not accepted
     (event location and error control) in proportion to their counts."""
     s, c = result["seconds"], result["counts"]
-    kernel = s["kernel"]
-    open_cost = bare["seconds"]["kernel"] / max(bare["counts"]["trial_steps"], 1)
+    open_rk, rest_cost = trial_costs(result, bare)
     not_accepted = c["trial_steps"] - c["accepted"]
-    open_rk = min(kernel, (c["accepted"] - c["contact"] - c["exact"]) * open_cost)
-    rest_cost = (kernel - open_rk) / max(c["contact"] + not_accepted + c["exact"], 1)
     return {
         "Runge-Kutta steps, no impact under way": open_rk,
         "steps with an impact under way": c["contact"] * rest_cost,
         "closed-form steps": c["exact"] * rest_cost,
         "event location and error control": not_accepted * rest_cost,
         "closed form's build": s.get("closed_form_build", 0.0),
-        "rest of integrate()": s["integrate"] - kernel - s.get("closed_form_build", 0.0),
+        "rest of integrate()": s["integrate"] - s["kernel"] - s.get("closed_form_build", 0.0),
         "outside the solver": s["simulate"] - s["integrate"],
     }
 
 
-def report(name: str, result: dict, exact: dict, bare: dict) -> None:
-    """Print one model's split."""
+def report(name: str, result: dict, exact: dict, bare: dict) -> dict:
+    """Print one model's split; returns it (:func:`split`)."""
     s, c = result["seconds"], result["counts"]
     print(f"\n{name}: simulate() {1e3 * s['simulate']:.2f} ms, compiled solver {1e3 * s['kernel']:.2f} ms; "
           f"{c['trial_steps']} trial steps ({c['accepted']} accepted, {c['exact']} exact, {c['contact']} with an "
           f"impact under way, {c['rejected']} rejected), {c['impacts']} impacts"
           + (f", {c['contact'] / c['impacts']:.1f} steps per impact" if c["impacts"] else ""))
-    total = s["simulate"]
-    for label, seconds in split(result, bare).items():
+    total, parts = s["simulate"], split(result, bare)
+    for label, seconds in parts.items():
         print(f"  {label:42s} {1e3 * seconds:8.2f} ms  {100 * seconds / total:5.1f} %")
     per = 1e6 * s["kernel"] / max(c["trial_steps"], 1)
     per_bare = 1e6 * bare["seconds"]["kernel"] / max(bare["counts"]["trial_steps"], 1)
-    shared = split(result, bare)
-    rest = max(c["trial_steps"] - c["accepted"] + c["contact"] + c["exact"], 1)
     print(f"  time per trial step: {per:.2f} us; without an impact under way (the same buildings without "
-          f"contacts) {per_bare:.2f} us; with one, or not accepted, "
-          f"{1e6 * (s['kernel'] - shared['Runge-Kutta steps, no impact under way']) / rest:.2f} us")
+          f"contacts) {per_bare:.2f} us; with one, or not accepted, {1e6 * trial_costs(result, bare)[1]:.2f} us")
     ce = exact["counts"]
     if ce["exact"]:
         rk_trials = ce["trial_steps"] - ce["exact"]
         per_exact = (1e6 * exact["seconds"]["kernel"] - per * rk_trials) / ce["exact"]
         print(f"  every linear phase in closed form: {1e3 * exact['seconds']['kernel']:.2f} ms, {ce['exact']} exact "
               f"steps, about {per_exact:.2f} us each ({per_exact / per:.1f} Runge-Kutta trial steps)")
+    return parts
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -176,8 +181,8 @@ def main(argv: list[str] | None = None) -> int:
         path = ROOT / "models" / f"{name}.yaml"
         result = measured(clocks, variant(path, args.rtol), args.repeat)
         bare = measured(clocks, variant(path, args.rtol, drop_contacts=True), args.repeat)
-        report(name, result, forced_exact(clocks, path, args), bare)
-        results[name] = {"default": result, "split": split(result, bare), "without_contacts": bare}
+        parts = report(name, result, forced_exact(clocks, path, args), bare)
+        results[name] = {"default": result, "split": parts, "without_contacts": bare}
     out = out_dir(args, "time_split") / "time_split.json"
     out.write_text(json.dumps(results, indent=1))
     print(f"\nwritten: {out}")
