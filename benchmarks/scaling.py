@@ -76,6 +76,7 @@ sys.path.insert(0, str(ROOT))
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402
+from _sides import WorkerProcess, this_tree_label, tree_of  # noqa: E402
 from _scaling_worker import RECORD, pair_yaml, repeated_record  # noqa: E402
 
 DOCS_FIGURE = ROOT / "docs" / "scaling.png"
@@ -91,19 +92,11 @@ class Side:
     def __init__(self, name: str, tree_label: str, tree: Path, settings: list[str], clock: str) -> None:
         self.name, self.tree, self.settings = name, tree, settings
         self.tree_label, self.label = tree_label, tree_label + (f" [{', '.join(settings)}]" if settings else "")
-        env = dict(os.environ, PYTHONPATH=str(tree))
-        self.process = subprocess.Popen([sys.executable, str(WORKER), clock], cwd=tree, env=env, text=True,
-                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        self.worker = WorkerProcess(WORKER, tree, [clock], name=name, script="scaling.py")
 
     def ask(self, **request) -> dict:
         """One answer of the worker; stops the run in one line on a model error or a dead worker."""
-        self.process.stdin.write(json.dumps(dict(request, settings=self.settings)) + "\n")
-        self.process.stdin.flush()
-        line = self.process.stdout.readline()
-        if not line:
-            raise SystemExit(f"scaling.py: the {self.name} side's process ({self.tree}) ended "
-                             f"(exit {self.process.wait()}); its error is printed above")
-        answer = json.loads(line)
+        answer = self.worker.ask(dict(request, settings=self.settings))
         if "error" in answer:
             given = " ".join(f"{'--before-settings' if self.name == 'before' else '--settings'} {s}"
                              for s in self.settings)
@@ -115,9 +108,7 @@ class Side:
         return self.ask(op="run", storeys=storeys, duration=duration, repeated=repeated)
 
     def close(self) -> None:
-        if self.process.poll() is None:
-            self.process.stdin.close()
-            self.process.wait()
+        self.worker.close()
 
 
 def setting(text: str) -> str:
@@ -128,45 +119,13 @@ def setting(text: str) -> str:
     return text
 
 
-def git(*args: str) -> str:
-    return subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True).stdout.strip()
-
-
-def this_tree_label() -> str:
-    """``<branch>@<commit>``, with ``+changes`` if tracked files differ from it."""
-    branch, commit = git("rev-parse", "--abbrev-ref", "HEAD"), git("rev-parse", "--short", "HEAD")
-    changed = git("status", "--porcelain", "--untracked-files=no")
-    return f"{branch}@{commit}{'+changes' if changed else ''}" if commit else str(ROOT)
-
-
-def tree_of(ref: str, out: Path) -> tuple[Path, str]:
-    """The folder and label of ``--before REF``: a pounding checkout's folder, or a commit extracted once."""
-    folder = Path(ref).expanduser()
-    if (folder / "pounding" / "__init__.py").is_file():
-        return folder.resolve(), str(folder)
-    commit = git("rev-parse", "--verify", "--quiet", f"{ref}^{{commit}}")
-    if not commit:
-        raise SystemExit(f"scaling.py: --before {ref}: neither a commit of {ROOT} nor a folder holding "
-                         "pounding/__init__.py; give a commit (e.g. main, 66b6f41) or another checkout")
-    tree = out / "trees" / commit[:12]
-    if not (tree / ".extracted").is_file():
-        print(f"extracting {ref} ({commit[:12]}) into {tree} (kept; its first run compiles the solver)")
-        tree.mkdir(parents=True, exist_ok=True)
-        archive = subprocess.Popen(["git", "-C", str(ROOT), "archive", "--format=tar", commit], stdout=subprocess.PIPE)
-        subprocess.run(["tar", "-x", "-C", str(tree)], stdin=archive.stdout, check=True)
-        if archive.wait() != 0:
-            raise SystemExit(f"scaling.py: --before {ref}: git archive failed (exit {archive.returncode})")
-        (tree / ".extracted").write_text(commit + "\n")
-    return tree, ref
-
-
 def start_sides(args: argparse.Namespace, out: Path) -> list[Side]:
     """The measured sides, each checked (its models built with its settings) before any timing."""
     after = this_tree_label()
     if args.before is None and args.before_settings is None:
         sides = [Side("this", after, ROOT, args.settings, args.clock)]
     else:
-        tree, label = tree_of(args.before, out) if args.before else (ROOT, after)
+        tree, label = tree_of(args.before, out, "scaling.py") if args.before else (ROOT, after)
         sides = [Side("before", label, tree, args.before_settings or [], args.clock),
                  Side("after", after, ROOT, args.settings, args.clock)]
     try:
