@@ -16,7 +16,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -113,3 +113,16 @@ def serve(answer: Callable[[dict], dict]) -> None:
     for line in sys.stdin:
         replies.write(json.dumps(answer(json.loads(line))) + "\n")
         replies.flush()
+
+
+def checked(sides: list, check: Callable[[Any], None]) -> list:
+    """*sides* (each with ``close()``), each passed to *check* (its first requests, timed by the caller);
+    every side's process is closed if a check fails."""
+    try:
+        for side in sides:
+            check(side)
+    except BaseException:
+        for side in sides:
+            side.close()
+        raise
+    return sides

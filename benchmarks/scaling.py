@@ -76,7 +76,7 @@ sys.path.insert(0, str(ROOT))
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402
-from _sides import WorkerProcess, this_tree_label, tree_of  # noqa: E402
+from _sides import WorkerProcess, checked, this_tree_label, tree_of  # noqa: E402
 from _scaling_worker import RECORD, pair_yaml, repeated_record  # noqa: E402
 
 DOCS_FIGURE = ROOT / "docs" / "scaling.png"
@@ -128,18 +128,15 @@ def start_sides(args: argparse.Namespace, out: Path) -> list[Side]:
         tree, label = tree_of(args.before, out, "scaling.py") if args.before else (ROOT, after)
         sides = [Side("before", label, tree, args.before_settings or [], args.clock),
                  Side("after", after, ROOT, args.settings, args.clock)]
-    try:
-        for side in sides:
-            started = time.perf_counter()
-            version = side.ask(op="check")["version"]
-            side.run(5, duration=1.0)
-            print(f"{side.name}: {side.label} ({side.tree}), pounding {version}; first run (imports, cache load "
-                  f"or compile, record): {time.perf_counter() - started:.2f} s, excluded", flush=True)
-    except BaseException:
-        for side in sides:
-            side.close()
-        raise
-    return sides
+
+    def check(side: Side) -> None:
+        started = time.perf_counter()
+        version = side.ask(op="check")["version"]
+        side.run(5, duration=1.0)
+        print(f"{side.name}: {side.label} ({side.tree}), pounding {version}; first run (imports, cache load "
+              f"or compile, record): {time.perf_counter() - started:.2f} s, excluded", flush=True)
+
+    return checked(sides, check)
 
 
 def measure(sides: list[Side], repeat: int, storeys: int, duration: float | None = None,

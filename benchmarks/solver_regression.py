@@ -33,20 +33,13 @@ MODELS = ["pair", "pair_inelastic", "pair_collapse", "isolated_moat", "pair_bump
 #: from before the one structure model, a plan model through its own loader and ``simulate_plan``).
 WORKER = """
 import sys
-import time
 import pounding
-import pounding.simulation as simulation
 from pounding.model.model import is_plan_file
 from pounding.simulation import simulate
+sys.path.insert(0, sys.argv[2])   # benchmarks/ of the checkout that runs the comparison
+from _sides import time_solver_thread
 clock, spent = sys.argv[1], []
-solve = simulation.integrate
-def timed(*args, **kwargs):
-    start = time.thread_time()
-    try:
-        return solve(*args, **kwargs)
-    finally:
-        spent.append(time.thread_time() - start)
-simulation.integrate = timed
+time_solver_thread(spent)
 models = {}
 for line in sys.stdin:
     name = line.strip()
@@ -71,7 +64,7 @@ class Worker:
     """A Python process of one tree that simulates models on request."""
 
     def __init__(self, tree: Path, clock: str = "wall") -> None:
-        self.process = subprocess.Popen([sys.executable, "-c", WORKER, clock], cwd=tree, text=True,
+        self.process = subprocess.Popen([sys.executable, "-c", WORKER, clock, str(Path(__file__).resolve().parent)], cwd=tree, text=True,
                                         env=dict(os.environ, PYTHONPATH=str(tree)),
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE)
 

@@ -37,7 +37,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402
-from _sides import ROOT, WorkerProcess, this_tree_label, tree_of  # noqa: E402
+from _sides import ROOT, WorkerProcess, checked, this_tree_label, tree_of  # noqa: E402
 
 WORKER = Path(__file__).resolve().parent / "_share_worker.py"
 STUDIES = ("sweep", "compare", "gap")
@@ -87,19 +87,15 @@ def start_sides(args: argparse.Namespace, out: Path) -> list[Side]:
     else:
         tree, label = tree_of(args.before, out, "worker_share.py")
         named = [("before", label, tree), ("after", after, ROOT)]
-    sides: list[Side] = []
-    try:
-        for name, label, tree in named:
-            started = time.perf_counter()
-            sides.append(Side(name, label, tree))
-            answer = sides[-1].ask(op="check")
-            print(f"{name}: {label} ({tree}), pounding {answer['version']}, tasks {answer['tasks']}; first runs "
-                  f"(imports, kernels, records): {time.perf_counter() - started:.1f} s, excluded", flush=True)
-    except BaseException:
-        for side in sides:
-            side.close()
-        raise
-    return sides
+    sides = [Side(name, label, tree) for name, label, tree in named]
+
+    def check(side: Side) -> None:
+        started = time.perf_counter()
+        answer = side.ask(op="check")
+        print(f"{side.name}: {side.label} ({side.tree}), pounding {answer['version']}, tasks {answer['tasks']}; "
+              f"first runs (imports, kernels, records): {time.perf_counter() - started:.1f} s, excluded", flush=True)
+
+    return checked(sides, check)
 
 
 def measure(sides: list[Side], studies: list[str], rounds: int) -> dict:
