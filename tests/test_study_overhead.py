@@ -169,3 +169,87 @@ def test_a_sweep_scenario_keeps_the_same_values_whether_its_archive_is_written_o
         for name in ("dataset", "wall_time", "solver_wall_time"):   # the clock; the archive kept
             part.pop(name, None)
     assert kept == light
+
+
+def test_buildings_of_the_same_storeys_share_their_modes_and_a_changed_storey_gets_its_own():
+    """A sweep's worker builds a new model for every scenario; the modes of a building whose storeys are
+    unchanged are kept (pounding.model.building.modes_key), those of a changed one computed: each equal,
+    bit for bit, to the eigensolution of its own matrices."""
+    from pounding.model import floors
+
+    first, twin, stiffer = pair(), pair(), pair(stiffness=7.0e8)
+    assert twin.buildings[0] is not first.buildings[0]
+    assert twin.buildings[0].modes[1] is first.buildings[0].modes[1]   # kept: solved once for both
+    assert stiffer.buildings[1].modes[1] is first.buildings[1].modes[1]   # B is the same in all three
+    assert not np.array_equal(stiffer.buildings[0].modes[0], first.buildings[0].modes[0])
+    # building A: 8 storeys of 3.5e8 N/m, 2.5e5 kg; first period 0.91 s (models/pair.yaml), 0.91 / sqrt(2) stiffer
+    assert first.buildings[0].periods[0] == pytest.approx(0.91, abs=0.005)   # the file's own 2-digit figure
+    assert stiffer.buildings[0].periods[0] == pytest.approx(first.buildings[0].periods[0] / np.sqrt(2.0),
+                                                            rel=1e-12)   # K doubled, M the same: round-off only
+    for building in (first.buildings[0], stiffer.buildings[0], first.buildings[1]):
+        omega, phi = floors.natural_modes(building.stiffness_matrix(), building.mass_matrix(),
+                                          building.dofs_per_floor)
+        np.testing.assert_array_equal(building.modes[0], omega)   # bit for bit: the same solution
+        np.testing.assert_array_equal(building.modes[1], phi)
+
+
+def test_the_modes_key_holds_every_bit_the_matrices_are_made_of():
+    """Storeys that differ in any number a building's mass or stiffness matrix reads get two keys, down to the
+    sign of a zero (equal as floats, but not the same bits); numbers written as an integer or a float are one."""
+    from pounding.model.building import modes_key
+    from pounding.model.floors import Plane, Storey
+
+    def storey(**changed) -> Storey:
+        fields = dict(mass=2.5e5, height=3.2, centre=(0.0, 0.0), radius_of_gyration=0.0,
+                      planes=(Plane("x", 0.0, 3.5e8),))
+        fields.update(changed)
+        return Storey(**fields)
+
+    base = modes_key((storey(),), 1)
+    assert modes_key((storey(),), 1) == base
+    assert modes_key((storey(mass=250000),), 1) == base   # the same float
+    assert modes_key((storey(height=3.0),), 1) == base   # a height is in neither matrix
+    for other in (storey(mass=2.5e5 * (1 + 2 ** -52)), storey(centre=(-0.0, 0.0)), storey(radius_of_gyration=1.0),
+                  storey(planes=(Plane("x", 0.0, 3.5e8 + 1.0),)), storey(planes=(Plane("y", 0.0, 3.5e8),)),
+                  storey(planes=(Plane("x", 1.0, 3.5e8),))):
+        assert modes_key((other,), 1) != base, other
+    assert modes_key((storey(),), 3) != base   # floors in plan
+    assert modes_key((storey(), storey()), 1) != base
+
+
+def test_a_run_left_as_arrays_computes_a_history_only_when_it_is_read():
+    """The histories a study's worker does not read (here the floors' absolute accelerations) are computed
+    when read, once, and then hold the archive's values; the worker's own reads leave them uncomputed."""
+    from pounding.results.checks import run_warnings
+    from pounding.results.run_arrays import Deferred
+    from pounding.simulation import simulate_arrays
+    from pounding.studies.sweep.scenario import scenario_peaks
+
+    model = pair(duration=3.0)
+    run = simulate_arrays(model)
+    scenario_peaks(run), run_warnings(run), run.dims
+    assert isinstance(run.data_vars["absolute_acceleration"][1], Deferred)   # not read: not computed
+    values = run["absolute_acceleration"].values
+    assert run["absolute_acceleration"].values is values   # computed once
+    np.testing.assert_array_equal(values, simulate(model).absolute_acceleration.values)   # bit for bit
+    calls = []
+    later = Deferred(lambda: calls.append(1) or 7.0)
+    assert calls == [] and later() == later() == 7.0 and calls == [1]
+
+
+def test_a_sweep_worker_gives_the_same_part_with_the_modes_kept_or_solved_afresh():
+    """run_scenario on a scenario, with every kept mode forgotten first and then with the modes the first run
+    kept: the same part, bit for bit (less the clock)."""
+    from pounding.model.building import forget_modes
+    from pounding.studies.sweep.scenario import run_scenario
+    from pounding.studies.sweep.spec import load_sweep
+
+    sweep = load_sweep(ROOT / "tests" / "data" / "fingerprint_sweep.yaml")
+    task = next(iter(sweep.scenarios())).task(sweep_label=sweep.label, name=sweep.model_name)
+    forget_modes()
+    fresh, kept = run_scenario(task), run_scenario(task)
+    assert fresh["status"] == "ok", fresh["error"]
+    for part in (fresh, kept):
+        for name in ("wall_time", "solver_wall_time"):
+            part.pop(name)
+    assert repr(fresh) == repr(kept)   # repr: every float to the bit, a NaN equal to a NaN

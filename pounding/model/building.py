@@ -18,6 +18,7 @@ stiffness k_i and height h_i.  M is diagonal, K tridiagonal::
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -31,7 +32,39 @@ from pounding.model.foundation import BASE_DOFS, Foundation, effective_damping, 
     founded_weights
 from pounding.model.floors import PLAN_DOFS, PLANAR_DOFS, Outline, Plane, Storey
 
-__all__ = ["Damping", "Building", "planar_storeys"]
+__all__ = ["Damping", "Building", "planar_storeys", "modes_key", "forget_modes", "MODES_KEPT"]
+
+#: How many buildings' modes a process keeps (:func:`modes_key`): a study's worker meets the same few
+#: buildings in every scenario; a study of many different buildings recomputes what it has dropped.
+MODES_KEPT = 64
+#: Modes by :func:`modes_key`, least recently used first (read-only arrays, shared by equal buildings).
+_MODES: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+_MODES_LOCK = threading.Lock()
+
+
+def forget_modes() -> None:
+    """Drop every kept mode (:func:`modes_key`): the next building computes its own again."""
+    with _MODES_LOCK:
+        _MODES.clear()
+
+
+def modes_key(storeys: tuple[Storey, ...], dofs: int) -> tuple:
+    """What a building's undamped modes are computed from, exactly: the key of the modes a process keeps.
+
+    :meth:`Building.modes` solves ``K φ = ω² M φ`` with M from each floor's mass and radius of gyration
+    and K from each storey plane's direction, line and initial stiffness and the floors' centres
+    (:func:`pounding.model.floors.mass_matrix`, :func:`~pounding.model.floors.stiffness_matrix`), per floor
+    *dofs* degrees of freedom.  The key holds those values as the hexadecimal text of their floats (so
+    ``-0.0`` and ``0.0``, which compare equal, are two keys): two buildings share modes only when every
+    number their matrices are made of is the same to the bit; a scenario of a sweep that changes a gap
+    or a contact law meets the modes of the buildings it did not change.
+    """
+    def bits(value: float) -> str:
+        return float(value).hex()
+
+    return (dofs, tuple((bits(s.mass), bits(s.radius_of_gyration), tuple(bits(c) for c in s.centre),
+                         tuple((p.direction, bits(p.at), bits(p.initial_stiffness)) for p in s.planes))
+                        for s in storeys))
 
 
 @dataclass(frozen=True)
@@ -321,10 +354,19 @@ class Building:
         checking the dense matrices fit in memory (:meth:`check_modes_memory`).
         """
         self.check_modes_memory()
-        omega, phi = floors.natural_modes(self.stiffness_matrix(), self.mass_matrix(), self.dofs_per_floor)
-        omega.setflags(write=False)
-        phi.setflags(write=False)
-        return omega, phi
+        key = modes_key(self.storeys, self.dofs_per_floor)
+        with _MODES_LOCK:
+            found = _MODES.pop(key, None)
+        if found is None:
+            omega, phi = floors.natural_modes(self.stiffness_matrix(), self.mass_matrix(), self.dofs_per_floor)
+            omega.setflags(write=False)
+            phi.setflags(write=False)
+            found = (omega, phi)
+        with _MODES_LOCK:
+            _MODES[key] = found   # the most recently used last
+            while len(_MODES) > MODES_KEPT:
+                del _MODES[next(iter(_MODES))]
+        return found
 
     def check_modes_memory(self) -> None:
         """Refuse in one line, before allocating, modes whose dense matrices would not fit in memory.

@@ -53,7 +53,7 @@ from pounding.model.model import Model, column_weights
 from pounding.model.schema import WALL_NAME
 from pounding.results.corners import CORNERS, corner_displacements, floor_corners, hermite_at
 from pounding.results.lazy_dask import defer_dask_import
-from pounding.results.run_arrays import RunArrays
+from pounding.results.run_arrays import Deferred, RunArrays
 from pounding.solver.assembly import Assembly, storey_stop_ratios
 from pounding.solver.integrator import RawSolution, System
 from pounding.solver.kinematics import penetration as combined_penetration
@@ -596,27 +596,31 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
     rows = None if assembly.chain else assembly   # planar storeys as weighted rows: a building on a foundation
     floor = floor_dofs(model)
     labels = _labels(model)
-    u = raw.state[:, floor]
-    v = raw.state[:, n:2 * n][:, floor]
+    # The histories no study's worker reads are Deferred: computed when read (RunArrays), every one for an archive.
+    u = Deferred(lambda: raw.state[:, floor])
     lay = system.layout
     work = raw.state[:, lay.work:lay.internal]
     e_input = raw.state[:, lay.input_energy]
     e_damping = raw.state[:, lay.damping_energy]
 
-    drift = _storey_drift(u, system.below) if rows is None else raw.state[:, :n] @ assembly.plane_weights.T
+    drift = Deferred(lambda: _storey_drift(u(), system.below) if rows is None
+                     else raw.state[:, :n] @ assembly.plane_weights.T)
     heights = labels["height"]
     ground = _grounds(model, record, system, raw, supports)
+    ground_velocity = Deferred(lambda: ground["motion"]()[0])
+    ground_displacement = Deferred(lambda: ground["motion"]()[1])
     # Contacts first, then links (pounding.solver.assembly.assemble puts the links after the gap elements).
     ng = len(model.gaps)
     # Total displacements: the differential ground displacement of each gap element's two sides joins
     # (0 on one common ground, and for a wall, which moves with the ground of the building it faces).
-    penetration = _penetration(raw.state[:, :n], system, ground["displacement"])[:, :ng]
-    links = _link_results(system, raw, ng, ground["displacement"])
+    penetration = Deferred(lambda: _penetration(raw.state[:, :n], system, ground_displacement())[:, :ng])
+    # Without links their (time, 0) arrays need no ground: the same empty histories, the same sums.
+    links = _link_results(system, raw, ng, ground_displacement() if system.contact_left.size > ng else None)
 
     kinetic = 0.5 * np.einsum("ij,ij,j->i", raw.state[:, n:2 * n], raw.state[:, n:2 * n], system.mass)
     # Recoverable storey energy (with the P-Delta potential), summed by the solver at each output time;
     # a yielding storey's dissipated energy is its work ∫F dΔ minus its recoverable part.
-    strain = raw.storey_energy[:, 0] if rows is None else _row_strain(model, assembly, raw, drift)
+    strain = raw.storey_energy[:, 0] if rows is None else _row_strain(model, assembly, raw, drift())
     storey_work = raw.state[:, lay.storey_work:lay.ground_work]
     hysteretic = storey_work.sum(axis=1) - raw.storey_energy[:, 1]
     inelastic = _inelastic_summary(system, raw, heights, rows)
@@ -661,14 +665,16 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
     variables = {
         "displacement": _var(("time", "floor"), u, "m", "floor displacement relative to the ground (on a foundation: "
                              "to the free field, the base mat's sway and rocking included)"),
-        "velocity": _var(("time", "floor"), v, "m s-1", "floor velocity relative to the ground"),
-        "absolute_acceleration": _var(("time", "floor"),
-                                      raw.acceleration[:, floor]
-                                      + np.take(ground["acceleration"], system.floor_ground[floor], axis=1),
+        "velocity": _var(("time", "floor"), Deferred(lambda: raw.state[:, n:2 * n][:, floor]), "m s-1",
+                         "floor velocity relative to the ground"),
+        "absolute_acceleration": _var(("time", "floor"), Deferred(
+                                      lambda: raw.acceleration[:, floor]
+                                      + np.take(ground["acceleration"], system.floor_ground[floor], axis=1)),
                                       "m s-2", "absolute floor acceleration (over the building's own ground)"),
         "storey_drift": _var(("time", "storey"), drift, "m", "storey drift u_i - u_(i-1) (on a foundation: the "
                              "storey's deformation, without the base mat's rocking)"),
-        "drift_ratio": _var(("time", "storey"), drift / heights, "1", "storey drift ratio (drift / height)"),
+        "drift_ratio": _var(("time", "storey"), Deferred(lambda: drift() / heights), "1",
+                            "storey drift ratio (drift / height)"),
         "contact_force": _var(("time", "contact"), raw.contact_force[:, :ng], "N", "contact force (>= 0 pushes apart)"),
         "penetration": _var(("time", "contact"), penetration, "m",
                             "penetration u_left - u_right + u_ground_left - u_ground_right - gap "
@@ -682,19 +688,21 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
                            "wave-passage time lag applied (rounded to the record step)"),
         "ground_lag_requested": _var(("ground",), ground["lag_requested"], "s",
                                      "wave-passage time lag (position - first position) / apparent velocity"),
-        "building_ground_acceleration": _var(("time", "ground"), ground["acceleration"][:, ground["row"]],
+        "building_ground_acceleration": _var(("time", "ground"),
+                                             Deferred(lambda: ground["acceleration"][:, ground["row"]]),
                                              "m s-2", "ground acceleration under the building"),
-        "building_ground_velocity": _var(("time", "ground"), ground["velocity"][:, ground["row"]], "m s-1",
-                                         "ground velocity under the building (exact integral from rest)"),
-        "building_ground_displacement": _var(("time", "ground"), ground["displacement"][:, ground["row"]], "m",
+        "building_ground_velocity": _var(("time", "ground"), Deferred(lambda: ground_velocity()[:, ground["row"]]),
+                                         "m s-1", "ground velocity under the building (exact integral from rest)"),
+        "building_ground_displacement": _var(("time", "ground"),
+                                             Deferred(lambda: ground_displacement()[:, ground["row"]]), "m",
                                              "ground displacement under the building (exact integral from rest)"),
         "peak_displacement": _var(("floor",), raw.peak_displacement[floor], "m",
                                   "peak absolute floor displacement relative to the ground"),
         "peak_storey_drift": _var(("storey",), raw.peak_drift if rows is None else raw.peak_plane_drift, "m",
                                   "peak absolute storey drift"),
         "peak_drift_ratio": _var(("storey",), peaks["peak_drift_ratio"], "1", "peak absolute storey drift ratio"),
-        "collapse_drift_ratio": _var(("storey",), np.where(storey_stop_ratios(model) > 0, storey_stop_ratios(model),
-                                                           np.nan), "1",
+        "collapse_drift_ratio": _var(("storey",), Deferred(lambda: np.where(storey_stop_ratios(model) > 0,
+                                                                            storey_stop_ratios(model), np.nan)), "1",
                                      "collapse drift ratio of the storey's building (the run ends when the storey's "
                                      "|drift ratio| first exceeds it; NaN: no drift limit)"),
         "peak_contact_force": _var(("contact",), peaks["peak_contact_force"], "N", "peak contact force"),
@@ -747,7 +755,7 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "link_dissipated_energy": _var(("link",), links["work"][-1] - links["stored"][-1], "J",
                                        "energy dissipated by the link over the run"),
         "storey_shear": _var(("time", "storey"), raw.storey_shear if rows is None else
-                             _plane_shear(assembly, raw, drift), "N",
+                             Deferred(lambda: _plane_shear(assembly, raw, drift())), "N",
                              "storey restoring (column) shear, without P-Delta and damping"),
         "residual_drift_ratio": _var(("storey",), peaks["residual_drift_ratio"], "1",
                                      "signed storey drift ratio at the end of the run"),
@@ -863,18 +871,16 @@ def _grounds(model: Model, record: Record, system: System, raw: RawSolution, sup
         row = list(supports.building_row)
     # Accelerations as the solver evaluated them; velocity and displacement by the same closed forms.
     acc = raw.support_acceleration if raw.support_acceleration is not None else raw.ground_acceleration[:, None]
-    if step is None:
-        vel = disp = np.zeros_like(acc)
-    else:
-        _, vel, disp = kinematics.ground_state_at(rows, step, raw.time)
+    # (velocity, displacement), computed when first read (a worker that reads neither does not pay for them)
+    motion = Deferred(lambda: (np.zeros_like(acc),) * 2 if step is None
+                      else kinematics.ground_state_at(rows, step, raw.time)[1:])
     return {"record": np.array([r.name for r in records], dtype=object),
             "pga": [loaded_record_pga(r) for r in records],
             "source": np.array([r.source for r in records], dtype=object),
             "scale": np.array([float(r.scale) for r in records]),
             "sha256": [str(r.metadata.get("sha256", "")) for r in records],
             "lag": np.array(lags, dtype=float), "lag_requested": np.array(requested, dtype=float),
-            "row": np.asarray(row, dtype=np.int64), "acceleration": acc, "velocity": vel,
-            "displacement": disp}
+            "row": np.asarray(row, dtype=np.int64), "acceleration": acc, "motion": motion}
 
 
 def run_spec(model: Model, record: Record, end_time: float, ground: dict | None = None) -> dict:

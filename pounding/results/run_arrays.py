@@ -14,16 +14,47 @@ as a dataset would: ``name in run``, ``run[name].values``,
 ``run.coords`` and ``run.attrs``.  The arrays are the ones the dataset
 would hold (``numpy.asarray`` of the same values), so every value read is
 the archive's, bit for bit.
+
+A value may be left :class:`Deferred` (a history no worker of a study reads, e.g. the floors'
+absolute accelerations): it is computed, by the same code, the first time it is read, and
+:meth:`RunArrays.to_dataset` computes every one that is left.  A worker then pays only for the
+values it reads.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
-__all__ = ["RunArrays", "LabelledArray"]
+__all__ = ["RunArrays", "LabelledArray", "Deferred"]
+
+
+class Deferred:
+    """A value of a :class:`RunArrays` computed when first read: ``Deferred(compute)``, *compute* taking no
+    argument.  Calling it computes the value once and returns it every time after."""
+
+    __slots__ = ("_compute", "_value")
+
+    def __init__(self, compute: Callable[[], Any]) -> None:
+        self._compute: Callable[[], Any] | None = compute
+        self._value: Any = None
+
+    def __call__(self) -> Any:
+        if self._compute is not None:
+            self._value, self._compute = self._compute(), None
+        return self._value
+
+
+def _resolved(entries: dict[str, tuple], name: str) -> tuple:
+    """*entries[name]* with a :class:`Deferred` value computed, stored back in *entries*."""
+    entry = entries[name]
+    if isinstance(entry[1], Deferred):
+        entry = (entry[0], entry[1](), *entry[2:])
+        entries[name] = entry
+    return entry
 
 
 @dataclass(frozen=True)
@@ -60,42 +91,100 @@ class RunArrays:
 
     def __post_init__(self) -> None:
         self._arrays: dict[str, LabelledArray] = {}
-        for name, entry in (*self.data_vars.items(), *self.coordinates.items()):
+
+    def _entries(self, name: str) -> dict[str, tuple] | None:
+        """The mapping (variables or coordinates) that holds *name*, None if neither does."""
+        if name in self.data_vars:
+            return self.data_vars
+        return self.coordinates if name in self.coordinates else None
+
+    def _array(self, name: str) -> LabelledArray:
+        """Variable or coordinate *name* (computed first if :class:`Deferred`); KeyError if there is none."""
+        found = self.__dict__["_arrays"].get(name)
+        if found is None:
+            entries = self._entries(name)
+            if entries is None:
+                raise KeyError(name)
+            entry = _resolved(entries, name)
             dims = (entry[0],) if isinstance(entry[0], str) else tuple(entry[0])
-            self._arrays[name] = LabelledArray(dims, np.asarray(entry[1]))
+            found = self._arrays[name] = LabelledArray(dims, np.asarray(entry[1]))
+        return found
 
     def __contains__(self, name: object) -> bool:
-        return name in self._arrays
+        return name in self.data_vars or name in self.coordinates
 
     def __getitem__(self, name: str) -> LabelledArray:
-        return self._arrays[name]
+        return self._array(name)
 
     def __getattr__(self, name: str) -> LabelledArray:
-        arrays = self.__dict__.get("_arrays", {})
-        if name in arrays:
-            return arrays[name]
-        raise AttributeError(name)
+        if name.startswith("_") or "data_vars" not in self.__dict__:
+            raise AttributeError(name)
+        try:
+            return self._array(name)
+        except KeyError:
+            raise AttributeError(name) from None
 
     @property
-    def variables(self) -> dict[str, LabelledArray]:
-        """Every variable and coordinate by name (as ``Dataset.variables``)."""
-        return self._arrays
+    def variables(self) -> Mapping[str, LabelledArray]:
+        """Every variable and coordinate by name (as ``Dataset.variables``; a deferred one computed when read)."""
+        return _Named(self, (*self.data_vars, *self.coordinates))
 
     @property
-    def coords(self) -> dict[str, LabelledArray]:
+    def coords(self) -> Mapping[str, LabelledArray]:
         """The coordinates by name."""
-        return {name: self._arrays[name] for name in self.coordinates}
+        return _Named(self, tuple(self.coordinates))
 
     @property
     def dims(self) -> dict[str, int]:
-        """Each dimension's length."""
+        """Each dimension's length (from the values computed; a deferred one only if no other has its dimension).
+
+        Found once: the values of a run do not change after it is made (its attributes may)."""
+        if "_dims" not in self.__dict__:
+            self.__dict__["_dims"] = self._found_dims()
+        return self.__dict__["_dims"]
+
+    def _found_dims(self) -> dict[str, int]:
         found: dict[str, int] = {}
-        for array in self._arrays.values():
+        deferred = []
+        for name, entry in (*self.data_vars.items(), *self.coordinates.items()):
+            if isinstance(entry[1], Deferred) and name not in self._arrays:
+                deferred.append(name)
+                continue
+            array = self._array(name)
             found.update(zip(array.dims, array.values.shape))
+        for name in deferred:
+            dims = self.data_vars[name][0] if name in self.data_vars else self.coordinates[name][0]
+            if any(d not in found for d in ((dims,) if isinstance(dims, str) else dims)):
+                array = self._array(name)
+                found.update(zip(array.dims, array.values.shape))
         return found
 
     def to_dataset(self):
         """The run's archive: an ``xarray.Dataset`` of these variables, coordinates and attributes."""
         import xarray as xr
 
+        for entries in (self.data_vars, self.coordinates):
+            for name in list(entries):
+                _resolved(entries, name)
         return xr.Dataset(self.data_vars, coords=self.coordinates, attrs=self.attrs)
+
+
+class _Named(Mapping):
+    """Some of a :class:`RunArrays`' values by name, each read (and computed, if deferred) when asked for."""
+
+    def __init__(self, run: RunArrays, names: tuple[str, ...]) -> None:
+        self._run, self._names = run, names
+
+    def __getitem__(self, name: str) -> LabelledArray:
+        if name not in self._names:
+            raise KeyError(name)
+        return self._run[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
