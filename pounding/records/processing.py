@@ -489,4 +489,4 @@ def scale_record(record: Record, scaling: float | Scaling, *, period: float | No
     metadata = dict(record.metadata, scale_method=scaling.method, scale_description=scaling.describe(t),
                     scale_factor=float(factor), **extra)
     scaled = record.scaled(factor) if factor != 1.0 else record
-    return dataclasses.replace(scaled, metadata=metadata)
+    return scaled.with_metadata(metadata)   # the samples validated once, not copied again

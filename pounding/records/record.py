@@ -173,6 +173,17 @@ class Record:
         factor = positive_value("scale", factor, self.source)
         return dataclasses.replace(self, acceleration=self.acceleration * factor, scale=self.scale * factor)
 
+    def with_metadata(self, metadata: dict) -> Record:
+        """This record with *metadata* instead of its own: the same samples (the same read-only array, not
+        a copy, validated when this record was made), their ``sha256`` set again; values made plain as
+        when a record is made."""
+        plain = {str(k): _plain(v) for k, v in dict(metadata).items()}
+        plain["sha256"] = self.metadata["sha256"]
+        record = object.__new__(Record)
+        for each in dataclasses.fields(self):
+            object.__setattr__(record, each.name, plain if each.name == "metadata" else getattr(self, each.name))
+        return record
+
     def truncated(self, duration: float) -> Record:
         """A copy keeping the samples at ``t <= duration`` s (the whole record if it is shorter)."""
         duration = positive_value("duration", duration, self.source)
