@@ -66,7 +66,7 @@ from pounding.registry import add_unique
 
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "order_statistic",
            "records_ran", "record_outcomes", "bounded_value", "NOT_BOUNDED", "COLLAPSE_STATUSES", "gap_attrs",
-           "normal_mode", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
+           "normal_mode", "normal_modes", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
            "gap_summary", "gap_table", "gap_tables", "not_bounded_words", "plot_gap"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
@@ -192,8 +192,7 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     rise = np.maximum(y0, y1) + (4.0 / 27.0) * (np.abs(m0) + np.abs(m1))
     pad = 1e-12 * (abs(best) + float(np.max(np.abs(rise), initial=0.0)))
     candidates = np.flatnonzero(((m0 > 0.0) | (m1 < 0.0)) & (rise >= best - pad))
-    for k in candidates:
-        roots = np.roots([a[k], b[k], c[k]]) if a[k] != 0.0 or b[k] != 0.0 else np.empty(0)
+    for k, roots in zip(candidates, _slope_roots(a[candidates], b[candidates], c[candidates])):
         for s in roots:
             if abs(s.imag) > 1e-12 or not 0.0 < s.real < 1.0:
                 continue
@@ -203,6 +202,29 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
                  + (-2 * s3 + 3 * s2) * y1[k] + (s3 - s2) * m1[k])
             best = max(best, float(y))
     return best
+
+
+def _slope_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[np.ndarray]:
+    """The roots of each ``a s² + b s + c``, each what ``numpy.roots([a, b, c])`` gives, bit for bit (none when
+    ``a = b = 0``).
+
+    ``numpy.roots`` of a quadratic with ``a ≠ 0`` and ``c ≠ 0`` is the eigenvalues of its companion matrix
+    ``[[-b/a, -c/a], [1, 0]]``; those are found here in one call of ``numpy.linalg.eigvals`` on the stack of
+    them (the same LAPACK routine on the same matrices, one at a time), the few others by ``numpy.roots``
+    itself.  Complex roots have their own imaginary parts, real roots an imaginary part of exactly 0.
+    """
+    out: list[np.ndarray] = [np.empty(0)] * a.size
+    full = np.flatnonzero((a != 0.0) & (c != 0.0))
+    if full.size:
+        companion = np.zeros((full.size, 2, 2))
+        companion[:, 0, 0] = -b[full] / a[full]
+        companion[:, 0, 1] = -c[full] / a[full]
+        companion[:, 1, 0] = 1.0
+        for k, roots in zip(full, np.linalg.eigvals(companion)):
+            out[k] = roots
+    for k in np.flatnonzero(~((a != 0.0) & (c != 0.0)) & ((a != 0.0) | (b != 0.0))):
+        out[k] = np.roots([a[k], b[k], c[k]])
+    return out
 
 
 def normal_mode(building, normal: str = "x") -> tuple[float, float]:
@@ -218,6 +240,19 @@ def normal_mode(building, normal: str = "x") -> tuple[float, float]:
     gamma = phi.T @ (building.mass_matrix() @ r)
     i = int(np.argmax(gamma * gamma))
     return float(building.periods[i]), float(building.modal_damping_ratios[i])
+
+
+def normal_modes(model) -> Callable[[int, str], tuple[float, float]]:
+    """``mode(b, normal)``: :func:`normal_mode` of *model*'s building *b* along *normal*, worked out once per
+    building and normal of this model (a run's contacts ask for the same few, ~20 times a run)."""
+    found: dict[tuple[int, str], tuple[float, float]] = {}
+
+    def mode(building: int, normal: str) -> tuple[float, float]:
+        if (building, normal) not in found:
+            found[building, normal] = normal_mode(model.buildings[building], normal)
+        return found[building, normal]
+
+    return mode
 
 
 def side_vectors(model) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray | None]]:
@@ -270,7 +305,8 @@ def _side_peak(time: np.ndarray, q: np.ndarray, qd: np.ndarray, a: np.ndarray | 
     return max(max_hermite(time, value, rate), max_hermite(time, -value, -rate))
 
 
-def required_separations(model, ds) -> dict[str, np.ndarray]:
+def required_separations(model, ds, modes: Callable[[int, str], tuple[float, float]] | None = None
+                         ) -> dict[str, np.ndarray]:
     """Required separation, the sides' peak displacements and their correlation per contact of a contact-free run.
 
     Parameters
@@ -290,12 +326,15 @@ def required_separations(model, ds) -> dict[str, np.ndarray]:
         ``peak_right`` (m: each side's peak displacement at the point along the normal, 0 for a wall),
         ``correlation`` (1: the CQC coefficient of the two buildings' modes of largest effective mass along
         the normal, :func:`normal_mode`; 0 against a wall, where every rule gives the building's own).
+    modes : callable, optional
+        :func:`normal_modes` of *model*, shared with the run's other uses of the modes (default: its own).
     """
     from pounding.model.model import WALL
     from pounding.studies.common import dof_peaks, floor_states
 
     q, qd = floor_states(ds)
     t = ds.time.values
+    mode = normal_modes(model) if modes is None else modes
     found: dict[str, np.ndarray] = {}
 
     def peak_of(k: int) -> float:   # the run's full-resolution peaks, read when a side is one degree of freedom
@@ -311,15 +350,15 @@ def required_separations(model, ds) -> dict[str, np.ndarray]:
         if WALL in (g.left, g.right):
             out["correlation"].append(0.0)
         else:
-            modes = [normal_mode(model.buildings[b], g.normal) for b in (g.left, g.right)]
-            out["correlation"].append(cqc_correlation(modes[0][0], modes[1][0], modes[0][1], modes[1][1]))
+            sides = [mode(b, g.normal) for b in (g.left, g.right)]
+            out["correlation"].append(cqc_correlation(sides[0][0], sides[1][0], sides[0][1], sides[1][1]))
     return {k: np.array(v, dtype=float) for k, v in out.items()}
 
 
-def _contact_info(model, ds) -> dict[str, list]:
+def _contact_info(model, ds, mode: Callable[[int, str], tuple[float, float]]) -> dict[str, list]:
     """Per gap element: its label and sides (from the run's ``contact`` coordinates), the model's gap, the sides'
-    elevations and modes; for points in plan their place (``point_x``, ``point_y``, ``point_normal``,
-    ``point_face``: the face ``A:1-B:1``)."""
+    elevations and modes (*mode*: :func:`normal_modes` of *model*); for points in plan their place
+    (``point_x``, ``point_y``, ``point_normal``, ``point_face``: the face ``A:1-B:1``)."""
     from pounding.model.model import WALL
 
     names = [b.name for b in model.buildings]
@@ -327,7 +366,7 @@ def _contact_info(model, ds) -> dict[str, list]:
     def side(building: int, level: int, other: int, other_level: int, normal: str) -> tuple[float, float, float]:
         if building == WALL:   # a wall faces the floor on the other side: its elevation, no mode
             return float(model.buildings[other].elevation[other_level - 1]), math.nan, math.nan
-        period, damping = normal_mode(model.buildings[building], normal)
+        period, damping = mode(building, normal)
         return float(model.buildings[building].elevation[level - 1]), period, damping
 
     info: dict[str, list] = {k: [] for k in ("elevation_left", "elevation_right", "period_left", "period_right",
@@ -379,11 +418,12 @@ def run_gap_scenario(task: dict[str, Any]) -> dict[str, Any]:
             raise PoundingError(f"{message}; the contact-free run did not reach the record's end")
         # A building that collapsed or lost its resistance stops the run: its need is at least what the
         # truncated history reached and unbounded after; the statistics count it as +inf (over_records).
-        found = required_separations(model, ds)
+        modes = normal_modes(model)   # each building's mode along each normal worked out once
+        found = required_separations(model, ds, modes)
         # One record: its PGA as the archive has it; a pair: the geometric mean of its components' PGAs.
         intensity = ground_pga([r for r in component_records(model) if r is not None]) \
             if model.ground_motion.two_components else record_pga(ds)[1]
-        result.update(_contact_info(model, ds))
+        result.update(_contact_info(model, ds, modes))
         result.update({
             "status": "ok",
             "outcome": "collapsed" if status in COLLAPSE_STATUSES else "completed",
