@@ -66,7 +66,7 @@ from pounding.registry import add_unique
 
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "order_statistic",
            "records_ran", "record_outcomes", "bounded_value", "NOT_BOUNDED", "COLLAPSE_STATUSES", "gap_attrs",
-           "normal_mode", "normal_modes", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
+           "normal_mode", "normal_modes", "slope_roots", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
            "gap_summary", "gap_table", "gap_tables", "not_bounded_words", "plot_gap"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
@@ -192,7 +192,7 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     rise = np.maximum(y0, y1) + (4.0 / 27.0) * (np.abs(m0) + np.abs(m1))
     pad = 1e-12 * (abs(best) + float(np.max(np.abs(rise), initial=0.0)))
     candidates = np.flatnonzero(((m0 > 0.0) | (m1 < 0.0)) & (rise >= best - pad))
-    for k, roots in zip(candidates, _slope_roots(a[candidates], b[candidates], c[candidates])):
+    for k, roots in zip(candidates, slope_roots(a[candidates], b[candidates], c[candidates])):
         for s in roots:
             if abs(s.imag) > 1e-12 or not 0.0 < s.real < 1.0:
                 continue
@@ -204,7 +204,7 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     return best
 
 
-def _slope_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[np.ndarray]:
+def slope_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[np.ndarray]:
     """The roots of each ``a s² + b s + c``, each what ``numpy.roots([a, b, c])`` gives, bit for bit (none when
     ``a = b = 0``).
 
