@@ -237,6 +237,27 @@ def test_a_run_left_as_arrays_computes_a_history_only_when_it_is_read():
     assert calls == [] and later() == later() == 7.0 and calls == [1]
 
 
+def test_a_run_in_plan_left_as_arrays_computes_the_histories_no_worker_reads_only_when_read():
+    """In plan as on one axis: a sweep's and gap study's worker reads the peaks, labels, energies and the floors'
+    states; the points' penetrations, the planes' shears and drift ratios are computed when read, and then
+    hold the archive's values bit for bit."""
+    from pounding.model.model import load_model
+    from pounding.results.checks import run_warnings
+    from pounding.results.run_arrays import Deferred
+    from pounding.simulation import simulate_arrays
+    from pounding.studies.common import floor_states
+    from pounding.studies.sweep.scenario import scenario_peaks
+
+    model = load_model(ROOT / "models/corner_pair.yaml").with_ground_motion(duration=3.0)
+    run = simulate_arrays(model)
+    scenario_peaks(run), run_warnings(run), floor_states(run), run.dims
+    deferred = ("penetration", "plane_shear", "plane_drift_ratio")
+    assert all(isinstance(run.data_vars[name][1], Deferred) for name in deferred)   # not read: not computed
+    ds = simulate(model)
+    for name in deferred:
+        np.testing.assert_array_equal(run[name].values, ds[name].values, err_msg=name)   # bit for bit
+
+
 def test_a_sweep_worker_gives_the_same_part_with_the_modes_kept_or_solved_afresh():
     """run_scenario on a scenario, with every kept mode forgotten first and then with the modes the first run
     kept: the same part, bit for bit (less the clock)."""

@@ -1156,12 +1156,12 @@ def _plane_variables(model: Model, assembly: Assembly, raw: RawSolution, drift: 
     storeys = _storey_peaks(model, ratio)
     return {
         "plane_drift": _var(("time", "plane"), drift, "m", "drift of the plane's line"),
-        "plane_drift_ratio": _var(("time", "plane"), drift / heights, "1", "drift ratio of the plane (drift / storey "
-                                                                            "height)"),
+        "plane_drift_ratio": _var(("time", "plane"), Deferred(lambda: drift / heights), "1",
+                                  "drift ratio of the plane (drift / storey height)"),
         "peak_plane_drift": _var(("plane",), raw.peak_plane_drift, "m", "peak |drift| of the plane (full resolution)"),
         "peak_plane_drift_ratio": _var(("plane",), ratio, "1", "peak |drift ratio| of the plane (full resolution)"),
         "plane_stiffness": _var(("plane",), assembly.plane_stiffness, "N/m", "elastic stiffness of the plane"),
-        "plane_shear": _var(("time", "plane"), _plane_shear(assembly, raw, drift), "N",
+        "plane_shear": _var(("time", "plane"), Deferred(lambda: _plane_shear(assembly, raw, drift)), "N",
                             "shear of the plane (restoring force, without P-Delta)"),
         "peak_drift_ratio": _var(("storey",), storeys["peak"], "1",
                                  "peak |drift ratio| of the storey: the largest of its planes' (full resolution)"),
@@ -1288,9 +1288,10 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
     npt = assembly.n_points
     u = raw.state[:, :n].reshape(-1, nf, DOF_PER_FLOOR)
     v = raw.state[:, n:2 * n].reshape(-1, nf, DOF_PER_FLOOR)
-    grounds = (kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)[2] if supports is not None
-               else np.zeros((raw.time.size, 1)))
-    delta = _penetration(raw.state[:, :n], system, grounds)
+    # The histories no study's worker reads are Deferred (as in run_arrays): computed when read, all for an archive.
+    delta = Deferred(lambda: _penetration(raw.state[:, :n], system, (
+        kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)[2] if supports is not None
+        else np.zeros((raw.time.size, 1)))))
     drift = raw.state[:, :n] @ assembly.plane_weights.T
     peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
     counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
@@ -1319,7 +1320,8 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
         **_plane_variables(model, assembly, raw, drift),
         "contact_force": _var(("time", "contact"), raw.contact_force[:, :npt], "N",
                               "normal contact force at the point (compression positive)"),
-        "penetration": _var(("time", "contact"), delta[:, :npt], "m", "penetration at the point (overlap positive)"),
+        "penetration": _var(("time", "contact"), Deferred(lambda: delta()[:, :npt]), "m",
+                            "penetration at the point (overlap positive)"),
         "peak_contact_force": _var(("contact",), raw.peak_contact_force[:npt], "N",
                                    "peak normal contact force at the point (full resolution)"),
         "impact_count": _var(("contact",), counts, "1", "number of impacts at the point"),
