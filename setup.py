@@ -38,7 +38,7 @@ class BuildWithKernels(build_py):
                 shutil.rmtree(target, ignore_errors=True)   # none left from an earlier build in the same build/
             return
         path = os.pathsep.join(p for p in (str(root), os.environ.get("PYTHONPATH", "")) if p)
-        print(f"pounding: compiling the solver's kernels into {target} (about a minute; POUNDING_PREBUILD=0 skips)")
+        print(f"pounding: compiling the solver's kernels into {target} (a few minutes; POUNDING_PREBUILD=0 skips)")
         done = subprocess.run([sys.executable, "-m", "pounding.prebuild", str(target)], cwd=root,
                               env=dict(os.environ, PYTHONPATH=path), check=False)
         if done.returncode != 0:
