@@ -737,7 +737,7 @@ class Model:
         Storeys are written out one by one and contact levels as explicit
         pairs; floats are written with ``repr`` so they round-trip exactly.
         Written once per model (a model does not change; every ``with_*`` makes a new one): a run's
-        archive holds it (``run_spec``), 3–10 ms of the shipped models' text.
+        archive holds it (``run_spec``), 2–7 ms of a run of the shipped models.
         """
         return self._yaml_text
 
