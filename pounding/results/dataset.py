@@ -1141,11 +1141,12 @@ def plane_peaks(model: Model, assembly: Assembly, raw: RawSolution) -> dict[str,
     }
 
 
-def _ground_xy(supports, raw: RawSolution) -> np.ndarray | None:
-    """(nt, 2) the first building's ground acceleration along x and y at the output times, m/s²."""
+def _ground_xy(supports, ground_state: Deferred) -> np.ndarray | None:
+    """(nt, 2) the first building's ground acceleration along x and y at the output times, m/s² (*ground_state*:
+    :func:`_plan_ground_state`)."""
     if supports is None or not supports.building_row_y:
         return None
-    acceleration, _, _ = kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)
+    acceleration, _, _ = ground_state()
     return acceleration[:, [supports.building_row[0], supports.building_row_y[0]]]
 
 
@@ -1234,14 +1235,16 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
     return attrs
 
 
-def _plane_link_variables(model: Model, assembly: Assembly, raw: RawSolution, supports) -> dict[str, tuple]:
-    """The links' histories, peaks and energies of a run with floors in plan ({} without links)."""
+def _plane_link_variables(model: Model, assembly: Assembly, raw: RawSolution, supports,
+                          ground_state: Deferred) -> dict[str, tuple]:
+    """The links' histories, peaks and energies of a run with floors in plan ({} without links; *ground_state*:
+    :func:`_plan_ground_state`)."""
     if not model.links:
         return {}
     npt = assembly.n_points
     grounds = None
     if supports is not None and supports.rows.shape[0] > 1:
-        grounds = kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)[2]
+        grounds = ground_state()[2]
     links = _link_results(assembly.system, raw, npt, grounds, weighted=True)
     return {
         "link_force": _var(("time", "link"), raw.contact_force[:, npt:], "N",
@@ -1289,9 +1292,9 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
     u = raw.state[:, :n].reshape(-1, nf, DOF_PER_FLOOR)
     v = raw.state[:, n:2 * n].reshape(-1, nf, DOF_PER_FLOOR)
     # The histories no study's worker reads are Deferred (as in run_arrays): computed when read, all for an archive.
+    ground_state = _plan_ground_state(supports, raw)
     delta = Deferred(lambda: _penetration(raw.state[:, :n], system, (
-        kinematics.ground_state_at(supports.rows, supports.time_step, raw.time)[2] if supports is not None
-        else np.zeros((raw.time.size, 1)))))
+        ground_state()[2] if supports is not None else np.zeros((raw.time.size, 1)))))
     drift = raw.state[:, :n] @ assembly.plane_weights.T
     peak_u = raw.peak_displacement.reshape(nf, DOF_PER_FLOOR)
     counts = np.bincount(raw.impact_contact, minlength=npt)[:npt] if raw.impact_contact.size else np.zeros(npt, int)
@@ -1343,11 +1346,11 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
         **_plane_yielding(assembly, raw),
     }
     data.update(_friction_variables(assembly, raw))
-    data.update(_plane_link_variables(model, assembly, raw, supports))
+    data.update(_plane_link_variables(model, assembly, raw, supports, ground_state))
     for name, values in _plane_energies(assembly, raw, drift).items():
         label = name.removeprefix("energy_").replace("_", " ")
         data[name] = _var(("time",), values, "J", f"energy: {label}")
-    ground = _ground_xy(supports, raw)
+    ground = _ground_xy(supports, ground_state)
     if ground is not None:
         data["ground_acceleration"] = _var(("time", "direction"), ground, "m/s²", "ground acceleration along x and y")
     coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
@@ -1362,6 +1365,13 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
     ds.attrs["energy_closure_error"] = ds.attrs["energy_closure"]
     ds.attrs["title"] = f"pounding simulation of {run_title(ds)}"
     return ds
+
+
+def _plan_ground_state(supports, raw: RawSolution) -> Deferred:
+    """The ground rows' (acceleration, velocity, displacement) at the output times
+    (:func:`pounding.solver.kinematics.ground_state_at`), worked out once when first read: the points'
+    penetrations, the links and the archive's ground acceleration share them."""
+    return Deferred(lambda: kinematics.ground_state_at(supports.rows, supports.time_step, raw.time))
 
 
 def _trace_variables(raw: RawSolution) -> dict[str, tuple]:
