@@ -664,10 +664,15 @@ def _fill_tail(i_out, t, seg, forcing, structure, contacts, cstate, work, storey
     return n_out
 
 
+# In the loop below: events at the step's start are applied at t and the step redone (they may end the linear
+# phase or change its constant load); a step is retaken to end at its first event; events at the step's end are
+# those the retaken step was shortened to and any other found there; after them the next step is the size
+# accepted before the event cut it short (a newly closed contact: its cap).  The contacts' event location and
+# the recording of closed contacts are written in the loop, not in functions of their own: inlined from them,
+# the driver ran pair.yaml's Runge-Kutta steps ~10 % slower (docs/performance.md).
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED)
 def _integrate(lay, structure, contacts, storey, ground, friction, forcing, settings, y_initial, cf):
-    """The run (module docstring); *storey*, *ground*, *friction* None: their blocks are pruned at compile time;
-    *cf* the linear phases' closed form (:mod:`.closed_form`; :func:`~.closed_form.no_closed_form`: none)."""
+    """The run (module docstring; *storey*, *ground*, *friction* None: pruned; *cf*: :mod:`.closed_form`)."""
     n, nc, nh, S = lay.n_floors, lay.n_contacts, lay.n_hysteretic, lay.size
     dt_rec, t_end, output_dt = forcing.record_step, settings.end_time, settings.output_step
     n_out = int(math.floor(t_end / output_dt + 1e-9)) + 1
@@ -699,13 +704,9 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             seg += 1
         seg_end = min((seg + 1) * dt_rec, t_end)
         room = seg_end - t
-        h_try = h
-        if h_try >= room or t + 1.01 * h_try >= seg_end:
-            h_try = room
         linear, linear_known, exact = _phase_now(cf, linear, linear_known, t, seg, forcing, cstate, structure, storey,
                                                  ground, friction, work)
-        if exact:
-            h_try = room
+        h_try = room if exact or h >= room or t + 1.01 * h >= seg_end else h
         h_before_events = h_try  # the error-controlled size a located event shortens
         rejected, n_retake, collapse_pending, n_graze = False, zero, False, zero
         _set_pending(events, -1.0, friction)
@@ -725,10 +726,7 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 h_before_events, n_retake, collapse_pending = h_try, zero, False
                 _set_pending(events, -1.0, friction)
                 continue
-            # The contacts' events, their friction faces' and their stuck contacts' releases, written here rather
-            # than in a function of their own: inlined from one, the driver ran pair.yaml's steps ~10 % slower.
-            s_first, n_release = locate_contact_events(work, h_try, t, seg, forcing, lay, contacts, cstate, events,
-                                                       ground)
+            s_first, n_release = locate_contact_events(work, h_try, t, seg, forcing, lay, contacts, cstate, events, ground)
             if friction is not None:  # before locate_releases: friction.force still holds the step's end
                 s_first = min(s_first, locate_friction_events(work, h_try, t, seg, forcing, lay, structure, contacts,
                                                               cstate, storey, ground, friction))
@@ -744,7 +742,6 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 _set_pending(events, -1.0, friction)
                 continue
             if s_first <= 1.0 and s_first * h_try <= tiny:
-                # Events at the very start of the step: apply them at t and redo the step.
                 _keep_events_within(events, h_try, tiny, friction)
                 if collapse_s >= 0.0 and collapse_s * h_try <= tiny:
                     status = stop_status
@@ -757,7 +754,6 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 if status != 0:
                     break
                 _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
-                # the events may end the linear phase, or change its constant load
                 linear, exact = _phase_after_events(cf, t, seg, forcing, cstate, structure, storey, ground, friction,
                                                     work)
                 if cap < h_try:
@@ -766,7 +762,6 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
                 _set_pending(events, -1.0, friction)
                 continue
             if s_first < 1.0 - EVENT_END_TOLERANCE and n_retake < MAX_RETAKES:
-                # Retake the step to end at the first event; the retaken step is searched again.
                 _set_pending(events, s_first, friction)
                 collapse_pending = collapse_s >= 0.0 and collapse_s <= s_first
                 h_try = s_first * h_try
@@ -778,13 +773,11 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         h_used = h_try
         t_new = t + h_used if h_used != room else seg_end
         _record_peaks(cf, exact, work, h_used, n, structure, peaks)
-        # The closed contacts over the step, the trace grown to hold their samples (written here for the same reason).
         added = trace_rows(contacts, cstate)
         rows = min(n_trace + added, zero + TRACE_ROW_LIMIT)
         if rows > trace.shape[0]:
             trace = grown(trace, n_trace, rows, zero + TRACE_ROW_LIMIT)
-        n_trace, status = record_contacts(work, h_used, t, lay, contacts, cstate, ground, peaks, impacts, trace,
-                                          n_trace)
+        n_trace, status = record_contacts(work, h_used, t, lay, contacts, cstate, ground, peaks, impacts, trace, n_trace)
         n_contact += 1 if added > 0 else 0   # an impact under way
         if status != 0:
             break
@@ -801,7 +794,6 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
         _accept(work)
         _exact_accepted(cf, exact, linear, t_new == seg_end)
         n_steps += 1
-        # Events at the step's end: those the retaken step was shortened to, and any other found there.
         _exact_end_events(exact, events, friction)
         any_events = _with_pending(events, friction)
         if storey is not None:  # located: this step ends where the drift limit is first exceeded (or stability lost)
@@ -817,7 +809,6 @@ def _integrate(lay, structure, contacts, storey, ground, friction, forcing, sett
             window_start, window_events, status = _count_events(t, n_applied, window_start, window_events, dt_rec,
                                                                 event_cap, status)
             _rates_after(t, seg, y, k1, forcing, structure, contacts, cstate, work, storey, ground, friction)
-            # the step accepted before the event cut it short (a newly closed contact: its cap)
             h = min(h_before_events, cap)
             if status != 0:
                 break
