@@ -243,7 +243,7 @@ def floor_states(ds) -> tuple[Any, Any]:
 
     u, v = ds.displacement.values, ds.velocity.values
     if u.ndim == 2:
-        if "foundation" in ds.dims:   # a founded building's base mat: its sway and rocking after its floors
+        if "foundation" in ds.coords:   # a founded building's base mat: its sway and rocking after its floors
             return (with_base_mats(ds, u, ds.base_sway.values, ds.base_rocking.values),
                     with_base_mats(ds, v, ds.base_sway_rate.values, ds.base_rocking_rate.values))
         return u, v
@@ -276,7 +276,7 @@ def dof_peaks(ds) -> Any:
 
     peak = ds.peak_displacement.values
     if peak.ndim == 1:
-        if "foundation" in ds.dims:
+        if "foundation" in ds.coords:
             return with_base_mats(ds, peak[None, :], ds.peak_base_sway.values[None, :],
                                   ds.peak_base_rocking.values[None, :])[0]
         return peak

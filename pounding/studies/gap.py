@@ -54,6 +54,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -64,9 +65,12 @@ import numpy as np
 from pounding.errors import PoundingError
 from pounding.registry import add_unique
 
-__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "over_records", "order_statistic",
+__all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "hermite_maxima",
+           "hermite_candidates", "slope_root_table", "over_records", "order_statistic",
            "records_ran", "record_outcomes", "bounded_value", "NOT_BOUNDED", "COLLAPSE_STATUSES", "gap_attrs",
-           "normal_mode", "normal_modes", "slope_roots", "side_vectors", "required_separations", "run_gap_scenario", "POINT_COORDS", "build_gap_sweep", "gap_study", "assemble_gap_dataset",
+           "normal_mode", "normal_modes", "slope_roots", "side_vectors", "side_vectors_key", "side_layout", "one_dof",
+           "computed_side_vectors", "searched_histories", "SIDE_VECTORS_KEPT", "required_separations", "run_gap_scenario", "POINT_COORDS",
+           "build_gap_sweep", "gap_study", "assemble_gap_dataset",
            "gap_summary", "gap_table", "gap_tables", "not_bounded_words", "plot_gap"]
 
 #: Version of this study's part layout (stored in each part, checked when parts are reused).
@@ -75,6 +79,12 @@ GAP_PART = "gap-2"
 COLLAPSE_STATUSES = ("collapsed", "unstable")
 #: How a statistic that falls on a collapsed record (+inf in the archive) is written in text, CSV and JSON.
 NOT_BOUNDED = "not bounded"
+#: How many models' side vectors a process keeps (:func:`side_layout`): a gap study's worker meets the same
+#: model in every run, under another record.
+SIDE_VECTORS_KEPT = 16
+#: Side vectors by :func:`side_vectors_key`, least recently used first (read-only arrays, shared by equal models).
+_SIDE_VECTORS: dict[tuple, tuple[tuple, tuple]] = {}
+_SIDE_VECTORS_LOCK = threading.Lock()
 
 
 # --------------------------------------------------------------------------- #
@@ -175,37 +185,78 @@ def max_hermite(time: np.ndarray, value: np.ndarray, rate: np.ndarray) -> float:
     Returns
     -------
     float
-        max over the whole span of the interpolant (≥ the largest sample).
+        max over the whole span of the interpolant (≥ the largest sample); :func:`hermite_maxima` of the one
+        history.
     """
-    best = float(np.max(value))
+    return float(hermite_maxima(time, [value], [rate])[0])
+
+
+def hermite_maxima(time: np.ndarray, values: list[np.ndarray], rates: list[np.ndarray]) -> np.ndarray:
+    """Largest value of each history's piecewise cubic Hermite interpolant, all histories in one pass.
+
+    Each history's maximum is found by the same floating-point operations, in the same order, as one
+    history searched alone, interval by interval (numpy's elementwise operations give each element the
+    bits the scalar expression gives): its largest sample, then the interior maxima of the candidate
+    intervals (:func:`hermite_candidates`) at the real roots in (0, 1) of their slopes
+    (:func:`slope_root_table`), taken in the order of the intervals and of their roots.
+
+    Parameters
+    ----------
+    time : (n,) array
+        Sample times, s, increasing (shared by every history).
+    values, rates : list of (n,) arrays
+        Each history's samples (m) and their time derivatives (m/s) at *time*.
+
+    Returns
+    -------
+    (len(values),) array
+        Each history's max over the whole span of its interpolant (m, ≥ its largest sample).
+    """
+    best = np.array([float(np.max(value)) for value in values], dtype=float)
+    if not values:
+        return best
     h = np.diff(time)
-    y0, y1 = value[:-1], value[1:]
-    m0, m1 = rate[:-1] * h, rate[1:] * h
+    value, rate = np.stack(values), np.stack(rates)
+    y0, y1 = value[:, :-1], value[:, 1:]
+    m0, m1 = rate[:, :-1] * h, rate[:, 1:] * h
+    rows, k = hermite_candidates(best, y0, y1, m0, m1)
+    y0, y1, m0, m1 = y0[rows, k], y1[rows, k], m0[rows, k], m1[rows, k]
     # y(s) = h00 y0 + h10 m0 + h01 y1 + h11 m1, s in [0, 1]; y'(s) = a s² + b s + c
     a = 6.0 * y0 + 3.0 * m0 - 6.0 * y1 + 3.0 * m1
     b = -6.0 * y0 - 4.0 * m0 + 6.0 * y1 - 2.0 * m1
-    c = m0
-    # Only intervals whose ends bracket a maximum can hold an interior one above both ends, and only those whose
-    # interpolant can rise above the largest sample: y(s) <= max(y0, y1) + 4/27 (|m0| + |m1|) on [0, 1] (the
-    # Hermite basis: h00 + h01 = 1, both in [0, 1]; |h10|, |h11| <= 4/27), so the others cannot change the
-    # maximum (the bound is padded for round-off: a skipped interval lies below the largest sample).
+    roots = slope_root_table(a, b, m0)
+    inside = ~(np.abs(roots.imag) > 1e-12) & (0.0 < roots.real) & (roots.real < 1.0)
+    at, which = np.nonzero(inside)   # (candidate, root) in the order of the candidates, then of their roots
+    s = roots.real[at, which]
+    s2, s3 = s * s, s * s * s
+    y = ((2 * s3 - 3 * s2 + 1) * y0[at] + (s3 - 2 * s2 + s) * m0[at]
+         + (-2 * s3 + 3 * s2) * y1[at] + (s3 - s2) * m1[at])
+    found = best.tolist()
+    for row, top in zip(rows[at].tolist(), y.tolist()):
+        found[row] = max(found[row], top)
+    return np.array(found, dtype=float)
+
+
+def hermite_candidates(best: np.ndarray, y0: np.ndarray, y1: np.ndarray, m0: np.ndarray, m1: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """``(rows, intervals)``: the intervals, history by history in order, whose interpolant may rise above
+    the history's largest sample *best* (m).
+
+    *y0*, *y1* (m) are each interval's end values and *m0*, *m1* (m) its end rates times its length, one
+    history a row.  Only intervals whose ends bracket a maximum can hold an interior one above both ends,
+    and only those whose interpolant can rise above the largest sample: y(s) <= max(y0, y1) + 4/27 (|m0| +
+    |m1|) on [0, 1] (the Hermite basis: h00 + h01 = 1, both in [0, 1]; |h10|, |h11| <= 4/27), so the others
+    cannot change the maximum (the bound is padded for round-off: a skipped interval lies below the largest
+    sample).
+    """
     rise = np.maximum(y0, y1) + (4.0 / 27.0) * (np.abs(m0) + np.abs(m1))
-    pad = 1e-12 * (abs(best) + float(np.max(np.abs(rise), initial=0.0)))
-    candidates = np.flatnonzero(((m0 > 0.0) | (m1 < 0.0)) & (rise >= best - pad))
-    for k, roots in zip(candidates, slope_roots(a[candidates], b[candidates], c[candidates])):
-        for s in roots:
-            if abs(s.imag) > 1e-12 or not 0.0 < s.real < 1.0:
-                continue
-            s = s.real
-            s2, s3 = s * s, s * s * s
-            y = ((2 * s3 - 3 * s2 + 1) * y0[k] + (s3 - 2 * s2 + s) * m0[k]
-                 + (-2 * s3 + 3 * s2) * y1[k] + (s3 - s2) * m1[k])
-            best = max(best, float(y))
-    return best
+    pad = 1e-12 * (np.abs(best) + np.max(np.abs(rise), axis=1, initial=0.0))
+    return np.nonzero(((m0 > 0.0) | (m1 < 0.0)) & (rise >= (best - pad)[:, None]))
 
 
-def slope_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[np.ndarray]:
-    """The roots of each ``a s² + b s + c``, each what ``numpy.roots([a, b, c])`` gives, bit for bit (none when
+def slope_root_table(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(n, 2) complex: row k the roots of ``a_k s² + b_k s + c_k``, what ``numpy.roots([a_k, b_k, c_k])`` gives,
+    bit for bit and in its order, then NaN where it gives fewer than two (one when ``a = 0``, none when
     ``a = b = 0``).
 
     ``numpy.roots`` of a quadratic with ``a ≠ 0`` and ``c ≠ 0`` is the eigenvalues of its companion matrix
@@ -213,18 +264,24 @@ def slope_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[np.ndarray]
     them (the same LAPACK routine on the same matrices, one at a time), the few others by ``numpy.roots``
     itself.  Complex roots have their own imaginary parts, real roots an imaginary part of exactly 0.
     """
-    out: list[np.ndarray] = [np.empty(0)] * a.size
+    table = np.full((a.size, 2), np.nan, dtype=complex)
     full = np.flatnonzero((a != 0.0) & (c != 0.0))
     if full.size:
         companion = np.zeros((full.size, 2, 2))
         companion[:, 0, 0] = -b[full] / a[full]
         companion[:, 0, 1] = -c[full] / a[full]
         companion[:, 1, 0] = 1.0
-        for k, roots in zip(full, np.linalg.eigvals(companion)):
-            out[k] = roots
+        table[full] = np.linalg.eigvals(companion)
     for k in np.flatnonzero(~((a != 0.0) & (c != 0.0)) & ((a != 0.0) | (b != 0.0))):
-        out[k] = np.roots([a[k], b[k], c[k]])
-    return out
+        roots = np.roots([a[k], b[k], c[k]])
+        table[k, :roots.size] = roots
+    return table
+
+
+def slope_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> list[np.ndarray]:
+    """The roots of each ``a s² + b s + c``, each what ``numpy.roots([a, b, c])`` gives, bit for bit (none when
+    ``a = b = 0``): the rows of :func:`slope_root_table` without their NaN (complex)."""
+    return [row[~np.isnan(row.real)] for row in slope_root_table(a, b, c)]
 
 
 def normal_mode(building, normal: str = "x") -> tuple[float, float]:
@@ -263,8 +320,63 @@ def side_vectors(model) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray 
     displacement there along the normal (m; None for a fixed wall).  A floor of one degree of freedom
     moves alike everywhere (``a`` picks its u_x); a floor in plan moves at a point p by
     ``u + θ ẑ × (p − c)`` (its centre of mass c), the point's penetration weights
-    (:meth:`pounding.model.model.Model.penetration_vectors`).
+    (:meth:`pounding.model.model.Model.penetration_vectors`).  The arrays are read-only, kept per process
+    (:func:`side_layout`).
     """
+    return list(side_layout(model)[0])
+
+
+def side_vectors_key(model) -> tuple:
+    """What :func:`side_vectors` of *model* is computed from, exactly: the key of the side vectors a process keeps.
+
+    Each building's degrees of freedom per floor and in the model's vector (where each floor's lie), each
+    gap element's buildings, floors and face, and each face's floors, which side is low and its points'
+    penetration weights as the bytes of their floats (so ``-0.0`` and ``0.0`` are two keys): two models share
+    side vectors only when everything they are made of is the same to the bit (a gap study's runs differ by
+    their record alone).
+    """
+    def weights(point) -> tuple:
+        return point.weights.dtype.str, point.weights.shape, point.weights.tobytes()
+
+    return (tuple((b.dofs_per_floor, b.n_model_dof) for b in model.buildings),
+            tuple((g.left, g.right, g.level_left, g.level_right, g.face) for g in model.gaps),
+            tuple((f.first, f.level_first, f.second, f.level_second, f.face.first_low,
+                   tuple(weights(p) for p in f.points)) for f in model.faces))
+
+
+def side_layout(model) -> tuple[tuple, tuple]:
+    """``(vectors, units)``: :func:`side_vectors` of *model* as a tuple, and per gap element ``(left, right)``
+    the degree of freedom each side's vector picks alone (:func:`one_dof`; None for a wall or a point in
+    plan that moves with its floor's rotation).
+
+    Kept per process by :func:`side_vectors_key`, the last :data:`SIDE_VECTORS_KEPT` (read-only arrays): a
+    gap study's worker meets the same model in every run.
+    """
+    key = side_vectors_key(model)
+    with _SIDE_VECTORS_LOCK:
+        found = _SIDE_VECTORS.pop(key, None)
+    if found is None:
+        vectors = tuple(computed_side_vectors(model))
+        for a in (a for sides in vectors for a in sides if a is not None):
+            a.setflags(write=False)
+        found = vectors, tuple((one_dof(left), one_dof(right)) for _, left, right in vectors)
+    with _SIDE_VECTORS_LOCK:
+        _SIDE_VECTORS[key] = found   # the most recently used last
+        while len(_SIDE_VECTORS) > SIDE_VECTORS_KEPT:
+            del _SIDE_VECTORS[next(iter(_SIDE_VECTORS))]
+    return found
+
+
+def one_dof(a: np.ndarray | None) -> int | None:
+    """The degree of freedom *a* picks alone (one entry ±1, every other 0), else None (a wall's None too)."""
+    if a is None:
+        return None
+    nonzero = np.flatnonzero(a)
+    return int(nonzero[0]) if nonzero.size == 1 and abs(a[nonzero[0]]) == 1.0 else None
+
+
+def computed_side_vectors(model) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray | None]]:
+    """:func:`side_vectors` of *model*, worked out from the model (new, writable arrays)."""
     from pounding.model.model import WALL
 
     def unit(building: int, level: int) -> np.ndarray | None:
@@ -292,17 +404,21 @@ def side_vectors(model) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray 
     return out
 
 
-def _side_peak(time: np.ndarray, q: np.ndarray, qd: np.ndarray, a: np.ndarray | None,
-               peak_of: Callable[[int], float]) -> float:
-    """Peak |a · q| (m): the run's own full-resolution peak where *a* is one degree of freedom, else the largest
-    of the cubic Hermite interpolant of the stored samples (:func:`max_hermite`); 0 for a wall (None)."""
-    if a is None:
-        return 0.0
-    nonzero = np.flatnonzero(a)
-    if nonzero.size == 1 and abs(a[nonzero[0]]) == 1.0:
-        return peak_of(int(nonzero[0]))
-    value, rate = q @ a, qd @ a
-    return max(max_hermite(time, value, rate), max_hermite(time, -value, -rate))
+def searched_histories(q: np.ndarray, qd: np.ndarray, vectors: tuple, units: tuple
+                       ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """``(values, rates)``: the histories :func:`required_separations` searches (:func:`hermite_maxima`), in
+    order, per gap element: its approach ``w · q``, then for each side that is no wall and no one degree of
+    freedom (*units*: :func:`side_layout`) its displacement ``a · q`` and the negative of it (m; rates m/s)."""
+    values, rates = [], []
+    for (w, *sides), picks in zip(vectors, units):
+        values.append(q @ w)
+        rates.append(qd @ w)
+        for a, pick in zip(sides, picks):
+            if a is not None and pick is None:
+                value, rate = q @ a, qd @ a
+                values += [value, -value]
+                rates += [rate, -rate]
+    return values, rates
 
 
 def required_separations(model, ds, modes: Callable[[int, str], tuple[float, float]] | None = None
@@ -323,9 +439,11 @@ def required_separations(model, ds, modes: Callable[[int, str], tuple[float, flo
     dict
         Arrays along the gap elements (``ds.contact``): ``required`` (m, ≥ 0: the largest approach
         ``w · q`` of the two sides along the normal, on the cubic Hermite interpolant), ``peak_left``,
-        ``peak_right`` (m: each side's peak displacement at the point along the normal, 0 for a wall),
-        ``correlation`` (1: the CQC coefficient of the two buildings' modes of largest effective mass along
-        the normal, :func:`normal_mode`; 0 against a wall, where every rule gives the building's own).
+        ``peak_right`` (m: each side's peak displacement at the point along the normal, 0 for a wall: the
+        run's own full-resolution peak where the side is one degree of freedom, else the largest of the
+        interpolant of ±its displacement), ``correlation`` (1: the CQC coefficient of the two buildings'
+        modes of largest effective mass along the normal, :func:`normal_mode`; 0 against a wall, where every
+        rule gives the building's own).  Every history is searched in one call (:func:`hermite_maxima`).
     modes : callable, optional
         :func:`normal_modes` of *model*, shared with the run's other uses of the modes (default: its own).
     """
@@ -333,20 +451,22 @@ def required_separations(model, ds, modes: Callable[[int, str], tuple[float, flo
     from pounding.studies.common import dof_peaks, floor_states
 
     q, qd = floor_states(ds)
-    t = ds.time.values
     mode = normal_modes(model) if modes is None else modes
-    found: dict[str, np.ndarray] = {}
+    vectors, units = side_layout(model)
+    tops = iter(hermite_maxima(ds.time.values, *searched_histories(q, qd, vectors, units)).tolist())
+    # the run's full-resolution peaks, read when a side is one degree of freedom
+    peaks = dof_peaks(ds) if any(pick is not None for picks in units for pick in picks) else None
 
-    def peak_of(k: int) -> float:   # the run's full-resolution peaks, read when a side is one degree of freedom
-        if "peaks" not in found:
-            found["peaks"] = dof_peaks(ds)
-        return float(found["peaks"][k])
+    def side_peak(a: np.ndarray | None, pick: int | None) -> float:
+        if a is None:
+            return 0.0
+        return float(peaks[pick]) if pick is not None else max(next(tops), next(tops))
 
     out: dict[str, list[float]] = {k: [] for k in ("required", "peak_left", "peak_right", "correlation")}
-    for g, (w, left, right) in zip(model.gaps, side_vectors(model)):
-        out["required"].append(max(0.0, max_hermite(t, q @ w, qd @ w)))
-        out["peak_left"].append(_side_peak(t, q, qd, left, peak_of))
-        out["peak_right"].append(_side_peak(t, q, qd, right, peak_of))
+    for g, (w, left, right), (pick_left, pick_right) in zip(model.gaps, vectors, units):
+        out["required"].append(max(0.0, next(tops)))
+        out["peak_left"].append(side_peak(left, pick_left))
+        out["peak_right"].append(side_peak(right, pick_right))
         if WALL in (g.left, g.right):
             out["correlation"].append(0.0)
         else:
