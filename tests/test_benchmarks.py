@@ -21,7 +21,7 @@ SCRIPTS = sorted(p for p in BENCHMARKS.glob("*.py") if not p.name.startswith("_"
 OWNS = {"scaling.py": ["docs/scaling.png"], "vs_opensees.py": [], "sweep_scaling.py": [], "configurations.py": [],
         "ida_throughput.py": [], "startup.py": [], "solver_regression.py": [], "p695_full.py": [],
         "collapse_ida.py": [], "plan_speed.py": [], "time_split.py": [],
-        "worker_share.py": []}
+        "worker_share.py": [], "open_phase_bound.py": [], "contact_phase_order.py": []}
 
 
 def _output_module():

@@ -401,10 +401,15 @@ class Model:
         """True if the buildings' floors are rigid diaphragms in plan (u_x, u_y, θ each)."""
         return any(b.in_plan for b in self.buildings)
 
-    @property
-    def dof_offsets(self) -> list[int]:
-        """Index of each building's first degree of freedom in the model's vector."""
-        return [int(x) for x in np.cumsum([0] + [b.n_model_dof for b in self.buildings])[:-1]]
+    @cached_property
+    def dof_offsets(self) -> tuple[int, ...]:
+        """Index of each building's first degree of freedom in the model's vector (worked out once per model:
+        assembling and labelling a run read it ~20 times)."""
+        offsets, total = [], 0
+        for b in self.buildings:
+            offsets.append(total)
+            total += b.n_model_dof
+        return tuple(offsets)
 
     @property
     def n_dof(self) -> int:
