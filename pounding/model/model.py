@@ -23,7 +23,6 @@ SI units throughout (kg, N/m, m, s).
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 from dataclasses import dataclass
 from functools import cached_property

@@ -55,7 +55,7 @@ from pounding.errors import ModelError, did_you_mean
 from pounding.model.document import DataSource, Document, Location, parse_document, plural
 from pounding.model.floors import storey_gravity_load
 from pounding.registry import lookup
-from pounding.units import STANDARD_GRAVITY, UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
+from pounding.units import UNIT_ALIASES, UNIT_CHOICES, canonical_unit, number_from_text
 
 __all__ = [
     "ModelEntry", "BuildingEntry", "DesignEntry", "Asce722DesignEntry", "Ec8DesignEntry", "StoreyEntry", "StoreyShorthand", "RayleighEntry", "ModalEntry",

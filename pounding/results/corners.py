@@ -9,10 +9,7 @@ between output times (an impact's onset).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
-import xarray as xr
 
 from pounding.model.floors import DOF_PER_FLOOR, point_weights
 

@@ -632,9 +632,7 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
     floor_names = peaks["storey"]
     building_names = [b.name for b in model.buildings]
     gaps = model.gaps
-    contact_names = peaks["contact"]
     impact_count = peaks["impact_count"]
-    side_names = building_names + [WALL_NAME]  # index WALL (−1) is the wall
     with np.errstate(invalid="ignore", divide="ignore"):
         # No ratio for floors that close at zero approach velocity (touching at rest, gap 0): NaN, not inf.
         restitution = np.where(raw.impact_velocity > 0.0, raw.impact_separation_velocity / raw.impact_velocity,
