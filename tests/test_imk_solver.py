@@ -151,3 +151,33 @@ def test_opensees_export_of_the_shipped_collapse_pair_agrees_on_peaks():
     np.testing.assert_allclose(peaks["peak_displacement"], ds.peak_displacement.values, rtol=0.01)
     force = ds.peak_contact_force.values
     np.testing.assert_allclose(peaks["peak_contact_force"], force, rtol=0, atol=0.01 * force.max())
+
+
+def _on_the_backbone_state() -> np.ndarray:
+    """An IMKBilin state on its backbone, loading towards +: hardening line 4e5 → 4.6e5 N over 0.01 → 0.05 m
+    (1.5e6 N/m), residual floor 1.2e5 N; the hardening line rises from the floor at 0.05 − 3.4e5/1.5e6 m."""
+    from pounding.solver import imk
+
+    st = np.zeros(imk.N_STATE)
+    for offset in (0, imk.SIDE):
+        for index, value in ((imk.FY, 4.0e5), (imk.UY, 0.01), (imk.KP, 1.5e6), (imk.KPC, -2.0e6), (imk.UCAP, 0.05),
+                             (imk.FCAP, 4.6e5), (imk.FRES, 1.2e5), (imk.URES, 0.22), (imk.UU, 0.3)):
+            st[offset + index] = value
+    st[imk.KE] = st[imk.KUN] = st[imk.KRE] = 4.0e7
+    st[imk.DIR], st[imk.ONBB], st[imk.VARIANT] = 1.0, 1.0, imk.V_BILINEAR
+    return st
+
+
+@pytest.mark.parametrize("relative, rising", [(-1e-14, True), (1e-14, True), (-1e-9, False)])
+def test_a_branch_decided_at_the_rise_from_the_residual_floor_is_the_rising_line(relative, rising):
+    """Reloading onto the backbone where the hardening line rises from the residual floor, the limit is
+    that intersection, so the line there is F_r only to round-off: a hair (1e-14) below F_r is the rising
+    line, not the floor (deciding by ``line > F_r`` sent a storey onto the floor from 3e-15 m of round-off
+    and lost its collapse); 1e-9 below, far beyond round-off, is the floor."""
+    from pounding.solver import imk
+
+    st = _on_the_backbone_state()
+    at = 0.05 + (1.2e5 * (1.0 + relative) - 4.6e5) / 1.5e6   # the hardening line at F_r·(1 + relative)
+    row = np.zeros(6)
+    imk.set_row(st, row, at, at)
+    assert row[imk.P_SLOPE] == (1.5e6 if rising else 0.0)

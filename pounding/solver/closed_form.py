@@ -84,6 +84,8 @@ EXACT_SAMPLES = 512
 SAME_STEP = 1e-12
 #: Terms of the φ functions' Taylor series below |x| = 1 (1/20! ≈ 4e-19).
 SERIES_TERMS = 20
+#: φ₃'s Taylor coefficients 1/(j + 3)!, j = 0 … SERIES_TERMS − 1 (Horner's rule in :func:`phi_values`).
+PHI3_SERIES = np.array([1.0 / math.factorial(j + 3) for j in range(SERIES_TERMS)])
 
 
 class ClosedForm(NamedTuple):
@@ -431,23 +433,19 @@ def _fill_factors(cf: ClosedForm, step: float) -> None:
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def phi_values(x):
-    """``(e^x, φ₁(x), φ₂(x), φ₃(x))``: their Taylor series below |x| = 1 (SERIES_TERMS terms), the
-    recurrence ``φ_k = (φ_{k−1} − 1/(k − 1)!)/x`` above (its cancellation is below a few ulps there)."""
+    """``(e^x, φ₁(x), φ₂(x), φ₃(x))``: below |x| = 1 φ₃ by Horner's rule on its Taylor series (SERIES_TERMS
+    terms, :data:`PHI3_SERIES`) and ``φ_k = 1/k! + x·φ_{k+1}`` down to φ₁; above, the recurrence
+    ``φ_k = (φ_{k−1} − 1/(k − 1)!)/x`` up from eˣ (its cancellation is below a few ulps there)."""
     e = cmath.exp(x)
     if abs(x) >= 1.0:
         p1 = (e - 1.0) / x
         p2 = (p1 - 1.0) / x
         return e, p1, p2, (p2 - 0.5) / x
-    p1, p2, p3 = 0j, 0j, 0j
-    t1, t2, t3 = 1.0 + 0j, 0.5 + 0j, 0.5 / 3.0 + 0j
-    for j in range(SERIES_TERMS):
-        p1 += t1
-        p2 += t2
-        p3 += t3
-        t1 *= x / (j + 2)
-        t2 *= x / (j + 3)
-        t3 *= x / (j + 4)
-    return e, p1, p2, p3
+    p3 = PHI3_SERIES[SERIES_TERMS - 1] + 0j
+    for j in range(SERIES_TERMS - 2, -1, -1):
+        p3 = p3 * x + PHI3_SERIES[j]
+    p2 = 0.5 + x * p3
+    return e, 1.0 + x * p2, p2, p3
 
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)  # with a Python wrapper: :func:`phis`
@@ -775,6 +773,9 @@ def _exact_at(cf, modes, r, tau):
 #: Newton steps on the exact rate from the Hermite cubic's stationary point (converged to round-off
 #: in 2–3 from a start within the cubic's error).
 NEWTON_STEPS = 4
+#: A Newton update below this fraction of the step ends the search (the extremum is flat there: its value
+#: moves by the square of the update).
+NEWTON_CONVERGED = 1e-12
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.INLINED, **jit.NO_REFCOUNT)
@@ -794,7 +795,11 @@ def _row_peak(cf, modes, size, r, y0, r0, y1, r1, h, peak) -> float:
         _, rate, accel = _exact_at(cf, modes, r, tau)
         if accel == 0.0:
             break
-        tau = min(h, max(0.0, tau - rate / accel))
+        moved = min(h, max(0.0, tau - rate / accel))
+        if abs(moved - tau) <= NEWTON_CONVERGED * h:
+            tau = moved
+            break
+        tau = moved
     value, _, _ = _exact_at(cf, modes, r, tau)
     return max(peak, abs(value))
 

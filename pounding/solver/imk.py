@@ -49,6 +49,10 @@ V_BILINEAR, V_PEAK, V_PINCHING = range(3)
 P_SLOPE, P_UNLOAD, P_LOWER, P_UPPER, P_WATCH = 1, 2, 3, 4, 5
 # Event kinds (pounding.solver.storey_events numbers them after the bilinear ones).
 KIND_LOWER, KIND_UPPER, KIND_REVERSAL = range(3)
+#: Relative round-off within which a reloading line that reaches the backbone where its hardening line rises
+#: from the residual floor (``line = F_r``) is on the line: the limit is that intersection, so the line is
+#: F_r there only to round-off (as the backbone's own test in :func:`_bilinear_event`, 1e-12).
+ON_LINE_TOLERANCE = 1e-12
 
 INF = np.inf
 
@@ -516,7 +520,7 @@ def set_row(st, row, u, at):
                 on_line = x < st[o + URES]
             else:
                 # At the rise onto the hardening line (line = F_r, rising) the line is ahead: its slope.
-                on_line = line > st[o + FRES] or (line == st[o + FRES] and segment > 0.0)
+                on_line = line > st[o + FRES] or (segment > 0.0 and line >= st[o + FRES] * (1.0 - ON_LINE_TOLERANCE))
             slope = segment if on_line else 0.0
             st[UREF], st[FREF] = at, sigma * max(line, st[o + FRES])
             force = st[FREF] + slope * (u - at)
