@@ -32,17 +32,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.interpolate import CubicSpline
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-
-from pounding.model.model import model_from_text  # noqa: E402
-from pounding.simulation import simulate  # noqa: E402
-from pounding.solver.assembly import assemble  # noqa: E402
-from pounding.solver.closed_form import linear_matrices  # noqa: E402
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402
 
@@ -51,6 +43,11 @@ class Equations:
     """The model's equations of motion with its contacts, as scipy integrates them (relative coordinates)."""
 
     def __init__(self, model, ds, free_steps: bool) -> None:
+        from scipy.interpolate import CubicSpline
+
+        from pounding.solver.assembly import assemble
+        from pounding.solver.closed_form import linear_matrices
+
         system = assemble(model).system
         mass, self.damping, self.stiffness = linear_matrices(system)
         self.n = mass.shape[0]
@@ -90,6 +87,8 @@ class Equations:
 
 def count(eq: Equations, method: str, end: float, rtol: float, atol: np.ndarray, free_steps: bool) -> dict:
     """Accepted steps and evaluations of *method* with a contact closed and with every contact open."""
+    from scipy.integrate import solve_ivp
+
     t, y, closed = 0.0, np.zeros(2 * eq.n), {}
     tally = {"impacts": 0, "closed_steps": 0, "closed_evaluations": 0, "open_steps": 0, "open_evaluations": 0}
     last_step = None
@@ -131,6 +130,9 @@ def main() -> None:
                         help="let the steps straddle record samples (over a cubic spline of the record)")
     add_output_arguments(parser, "contact_phase_order")
     args = parser.parse_args()
+    from pounding.model.model import model_from_text
+    from pounding.simulation import simulate
+
     path = ROOT / "models" / f"{args.model}.yaml"
     model = model_from_text(path.read_text(), name=path.stem, path=str(path))
     ds = simulate(model)

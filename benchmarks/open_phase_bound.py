@@ -37,11 +37,6 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pounding.model.model import model_from_text  # noqa: E402
-from pounding.simulation import simulate  # noqa: E402
-from pounding.solver.assembly import assemble  # noqa: E402
-from pounding.solver.closed_form import closed_form  # noqa: E402
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _output import add_output_arguments, out_dir  # noqa: E402
 
@@ -72,6 +67,11 @@ def modal_history(cf, state: np.ndarray) -> tuple[np.ndarray, float]:
 
 def skippable(path: Path, margin: float) -> dict:
     """The counts of :mod:`this script <open_phase_bound>` for the model file *path*."""
+    from pounding.model.model import model_from_text
+    from pounding.simulation import simulate
+    from pounding.solver.assembly import assemble
+    from pounding.solver.closed_form import closed_form
+
     model = model_from_text(path.read_text(), name=path.stem, path=str(path))
     ds = simulate(model)
     step = float(ds.time[1] - ds.time[0])
