@@ -18,7 +18,6 @@ import time as _time
 import dataclasses
 import threading
 import weakref
-from collections import OrderedDict
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ import xarray as xr
 from pounding.errors import PoundingError
 from pounding.errors import ArchiveError, ModelError, RecordError
 from pounding.memory import MEMORY_FRACTION, available_memory, check_memory
+from pounding.recently_used import RecentlyUsed
 from pounding.records.catalogue import is_catalogue_name
 from pounding.records.readers import FIXES, declared_in_header
 from pounding.records.record import Record
@@ -121,27 +121,14 @@ def processed_record_for(model: Model, *, where: str = "yaml", building: int | s
     spec = model.ground_motion if building is None else model.ground_motion_of(building)
     if where == "yaml":
         _check_record_file(model, spec, building)
-    key = processed_record_key(spec, where)
-    with _PROCESSED_LOCK:
-        record = _PROCESSED.get(key)
-        if record is not None:
-            _PROCESSED.move_to_end(key)
-            return record
-    record = process(load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where),
-                     spec.processing)
-    with _PROCESSED_LOCK:
-        _PROCESSED[key] = record
-        while len(_PROCESSED) > _PROCESSED_KEPT:
-            _PROCESSED.popitem(last=False)
-    return record
+    return _PROCESSED.get(processed_record_key(spec, where), lambda: process(
+        load_record(spec.record, base_dir=spec.base_dir, dt=spec.dt, units=spec.units, where=where), spec.processing))
 
 
-#: This process's records read and processed (not scaled), by :func:`processed_record_key`: a sweep's or
-#: compare's scenarios that share a record read it once per worker (~0.8 ms of every run).  A Record is
+#: This process's last 8 records read and processed (not scaled), by :func:`processed_record_key`: a sweep's
+#: or compare's scenarios that share a record read it once per worker (~0.8 ms of every run).  A Record is
 #: immutable (read-only samples, frozen), so every run reads the same samples it would have read.
-_PROCESSED: OrderedDict = OrderedDict()
-_PROCESSED_KEPT = 8
-_PROCESSED_LOCK = threading.Lock()
+_PROCESSED: RecentlyUsed[Record] = RecentlyUsed(8)
 
 
 def processed_record_key(spec: Any, where: str = "yaml") -> str:

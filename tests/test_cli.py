@@ -161,6 +161,20 @@ def test_the_command_line_imports_no_heavy_library_before_a_command_needs_it():
     _python_succeeds(code)
 
 
+def test_an_existing_archive_is_refused_before_the_numerical_libraries_are_imported(tmp_path):
+    # `pounding run -o existing.nc` refuses in a tenth of a second, not after ~0.7 s of importing
+    # xarray and numba for a run it will not make (pounding.results.output_place is standard library only).
+    out = tmp_path / "run.nc"
+    out.write_text("keep me")
+    code = ("import sys; from pounding.cli import main; "
+            f"assert main(['run', {PAIR!r}, '-o', {str(out)!r}]) == 2; "
+            "heavy = sorted({m.split('.')[0] for m in sys.modules} & "
+            "{'dask', 'matplotlib', 'xarray', 'numba', 'netCDF4', 'pydantic', 'scipy'}); "
+            "assert not heavy, f'imported: {heavy}'")
+    _python_succeeds(code)
+    assert out.read_text() == "keep me"
+
+
 def _python_succeeds(code: str) -> None:
     """Run *code* in a fresh interpreter (its imports are its own) and require exit status 0."""
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -22,6 +22,7 @@ from scipy.stats import norm
 from pounding.cli import main
 from pounding.errors import PoundingError
 from pounding.model.model import load_model
+from pounding.recently_used import RecentlyUsed
 from pounding.records.spectra import spectral_acceleration
 from pounding.simulation import record_for
 from pounding.studies import ida
@@ -482,8 +483,7 @@ def test_runs_of_one_template_reuse_its_model_and_record_and_give_the_fresh_runs
     monkeypatch.setattr(model_module, "model_from_data", counting_model_from_data)
     from pounding.studies.ida import runs
 
-    monkeypatch.setattr(runs, "_TEMPLATES", type(runs._TEMPLATES)())
-    monkeypatch.setattr(runs, "_TEMPLATES_KEPT", 2)
+    monkeypatch.setattr(runs, "_TEMPLATES", RecentlyUsed(2))
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.2,0.9", without_contacts=True, duration=4.0)
     with_0, without_0, with_1 = ("with_contacts", 0), ("without_contacts", 0), ("with_contacts", 1)
     # (template, level, validated afresh?) with two templates kept, least recently used dropped first

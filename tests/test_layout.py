@@ -26,7 +26,7 @@ PACKAGE = Path(pounding.__file__).parent
 #: package or from any lower layer, never from a higher one or a sibling package.
 LAYERS: list[tuple[str, ...]] = [
     ("pounding", "pounding.errors", "pounding.data", "pounding.units", "pounding.numba_cache",
-     "pounding.registry", "pounding.provenance"),
+     "pounding.registry", "pounding.provenance", "pounding.recently_used"),
     ("pounding.records", "pounding.contact", "pounding.hysteresis", "pounding.memory"),
     ("pounding.model",),
     ("pounding.solver",),

@@ -16,6 +16,7 @@ import pytest
 import yaml
 
 from pounding.model.model import model_from_data
+from pounding.recently_used import RecentlyUsed
 from pounding.records.processing import scale_record
 from pounding.simulation import processed_record_for, record_for
 
@@ -34,7 +35,7 @@ def fresh(monkeypatch, model, **kwargs):
     """:func:`processed_record_for` of *model* read afresh: the worker's kept records emptied first."""
     import pounding.simulation as simulation
 
-    monkeypatch.setattr(simulation, "_PROCESSED", type(simulation._PROCESSED)())
+    monkeypatch.setattr(simulation, "_PROCESSED", RecentlyUsed(simulation._PROCESSED.kept))
     return processed_record_for(model, **kwargs)
 
 

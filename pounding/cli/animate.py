@@ -14,7 +14,7 @@ def _cmd_animate(args: argparse.Namespace) -> int:
     from pounding.cli.run import open_archive
     from pounding.errors import PoundingError
     from pounding.results.animation import RunAnimation, film_format, parse_window
-    from pounding.results.archive import check_writable
+    from pounding.results.output_place import check_writable
 
     out = Path(args.output)
     suffix = film_format(out)

@@ -90,7 +90,7 @@ def check_outputs(args: argparse.Namespace, inputs: list | tuple = (), *, model=
     ArchiveError
         Naming the output and the input it would destroy.
     """
-    from pounding.results.archive import check_not_input, check_output_place
+    from pounding.results.output_place import check_not_input, check_output_place
 
     read = [*command_inputs(args, model=model), *inputs]
     output = getattr(args, "output", None)

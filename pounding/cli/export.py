@@ -15,7 +15,8 @@ def _cmd_export_opensees(args: argparse.Namespace) -> int:
     from pounding.cli.csv_option import check_outputs
     from pounding.export.opensees import DEFAULT_DT, opensees_script_and_notes
     from pounding.model.model import load_model
-    from pounding.results.archive import atomic_path, check_output_place
+    from pounding.results.archive import atomic_path
+    from pounding.results.output_place import check_output_place
     from pounding.simulation import record_path
 
     dt = DEFAULT_DT if args.dt is None else args.dt

@@ -9,7 +9,8 @@ __all__ = ["register_cli"]
 
 def _cmd_hysteresis(args: argparse.Namespace) -> int:
     from pounding.cli.csv_option import check_outputs
-    from pounding.results.archive import check_output_place, check_writable, save_run
+    from pounding.results.archive import save_run
+    from pounding.results.output_place import check_output_place, check_writable
     from pounding.studies.cyclic import PROTOCOLS, hysteresis_test, plot_hysteresis, write_csv
 
     inputs = [args.model] + ([] if args.protocol in PROTOCOLS else [args.protocol])

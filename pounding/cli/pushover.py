@@ -13,7 +13,8 @@ PATTERNS = ("first-mode", "triangular", "uniform")
 
 def _cmd_pushover(args: argparse.Namespace) -> int:
     from pounding.cli.csv_option import check_outputs
-    from pounding.results.archive import check_output_place, check_writable, save_run
+    from pounding.results.archive import save_run
+    from pounding.results.output_place import check_output_place, check_writable
     from pounding.studies.pushover import plot_pushover, pushover, pushover_table
 
     if args.output:

@@ -78,7 +78,7 @@ def _check_png(path: str, source: str) -> None:
     """
     from pathlib import Path
 
-    from pounding.results.archive import check_writable
+    from pounding.results.output_place import check_writable
 
     target = Path(path)
     if target.suffix.lower() != ".png":

@@ -95,7 +95,7 @@ def damaged_if_garbled(source):
 
 def _check_plot_dir(directory: str) -> None:
     """Fail before any computation if --plot DIR cannot be created or written."""
-    from pounding.results.archive import check_output_place
+    from pounding.results.output_place import check_output_place
 
     check_output_place(directory, "--plot", folder=True)
 
@@ -106,13 +106,15 @@ def _check_plot_dir(directory: str) -> None:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable, output_lock
+    from pounding.results.output_place import check_writable
 
     started = time.perf_counter()
     output = Path(args.output) if args.output else Path(Path(args.model).stem + ".nc")
-    check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing anything
+    check_writable(output, overwrite=args.overwrite, inputs=[args.model])  # before computing or importing xarray
     if args.plot:
         _check_plot_dir(args.plot)
+    from pounding.results.archive import output_lock
+
     model = _model_or_none(args.model)   # read once: for the inputs checked here and for the run
     check_outputs(args, model=model)
     with output_lock(output):   # a second run onto the same name refuses here, before computing
@@ -133,7 +135,8 @@ def _model_or_none(path: str):
 def _run_locked(args: argparse.Namespace, output: Path, started: float, model=None) -> int:
     """``pounding run`` once *output* is claimed; *model* is ``MODEL`` if already loaded."""
     from pounding.errors import PoundingError
-    from pounding.results.archive import check_writable, save_run
+    from pounding.results.archive import save_run
+    from pounding.results.output_place import check_writable
     from pounding.results.checks import print_warnings, run_warnings
     from pounding.model.model import load_model
     from pounding.simulation import model_inputs, simulate
@@ -195,7 +198,8 @@ def outcome_status(ds) -> int:
 
 
 def _cmd_rerun(args: argparse.Namespace) -> int:
-    from pounding.results.archive import check_writable, open_run, output_lock, save_run
+    from pounding.results.archive import open_run, output_lock, save_run
+    from pounding.results.output_place import check_writable
     from pounding.results.summary import compare_runs
     from pounding.simulation import rerun
 

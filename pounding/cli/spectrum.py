@@ -122,7 +122,7 @@ def _cmd_spectrum(args: argparse.Namespace) -> int:
     from pounding.units import STANDARD_GRAVITY
 
     from pounding.cli.csv_option import check_outputs
-    from pounding.results.archive import check_output_place
+    from pounding.results.output_place import check_output_place
 
     check_outputs(args)   # --csv: not the user spectrum's own file
     if args.plot:   # a file

@@ -32,14 +32,14 @@ def add_cluster_options(parser: argparse.ArgumentParser) -> None:
 
 def check_study_options(args: argparse.Namespace) -> None:
     """Before a study runs (compare, gap): ``--workers`` >= 1, a writable ``-o``, a ``--plot`` that is no file."""
-    from pounding.results.archive import check_writable
+    from pounding.results.output_place import check_writable
 
     if args.workers is not None and args.workers < 1:
         raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
     if args.output:
         check_writable(args.output, overwrite=args.overwrite)
     if args.plot:
-        from pounding.results.archive import check_output_place
+        from pounding.results.output_place import check_output_place
 
         check_output_place(args.plot, "--plot", folder=True)
 

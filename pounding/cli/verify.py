@@ -45,7 +45,8 @@ class _ModelList(argparse.Action):
 
 def _cmd_verify(args: argparse.Namespace) -> int:
     """Handler of ``pounding verify``."""
-    from pounding.results.archive import check_writable, save_run
+    from pounding.results.archive import save_run
+    from pounding.results.output_place import check_writable
     from pounding.studies.verify import DEFAULT_E_PRE, format_report, plot_verification, run_verification, to_json
 
     if args.output:

@@ -18,7 +18,6 @@ stiffness k_i and height h_i.  M is diagonal, K tridiagonal::
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -27,6 +26,7 @@ import numpy as np
 
 from pounding.errors import ModelError
 from pounding.memory import check_memory
+from pounding.recently_used import RecentlyUsed
 from pounding.model import floors, schema
 from pounding.model.foundation import BASE_DOFS, Foundation, effective_damping, founded_mass, founded_matrix, \
     founded_weights
@@ -37,15 +37,13 @@ __all__ = ["Damping", "Building", "planar_storeys", "modes_key", "forget_modes",
 #: How many buildings' modes a process keeps (:func:`modes_key`): a study's worker meets the same few
 #: buildings in every scenario; a study of many different buildings recomputes what it has dropped.
 MODES_KEPT = 64
-#: Modes by :func:`modes_key`, least recently used first (read-only arrays, shared by equal buildings).
-_MODES: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
-_MODES_LOCK = threading.Lock()
+#: Modes by :func:`modes_key` (read-only arrays, shared by equal buildings).
+_MODES: RecentlyUsed[tuple[np.ndarray, np.ndarray]] = RecentlyUsed(MODES_KEPT)
 
 
 def forget_modes() -> None:
     """Drop every kept mode (:func:`modes_key`): the next building computes its own again."""
-    with _MODES_LOCK:
-        _MODES.clear()
+    _MODES.clear()
 
 
 def modes_key(storeys: tuple[Storey, ...], dofs: int) -> tuple:
@@ -354,19 +352,13 @@ class Building:
         checking the dense matrices fit in memory (:meth:`check_modes_memory`).
         """
         self.check_modes_memory()
-        key = modes_key(self.storeys, self.dofs_per_floor)
-        with _MODES_LOCK:
-            found = _MODES.pop(key, None)
-        if found is None:
-            omega, phi = floors.natural_modes(self.stiffness_matrix(), self.mass_matrix(), self.dofs_per_floor)
-            omega.setflags(write=False)
-            phi.setflags(write=False)
-            found = (omega, phi)
-        with _MODES_LOCK:
-            _MODES[key] = found   # the most recently used last
-            while len(_MODES) > MODES_KEPT:
-                del _MODES[next(iter(_MODES))]
-        return found
+        return _MODES.get(modes_key(self.storeys, self.dofs_per_floor), self._computed_modes)
+
+    def _computed_modes(self) -> tuple[np.ndarray, np.ndarray]:
+        omega, phi = floors.natural_modes(self.stiffness_matrix(), self.mass_matrix(), self.dofs_per_floor)
+        omega.setflags(write=False)
+        phi.setflags(write=False)
+        return omega, phi
 
     def check_modes_memory(self) -> None:
         """Refuse in one line, before allocating, modes whose dense matrices would not fit in memory.

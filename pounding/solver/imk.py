@@ -51,7 +51,7 @@ P_SLOPE, P_UNLOAD, P_LOWER, P_UPPER, P_WATCH = 1, 2, 3, 4, 5
 KIND_LOWER, KIND_UPPER, KIND_REVERSAL = range(3)
 #: Relative round-off within which a reloading line that reaches the backbone where its hardening line rises
 #: from the residual floor (``line = F_r``) is on the line: the limit is that intersection, so the line is
-#: F_r there only to round-off (as the backbone's own test in :func:`_bilinear_event`, 1e-12).
+#: F_r there only to round-off (the tolerance of the backbone's own reaching test in :func:`_bilinear_event` as well).
 ON_LINE_TOLERANCE = 1e-12
 
 INF = np.inf
@@ -450,7 +450,7 @@ def _bilinear_event(st, kind, u, f, work):
         st[UREF], st[FREF] = u, 0.0
         return fail
     line = st[FREF] + st[KUN] * (u - st[UREF])
-    if moving * line >= _bilinear_backbone(st, o, x) * (1.0 - 1e-12):
+    if moving * line >= _bilinear_backbone(st, o, x) * (1.0 - ON_LINE_TOLERANCE):
         # The unloading/reloading line reaches the backbone.
         st[ONBB], st[DIR], st[YIELDED] = 1.0, moving, 1.0
         if st[o + KPC] != 0.0 and x >= st[o + URES]:

@@ -54,7 +54,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -63,6 +62,7 @@ from typing import Any, Callable
 import numpy as np
 
 from pounding.errors import PoundingError
+from pounding.recently_used import RecentlyUsed
 from pounding.registry import add_unique
 
 __all__ = ["SeparationRule", "RULES", "register_rule", "cqc_correlation", "max_hermite", "hermite_maxima",
@@ -82,9 +82,8 @@ NOT_BOUNDED = "not bounded"
 #: How many models' side vectors a process keeps (:func:`side_layout`): a gap study's worker meets the same
 #: model in every run, under another record.
 SIDE_VECTORS_KEPT = 16
-#: Side vectors by :func:`side_vectors_key`, least recently used first (read-only arrays, shared by equal models).
-_SIDE_VECTORS: dict[tuple, tuple[tuple, tuple]] = {}
-_SIDE_VECTORS_LOCK = threading.Lock()
+#: Side vectors by :func:`side_vectors_key` (read-only arrays, shared by equal models).
+_SIDE_VECTORS: RecentlyUsed[tuple[tuple, tuple]] = RecentlyUsed(SIDE_VECTORS_KEPT)
 
 
 # --------------------------------------------------------------------------- #
@@ -355,19 +354,13 @@ def side_layout(model) -> tuple[tuple, tuple]:
     Kept per process by :func:`side_vectors_key`, the last :data:`SIDE_VECTORS_KEPT` (read-only arrays): a
     gap study's worker meets the same model in every run.
     """
-    key = side_vectors_key(model)
-    with _SIDE_VECTORS_LOCK:
-        found = _SIDE_VECTORS.pop(key, None)
-    if found is None:
+    def computed() -> tuple[tuple, tuple]:
         vectors = tuple(computed_side_vectors(model))
         for a in (a for sides in vectors for a in sides if a is not None):
             a.setflags(write=False)
-        found = vectors, tuple((one_dof(left), one_dof(right)) for _, left, right in vectors)
-    with _SIDE_VECTORS_LOCK:
-        _SIDE_VECTORS[key] = found   # the most recently used last
-        while len(_SIDE_VECTORS) > SIDE_VECTORS_KEPT:
-            del _SIDE_VECTORS[next(iter(_SIDE_VECTORS))]
-    return found
+        return vectors, tuple((one_dof(left), one_dof(right)) for _, left, right in vectors)
+
+    return _SIDE_VECTORS.get(side_vectors_key(model), computed)
 
 
 def one_dof(a: np.ndarray | None) -> int | None:

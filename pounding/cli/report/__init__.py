@@ -50,7 +50,8 @@ def write_report(archives: Sequence[str | Path], output: str | Path, *, overwrit
         *output* exists (without *overwrite*), is one of *archives* or cannot be written; or an archive
         cannot be read (:func:`report_html`).
     """
-    from pounding.results.archive import atomic_path, check_writable
+    from pounding.results.archive import atomic_path
+    from pounding.results.output_place import check_writable
 
     target = check_writable(output, overwrite=overwrite, inputs=list(archives))
     text = report_html(archives)

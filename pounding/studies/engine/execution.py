@@ -176,7 +176,7 @@ def run_study(source: TaskSource, output: str | os.PathLike | None = None, *, wo
     plan : str, optional
         The study's number of runs, said once its inputs are checked and before any run starts.
     """
-    from pounding.results.archive import check_writable
+    from pounding.results.output_place import check_writable
 
     say = log or (lambda line: print(line, file=sys.stderr))
     if scheduler and client is None:

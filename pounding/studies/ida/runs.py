@@ -8,13 +8,12 @@ plan), and for floors in plan each plane's peak drift ratio beside them.
 from __future__ import annotations
 
 import math
-import threading
 import time
-from collections import OrderedDict
 from typing import Any
 
 import numpy as np
 
+from pounding.recently_used import RecentlyUsed
 from pounding.studies.ida.schedule import IdaPlan
 
 __all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in", "collapse_building_of",
@@ -32,9 +31,7 @@ def _plain(value: float) -> float | None:
 #: templates (a variant and a record).  The runs of one template differ only in their
 #: ``ground_motion.scale``, a plain factor; validating the model and reading and processing the
 #: record took ~3 ms of every ~30 ms run, and is now done once per worker and template.
-_TEMPLATES: OrderedDict = OrderedDict()
-_TEMPLATES_KEPT = 8
-_TEMPLATES_LOCK = threading.Lock()
+_TEMPLATES: RecentlyUsed[tuple] = RecentlyUsed(8)
 
 
 def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any, list | None]:
@@ -60,19 +57,13 @@ def _model_and_record(task: dict[str, Any]) -> tuple[Any, Any, list | None]:
         model = model_from_data(data, name=name, source=task["document"], base_dir=task.get("base_dir"))
         return model, None, _alone_models(task, model)
     key = repr((dict(data, ground_motion=dict(ground_motion, scale=None)), task.get("base_dir"), name))
-    with _TEMPLATES_LOCK:
-        template = _TEMPLATES.get(key)
-        if template is not None:
-            _TEMPLATES.move_to_end(key)
+    template = _TEMPLATES.find(key)
     if template is None:
         model = model_from_data(data, name=name, source=task["document"], base_dir=task.get("base_dir"))
         if model.has_building_records:
             return model, None, None
         template = (model, processed_record_for(model, where="yaml"), _alone_models(task, model))
-        with _TEMPLATES_LOCK:
-            _TEMPLATES[key] = template
-            while len(_TEMPLATES) > _TEMPLATES_KEPT:
-                _TEMPLATES.popitem(last=False)
+        _TEMPLATES.put(key, template)
     model, processed, alone = template
     return model, scale_record(processed, float(scale)), alone
 

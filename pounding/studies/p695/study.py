@@ -201,7 +201,8 @@ def p695_study(model: str | os.PathLike, inputs: P695Inputs, output: str | os.Pa
     study resumes where it stopped.  *run_options* go to :func:`pounding.studies.engine.execution.run_study`.
     """
     from pounding.model.model import load_model
-    from pounding.results.archive import check_writable, save_run
+    from pounding.results.archive import save_run
+    from pounding.results.output_place import check_writable
     from pounding.studies.ida import build_ida_plan, ida_study
     from pounding.studies.p695.ductility import building_ductility
 
