@@ -414,3 +414,24 @@ def test_every_figure_kind_keeps_its_titles_inside_with_units(archives, plan_run
         assert name in seen, f"{name}: no figure written"
     bad = [f"{name}: {problem}" for name, problems in seen.items() for problem in dict.fromkeys(problems)]
     assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("name, duration", [("pair_wave_passage.yaml", 12.0), ("pair.yaml", 8.0)])
+def test_the_contact_displacement_curves_meet_where_the_archive_says_the_contact_is_closed(name, duration, figures,
+                                                                                         tmp_path):
+    # Each building's floors are archived relative to its own ground: under wave passage the grounds differ by
+    # ~0.1 m, so the two drawn sides must be in one frame for "left" to cross "right + gap" when the faces meet.
+    from pounding import load_model, simulate
+
+    ds = simulate(load_model(Path("models") / name), duration=duration)
+    assert int(ds.impact_count.sum()) > 0
+    plots.plot_run(ds, tmp_path)
+    axes = figures["contact_displacements.png"].axes
+    for i in range(ds.sizes["contact"]):
+        left, right = (line.get_ydata() / 1e3 for line in axes[i].get_lines()[:2])   # drawn in mm
+        penetration = ds.penetration.values[:, i]
+        closed = penetration > 0.0
+        assert closed.any()
+        # the same sums of the same archived floats: round-off of ~0.1 m values (1e-17 seen)
+        np.testing.assert_allclose((left - right)[closed], penetration[closed], rtol=0, atol=1e-12)
+        assert ((left - right)[~closed] <= 1e-12).all()   # open: left below right + gap

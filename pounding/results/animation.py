@@ -30,7 +30,7 @@ from matplotlib.animation import FFMpegWriter, PillowWriter
 
 from pounding.errors import PoundingError
 from pounding.results.describe import run_title
-from pounding.results.plots import lay_out, magnification, pyplot, side_displacement, suptitle
+from pounding.results.plots import ground_offsets, lay_out, magnification, pyplot, side_displacement, suptitle
 from pounding.results.summary import force_text
 from pounding.units import STANDARD_GRAVITY
 
@@ -295,7 +295,7 @@ class _ElevationScene:
         self.width = max(0.3 * float(ds.elevation.values.max()), 3.0)   # drawn width of a building, m
         self.floors = {b: np.flatnonzero(ds.building.values == b)[np.argsort(
             ds.level.values[ds.building.values == b])] for b in order}
-        self.ground = _ground_offsets(ds, order)
+        self.ground = ground_offsets(ds, order)
         peak = max(float(np.abs(ds.displacement.values[:, f] + self.ground[b][:, None]).max(initial=0.0))
                    for b, f in self.floors.items())
         self.factor = float(exaggerate) if exaggerate else _default_factor(ds, peak, 0.25 * self.width, self.width)
@@ -536,15 +536,6 @@ def _fit_aspect(ax) -> None:
         ax.set_ylim(middle - half, middle + half)
 
 
-def _ground_offsets(ds: xr.Dataset, order: list[str]) -> dict[str, np.ndarray]:
-    """Per building, its ground's displacement less the first building's, m (time,): zero under one ground
-    motion; with a record or a time lag per building, the difference that closes or opens the gaps."""
-    zero = np.zeros(ds.sizes["time"])
-    if "building_ground_displacement" not in ds or ds.sizes.get("ground", 0) < 2:
-        return {b: zero for b in order}
-    grounds = {str(g): ds.building_ground_displacement.values[:, k] for k, g in enumerate(ds.ground.values)}
-    first = grounds.get(order[0], zero)
-    return {b: grounds.get(b, first) - first for b in order}
 
 
 

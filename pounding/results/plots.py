@@ -43,7 +43,7 @@ from pounding.results.summary import force_text, rotating_buildings, yielding_pl
 __all__ = ["plot_run", "plot_sweep", "plot_directory", "save_figure", "lay_out", "fit_titles", "pyplot", "suptitle",
            "storey_spans", "draw_drift_profile", "finish_drift_axes", "finish_profile_panel", "hysteresis_storeys",
            "hysteresis_left_out", "LOOPS_SHOWN", "sweep_axis_is_numeric", "plan_view_instant", "shown_floors",
-           "side_displacement", "magnification"]
+           "side_displacement", "contact_side", "ground_offsets", "magnification"]
 
 def pyplot():
     """``matplotlib.pyplot`` on the non-interactive Agg backend (imported on first use: it is slow)."""
@@ -179,20 +179,49 @@ def side_displacement(ds: xr.Dataset, i: int, side: str) -> tuple[str, np.ndarra
     return f"{building} storey {level} at {at:g}", (1.0 - n2) * below + n2 * above
 
 
+def ground_offsets(ds: xr.Dataset, order: list[str]) -> dict[str, np.ndarray]:
+    """Per building of *order*, its ground's displacement less the first building's, m (time,): zero under one
+    ground motion; with a record or a time lag per building, the difference that closes or opens the gaps.
+
+    A floor's ``displacement`` is relative to its own building's ground; adding its building's offset puts
+    every building in the first one's frame, where ``left − right − gap`` is the contact's penetration.
+    """
+    zero = np.zeros(ds.sizes["time"])
+    if "building_ground_displacement" not in ds or ds.sizes.get("ground", 0) < 2:
+        return {b: zero for b in order}
+    grounds = {str(g): ds.building_ground_displacement.values[:, k] for k, g in enumerate(ds.ground.values)}
+    first = grounds.get(order[0], zero)
+    return {b: grounds.get(b, first) - first for b in order}
+
+
+def contact_side(ds: xr.Dataset, i: int, side: str, grounds: dict[str, np.ndarray]) -> tuple[str, np.ndarray]:
+    """:func:`side_displacement` of one side of contact *i* in the first building's ground frame (*grounds*:
+    :func:`ground_offsets`), m: a wall moves with the ground of the building it faces.  ``left − right − gap``
+    of the two sides is then the contact's penetration, under one ground motion or a ground per building."""
+    name, motion = side_displacement(ds, i, side)
+    building = str(ds[f"building_{side}"].values[i])
+    if building == "wall":
+        building = str(ds[f"building_{'right' if side == 'left' else 'left'}"].values[i])
+    return name, motion + grounds[building]
+
+
 def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
     n = ds.sizes["contact"]
     fig, axes = _grid(plt, n)
     t = ds.time.values
+    order = [str(b) for b in ds.building.values]
+    grounds = ground_offsets(ds, order)
+    frame = f" on {order[0]}'s ground" if any(g.any() for g in grounds.values()) else ""
     for i, ax in enumerate(axes[:n]):
-        left_name, left = side_displacement(ds, i, "left")
-        right_name, right = side_displacement(ds, i, "right")
+        left_name, left = contact_side(ds, i, "left", grounds)
+        right_name, right = contact_side(ds, i, "right", grounds)
         gap = float(ds.gap.values[i])
         ax.plot(t, 1e3 * left, lw=0.8, label=f"{left_name} (left)")
         ax.plot(t, 1e3 * (right + gap), lw=0.8, label=f"{right_name} (right) + gap")
         hits = ds.impact_time.values[ds.impact_contact.values == i]
         if hits.size:
             ax.plot(hits, 1e3 * np.interp(hits, t, left), "k|", ms=10, label="impact")
-        ax.set_ylabel("displacement (mm)")
+        ax.set_ylabel(f"displacement (mm){frame}")
         ax.set_title(f"{ds.contact.values[i]}, gap {1e3 * gap:.1f} mm", fontsize=9)
         ax.legend(fontsize=7, loc="upper right")
     axes[-1].set_xlabel("time (s)")
