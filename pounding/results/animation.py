@@ -6,7 +6,10 @@ recorded displacement times the exaggeration.  The gap between two buildings is 
 as the displacements, so the drawn floors touch exactly when the gap closes.  A model with floors in plan is
 drawn in plan: every floor's outline displaced and rotated (the roof's solid, its corners marked), the
 contact points moving with their floor; a building across a gap is drawn shifted along the face's normal so
-that its gap is exaggerated as the displacements are.
+that its gap is exaggerated as the displacements are.  With a ground motion per building (wave passage, a
+record each) every building is drawn on its own ground's displacement less the first building's, in
+elevation and in plan: floors are archived relative to their own ground, and drawn so the faces still
+touch exactly when the gap closes.
 
 Impacts flash: a frame marks each contact that carried a force since the previous frame, its marker sized
 and coloured by the largest force in that interval (the stored samples, every solver step of the
@@ -417,6 +420,9 @@ class _PlanScene:
         shift = self._shifts()
         names = [str(b) for b in ds.building.values]
         self.rest = rest + np.array([shift[b] for b in names])[:, None, :]
+        # each floor's ground less the first building's (time, floor, 2): zeros under one ground motion
+        grounds = ground_offsets(ds, list(dict.fromkeys(names)))
+        self.ground = np.stack([grounds[b] for b in names], axis=1) if names else np.zeros((ds.sizes["time"], 0, 2))
         roofs = {b: int(np.flatnonzero(ds.building.values == b)[-1]) for b in dict.fromkeys(names)}
         self.outlines = []
         for k, (b, roof) in enumerate(roofs.items()):
@@ -501,13 +507,14 @@ class _PlanScene:
 
     def draw(self, i: int) -> np.ndarray:
         ds, factor = self.ds, self.factor
-        moved = self.rest + factor * ds.corner_displacement.values[i]
+        moved = self.rest + factor * (ds.corner_displacement.values[i] + self.ground[i][:, None, :])
         for f, line in self.outlines:
             line.set_data(*np.r_[moved[f], moved[f][:1]].T)
         self.corners.set_data(*moved[self.roofs].reshape(-1, 2).T)
         floors, arm = self.points["floor"], self.points["arm"]
         theta = ds.rotation.values[i, floors]
-        motion = ds.displacement.values[i, floors] + theta[:, None] * np.column_stack([-arm[:, 1], arm[:, 0]])
+        motion = (ds.displacement.values[i, floors] + self.ground[i, floors]
+                  + theta[:, None] * np.column_stack([-arm[:, 1], arm[:, 0]]))
         at = self.points["place"] + factor * motion
         self.point_marks.set_data(at[:, 0], at[:, 1])
         return at

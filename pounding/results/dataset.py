@@ -1279,6 +1279,36 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
                         supports=supports).to_dataset()
 
 
+def _plan_building_grounds(model: Model, supports, ground_state: Deferred) -> tuple[dict[str, tuple], dict]:
+    """The ground under each building of a model in plan, as a planar archive has it (variables, coordinates):
+    its acceleration, velocity and displacement along x and y at the output times (time, ground, direction) and
+    its wave-passage lag; nothing without support motions.  A floor's displacement is relative to its own
+    building's ground, so these are what put two buildings in one frame (:func:`pounding.results.plots.ground_offsets`)."""
+    if supports is None:
+        return {}, {}
+    x, y = list(supports.building_row), list(supports.building_row_y)
+
+    def along_xy(k: int) -> Deferred:
+        def values() -> np.ndarray:
+            rows = ground_state()[k]
+            return np.stack([rows[:, x], rows[:, y] if y else np.zeros((rows.shape[0], len(x)))], axis=-1)
+        return Deferred(values)
+
+    dims = ("time", "ground", "direction")
+    data = {"building_ground_acceleration": _var(dims, along_xy(0), "m/s²", "ground acceleration under the building"),
+            "building_ground_velocity": _var(dims, along_xy(1), "m/s",
+                                             "ground velocity under the building (exact integral from rest)"),
+            "building_ground_displacement": _var(dims, along_xy(2), "m",
+                                                 "ground displacement under the building (exact integral from rest)"),
+            "ground_lag": _var(("ground",), np.array(supports.lag, dtype=float), "s",
+                               "wave-passage time lag applied (rounded to the record step)"),
+            "ground_lag_requested": _var(("ground",), np.array(supports.lag_requested, dtype=float), "s",
+                                         "wave-passage time lag (position - first position) / apparent velocity")}
+    coords = {"ground": ("ground", np.array([b.name for b in model.buildings], dtype=object),
+                         {"long_name": "building standing on the ground"})}
+    return data, coords
+
+
 def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolution, *, end_time: float,
                  wall_time: float, supports=None, archive: bool = True) -> RunArrays:
     """:func:`plane_dataset`'s variables, coordinates and attributes as plain arrays; *archive* as in
@@ -1351,7 +1381,9 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
     ground = _ground_xy(supports, ground_state)
     if ground is not None:
         data["ground_acceleration"] = _var(("time", "direction"), ground, "m/s²", "ground acceleration along x and y")
-    coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}),
+    grounds, ground_coords = _plan_building_grounds(model, supports, ground_state)
+    data.update(grounds)
+    coords = {"time": ("time", raw.time, {"units": "s", "long_name": "time"}), **ground_coords,
               "direction": ("direction", np.array(["x", "y"], dtype=object), {"long_name": "plan direction"}),
               **_floor_coords(model), **_plan_floor_labels(model), **_plane_labels(model), **_plane_coords(model),
               **contact_coords(model), **_point_labels(model), **_face_labels(model, assembly), **_link_coords(model)}

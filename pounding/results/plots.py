@@ -180,13 +180,15 @@ def side_displacement(ds: xr.Dataset, i: int, side: str) -> tuple[str, np.ndarra
 
 
 def ground_offsets(ds: xr.Dataset, order: list[str]) -> dict[str, np.ndarray]:
-    """Per building of *order*, its ground's displacement less the first building's, m (time,): zero under one
-    ground motion; with a record or a time lag per building, the difference that closes or opens the gaps.
+    """Per building of *order*, its ground's displacement less the first building's, m: (time,) in elevation,
+    (time, direction) in plan; zeros under one ground motion; with a record or a time lag per building, the
+    difference that closes or opens the gaps.
 
     A floor's ``displacement`` is relative to its own building's ground; adding its building's offset puts
     every building in the first one's frame, where ``left − right − gap`` is the contact's penetration.
     """
-    zero = np.zeros(ds.sizes["time"])
+    in_plan = "direction" in ds.displacement.dims
+    zero = np.zeros((ds.sizes["time"], 2) if in_plan else ds.sizes["time"])
     if "building_ground_displacement" not in ds or ds.sizes.get("ground", 0) < 2:
         return {b: zero for b in order}
     grounds = {str(g): ds.building_ground_displacement.values[:, k] for k, g in enumerate(ds.ground.values)}
@@ -196,20 +198,24 @@ def ground_offsets(ds: xr.Dataset, order: list[str]) -> dict[str, np.ndarray]:
 
 def contact_side(ds: xr.Dataset, i: int, side: str, grounds: dict[str, np.ndarray]) -> tuple[str, np.ndarray]:
     """:func:`side_displacement` of one side of contact *i* in the first building's ground frame (*grounds*:
-    :func:`ground_offsets`), m: a wall moves with the ground of the building it faces.  ``left − right − gap``
-    of the two sides is then the contact's penetration, under one ground motion or a ground per building."""
+    :func:`ground_offsets`), m: a wall moves with the ground of the building it faces, a point in plan with its
+    ground along the face's normal.  ``left − right − gap`` of the two sides is then the contact's
+    penetration, under one ground motion or a ground per building."""
     name, motion = side_displacement(ds, i, side)
     building = str(ds[f"building_{side}"].values[i])
     if building == "wall":
         building = str(ds[f"building_{'right' if side == 'left' else 'left'}"].values[i])
-    return name, motion + grounds[building]
+    offset = grounds[building]
+    if offset.ndim == 2:
+        offset = offset[:, 0 if str(ds.point_normal.values[i]) == "x" else 1]
+    return name, motion + offset
 
 
 def _contact_displacements(plt, ds: xr.Dataset, path: Path) -> None:
     n = ds.sizes["contact"]
     fig, axes = _grid(plt, n)
     t = ds.time.values
-    order = [str(b) for b in ds.building.values]
+    order = list(dict.fromkeys(str(b) for b in ds.building.values))
     grounds = ground_offsets(ds, order)
     frame = f" on {order[0]}'s ground" if any(g.any() for g in grounds.values()) else ""
     for i, ax in enumerate(axes[:n]):
