@@ -16,8 +16,8 @@ from pounding.errors import PoundingError
 from pounding.records.catalogue import is_catalogued
 
 __all__ = ["study_parts", "with_base_mats", "record_list", "record_values", "pair_values", "study_document", "study_sweep",
-           "check_duration", "finite_or_none", "records_text", "scale_spec_text", "sweep_heading", "record_sweep",
-           "floor_states", "dof_peaks", "ground_pga"]
+           "check_duration", "finite_or_none", "records_text", "scale_spec_text", "sweep_heading", "base_model_text",
+           "record_sweep", "floor_states", "dof_peaks", "ground_pga"]
 
 
 def record_list(text: str | list[str] | None, *, pairs: bool = False) -> list[str] | None:
@@ -186,6 +186,25 @@ def sweep_heading(sweep) -> str:
         swept = swept or axis.kind == "scale" or "scale" in str(axis.key).split(".")[-1:]
     intensity = "scale swept" if swept else scale_spec_text(ground.get("scale"))
     return f"model '{sweep.model_name}' under {records_text(records)}, {intensity}"
+
+
+def base_model_text(model: Any) -> str:
+    """The ``base_model`` attribute of a study's archive: the model the study ran, as YAML text.
+
+    A study's archive keeps it so that the model can be read again, and the study run again, after its file
+    has changed or is gone (``pounding report`` rebuilds it with :func:`pounding.model.model.model_from_text`).
+
+    Parameters
+    ----------
+    model : pounding.model.model.Model or dict
+        A loaded model: its plain document with the record files of its ground motion made absolute
+        against the model file's folder (:func:`pounding.studies.sweep.spec.model_document`); or a
+        sweep's ``base_document``, already so and with the study's fixed settings (``set``) written in.
+    """
+    from pounding.model.document import dump_document
+    from pounding.studies.sweep.spec import model_document
+
+    return dump_document(model if isinstance(model, dict) else model_document(model))
 
 
 def study_parts(scenarios: list, results: dict[str, dict[str, Any]], study: str) -> list[dict[str, Any]]:

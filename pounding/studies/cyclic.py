@@ -206,9 +206,11 @@ def hysteresis_test(model, storey: str, protocol: str, amplitude: float | None =
     -------
     xarray.Dataset
         ``storey_drift`` (m) and ``storey_shear`` (N) on the ``step`` dimension; attributes
-        ``kind = "hysteresis"``, the storey, its model, stiffness and height, the protocol.
+        ``kind = "hysteresis"``, the storey, its model (``model_file``, and the model itself as YAML text:
+        ``base_model``), stiffness and height, the protocol.
     """
     from pounding.model.model import load_model
+    from pounding.studies.common import base_model_text
 
     loaded = load_model(model) if isinstance(model, (str, Path)) else model
     building, level = _storey(loaded, storey)
@@ -248,7 +250,8 @@ def hysteresis_test(model, storey: str, protocol: str, amplitude: float | None =
                "storey": storey, "hysteresis": "elastic" if law is None else law.describe(),
                "stiffness": k, "height": h, "protocol": str(protocol),
                "amplitude_drift_ratio": float("nan") if amplitude is None else float(amplitude),
-               "model_file": str(model) if isinstance(model, (str, Path)) else ""})
+               "model_file": str(model) if isinstance(model, (str, Path)) else "",
+               "base_model": base_model_text(loaded)})
 
 
 def _storey(model, storey: str):

@@ -200,9 +200,11 @@ def code_gap_study(model_path: str | os.PathLike, code: str, spectrum_options: d
         analysis), ``intensities`` (factor, period range, clause, per record ``status``),
         ``contacts`` (per contact: ``gap``, the sides' design displacements, ``separation``, and per
         intensity ``simulated``: mean, max, median, p84, exceeding, fraction, per record ``needs``; m),
-        ``level_pairs`` (:func:`level_pairs`), ``answers`` (:func:`plain_answers`), ``warnings``.
+        ``level_pairs`` (:func:`level_pairs`), ``answers`` (:func:`plain_answers`), ``warnings``, and
+        ``base_model``: the model checked, as YAML text (:func:`pounding.studies.common.base_model_text`).
     """
     from pounding.model.model import load_model
+    from pounding.studies.common import base_model_text
 
     model = load_model(model_path)
     source = code_check_source(model, model_path, code, spectrum_options, records, duration)
@@ -214,7 +216,7 @@ def code_gap_study(model_path: str | os.PathLike, code: str, spectrum_options: d
     result = {"code": code, "model": str(model_path), "rule": source["found"]["rule"],
               "statistic": source["found"]["statistic"], "records": source["records"], "intensities": intensities,
               "contacts": source["rows"], "sides": source["sides"], "buildings": source["buildings"],
-              "options": dict(spectrum_options), "duration": duration,
+              "options": dict(spectrum_options), "duration": duration, "base_model": base_model_text(model),
               "warnings": suite_warnings(model, source["records"], source["read"], factors)}
     result["level_pairs"] = level_pairs(result)
     result["answers"] = plain_answers(result)
@@ -463,10 +465,11 @@ def _json_simulated(entry: dict[str, Any], records: list[str]) -> dict[str, Any]
 
 def code_gap_summary(result: dict[str, Any]) -> dict[str, Any]:
     """The code check as one JSON-ready document (metres); a value that is not bounded (a collapsed record) is
-    the words :data:`pounding.studies.gap.NOT_BOUNDED`, one that is not determined (no record ran) null."""
+    the words :data:`pounding.studies.gap.NOT_BOUNDED`, one that is not determined (no record ran) null.  The
+    model's YAML text (``base_model``) is left to the archive."""
     first, second = result.get("sides", ("left", "right"))
     records = [str(r) for r in result.get("records", [])]
-    out = dict(result)
+    out = {k: v for k, v in result.items() if k != "base_model"}
     out["contacts"] = [{**{k: v for k, v in row.items() if k not in ("separation", "simulated")},
                         "simulated": {name: _json_simulated(entry, records)
                                       for name, entry in row.get("simulated", {}).items()},
@@ -508,6 +511,7 @@ def _archive_attrs(result: dict[str, Any], command: str) -> dict[str, Any]:
     return {"title": f"pounding gap --code {result['code']} of {os.path.basename(model)}",
             "source": f"pounding {__version__}", "kind": CODE_GAP_KIND, "code": result["code"],
             "rule": result["rule"], "statistic": result["statistic"], "model_path": model,
+            "base_model": result.get("base_model", ""),
             "model_name": os.path.splitext(os.path.basename(model))[0],
             "spectrum_options": json.dumps(result.get("options", {})), "records": json.dumps(result["records"]),
             "duration": "" if result.get("duration") is None else float(result["duration"]),

@@ -690,7 +690,7 @@ def gap_attrs(sweep, title: str, status: np.ndarray, *, ran: int, elapsed: float
     Parameters
     ----------
     sweep : Sweep
-        The study's sweep (its heading, model name and path).
+        The study's sweep (its heading, model name, path and base document: ``base_model``).
     title : str
         The title's opening, followed by ``of`` and the sweep's heading.
     status : ndarray of str
@@ -701,11 +701,11 @@ def gap_attrs(sweep, title: str, status: np.ndarray, *, ran: int, elapsed: float
         Wall time of this call, s.
     """
     from pounding import __version__
-    from pounding.studies.common import sweep_heading
+    from pounding.studies.common import base_model_text, sweep_heading
 
     attrs: dict[str, Any] = {"title": f"{title} of {sweep_heading(sweep)}", "model_name": sweep.model_name,
                              "source": f"pounding {__version__}", "study": "gap"}
-    attrs.update({"model_path": sweep.model_path or "",
+    attrs.update({"model_path": sweep.model_path or "", "base_model": base_model_text(sweep.base_document),
                   "rules": "; ".join(f"{r.key}: {r.title} ({r.reference})" for r in RULES.values()),
                   "n_records": len(status), "n_collapsed": int((status == "collapsed").sum()),
                   "n_failed": int((status == "error").sum()), "n_run": ran, "elapsed_time": elapsed,

@@ -164,8 +164,10 @@ def fema_p695_quantities(building, curve: dict, *, period: float | None = None,
 def pushover(model, *, pattern: str = "first-mode", building: str | None = None, steps: int = 400,
              period: float | None = None, design_cs: float | None = None) -> xr.Dataset:
     """The pushover of every building of *model* (a path or a loaded model), or of *building*: a dataset
-    with ``kind = "pushover"`` (capacity curves on ``step``, padded with NaN; FEMA P695 quantities per building)."""
+    with ``kind = "pushover"`` (capacity curves on ``step``, padded with NaN; FEMA P695 quantities per building;
+    the model pushed as YAML text in ``base_model``)."""
     from pounding.model.model import load_model
+    from pounding.studies.common import base_model_text
 
     if steps < MIN_STEPS:
         raise PoundingError(f"--steps must be at least {MIN_STEPS} (got {steps}): fewer equal steps to the drift "
@@ -240,7 +242,8 @@ def pushover(model, *, pattern: str = "first-mode", building: str | None = None,
                              "history": f"pounding pushover {model if isinstance(model, (str, Path)) else '(a loaded model)'} "
                                         f"--pattern {pattern}" + (f" --building {building}" if building else ""),
                              "pattern": pattern, "steps": steps,
-                             "model_file": str(model) if isinstance(model, (str, Path)) else ""})
+                             "model_file": str(model) if isinstance(model, (str, Path)) else "",
+                             "base_model": base_model_text(loaded)})
 
 
 def pushover_table(ds: xr.Dataset) -> str:

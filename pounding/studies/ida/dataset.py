@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from pounding.errors import PoundingError
-from pounding.studies.common import records_text
+from pounding.studies.common import base_model_text, records_text
 from pounding.studies.ida.schedule import SA_DAMPING, IdaPlan, limit_label
 from pounding.studies.ida.runs import building_drifts, collapse_building_of, run_collapses, run_outcome
 from pounding.units import STANDARD_GRAVITY
@@ -205,6 +205,7 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "history": f"{time.strftime('%Y-%m-%d %H:%M:%S')} pounding ida ({'stripes' if stripes else 'hunt-and-fill'}, "
                    f"{nr} records, {len(entries)} runs)",
         "model_path": plan.model_path,
+        "base_model": base_model_text(plan.sweep.base_document),
         "im": plan.im.name,
         "im_building": plan.im.building,
         "im_period": plan.im.period,

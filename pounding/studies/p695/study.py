@@ -260,6 +260,7 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
     import xarray as xr
 
     from pounding import __version__
+    from pounding.studies.common import base_model_text
 
     names = list(rows)
     variants = rows[names[0]]["variants"]
@@ -348,6 +349,7 @@ def _assemble(base, inputs: P695Inputs, periods, heights, rows, idas, model):
         "source": f"pounding {__version__}", "Conventions": "CF-1.8",
         "history": f"{time.strftime('%Y-%m-%d %H:%M:%S')} pounding p695 {os.fspath(model)}",
         "model_name": base.name, "model_path": os.path.abspath(os.fspath(model)),
+        "base_model": base_model_text(base),
         "sdc": spectrum.sdc, "spectrum_source": spectrum.source, "s_ms": spectrum.s_ms * g,
         "s_m1": spectrum.s_m1 * g, "quality": str(inputs.quality), "records_spec": inputs.records,
         "pattern": inputs.pattern, "group": ",".join(inputs.group),

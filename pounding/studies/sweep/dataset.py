@@ -7,8 +7,7 @@ from datetime import datetime, timezone
 from typing import Any, Iterable
 
 from pounding import __version__
-from pounding.model.document import dump_document
-from pounding.studies.common import sweep_heading
+from pounding.studies.common import base_model_text, sweep_heading
 from pounding.studies.sweep.spec import Axis, Sweep
 
 __all__ = ["build_dataset", "sweep_attrs"]
@@ -277,7 +276,7 @@ def sweep_attrs(sweep, status, *, ran: int, elapsed: float, title: str) -> dict[
         "sweep_name": sweep.name,
         "sweep_file": sweep.label,
         "sweep_text": sweep.text,
-        "base_model": dump_document(sweep.base_document),
+        "base_model": base_model_text(sweep.base_document),
         "base_model_file": sweep.model_path or "",
         "axes": json.dumps({a.name: a.key for a in sweep.axes}),
         "n_scenarios": int(sweep.size),
