@@ -232,6 +232,19 @@ def _recoverable(model: int, table: np.ndarray, row: int, stiffness: float, drif
     return float(recoverable_energy(model, table, row, stiffness, drift, state))
 
 
+def _impact_law_values(gaps, raw: RawSolution) -> tuple[np.ndarray, np.ndarray]:
+    """Per impact ``(ξ, restitution)``: the damping constant the law fixed at the onset (N s m⁻²·⁵; NaN for a
+    law without one) and the separation over the approach velocity (NaN at zero approach velocity: floors
+    touching at rest, gap 0), for the contacts (planar) or contact points (in plan) *gaps*."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        restitution = np.where(raw.impact_velocity > 0.0, raw.impact_separation_velocity / raw.impact_velocity,
+                               np.nan)
+    has_xi = np.array([type(g.law).onset_xi for g in gaps], dtype=bool)  # the law's class says (ContactLaw)
+    impact_xi = np.where(has_xi[raw.impact_contact] if len(gaps) else np.zeros(0, bool), raw.impact_constant,
+                         np.nan)
+    return impact_xi, restitution
+
+
 def _penetration(u: np.ndarray, system: System, ground_displacement: np.ndarray) -> np.ndarray:
     """(nt, nc) penetration ``Σ_k w_k·u[floor_k] + u_g,L − u_g,R − gap`` of every contact, by the solver's
     kinematics (:func:`pounding.solver.kinematics.penetration`).
@@ -633,12 +646,7 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
     building_names = [b.name for b in model.buildings]
     gaps = model.gaps
     impact_count = peaks["impact_count"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        # No ratio for floors that close at zero approach velocity (touching at rest, gap 0): NaN, not inf.
-        restitution = np.where(raw.impact_velocity > 0.0, raw.impact_separation_velocity / raw.impact_velocity,
-                               np.nan)
-    has_xi = np.array([type(g.law).onset_xi for g in gaps], dtype=bool)  # the law's class says (ContactLaw)
-    impact_xi = np.where(has_xi[raw.impact_contact] if ng else np.zeros(0, bool), raw.impact_constant, np.nan)
+    impact_xi, restitution = _impact_law_values(gaps, raw)
 
     coords = {
         "time": ("time", raw.time, {"units": "s", "long_name": "time", "standard_name": "time"}),
@@ -1279,6 +1287,23 @@ def plane_dataset(model: Model, record: Record, assembly: Assembly, raw: RawSolu
                         supports=supports).to_dataset()
 
 
+def _plan_absolute_acceleration(system: System, raw: RawSolution, supports, ground_state: Deferred) -> dict:
+    """``absolute_acceleration`` (time, floor, direction) of a model in plan, m/s²: each floor centre's relative
+    acceleration plus its building's ground acceleration along x and y (as a planar archive's ü + a_g); nothing
+    without support motions."""
+    if supports is None:
+        return {}
+    n = system.n_floors
+
+    def values() -> np.ndarray:
+        ground = np.take(ground_state()[0], system.floor_ground[:n], axis=1)
+        return (raw.acceleration[:, :n] + ground).reshape(raw.time.size, -1, DOF_PER_FLOOR)[:, :, :2]
+
+    return {"absolute_acceleration": _var(("time", "floor", "direction"), Deferred(values), "m/s²",
+                                          "absolute acceleration of the floor's centre of mass (over the "
+                                          "building's own ground)")}
+
+
 def _plan_building_grounds(model: Model, supports, ground_state: Deferred) -> tuple[dict[str, tuple], dict]:
     """The ground under each building of a model in plan, as a planar archive has it (variables, coordinates):
     its acceleration, velocity and displacement along x and y at the output times (time, ground, direction) and
@@ -1330,12 +1355,14 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
     magnitude = np.hypot(corner[..., 0], corner[..., 1])
     points = np.array([g.point for g in model.gaps], dtype=float).reshape(npt, 2)
     location = points[raw.impact_contact] if raw.impact_contact.size else np.zeros((0, 2))
+    impact_xi, restitution = _impact_law_values(model.gaps[:npt], raw)
     data = {
         "displacement": _var(("time", "floor", "direction"), u[:, :, :2], "m",
                              "displacement of the floor's centre of mass relative to the ground"),
         "rotation": _var(("time", "floor"), u[:, :, 2], "rad", "rotation of the floor, counter-clockwise"),
         "velocity": _var(("time", "floor", "direction"), v[:, :, :2], "m/s",
                          "velocity of the floor's centre of mass relative to the ground"),
+        **_plan_absolute_acceleration(system, raw, supports, ground_state),
         "rotation_rate": _var(("time", "floor"), v[:, :, 2], "rad/s", "rotation rate of the floor"),
         "peak_displacement": _var(("floor", "direction"), peak_u[:, :2], "m",
                                   "peak |displacement| of the centre of mass (full resolution)"),
@@ -1370,6 +1397,11 @@ def plane_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolut
         "impact_dissipated_energy": _var(("impact",), raw.impact_work, "J",
                                          "energy dissipated by the contact during the impact "
                                          "(work of the contact force; partial if still in contact at the end)"),
+        "impact_xi": _var(("impact",), impact_xi, "N s m-2.5",
+                          "Hertz-damp damping constant fixed at the onset (nan for other laws)"),
+        "impact_restitution": _var(("impact",), restitution, "1",
+                                   "separation velocity / approach velocity at the point (nan at zero approach "
+                                   "velocity)"),
         **_trace_variables(raw),
         **_plane_yielding(assembly, raw),
     }
