@@ -115,3 +115,13 @@ def test_floor_accelerations_grounds_and_impacts_agree(twins):
         np.testing.assert_allclose(xi.sum(axis=1), row.impact_xi.values[base], rtol=AGREE_FORCE, equal_nan=True)
         np.testing.assert_allclose(restitution[:, 0], row.impact_restitution.values[base], rtol=AGREE_FORCE,
                                    equal_nan=True)
+
+
+def test_the_archives_describe_model_and_solver_alike(twins):
+    """One description of a run's model and integration (attributes), whichever kind of model ran."""
+    _, row, twin = twins
+    same = ("solver", "solver_rtol", "solver_atol", "solver_atol_velocity", "solver_output_dt",
+            "solver_linear_phases", "multi_support", "p_delta", "xi_formulas", "stop_drift_ratio")
+    assert {k: row.attrs[k] for k in same} == {k: twin.attrs[k] for k in same}
+    for key in ("solver_steps", "solver_rejected_steps", "solver_exact_steps", "periods", "model_yaml"):
+        assert key in row.attrs and key in twin.attrs

@@ -798,12 +798,8 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "source": f"pounding {__version__}",
         "history": f"{now} simulated with pounding {__version__}",
         "references": REFERENCES,
-        "model_name": model.name,
-        "model_path": str(model.path or ""),
-        "model_yaml": model.source,
+        **_model_attrs(model),
         "run_spec": json.dumps(run_spec(model, record, end_time, ground)) if archive else "",
-        "multi_support": ("per-building records" if model.has_building_records else
-                          "wave passage" if model.ground_motion.wave_passage is not None else ""),
         "record_name": record.name,
         "record_source": record.source,
         "record_scale": float(record.scale),
@@ -815,15 +811,7 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "record_processing": str(record.metadata.get("processing", "[]")),
         "record_sha256": str(record.metadata.get("sha256", "")),
         "duration": float(end_time),
-        "solver": "Dormand-Prince 5(4), event-located contacts (pounding.solver)",
-        "solver_rtol": float(model.solver.rtol),
-        "solver_atol": float(model.solver.atol),
-        "solver_atol_velocity": float(model.solver.atol_velocity),
-        "solver_output_dt": float(model.solver.output_dt),
-        "solver_linear_phases": str(model.solver.linear_phases),
-        "solver_steps": int(raw.n_steps),
-        "solver_exact_steps": int(raw.exact_steps),
-        "solver_rejected_steps": int(raw.n_rejected),
+        **_solver_attrs(model, raw),
         "wall_time": float(wall_time),
         "energy_closure_error": closure,
         "status": peaks["status"],
@@ -831,12 +819,8 @@ def run_arrays(model: Model, record: Record, assembly: Assembly, raw: RawSolutio
         "collapse_storey": peaks["collapse_storey"],
         "collapse_building": peaks["collapse_building"],
         "collapse_cause": peaks["collapse_cause"],
-        "stop_drift_ratio": float(model.solver.stop_drift_ratio or 0.0),
         "hysteresis": json.dumps({b.name: [None if law is None else law.describe() for law in b.hysteresis]
                                   for b in model.buildings if b.is_inelastic}),
-        "p_delta": ", ".join(b.name for b in model.buildings if b.p_delta),
-        "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in gaps} - {""})),
-        "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
     }
     if "foundation" in ds.coords:   # per founded building: periods, damping, springs (from soil: at which ω)
         ds.attrs["foundations"] = json.dumps({b.name: {
@@ -887,6 +871,31 @@ def _grounds(model: Model, record: Record, system: System, raw: RawSolution, sup
             "sha256": [str(r.metadata.get("sha256", "")) for r in records],
             "lag": np.array(lags, dtype=float), "lag_requested": np.array(requested, dtype=float),
             "row": np.asarray(row, dtype=np.int64), "acceleration": acc, "motion": motion}
+
+
+def _model_attrs(model: Model) -> dict[str, Any]:
+    """A run archive's attributes that describe its model, the same for planar models and models in plan: its
+    name, file and text, how its ground moves, P-Delta, the ξ formulas of its contacts, each building's
+    periods (s) and the drift ratio that stops the run (0: none)."""
+    return {"model_name": model.name, "model_path": str(model.path or ""), "model_yaml": model.source,
+            "multi_support": ("per-building records" if model.has_building_records else
+                              "wave passage" if model.ground_motion.wave_passage is not None else ""),
+            "p_delta": ", ".join(b.name for b in model.buildings if b.p_delta),
+            "xi_formulas": ", ".join(sorted({getattr(g.law, "xi", "") for g in model.gaps} - {""})),
+            "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
+            "stop_drift_ratio": float(model.solver.stop_drift_ratio or 0.0)}
+
+
+def _solver_attrs(model: Model, raw: RawSolution) -> dict[str, Any]:
+    """A run archive's attributes that describe its integration, the same for both kinds of model: the
+    method, the tolerances (``solver_atol`` m, ``solver_atol_velocity`` m/s), the output step (s), how linear
+    phases ran, and the counts of accepted, exact and rejected steps."""
+    solver = model.solver
+    return {"solver": "Dormand-Prince 5(4), event-located contacts (pounding.solver)",
+            "solver_rtol": float(solver.rtol), "solver_atol": float(solver.atol),
+            "solver_atol_velocity": float(solver.atol_velocity), "solver_output_dt": float(solver.output_dt),
+            "solver_linear_phases": str(solver.linear_phases), "solver_steps": int(raw.n_steps),
+            "solver_exact_steps": int(raw.exact_steps), "solver_rejected_steps": int(raw.n_rejected)}
 
 
 def run_spec(model: Model, record: Record, end_time: float, ground: dict | None = None) -> dict:
@@ -1213,8 +1222,7 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
     attrs = {"Conventions": "CF-1.10", "title": f"pounding plan run: {model.name}", "model": model.name,
              "kind": "plan_run", "source": f"pounding {__version__}", "references": REFERENCES,
              "history": f"{now.strftime('%Y-%m-%dT%H:%M:%SZ')} simulated with pounding {__version__}",
-             "created": now.isoformat(), "model_name": model.name, "model_path": str(model.path or ""),
-             "model_yaml": model.source, "run_spec": json.dumps(spec),
+             "created": now.isoformat(), **_model_attrs(model), "run_spec": json.dumps(spec),
              "record_name": str(model.ground_motion.record or record.name), "record_source": record.source,
              "record_scale": float(meta.get("scale_factor", record.scale)),
              "record_scale_method": str(meta.get("scale_method", "factor")),
@@ -1222,20 +1230,13 @@ def _plan_run_attrs(model: Model, record: Record, raw: RawSolution, supports, *,
              "record_metadata": json.dumps(meta, default=str), "record_step": float(record.time_step),
              "angle": float(supports.angle if supports is not None and supports.angle is not None else 0.0),
              "end_time": float(end_time), "duration": float(end_time), "wall_time": float(wall_time),
-             "solver_rtol": float(model.solver.rtol), "solver_atol": float(model.solver.atol),
-             "solver_output_dt": float(model.solver.output_dt), "solver_steps": int(raw.n_steps),
-             "solver_linear_phases": str(model.solver.linear_phases), "solver_exact_steps": int(raw.exact_steps),
-             "solver_rejected_steps": int(raw.n_rejected),
-             "periods": json.dumps({b.name: [float(x) for x in b.periods] for b in model.buildings}),
+             **_solver_attrs(model, raw),
              "hysteresis": json.dumps({b.name: [None if p.hysteresis is None else p.hysteresis.describe()
-                                                for _, _, p in b.planes()] for b in model.buildings if b.is_inelastic}),
-             "p_delta": ", ".join(b.name for b in model.buildings if b.p_delta)}
+                                                for _, _, p in b.planes()] for b in model.buildings if b.is_inelastic})}
     attrs.update({k: v for k, v in status.items() if v != "" and not (isinstance(v, float) and np.isnan(v))})
     if model.contacts_held_open:
         attrs["contacts"] = (f"held open: every gap {model.gaps[0].gap:g} m, so no contact closes "
                              "(the run without pounding)")
-    attrs["multi_support"] = ("per-building records" if model.has_building_records else
-                              "wave passage" if model.ground_motion.wave_passage is not None else "")
     if not archive:
         del attrs["run_spec"]
     return attrs
