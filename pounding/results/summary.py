@@ -72,9 +72,9 @@ def yielding_planes(ds: xr.Dataset) -> np.ndarray:
     return departure > ROUND_OFF * np.abs(elastic).max(axis=0, initial=0.0)
 
 
-def _ground_lines(ds: xr.Dataset) -> list[str]:
-    """The record's PGA as recorded and as run (one line per building on its own record), or with two
-    components the peak ground acceleration along x and y as run; then each building's ground."""
+def _record_lines(ds: xr.Dataset) -> list[str]:
+    """The record's PGA as recorded and as run, per building on its own record; with two components (floors
+    in plan) the peak ground acceleration along x and y as run."""
     if "direction" in ds.ground_acceleration.dims:
         peak = np.abs(ds.ground_acceleration.values).max(axis=0, initial=0.0)
         along = ", ".join(f"{a / STANDARD_GRAVITY:.3g} g ({a:.3g} m/s2) along {d}"
@@ -90,19 +90,27 @@ def _ground_lines(ds: xr.Dataset) -> list[str]:
                 f"{scaled / STANDARD_GRAVITY:.3g} g ({scaled:.3g} m/s2) as run (x{factor:.4g})")
 
     if "ground_pga" in ds.attrs:   # each building on its own record: one line each
-        lines = [line(f"record PGA under {name} ({g['record']})", g["pga_recorded"], g["pga"], g["scale"])
-                 for name, g in json.loads(ds.attrs["ground_pga"]).items()]
-    else:
-        from pounding.results.dataset import record_pga
+        return [line(f"record PGA under {name} ({g['record']})", g["pga_recorded"], g["pga"], g["scale"])
+                for name, g in json.loads(ds.attrs["ground_pga"]).items()]
+    from pounding.results.dataset import record_pga
 
-        own, scaled = record_pga(ds)
-        lines = [line("record PGA", own, scaled, ds.attrs["record_scale"])]
-    if ds.attrs.get("multi_support") and "ground" in ds.dims:
-        lines.append(f"ground under each building ({ds.attrs['multi_support']}):")
-        for name in ds.ground.values:
-            g = ds.sel(ground=name)
-            lines.append(f"  {name}: {g.ground_record.item()} x{float(g.ground_scale):g}, lag {float(g.ground_lag):.3g} s, "
-                         f"peak ground displacement {float(np.abs(g.building_ground_displacement).max()):.3g} m")
+    own, scaled = record_pga(ds)
+    return [line("record PGA", own, scaled, ds.attrs["record_scale"])]
+
+
+def _grounds_lines(ds: xr.Dataset) -> list[str]:
+    """With a ground per building (wave passage, a record each): each building's record, lag and peak ground
+    displacement (in plan, of its magnitude over x and y), m."""
+    if not (ds.attrs.get("multi_support") and "ground" in ds.dims and "building_ground_displacement" in ds):
+        return []
+    lines = [f"ground under each building ({ds.attrs['multi_support']}):"]
+    for name in ds.ground.values:
+        g = ds.sel(ground=name)
+        displacement = g.building_ground_displacement.values
+        peak = np.hypot(displacement[:, 0], displacement[:, 1]) if displacement.ndim == 2 else np.abs(displacement)
+        record = f"{g.ground_record.item()} x{float(g.ground_scale):g}, " if "ground_record" in ds else ""
+        lines.append(f"  {name}: {record}lag {float(g.ground_lag):.3g} s, peak ground displacement "
+                     f"{float(peak.max(initial=0.0)):.3g} m")
     return lines
 
 
@@ -251,7 +259,7 @@ def run_summary(ds: xr.Dataset) -> str:
     event = record_event(ds)
     lines = [f"model '{ds.attrs['model_name']}' under {ds.attrs['record_name']} x{ds.attrs['record_scale']:g}"
              f"{f' ({event})' if event else ''}, {ds.attrs['duration']:.2f} s"]
-    lines += _ground_lines(ds)
+    lines += _record_lines(ds) + _grounds_lines(ds)
     if ds.attrs.get("contacts"):
         lines.append(f"contacts {ds.attrs['contacts']}")
     periods = json.loads(ds.attrs["periods"])
