@@ -10,6 +10,8 @@ peak drifts agree within 1e-6.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -181,3 +183,68 @@ def test_a_branch_decided_at_the_rise_from_the_residual_floor_is_the_rising_line
     row = np.zeros(6)
     imk.set_row(st, row, at, at)
     assert row[imk.P_SLOPE] == (1.5e6 if rising else 0.0)
+
+
+@pytest.mark.parametrize("relative", [k * 1e-15 for k in range(-20, 21, 2)] + [-1e-6, 1e-6])
+def test_a_reloading_line_through_the_rise_from_the_residual_floor_stops_there(relative):
+    """IMKBilin places the hardening line through the point where the reloading line reaches F_r, so the
+    reloading line, the floor and the hardening line meet in one point, to round-off.  The reloading
+    line's limit is that point whichever side of F_r round-off puts the hardening line (a 1e-14 shift of
+    the record once rejected both candidates: the storey reloaded with no limit past its strength, to the
+    ultimate drift and a collapse the reference run does not have); beyond round-off (1e-6) the hardening
+    line's own intersection (above F_r there) or the floor's (below)."""
+    from pounding.solver import imk
+
+    st = _on_the_backbone_state()
+    u0, fres, kp, fcap, kun = -0.2, 1.2e5, 1.5e6, 4.6e5, 2.0e7
+    floor = u0 + fres / kun   # where the reloading line from (u0, 0) reaches F_r
+    st[imk.ONBB], st[imk.YIELDED], st[imk.RESID], st[imk.KUN] = 0.0, 1.0, 1.0, kun
+    st[imk.UREF], st[imk.FREF] = u0, 0.0
+    # the hardening line at the floor point: F_r (1 + relative)
+    st[imk.UCAP] = floor - (fres * (1.0 + relative) - fcap) / kp
+    st[imk.URES] = st[imk.UCAP] + (fres - fcap) / st[imk.KPC]
+    row = np.zeros(6)
+    imk.set_row(st, row, u0, u0)
+    # the hardening line's own crossing of the reloading line, (f_cap − k_p u_cap + k_un u0)/(k_un − k_p)
+    crossing = (fcap - kp * st[imk.UCAP] + kun * u0) / (kun - kp)
+    expected = crossing if relative > 0 else floor   # above F_r at the floor point: the hardening line is the backbone there
+    # the two candidates differ by round-off at the triple point (1e-15 m seen); 1e-12 m is far below any drift
+    assert row[imk.P_UPPER] == pytest.approx(expected, abs=1e-12), (row[imk.P_UPPER], expected)
+
+
+def test_the_reloading_limit_at_the_triple_point_a_record_shift_produced():
+    """The state a 1e-14 relative shift of the record gave the first storey of the imk-bilinear building below
+    (its force back at zero after the residual branch, the backbone deteriorated ahead): the hardening line's
+    crossing came out 1.2e-10 N under F_r and the floor's point 5.8e-11 N over it, so exact tests rejected
+    both and the reloading line had no limit short of the ultimate drift (0.6 m)."""
+    from pounding.solver import imk
+
+    st = _on_the_backbone_state()
+    for offset in (0, imk.SIDE):
+        for index, value in ((imk.FCAP, 544387.9705579279), (imk.UCAP, 0.0420743621999021),
+                             (imk.KP, 1481695.3876804921), (imk.FRES, 144000.0), (imk.KPC, -3001509.4303544615),
+                             (imk.UU, 0.6)):
+            st[offset + index] = value
+        st[offset + imk.URES] = st[offset + imk.UCAP] + (st[offset + imk.FRES] - st[offset + imk.FCAP]) / st[offset + imk.KPC]
+    st[imk.ONBB], st[imk.YIELDED], st[imk.RESID], st[imk.KUN] = 0.0, 1.0, 1.0, 2.0e7
+    st[imk.UREF], st[imk.FREF] = -0.23534850134340143, 0.0
+    row = np.zeros(6)
+    imk.set_row(st, row, st[imk.UREF], st[imk.UREF])
+    # the floor's point u_ref + F_r/k_un, the hardening line's crossing within round-off of it
+    assert row[imk.P_UPPER] == pytest.approx(-0.23534850134340143 + 144000.0 / 2.0e7, abs=1e-15)
+
+
+@pytest.mark.parametrize("shift", [-1.35e-14, 1.0e-14, 1.35e-14])
+def test_a_record_shifted_by_round_off_gives_the_same_run(tmp_path, shift):
+    """The imk-bilinear building of the reference comparison under its record times (1 + shift): round-off
+    of the input must not change a branch (1.35e-14 once collapsed it at 2.45 s, peak drift 0.6 m against
+    the reference's 0.33 m)."""
+    amplitude, duration, ramp = MATCH["imk-bilinear"]
+    model = building(tmp_path, "imk-bilinear", amplitude=amplitude, duration=duration, ramp=ramp)
+    record = record_for(model)
+    shifted = dataclasses.replace(record, acceleration=record.acceleration * (1.0 + shift))
+    base, ds = pounding.simulate(model, record), pounding.simulate(model, shifted)
+    assert ds.attrs["status"] == base.attrs["status"] == "completed"
+    # the same branches: the peaks move by the shift's round-off only (measured ≤ 2e-13); 1e-9 is far below a
+    # changed branch (1e-2 and more)
+    np.testing.assert_allclose(ds.peak_storey_drift.values, base.peak_storey_drift.values, rtol=1e-9)

@@ -245,18 +245,27 @@ def _bilinear_backbone(st, o, x):
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _bilinear_hit(st, o, x_ref, f_ref, k):
-    """Smallest own drift x ≥ *x_ref* where the line f_ref + k(x − x_ref) reaches the backbone at *o*."""
+    """Smallest own drift x ≥ *x_ref* where the line f_ref + k(x − x_ref) reaches the backbone at *o*.
+
+    Where the line meets the backbone at the very point a segment crosses the residual floor (IMKBilin
+    places the hardening line through the point where the reloading line reaches F_r), the segment's
+    intersection and the floor's are the same point to round-off, and each is accepted within
+    :data:`ON_LINE_TOLERANCE` of the capping strength: with exact tests round-off could reject both, and
+    the reloading line ran on with no limit past the backbone's strength.
+    """
     best = INF
     fcap, ucap, fres = st[o + FCAP], st[o + UCAP], st[o + FRES]
+    tol = ON_LINE_TOLERANCE * max(abs(fcap), abs(fres))
     for slope, lo, hi in ((st[o + KP], -INF, ucap), (st[o + KPC], ucap, INF)):
         if k != slope:
             # f_ref + k(x − x_ref) = fcap + slope(x − ucap)
             x = (fcap - slope * ucap - f_ref + k * x_ref) / (k - slope)
-            if lo <= x < hi and x >= x_ref and fcap + slope * (x - ucap) >= fres and x < best:
+            if lo <= x < hi and x >= x_ref and fcap + slope * (x - ucap) >= fres - tol and x < best:
                 best = x
     if k > 0.0:
         x = x_ref + (fres - f_ref) / k
-        if x >= x_ref and _bilinear_backbone(st, o, x) <= fres and x < best:
+        segment = fcap + (x - ucap) * (st[o + KP] if x < ucap else st[o + KPC])   # the backbone's line, unclipped
+        if x >= x_ref and segment <= fres + tol and x < best:
             best = x
     if f_ref >= _bilinear_backbone(st, o, x_ref):
         best = x_ref
