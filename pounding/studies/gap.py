@@ -274,7 +274,8 @@ def slope_root_table(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
         companion[:, 0, 1] = -c[full] / a[full]
         companion[:, 1, 0] = 1.0
         table[full] = np.linalg.eigvals(companion)
-    for k in np.flatnonzero(~companions & (quadratic | (b != 0.0))) if full.size < a.size else ():
+    others = np.flatnonzero(~companions & (quadratic | (b != 0.0)))   # a linear, or a quadratic with c = 0
+    for k in others:
         roots = np.roots([a[k], b[k], c[k]])
         table[k, :roots.size] = roots
     return table
