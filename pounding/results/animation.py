@@ -543,9 +543,6 @@ def _fit_aspect(ax) -> None:
         ax.set_ylim(middle - half, middle + half)
 
 
-
-
-
 def film_format(path: str | os.PathLike) -> str:
     """The suffix of the film *path* (``.mp4`` or ``.gif``), refused in one line if unknown, or if it is an
     MP4 and ffmpeg is not installed (checked before any work)."""

@@ -34,7 +34,8 @@ from pounding.results.output_place import check_regular_file, check_writable
 
 defer_dask_import()   # xarray's variables without importing dask.array (lazy_dask)
 
-__all__ = ["save_run", "open_run", "load_within_memory", "atomic_path", "write_error", "write_reason", "check_archive", "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
+__all__ = ["save_run", "open_run", "load_within_memory", "atomic_path", "write_error", "write_reason", "check_archive",
+           "clean_stale_temporaries", "output_lock", "lock_path", "INTERRUPT_GRACE",
            "REQUIRED_VARIABLES", "REQUIRED_PLANE_VARIABLES",
            "REQUIRED_ATTRIBUTES", "RUN_SPEC_KEYS"]
 

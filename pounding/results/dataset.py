@@ -1309,7 +1309,8 @@ def _plan_building_grounds(model: Model, supports, ground_state: Deferred) -> tu
     """The ground under each building of a model in plan, as a planar archive has it (variables, coordinates):
     its acceleration, velocity and displacement along x and y at the output times (time, ground, direction) and
     its wave-passage lag; nothing without support motions.  A floor's displacement is relative to its own
-    building's ground, so these are what put two buildings in one frame (:func:`pounding.results.plots.ground_offsets`)."""
+    building's ground, so these are what put two buildings in one frame
+    (:func:`pounding.results.plots.ground_offsets`)."""
     if supports is None:
         return {}, {}
     x, y = list(supports.building_row), list(supports.building_row_y)
