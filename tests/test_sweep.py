@@ -457,3 +457,43 @@ zip:
     with pytest.raises(ModelError) as caught:   # a single component is not a pair
         sw.sweep_from_text(text.replace("fema-p695:farfield\n", "[fema-p695:farfield/1a]\n"), label="plan.yaml")
     assert "is not a record pair" in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_pounding_sweep_reads_its_sweep_file_once(tmp_path, monkeypatch, capsys):
+    """Reading a sweep file validates every axis value as a model (3,000 values: seconds): `pounding sweep`
+    reads it once, for its inputs' check and for the run, and refuses a sweep too large for memory then."""
+    import pounding.studies.sweep as package
+    import pounding.studies.sweep.spec as spec
+    from pounding.cli import main
+
+    reads = []
+    real = spec.load_sweep
+
+    def counted(path):
+        reads.append(path)
+        return real(path)
+
+    monkeypatch.setattr(spec, "load_sweep", counted)
+    monkeypatch.setattr(package, "load_sweep", counted)
+    values = ", ".join(f"{0.01 + 1e-4 * i:.4f}" for i in range(300))
+    (tmp_path / "big.yaml").write_text(f"name: big\nmodel: {ROOT / 'models' / 'pair.yaml'}\naxes:\n"
+                                       f"  contacts[*].gap: [{values}]\n  contacts[*].restitution: [{values}]\n"
+                                       f"  contacts[*].kh: [{', '.join(f'{1e9 * (1 + i)}' for i in range(300))}]\n"
+                                       "  records: fema-p695:farfield\n")   # 4e9 scenarios: tens of TB anywhere
+    assert main(["sweep", str(tmp_path / "big.yaml"), "-o", str(tmp_path / "big.nc")]) == 2
+    assert "would need about" in capsys.readouterr().err
+    assert len(reads) == 1
+
+
+def test_a_plain_copy_is_a_deep_copy_with_the_shared_parts_shared():
+    from pounding.model.document import plain_copy
+
+    shared = [0.01, {"kh": 1.0e10}]
+    document = {"buildings": [{"name": "A", "storeys": {"count": 3, "mass": 2.5e5}}], "a": shared, "b": shared,
+                "flags": [True, None, "text", 3]}
+    copied = plain_copy(document)
+    assert copied == document and copied is not document
+    assert copied["a"] is copied["b"] and copied["a"] is not shared   # aliasing kept, as copy.deepcopy keeps it
+    copied["buildings"][0]["storeys"]["mass"] = 1.0
+    copied["a"][1]["kh"] = 2.0
+    assert document["buildings"][0]["storeys"]["mass"] == 2.5e5 and shared[1]["kh"] == 1.0e10

@@ -77,13 +77,14 @@ def add_csv_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--csv", metavar="FILE", help=CSV_HELP)
 
 
-def check_outputs(args: argparse.Namespace, inputs: list | tuple = (), *, model=None) -> None:
+def check_outputs(args: argparse.Namespace, inputs: list | tuple = (), *, model=None, sweep=None) -> None:
     """Before anything runs: no file the command writes is one of the files it reads.
 
     The outputs are ``-o``, ``--csv`` and the tables written beside it (``STEM.NAME.csv``); the inputs
     are :func:`command_inputs` and *inputs*, compared after resolving links and ``..``.  ``--csv`` is
     also checked for its place (not a folder, not under a file, its folder writable).  *model*, the
-    command's ``MODEL`` already loaded, spares reading it again (:func:`command_inputs`).
+    command's ``MODEL`` already loaded, and *sweep*, its ``SWEEP`` file already read, spare reading them
+    again (:func:`command_inputs`: a sweep file's every axis value is validated as a model).
 
     Raises
     ------
@@ -92,7 +93,7 @@ def check_outputs(args: argparse.Namespace, inputs: list | tuple = (), *, model=
     """
     from pounding.results.output_place import check_not_input, check_output_place
 
-    read = [*command_inputs(args, model=model), *inputs]
+    read = [*command_inputs(args, model=model, sweep=sweep), *inputs]
     output = getattr(args, "output", None)
     if output:
         check_not_input(output, read, "-o")
@@ -105,7 +106,7 @@ def check_outputs(args: argparse.Namespace, inputs: list | tuple = (), *, model=
             check_not_input(beside, [*read, output], f"--csv {csv} writes tables beside it, and")
 
 
-def command_inputs(args: argparse.Namespace, *, model=None) -> list[str]:
+def command_inputs(args: argparse.Namespace, *, model=None, sweep=None) -> list[str]:
     """Every file the command of *args* reads that its outputs could land on.
 
     The model (``MODEL``) with its record files (:func:`pounding.simulation.model_inputs`: the model's
@@ -113,7 +114,8 @@ def command_inputs(args: argparse.Namespace, *, model=None) -> list[str]:
     file with its base model and records, an archive (``table``, ``rerun``: the records a rerun reads
     again), a user spectrum and a cyclic protocol file.  A model or archive that cannot be read adds only
     its own name: the command refuses it in its own words.  *model* is ``MODEL`` if the command has
-    loaded it already (:class:`pounding.model.model.Model`); else it is loaded here.
+    loaded it already (:class:`pounding.model.model.Model`), *sweep* its ``SWEEP`` file if read already
+    (:class:`pounding.studies.sweep.spec.Sweep`); else each is read here.
     """
     found: list[str] = []
     for name in ("model", "sweep", "archive", "run", "spectrum_file", "protocol", "record"):
@@ -133,7 +135,7 @@ def command_inputs(args: argparse.Namespace, *, model=None) -> list[str]:
             from pounding.studies.sweep import load_sweep
             from pounding.studies.sweep.execution import sweep_inputs
 
-            found += sweep_inputs(load_sweep(args.sweep))
+            found += sweep_inputs(load_sweep(args.sweep) if sweep is None else sweep)
         if isinstance(getattr(args, "run", None), str):
             found += archived_inputs(args.run)
     except (PoundingError, OSError):

@@ -111,7 +111,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise PoundingError(f"--workers must be >= 1 (got {args.workers})")
     sweep = load_sweep(args.sweep)
-    check_outputs(args)
+    check_outputs(args, sweep=sweep)   # the sweep read once: each axis value is validated as a model
     output = Path(args.output) if args.output else Path(Path(args.sweep).stem + ".nc")
     _announce_invalid(sweep, args.strict)
     print_warnings(filter(None, (axis_warning(a.name, a.values, a.units) for a in sweep.axes if a.kind == "path")))

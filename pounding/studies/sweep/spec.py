@@ -95,7 +95,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
 from pounding.model import schema
-from pounding.model.document import Document, dump_document, is_plan_document
+from pounding.model.document import Document, dump_document, is_plan_document, plain_copy
 from pounding.model.ground import pair_components
 from pounding.records.catalogue import is_catalogue_reference, is_catalogued
 from pounding.registry import lookup
@@ -678,7 +678,7 @@ class Sweep:
         order = sorted(range(len(self.axes)), key=lambda i: 0 if _changes_law(self.axes[i]) else 1)
         for index in itertools.product(*(range(d.size) for d in self.dimensions)):
             positions = [index[i] for i, d in enumerate(self.dimensions) for _ in d.axes]
-            document = copy.deepcopy(self.base_document)
+            document = plain_copy(self.base_document)
             error = None
             coords = {}
             for i, axis in enumerate(self.axes):
@@ -1078,7 +1078,7 @@ def _read_axis(doc: Document, key: str, entry: Any, base: _Base, names: dict[str
             seen[str(s)] = i
     if kind == "path":   # the path must lead somewhere (before naming the axis after it)
         try:
-            apply_path(copy.deepcopy(base.document), steps, values[0])
+            apply_path(plain_copy(base.document), steps, values[0])
         except PathError as exc:
             raise doc.error(loc, str(exc), line=key_line) from None
         except ModelError:
@@ -1087,7 +1087,7 @@ def _read_axis(doc: Document, key: str, entry: Any, base: _Base, names: dict[str
     axis = Axis(key, name, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line, target=target)
     errors: list[str | None] = []
     for position, value in enumerate(axis.values):
-        trial = copy.deepcopy(base.document)
+        trial = plain_copy(base.document)
         where = f"{doc.label}:{axis.lines[position]}: axes.{key}[{position}] = {axis.labels[position]}"
         if kind == "record":
             problem = _check_record(value)
