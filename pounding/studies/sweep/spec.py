@@ -814,9 +814,12 @@ def sweep_from_text(text: str, *, label: str = "<sweep>", base_dir: str | None =
             record = ground[sides[0]].get("record")
         axes.append(Axis("records", "record", "record", (), (record,),
                          (record if record is not None else _record_label(base.document),), (1,), 1, (None,)))
-    dimensions = _zip_groups(doc, top.zip, axes)
-    return Sweep(name, label, text, os.path.normpath(str(base.file)), base.document, base.folder, dimensions,
-                 model_name=base.model.name, pairs=base.pairs)
+    def sweep_of(axes: list[Axis]) -> Sweep:
+        return Sweep(name, label, text, os.path.normpath(str(base.file)), base.document, base.folder,
+                     _zip_groups(doc, top.zip, axes), model_name=base.model.name, pairs=base.pairs)
+
+    sweep_of(axes).check_size()   # a sweep too large is refused before any value is validated as a model
+    return sweep_of([a if a.errors else dataclasses.replace(a, errors=_axis_errors(doc, a, base)) for a in axes])
 
 
 @dataclass
@@ -1084,25 +1087,31 @@ def _read_axis(doc: Document, key: str, entry: Any, base: _Base, names: dict[str
         except ModelError:
             pass
     name = _axis_name(doc, loc, key, kind, steps, dim_name, names)
-    axis = Axis(key, name, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line, target=target)
+    return Axis(key, name, kind, steps, tuple(values), tuple(shown), tuple(lines), key_line, target=target)
+
+
+def _axis_errors(doc: Document, axis: Axis, base: _Base) -> tuple[str | None, ...]:
+    """Why each value of *axis* makes an invalid model (None: valid), each value written into the base document
+    and the model validated: the slow part of reading a sweep file (a model a value), done once its size is
+    known to fit (:meth:`Sweep.check_size`)."""
     errors: list[str | None] = []
     for position, value in enumerate(axis.values):
-        trial = plain_copy(base.document)
-        where = f"{doc.label}:{axis.lines[position]}: axes.{key}[{position}] = {axis.labels[position]}"
-        if kind == "record":
+        where = f"{doc.label}:{axis.lines[position]}: axes.{axis.key}[{position}] = {axis.labels[position]}"
+        if axis.kind == "record":
             problem = _check_record(value)
             errors.append(f"{where}: {problem}" if problem else None)
             continue
+        trial = plain_copy(base.document)
         try:
             axis.apply(trial, position)
         except PathError as exc:
-            raise doc.error(loc, str(exc), line=key_line) from None
+            raise doc.error(("axes", axis.key), str(exc), line=axis.line) from None
         except ModelError as exc:
             errors.append(f"{where}: {exc}")
             continue
         problem = base.problem(trial)
         errors.append(f"{where} makes the model invalid: {problem}" if problem else None)
-    return dataclasses.replace(axis, errors=tuple(errors))
+    return tuple(errors)
 
 
 class _Mark:
