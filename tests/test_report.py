@@ -231,6 +231,9 @@ def test_bad_inputs_are_one_line_errors_and_write_nothing(archives, tmp_path, ca
         assert main(["report", *argv, "-o", str(out)]) == 2
         assert expected in _one_error(capsys)
         assert not out.exists()
+    # the output is a folder: the name suggested is a report's
+    assert main(["report", str(archives["run"]), "-o", str(tmp_path)]) == 2
+    assert f"give a file name such as {tmp_path / 'report.html'}" in _one_error(capsys)
     # the output is one of the archives
     assert main(["report", str(archives["run"]), "-o", str(archives["run"])]) == 2
     assert "input of this command" in _one_error(capsys)

@@ -77,7 +77,7 @@ def make_folder(folder: str | os.PathLike, *, what: str) -> Path:
 
 
 def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
-                   inputs: tuple | list = ()) -> Path:
+                   inputs: tuple | list = (), example: str = "run.nc") -> Path:
     """Fail early (before any computation) if *path* cannot be written.
 
     Parameters
@@ -85,6 +85,8 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
     inputs : sequence of path-like
         Files the command reads (model, record, sweep file, archive): the
         output must not be one of them, even with *overwrite*.
+    example : str
+        The file name suggested inside a folder given as *path* (``report.html`` for a report).
 
     Raises
     ------
@@ -103,7 +105,7 @@ def check_writable(path: str | os.PathLike, *, overwrite: bool = False,
                            "UTF-8 name") from None
     check_not_input(target, inputs)
     if target.is_dir():
-        raise ArchiveError(f"{target} is a directory; give a file name such as {target / 'run.nc'}")
+        raise ArchiveError(f"{target} is a directory; give a file name such as {target / example}")
     if target.exists() or target.is_symlink():
         if not overwrite:
             raise ArchiveError(f"{target} already exists; pass --overwrite (overwrite=True) or choose another "

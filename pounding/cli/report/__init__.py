@@ -53,7 +53,7 @@ def write_report(archives: Sequence[str | Path], output: str | Path, *, overwrit
     from pounding.results.archive import atomic_path
     from pounding.results.output_place import check_writable
 
-    target = check_writable(output, overwrite=overwrite, inputs=list(archives))
+    target = check_writable(output, overwrite=overwrite, inputs=list(archives), example="report.html")
     text = report_html(archives)
     with atomic_path(target) as temporary:
         Path(temporary).write_text(text, encoding="utf-8")
