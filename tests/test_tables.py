@@ -75,6 +75,10 @@ def test_run_csv_has_a_row_per_storey_contact_and_link_with_units_and_the_archiv
     np.testing.assert_array_equal(contacts["peak_contact_force [N]"], ds.peak_contact_force.values)
     np.testing.assert_array_equal(contacts["impact_count [-]"], ds.impact_count.values)
     np.testing.assert_array_equal(contacts["gap [m]"], ds.gap.values)
+    floors = _read(csv.with_name("run.floors.csv"))   # as a plan run's: each floor's peak displacement
+    assert list(floors["floor"]) == [str(f) for f in ds.floor.values]
+    np.testing.assert_array_equal(floors["peak_displacement [m]"], ds.peak_displacement.values)
+    np.testing.assert_array_equal(floors["elevation [m]"], ds.elevation.values)
     links = _read(csv.with_name("run.links.csv"))
     np.testing.assert_array_equal(links["peak_link_force [N]"], ds.peak_link_force.values)
     np.testing.assert_array_equal(links["link_dissipated_energy [J]"], ds.link_dissipated_energy.values)

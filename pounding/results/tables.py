@@ -76,8 +76,9 @@ def run_tables(ds) -> dict:
 
     ``storeys`` (the main table: peak drift ratio, and drift, residual drift, ductility and hysteretic energy
     where the archive has them), ``planes`` where storeys are made of planes (peak drift and drift ratio per
-    plane), ``floors``, ``rotations`` and ``corners`` where floors move in plan (peak displacement per floor and
-    direction, peak rotation per floor, peak corner displacement per floor, corner and direction),
+    plane), ``floors`` (peak displacement per floor; in plan per floor and direction), ``rotations`` and
+    ``corners`` where floors move in plan (peak rotation per floor, peak corner displacement per floor, corner
+    and direction),
     ``contacts`` (gap, law, impacts, peak force; a contact point's location and normal) and ``links``.
     Floors and storeys are labelled ``A:1`` with their building and 1-based level.
     """
@@ -90,8 +91,10 @@ def run_tables(ds) -> dict:
     if ds.sizes.get("plane", 0):
         tables["planes"] = long_table(ds, ["peak_plane_drift_ratio", "peak_plane_drift"], extra=_present(
             ds, ["plane_building", "plane_storey", "plane_direction", "plane_at", "plane_height", "plane_stiffness"]))
-    if "direction" in ds.peak_displacement.dims:
-        floor = _present(ds, ["building", "level"])
+    floor = _present(ds, ["building", "level"])
+    if "direction" not in ds.peak_displacement.dims:   # a planar run's floors: peak displacement, as in plan
+        tables["floors"] = long_table(ds, ["peak_displacement"], extra=floor + _present(ds, ["elevation"]))
+    else:
         tables["floors"] = long_table(ds, ["peak_displacement"], extra=floor)
         tables["rotations"] = long_table(ds, ["peak_rotation"], extra=floor)
         tables["corners"] = long_table(ds, ["peak_corner_displacement"], extra=floor + _present(
