@@ -237,10 +237,16 @@ def _oriented_limits(st):
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def _bilinear_line(st, o, x):
+    """IMKBilin's hardening (before the capping point) or post-capping line at offset *o* at own drift *x*, N."""
+    slope = st[o + KP] if x < st[o + UCAP] else st[o + KPC]
+    return st[o + FCAP] + (x - st[o + UCAP]) * slope
+
+
+@njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def _bilinear_backbone(st, o, x):
     """IMKBilin's backbone at offset *o* at own drift *x*: the hardening or post-capping line, not below F_r."""
-    slope = st[o + KP] if x < st[o + UCAP] else st[o + KPC]
-    return max(st[o + FCAP] + (x - st[o + UCAP]) * slope, st[o + FRES])
+    return max(_bilinear_line(st, o, x), st[o + FRES])
 
 
 @njit(cache=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
@@ -264,8 +270,7 @@ def _bilinear_hit(st, o, x_ref, f_ref, k):
                 best = x
     if k > 0.0:
         x = x_ref + (fres - f_ref) / k
-        segment = fcap + (x - ucap) * (st[o + KP] if x < ucap else st[o + KPC])   # the backbone's line, unclipped
-        if x >= x_ref and segment <= fres + tol and x < best:
+        if x >= x_ref and _bilinear_line(st, o, x) <= fres + tol and x < best:
             best = x
     if f_ref >= _bilinear_backbone(st, o, x_ref):
         best = x_ref
