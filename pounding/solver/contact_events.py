@@ -28,6 +28,9 @@ __all__ = ["EVENT_NONE", "EVENT_CLOSE", "EVENT_SEPARATE", "EVENT_RELEASE", "EVEN
            "STEPS_PER_CONTACT", "EVENTS_PER_WINDOW_BASE", "EVENTS_PER_WINDOW_PER_CONTACT", "switch_crossing",
            "locate_contact_events", "locate_releases", "velocity_jump", "switch_contact", "plastic_jump", "instant_row", "resolve_rigid_contacts", "apply_contact_events"]
 
+#: A Hermite cubic stays within (4/27)·h·(|r0| + |r1|) of its ends' range (the basis functions' bounds):
+#: this factor, above 4/27, bounds it with room for round-off.
+HERMITE_REACH = 0.25
 #: Sub-intervals sampled on the interpolant when searching for a contact event.
 EVENT_SAMPLES = 8
 #: First step inside a newly closed compliant contact: its duration estimate over this.
@@ -61,6 +64,9 @@ def switch_crossing(claw, prm, const, mode, which, gap, kin, internal, h) -> flo
     """
     yl0, vl0, yl1, vl1, al0, al1 = kin
     q0, qr0, q1, qr1 = internal
+    reach = HERMITE_REACH * h * (abs(al0) + abs(al1))
+    if not kernels.switch_may_cross(claw, prm, const, mode, which, min(vl0, vl1) - reach, max(vl0, vl1) + reach):
+        return -1.0
     d = hermite(yl0, vl0, yl1, vl1, h, 0.0) - gap
     g = kernels.switch_value(claw, prm, const, mode, which, d, vl0, q0)
     been_positive = g > 0.0

@@ -356,6 +356,10 @@ def link_internal_rate(law_id: int, prm: np.ndarray, delta_rate: float, q: float
     return 0.0
 
 
+#: Relative margin of :func:`switch_may_cross`'s bound over the switch's round-off (the samples' own).
+SWITCH_MARGIN = 1e-9
+
+
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
 def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, which: int, delta: float,
                  delta_rate: float, q: float) -> float:
@@ -399,6 +403,23 @@ def switch_value(law_id: int, prm: np.ndarray, impact_constant: float, mode: int
             g = prm[4] + q * delta_rate
             return -g if (mode & BUMPER_HARD_CLAMPED) != 0 else g
     return 1.0
+
+
+@njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
+def switch_may_cross(law_id: int, prm: np.ndarray, impact_constant: float, mode: int, which: int, rate_low: float,
+                     rate_high: float) -> bool:
+    """False only where switch function *which* of *mode* stays positive for every δ̇ in
+    [*rate_low*, *rate_high*] (m/s), whatever δ and the internal state: a switch linear in δ̇ alone
+    (Hertz-damp's clamp ``±(kh + ξ·δ̇)``), bounded by its value at the interval's worse end.  True
+    otherwise (every other switch: the caller samples it)."""
+    if law_id == LAW_HERTZ_DAMP and which == 0:
+        kh, xi = prm[0], impact_constant
+        if mode == MODE_PUSH:
+            worst = kh + xi * rate_low if xi >= 0.0 else kh + xi * rate_high
+        else:
+            worst = -(kh + xi * rate_high) if xi >= 0.0 else -(kh + xi * rate_low)
+        return not worst > SWITCH_MARGIN * (kh + abs(xi) * max(abs(rate_low), abs(rate_high)))
+    return True
 
 
 @njit(cache=True, no_cfunc_wrapper=True, **jit.CALLED, **jit.NO_REFCOUNT)
