@@ -484,6 +484,9 @@ def test_runs_of_one_template_reuse_its_model_and_record_and_give_the_fresh_runs
     from pounding.studies.ida import runs
 
     monkeypatch.setattr(runs, "_TEMPLATES", RecentlyUsed(2))
+    # the linear buildings alone run directly here: this test is of the templates (superposition, which
+    # serves them from one unit run, has tests/test_ida_superposition.py)
+    monkeypatch.setattr(runs, "superposed_peaks", lambda *args: None)
     plan = ida.build_ida_plan(PAIR, RECORDS, levels="0.2,0.9", without_contacts=True, duration=4.0)
     with_0, without_0, with_1 = ("with_contacts", 0), ("without_contacts", 0), ("with_contacts", 1)
     # (template, level, validated afresh?) with two templates kept, least recently used dropped first

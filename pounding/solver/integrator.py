@@ -288,6 +288,20 @@ class System:
         return 0 if self.friction_coefficient is None else int(self.friction_coefficient.size)
 
     @property
+    def elastic_storeys(self) -> bool:
+        """Every storey linear elastic, without P-Delta or collapse limit (no storey state, no storey event)."""
+        return (self.n_hysteretic == 0 and not np.any(self.p_delta_stiffness)
+                and not np.any(self.storey_stop_ratio > 0.0))
+
+    @property
+    def responds_linearly(self) -> bool:
+        """The equations of motion are linear with constant coefficients for the whole run: no gap, wall or
+        link element, no friction face, every storey linear elastic without P-Delta or collapse limit.
+        From rest, the response to a ground motion scaled by λ is then λ times the response to the motion
+        itself (superposition), and no run ends early."""
+        return self.n_contacts == 0 and self.n_faces == 0 and self.elastic_storeys
+
+    @property
     def layout(self) -> Layout:
         """Offsets of the state vector (:func:`pounding.solver.layout.state_layout`)."""
         return state_layout(self.n_floors, self.n_contacts, self.n_hysteretic, self.n_faces)
@@ -833,7 +847,7 @@ def _storey_arguments(system: System, atol: float) -> Storeys | None:
     A state's tolerance is atol for a bilinear storey's plastic drift (m) and atol/u_y for
     Bouc–Wen's dimensionless z; its mode (a fresh array: the integrator changes it) starts elastic.
     """
-    if system.n_hysteretic == 0 and not np.any(system.p_delta_stiffness) and not np.any(system.storey_stop_ratio > 0.0):
+    if system.elastic_storeys:
         return None
     floors = np.flatnonzero(system.storey_state >= 0)
     state_floor = np.empty(floors.size, dtype=np.int64)

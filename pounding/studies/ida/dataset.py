@@ -71,6 +71,7 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
     max_drift = np.full((nv, nr, nl, nb), np.nan)
     collapsed = np.zeros((nv, nr, nl, nb), np.int8)
     censored = np.zeros((nv, nr, nl, nb), np.int8)
+    superposed = np.zeros((nv, nr, nl, nb), np.int8)
     collapse_building = np.full((nv, nr, nl), "", dtype=object)
     peak_drift = np.full((nv, nr, nl, ns), np.nan)
     residual = np.full((nv, nr, nl, ns), np.nan)
@@ -99,6 +100,7 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         scale_factor[i, r, j] = part.get("scale_factor", factor)
         max_drift[i, r, j] = building_drifts(part, plan.buildings)
         collapsed[i, r, j], censored[i, r, j] = run_collapses(part, plan)
+        superposed[i, r, j] = np.isin(np.array(plan.buildings, dtype=object), part.get("superposed", {}).get("building", []))
         collapse_building[i, r, j] = collapse_building_of(part)
         peak_drift[i, r, j] = part["storeys"]["peak_drift_ratio"]
         residual[i, r, j] = [np.nan if x is None else x for x in part["storeys"]["residual_drift_ratio"]]
@@ -144,6 +146,10 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         "censored": var(run + ("building",), censored, "1",
                         "1 if another building's collapse ended the run before this one collapsed: its outcome "
                         "at this intensity is unknown (right-censored)"),
+        "superposed": var(run + ("building",), superposed, "1",
+                          "1 if the building's peaks in the run are its run under the unscaled record, made at "
+                          "tolerances 10 times tighter, times the scale factor (a building that responds "
+                          "linearly, alone: superposition; no solver run of its own)"),
         "collapse_building": (run, collapse_building, {"long_name": "building whose collapse ended the run "
                                                                      "('' if none; buildings that ran alone, "
                                                                      "without contacts: every one that collapsed, "

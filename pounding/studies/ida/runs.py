@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from pounding.recently_used import RecentlyUsed
 from pounding.studies.ida.schedule import IdaPlan
+from pounding.studies.ida.superposition import superposed_peaks, unit_factor
 
 __all__ = ["IDA_PART", "run_ida_scenario", "run_outcome", "building_drifts", "collapsed_in", "collapse_building_of",
            "run_collapses", "buildings_alone", "separate_peaks"]
@@ -100,7 +101,7 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
             peaks = simulate_peaks(model, record, reuse=True)
             refuse_failed_run(peaks["status"], peaks["status_message"])   # energy_inconsistent: failed
         else:   # buildings that cannot act on each other: each its own run, so no collapse ends another's
-            peaks = separate_peaks(alone, record)
+            peaks = separate_peaks(alone, record, _unit_models(task))
         result.update({
             "status": "ok",
             # A storey that lost its lateral resistance (unstable) is a sidesway collapse of the building.
@@ -109,7 +110,9 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
             "collapse_time": _plain(peaks["collapse_time"]),
             "collapse_storey": peaks["collapse_storey"],
             "collapse_building": peaks["collapse_building"],
-            **({"collapse_buildings": peaks["collapse_buildings"]} if alone is not None else {}),
+            **({"collapse_buildings": peaks["collapse_buildings"],
+                # a group of its own: a part's top-level lists are of one length (the store's check)
+                "superposed": {"building": peaks["superposed_buildings"]}} if alone is not None else {}),
             "storeys": {
                 "storey": list(peaks["storey"]),
                 "building": list(peaks["storey_building"]),
@@ -134,6 +137,25 @@ def run_ida_scenario(task: dict[str, Any]) -> dict[str, Any]:
     return result
 
 
+def _unit_models(task: dict[str, Any]) -> tuple[float, list[tuple[str, Callable]]] | None:
+    """``(factor, [(key, unit model) per building])`` of a run of buildings alone whose record is scaled by one
+    plain factor (:func:`.superposition.unit_factor`): each building's key (its template's, the factor left
+    out) and its model at factor 1, validated when called; None otherwise."""
+    from pounding.model.model import model_from_data
+
+    factor, unit = unit_factor(task["data"])
+    if factor is None:
+        return None
+    name, base_dir = task.get("name", "model"), task.get("base_dir")
+    documents = buildings_alone(unit, None)
+    template = repr((unit, base_dir, name))
+
+    def validated(document: dict[str, Any]) -> Callable:
+        return lambda: model_from_data(document, name=name, source=task["document"], base_dir=base_dir)
+
+    return factor, [(f"{template}#{k}", validated(d)) for k, d in enumerate(documents)]
+
+
 def buildings_alone(document: dict[str, Any], model) -> list[dict[str, Any]] | None:
     """One model document per building of *model* (its *document*, plain data) when its buildings cannot act
     on each other, else None.
@@ -144,33 +166,41 @@ def buildings_alone(document: dict[str, Any], model) -> list[dict[str, Any]] | N
     else of the model but its contacts: the run of that building alone is its run in the model, and a
     neighbour's collapse can no longer end it (docs/ida.md "Collapse of each building").
     """
-    if (len(model.buildings) < 2 or model.links or (model.gaps and not model.contacts_held_open)
-            or model.is_multi_support):
+    if model is not None and (len(model.buildings) < 2 or model.links or (model.gaps and not model.contacts_held_open)
+                              or model.is_multi_support):
         return None
     rest = {k: v for k, v in document.items() if k not in ("buildings", "contacts", "links")}
     return [dict(rest, buildings=[building]) for building in document["buildings"]]
 
 
-def separate_peaks(models: list, record) -> dict[str, Any]:
+def separate_peaks(models: list, record, units: tuple[float, list[tuple[str, Callable]]] | None = None
+                   ) -> dict[str, Any]:
     """The peaks of one run of independent buildings: each building's model alone (:func:`buildings_alone`)
     run on the same scaled *record* (None: each model loads its own), merged in the model's order.
 
-    Every building that collapsed is in ``collapse_buildings``; ``collapse_building``, ``collapse_time`` and
+    With *units* (:func:`_unit_models`) a building that responds linearly takes its unit run's peaks times
+    the factor (:func:`.superposition.superposed_peaks`), and is listed in ``superposed_buildings``.  Every
+    building that collapsed is in ``collapse_buildings``; ``collapse_building``, ``collapse_time`` and
     ``collapse_storey`` are the first collapse's; the wall time is the sum.  A failed run of any building
     (energy_inconsistent) fails the whole run, as it would the model's.
     """
     from pounding.simulation import refuse_failed_run, simulate_peaks
 
-    runs = []
-    for model in models:
-        peaks = simulate_peaks(model, record, reuse=True)
-        refuse_failed_run(peaks["status"], peaks["status_message"])
+    runs, superposed = [], []
+    for index, model in enumerate(models):
+        peaks = None if units is None else superposed_peaks(*units[1][index], units[0])
+        if peaks is None:
+            peaks = simulate_peaks(model, record, reuse=True)
+            refuse_failed_run(peaks["status"], peaks["status_message"])
+        else:
+            superposed.append(model.buildings[0].name)
         runs.append(peaks)
     fallen = [p for p in runs if p["collapse_building"]]
     first = min(fallen, key=lambda p: p["collapse_time"]) if fallen else runs[0]
     merged = {key: first[key] for key in ("status", "status_message", "collapse_time", "collapse_storey",
                                           "collapse_building", "record_scale")}
     merged["collapse_buildings"] = [p["collapse_building"] for p in fallen]
+    merged["superposed_buildings"] = superposed
     merged["wall_time"] = float(sum(p["wall_time"] for p in runs))
     for key in ("storey", "storey_building", "contact", "plane"):
         if key in first:
