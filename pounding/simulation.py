@@ -46,7 +46,7 @@ from pounding.solver.integrator import STATUS_COLLAPSED, STATUS_MESSAGES, STATUS
 __all__ = ["assemble", "contact_side_terms", "simulate", "simulate_arrays", "with_overrides", "simulate_peaks", "record_for",
            "processed_record_for", "component_records", "ground_on_grid", "support_motions", "SupportMotions", "rerun", "record_path",
            "ENERGY_CLOSURE_LIMIT", "MEMORY_FRACTION", "estimate_memory", "available_memory", "check_memory",
-           "model_inputs", "FAILED_STATUSES", "refuse_failed_run", "ground_rows"]
+           "model_inputs", "FAILED_STATUSES", "refuse_failed_run", "ground_rows", "responds_linearly"]
 
 #: Run statuses that studies (``ida``, sweeps) count as failed: the run ended, but its numbers are
 #: not an answer (``energy_inconsistent``: the contacts dissipated energy the run never received).
@@ -616,6 +616,14 @@ def reused_assembly(model: Model, ground: GroundRows, end_time: float):
         with _ASSEMBLIES_LOCK:
             _ASSEMBLIES.setdefault(model, {})[key] = found
     return found
+
+
+def responds_linearly(model: Model) -> bool:
+    """Whether *model*'s equations of motion, assembled on its own ground motion, are linear with constant
+    coefficients for the whole run (:attr:`pounding.solver.integrator.System.responds_linearly`): its response
+    to its ground motion scaled by λ is then λ times its response to the motion itself."""
+    supports = support_motions(model, where="yaml")
+    return assemble(model, ground_rows(supports)).system.responds_linearly
 
 
 def refuse_failed_run(status: str, message: str) -> None:

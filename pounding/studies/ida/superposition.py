@@ -75,10 +75,9 @@ def superposed_peaks(key: str, model: Callable[[], Any], scale: float) -> dict[s
 def _unit_run(model) -> dict[str, Any] | None:
     """The peaks of the unit *model* (its record as stored) at tolerances :data:`UNIT_TIGHTENING` times
     tighter; None if it does not respond linearly or the run did not complete."""
-    from pounding.simulation import simulate_peaks
-    from pounding.solver.assembly import assemble
+    from pounding.simulation import responds_linearly, simulate_peaks
 
-    if not assemble(model).system.responds_linearly:
+    if not responds_linearly(model):
         return None
     solver = model.solver
     tight = model.with_solver(rtol=solver.rtol / UNIT_TIGHTENING, atol=solver.atol / UNIT_TIGHTENING,
