@@ -25,7 +25,8 @@ import numpy as np
 
 from pounding.recently_used import RecentlyUsed
 
-__all__ = ["UNIT_TIGHTENING", "SCALED", "unit_factor", "superposed_peaks", "scaled_peaks"]
+__all__ = ["UNIT_TIGHTENING", "SCALED", "unit_factor", "superposed_peaks", "scaled_peaks", "unit_result",
+           "tightened"]
 
 #: The unit run's tolerances are the model's over this; factors above it are run directly.
 UNIT_TIGHTENING = 10.0
@@ -68,8 +69,20 @@ def superposed_peaks(key: str, model: Callable[[], Any], scale: float) -> dict[s
     respond linearly, a unit run that did not complete."""
     if not 0.0 < scale <= UNIT_TIGHTENING:
         return None
-    unit = _UNIT_RUNS.get(key, lambda: _unit_run(model()))
+    unit = unit_result(("peaks", key), lambda: _unit_run(model()))
     return None if unit is None else scaled_peaks(unit, scale)
+
+
+def unit_result(key: Any, compute: Callable[[], Any]) -> Any:
+    """This worker's unit result under *key* (``(what, template key)``), computed by *compute* the first time."""
+    return _UNIT_RUNS.get(key, compute)
+
+
+def tightened(model):
+    """*model* with ``rtol``, ``atol`` and ``atol_velocity`` over :data:`UNIT_TIGHTENING` (a unit run's)."""
+    solver = model.solver
+    return model.with_solver(rtol=solver.rtol / UNIT_TIGHTENING, atol=solver.atol / UNIT_TIGHTENING,
+                             atol_velocity=solver.atol_velocity / UNIT_TIGHTENING)
 
 
 def _unit_run(model) -> dict[str, Any] | None:
@@ -79,10 +92,7 @@ def _unit_run(model) -> dict[str, Any] | None:
 
     if not responds_linearly(model):
         return None
-    solver = model.solver
-    tight = model.with_solver(rtol=solver.rtol / UNIT_TIGHTENING, atol=solver.atol / UNIT_TIGHTENING,
-                              atol_velocity=solver.atol_velocity / UNIT_TIGHTENING)
-    peaks = simulate_peaks(tight)
+    peaks = simulate_peaks(tightened(model))
     return peaks if peaks["status"] == "completed" else None
 
 

@@ -152,6 +152,10 @@ def run_risk_scenario(task: dict[str, Any]) -> dict[str, Any]:
         model = model_from_data(task["data"], name=task.get("name", "model"), source=task["document"],
                                 base_dir=task.get("base_dir"))
         if model.contacts_held_open:
+            superposed = _superposed_separations(task, result, model)
+            if superposed is not None:
+                result["separation"], result["unbounded"] = superposed, False
+                return result
             ds = simulate(model)
             status = ds.attrs.get("status", "completed")
             refuse_failed_run(status, str(ds.attrs.get("status_message", status)))
@@ -162,6 +166,38 @@ def run_risk_scenario(task: dict[str, Any]) -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - a failing run is a result, not a crash
         result.update(status="error", error=f"{task.get('where', 'scenario')}: {one_line(exc)}")
     return result
+
+
+def _superposed_separations(task: dict[str, Any], result: dict[str, Any], model) -> dict[str, list] | None:
+    """The required separations of a run with the contacts held open whose buildings the IDA's run took by
+    superposition (every one linear: :mod:`pounding.studies.ida.superposition`): its unit run's (the record at
+    factor 1, tolerances 10 times tighter), computed once per worker and record, times the factor, since the
+    largest approach of a response λ times another's is λ times its own.  None where the IDA's run was not
+    superposed in whole (the caller runs it)."""
+    from pounding.model.model import model_from_data
+    from pounding.simulation import simulate
+    from pounding.studies.gap import required_separations
+    from pounding.studies.ida.superposition import UNIT_TIGHTENING, tightened, unit_factor, unit_result
+
+    buildings = [b.name for b in model.buildings]
+    factor, unit = unit_factor(task["data"])
+    if (result.get("superposed", {}).get("building") != buildings or factor is None
+            or not 0.0 < factor <= UNIT_TIGHTENING):
+        return None
+    name, base_dir = task.get("name", "model"), task.get("base_dir")
+
+    def unit_separations() -> dict[str, Any] | None:
+        run = tightened(model_from_data(unit, name=name, source=task["document"], base_dir=base_dir))
+        ds = simulate(run)
+        if ds.attrs.get("status", "completed") != "completed":
+            return None
+        return {"contact": [str(c) for c in ds.contact.values],
+                "required": np.asarray(required_separations(run, ds)["required"], dtype=float)}
+
+    found = unit_result(("separation", repr((unit, base_dir, name))), unit_separations)
+    if found is None:
+        return None
+    return {"contact": list(found["contact"]), "required": [float(x) for x in found["required"] * factor]}
 
 
 def risk_study(plan: RiskPlan, output: str | os.PathLike | None = None, **run_options):
