@@ -100,7 +100,8 @@ def assemble_ida_dataset(plan: IdaPlan, results: dict[str, dict[str, Any]],
         scale_factor[i, r, j] = part.get("scale_factor", factor)
         max_drift[i, r, j] = building_drifts(part, plan.buildings)
         collapsed[i, r, j], censored[i, r, j] = run_collapses(part, plan)
-        superposed[i, r, j] = np.isin(np.array(plan.buildings, dtype=object), part.get("superposed", {}).get("building", []))
+        superposed[i, r, j] = np.isin(np.array(plan.buildings, dtype=object),
+                                      part.get("superposed", {}).get("building", []))
         collapse_building[i, r, j] = collapse_building_of(part)
         peak_drift[i, r, j] = part["storeys"]["peak_drift_ratio"]
         residual[i, r, j] = [np.nan if x is None else x for x in part["storeys"]["residual_drift_ratio"]]

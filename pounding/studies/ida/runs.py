@@ -164,7 +164,8 @@ def buildings_alone(document: dict[str, Any], model) -> list[dict[str, Any]] | N
     every one held open: the variant without contacts) and one ground motion that reaches every building at
     once (no wave passage, no per-building records).  Each document then keeps one building and everything
     else of the model but its contacts: the run of that building alone is its run in the model, and a
-    neighbour's collapse can no longer end it (docs/ida.md "Collapse of each building").
+    neighbour's collapse can no longer end it (docs/ida.md "Collapse of each building").  *model* None: the
+    caller has decided they cannot (the same run's unit document, :func:`_unit_models`).
     """
     if model is not None and (len(model.buildings) < 2 or model.links or (model.gaps and not model.contacts_held_open)
                               or model.is_multi_support):
