@@ -209,6 +209,31 @@ def test_study_separations_are_the_gap_study_of_each_run(risk_run):
         assert np.all(ds.pounding_probability.values[c][~below] <= p)
 
 
+def test_separations_of_a_yielding_pair_come_from_each_stripes_own_run(in_process_client, tmp_path):
+    """With a yielding building the pair is not linear: each stripe's separations are `required_separations`
+    of that stripe's own run, bit for bit (no superposition)."""
+    import yaml
+
+    from pounding.data import data_path
+    from pounding.model.model import load_model
+    from pounding.simulation import simulate
+    from pounding.studies.gap import required_separations
+    from pounding.studies.risk import build_risk_plan, risk_study
+
+    document = yaml.safe_load(data_path("models", "pair.yaml").read_text())
+    document["ground_motion"]["record"] = str(document["ground_motion"]["record"])
+    for storey in document["buildings"][1]["storeys"]:
+        storey["hysteresis"] = {"model": "bilinear", "yield_drift_ratio": 0.002, "post_yield_ratio": 0.03}
+    path = tmp_path / "yielding_pair.yaml"
+    path.write_text(yaml.safe_dump(document, sort_keys=False))
+    plan = build_risk_plan(path, read_hazard("example"), im="sa:1.0", stripes=2, duration=5.0)
+    ds = risk_study(plan, tmp_path / "risk.nc", client=in_process_client, progress=False)
+    level = float(ds.level.values[1]) / G
+    model = load_model(path).with_ground_motion(duration=5.0, scale=plan.ida.factor(0, level)).with_contacts_open()
+    expected = required_separations(model, simulate(model))["required"]
+    np.testing.assert_array_equal(ds.required_separation.values[0, 1], expected)
+
+
 def test_study_archive_has_units_and_names_and_the_cli_prints_it(risk_run, tmp_path):
     import xarray as xr
 
