@@ -142,7 +142,7 @@ def test_in_a_mixed_pair_only_the_linear_building_is_superposed(tmp_path):
 
 def test_the_variant_with_contacts_never_superposes():
     part, _ = _part("pair", 0.5, variant="with_contacts")
-    assert "superposed" not in part and sum(part["contacts"]["impact_count"]) >= 0
+    assert "superposed" not in part and part["solver_wall_time"] > 0.0   # the whole pair ran, at its factor
 
 
 @pytest.mark.parametrize("motion, factor", [

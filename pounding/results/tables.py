@@ -92,10 +92,11 @@ def run_tables(ds) -> dict:
         tables["planes"] = long_table(ds, ["peak_plane_drift_ratio", "peak_plane_drift"], extra=_present(
             ds, ["plane_building", "plane_storey", "plane_direction", "plane_at", "plane_height", "plane_stiffness"]))
     floor = _present(ds, ["building", "level"])
-    if "direction" not in ds.peak_displacement.dims:   # a planar run's floors: peak displacement, as in plan
-        tables["floors"] = long_table(ds, ["peak_displacement"], extra=floor + _present(ds, ["elevation"]))
-    else:
-        tables["floors"] = long_table(ds, ["peak_displacement"], extra=floor)
+    in_plan = "direction" in ds.peak_displacement.dims
+    # every run's floors: peak displacement (in plan per direction); a planar run's with its elevation
+    tables["floors"] = long_table(ds, ["peak_displacement"], extra=floor + ([] if in_plan else _present(
+        ds, ["elevation"])))
+    if in_plan:
         tables["rotations"] = long_table(ds, ["peak_rotation"], extra=floor)
         tables["corners"] = long_table(ds, ["peak_corner_displacement"], extra=floor + _present(
             ds, ["corner_x", "corner_y", "peak_corner_displacement_magnitude"]))

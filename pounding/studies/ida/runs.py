@@ -147,7 +147,7 @@ def _unit_models(task: dict[str, Any]) -> tuple[float, list[tuple[str, Callable]
     if factor is None:
         return None
     name, base_dir = task.get("name", "model"), task.get("base_dir")
-    documents = buildings_alone(unit, None)
+    documents = _one_building_each(unit)
     template = repr((unit, base_dir, name))
 
     def validated(document: dict[str, Any]) -> Callable:
@@ -164,12 +164,16 @@ def buildings_alone(document: dict[str, Any], model) -> list[dict[str, Any]] | N
     every one held open: the variant without contacts) and one ground motion that reaches every building at
     once (no wave passage, no per-building records).  Each document then keeps one building and everything
     else of the model but its contacts: the run of that building alone is its run in the model, and a
-    neighbour's collapse can no longer end it (docs/ida.md "Collapse of each building").  *model* None: the
-    caller has decided they cannot (the same run's unit document, :func:`_unit_models`).
+    neighbour's collapse can no longer end it (docs/ida.md "Collapse of each building").
     """
-    if model is not None and (len(model.buildings) < 2 or model.links or (model.gaps and not model.contacts_held_open)
-                              or model.is_multi_support):
+    if (len(model.buildings) < 2 or model.links or (model.gaps and not model.contacts_held_open)
+            or model.is_multi_support):
         return None
+    return _one_building_each(document)
+
+
+def _one_building_each(document: dict[str, Any]) -> list[dict[str, Any]]:
+    """One document per building of *document*: that building and everything else but the contacts and links."""
     rest = {k: v for k, v in document.items() if k not in ("buildings", "contacts", "links")}
     return [dict(rest, buildings=[building]) for building in document["buildings"]]
 
@@ -189,7 +193,11 @@ def separate_peaks(models: list, record, units: tuple[float, list[tuple[str, Cal
 
     runs, superposed = [], []
     for index, model in enumerate(models):
-        peaks = None if units is None else superposed_peaks(*units[1][index], units[0])
+        peaks = None
+        if units is not None:
+            factor, buildings = units
+            key, unit_model = buildings[index]
+            peaks = superposed_peaks(key, unit_model, factor)
         if peaks is None:
             peaks = simulate_peaks(model, record, reuse=True)
             refuse_failed_run(peaks["status"], peaks["status_message"])

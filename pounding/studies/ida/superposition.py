@@ -33,8 +33,9 @@ UNIT_TIGHTENING = 10.0
 #: What scales with the factor (signed values: a positive factor keeps their sign).
 SCALED = ("peak_drift_ratio", "residual_drift_ratio", "peak_plane_drift_ratio")
 
-#: This worker's unit runs, by template key and building (None: the building does not respond linearly,
-#: or its unit run did not complete).  A handful of templates are in flight at once on a worker.
+#: This worker's unit results by ``(what, template key)`` (:func:`unit_result`): a building's peaks, a risk
+#: study's separations (None: not linear, or the unit run did not complete).  A handful of templates are in
+#: flight at once on a worker.
 _UNIT_RUNS: RecentlyUsed[dict | None] = RecentlyUsed(16)
 
 
